@@ -1,0 +1,32 @@
+"""The kinegami exception hierarchy.
+
+Every error raised on purpose by kinegami is a :class:`KinegamiError`. The subclasses also
+inherit the matching builtin, so ``except ValueError`` keeps working (as ezdxf does with
+``DXFValueError``).
+"""
+
+from __future__ import annotations
+
+
+class KinegamiError(Exception):
+    """Base class of every error kinegami raises on purpose."""
+
+
+class InvalidParameterError(KinegamiError, ValueError):
+    """A parameter has a value outside its valid range (the message names both)."""
+
+
+class InvalidTypeError(KinegamiError, TypeError):
+    """A parameter has the wrong type."""
+
+
+class JointIndexError(KinegamiError, IndexError):
+    """A joint index does not name a joint of the chain."""
+
+
+class NoPathError(KinegamiError, ValueError):
+    """No acceptable CSC link (all turns < pi) joins two frames."""
+
+
+class IncompatibleJointError(KinegamiError, ValueError):
+    """A joint's ``numSides`` or ``r`` differs from the chain's."""
