@@ -1,5 +1,13 @@
-"""kinegami: tubular origami kinematic chains and their crease patterns."""
+"""kinegami: tubular origami kinematic chains and their crease patterns.
 
+``from kinegami import *`` gives the names the paper's listings use: ``KinematicChain``,
+the joints, ``LinkCSC``, ``TubularPattern``, ``SE3`` (spatialmath) and ``np`` (numpy).
+"""
+
+import numpy as np
+from spatialmath import SE3
+
+from kinegami.chain import KinematicChain, PlacementWarning
 from kinegami.errors import (
     IncompatibleJointError,
     InvalidParameterError,
@@ -8,14 +16,44 @@ from kinegami.errors import (
     KinegamiError,
     NoPathError,
 )
+from kinegami.geometry.balls import Ball
+from kinegami.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    Joint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+from kinegami.links import LinkCSC
+
+try:  # the pattern package is built alongside; keep the chain importable without it
+    from kinegami.pattern import TubularPattern
+except ImportError:  # pragma: no cover
+    TubularPattern = None
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "KinematicChain",
+    "RevoluteJoint",
+    "ExtendedRevoluteJoint",
+    "PrismaticJoint",
+    "Waypoint",
+    "StartTip",
+    "EndTip",
+    "Joint",
+    "LinkCSC",
+    "TubularPattern",
+    "Ball",
+    "SE3",
+    "np",
     "KinegamiError",
     "InvalidParameterError",
     "InvalidTypeError",
     "JointIndexError",
     "NoPathError",
     "IncompatibleJointError",
+    "PlacementWarning",
 ]

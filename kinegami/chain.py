@@ -1,0 +1,494 @@
+"""KinematicChain: append joints, place them, edit them, set their states (chain.md 4-5).
+
+The chain holds joints in world coordinates and, for every joint i >= 1, the link ``Links[i]``
+from joint i-1's distal Dubins frame to joint i's proximal Dubins frame (``Links[0]`` is the
+empty path at the root). Joints and links are values; every operation computes the new lists
+and the new bounding ball first and swaps them in only when everything succeeded, so a failed
+append, edit or state change leaves the chain bit-identical.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+
+from kinegami.errors import (
+    InvalidParameterError,
+    InvalidTypeError,
+    JointIndexError,
+    KinegamiError,
+)
+from kinegami.geometry.balls import Ball, merge_balls
+from kinegami.geometry.frames import rotation_about_line, translation
+from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube, pose_array
+from kinegami.links import LinkCSC
+from kinegami.placement import (
+    compact_lambda,
+    orient_by_common_normal,
+    published_safe_placement,
+    radial_safe_placement,
+)
+from kinegami.validation import check_max_angle_per_elbow, check_real
+
+__all__ = ["KinematicChain", "PlacementWarning"]
+
+
+class PlacementWarning(UserWarning):
+    """A placement, edit or state change was rejected; the chain is unchanged."""
+
+
+def _check_bool(name: str, value) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidTypeError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def _propagate_flag(propogate, propagate) -> bool:
+    """Accept the paper's spelling ``propogate`` and the correct ``propagate``."""
+    if propagate is None:
+        return _check_bool("propogate", propogate)
+    propagate = _check_bool("propagate", propagate)
+    if propogate is not True and bool(propogate) != propagate:
+        raise InvalidParameterError(
+            f"propogate={propogate!r} and propagate={propagate!r} disagree; give only one"
+        )
+    return propagate
+
+
+class KinematicChain:
+    """A serial chain of tubular origami joints joined by CSC links.
+
+    Parameters
+    ----------
+    startJoint : the root joint (copied; world coordinates).
+    maxAnglePerElbow : largest turn of a single elbow fitting, in (0, pi] (default pi/2).
+
+    Examples
+    --------
+    >>> chain = KinematicChain(StartTip(4, 1, Pose=SE3.Trans(3, 3, 0), length=1.5))
+    >>> chain.append(PrismaticJoint(4, 1, 3, 3, np.pi / 4, SE3.Trans(5, 5, 0)))
+    2
+    """
+
+    def __init__(self, startJoint: Joint, maxAnglePerElbow: float = np.pi / 2):
+        if not isinstance(startJoint, Joint):
+            raise InvalidTypeError(
+                f"startJoint must be a Joint, got {type(startJoint).__name__}"
+            )
+        if isinstance(startJoint, EndTip):
+            raise InvalidParameterError("startJoint cannot be an EndTip (nothing may follow it)")
+        self.maxAnglePerElbow = check_max_angle_per_elbow(maxAnglePerElbow)
+        self.numSides = startJoint.numSides
+        self.r = startJoint.r
+        root = startJoint._copy()
+        self._joints: list[Joint] = [root]
+        self._links: list[LinkCSC] = [self._root_link(root)]
+        ball = root.boundingBall()
+        if ball.r < self.r:
+            ball = Ball(root.pose_matrix[:3, 3], self.r)
+        self._ball = ball
+
+    # --- published read-only views -----------------------------------------------------------
+    @property
+    def Joints(self) -> tuple[Joint, ...]:
+        """The joints, in order (world coordinates)."""
+        return tuple(self._joints)
+
+    @property
+    def Links(self) -> tuple[LinkCSC, ...]:
+        """``Links[i]`` joins joint i-1's distal frame to joint i's proximal frame."""
+        return tuple(self._links)
+
+    @property
+    def Parents(self) -> tuple[int, ...]:
+        """Parent index of every joint (-1 for the root)."""
+        return tuple(range(-1, len(self._joints) - 1))
+
+    @property
+    def boundingBall(self) -> Ball:
+        """A ball (centre ``c``, radius ``r``) containing every joint and link."""
+        return self._ball
+
+    def __len__(self) -> int:
+        return len(self._joints)
+
+    def __repr__(self) -> str:
+        kinds = ", ".join(type(j).__name__ for j in self._joints)
+        return (
+            f"KinematicChain({len(self._joints)} joints: {kinds}; "
+            f"path length {self.totalPathLength():.6g})"
+        )
+
+    def totalPathLength(self) -> float:
+        """Sum of the centreline lengths of all links."""
+        return float(sum(link.path.length for link in self._links))
+
+    # --- helpers -----------------------------------------------------------------------------
+    def _root_link(self, root: Joint) -> LinkCSC:
+        frame = root.proximal_dubins_frame()
+        return LinkCSC(self.r, frame, frame, self.maxAnglePerElbow)
+
+    def _link(self, parent: Joint, child: Joint) -> LinkCSC:
+        return LinkCSC(self.r, parent.distal_dubins_frame(), child.proximal_dubins_frame(),
+                       self.maxAnglePerElbow)
+
+    def _index(self, jointIndex) -> int:
+        if isinstance(jointIndex, bool) or not isinstance(jointIndex, int | np.integer):
+            raise InvalidTypeError(f"jointIndex must be an integer, got {jointIndex!r}")
+        n = len(self._joints)
+        j = int(jointIndex)
+        if not -n <= j < n:
+            raise JointIndexError(
+                f"jointIndex must be in [{-n}, {n - 1}] for a chain of {n} joints, got {j}"
+            )
+        return j % n
+
+    @staticmethod
+    def _merge_link_and_joint(ball: Ball, link: LinkCSC, joint: Joint) -> Ball:
+        ball = merge_balls(ball, link.arc2Ball)
+        ball = merge_balls(ball, link.arc1Ball)
+        return merge_balls(ball, joint.boundingBall())
+
+    @staticmethod
+    def _ball_of(joints: Sequence[Joint], links: Sequence[LinkCSC]) -> Ball:
+        """The chain ball in the reference's recompute order (chain.md 3.3)."""
+        ball = joints[0].boundingBall()
+        for joint in joints[1:]:
+            ball = merge_balls(ball, joint.boundingBall())
+        for link in links:
+            ball = merge_balls(ball, link.arc1Ball)
+            ball = merge_balls(ball, link.arc2Ball)
+        return ball
+
+    def _commit(self, joints: list[Joint], links: list[LinkCSC], ball: Ball | None = None):
+        if ball is None:
+            ball = self._ball_of(joints, links)
+        self._joints, self._links, self._ball = joints, links, ball
+
+    def recomputeBoundingBall(self) -> Ball:
+        """Recompute the ball from every joint and link (chain.md 3.3) and return it."""
+        self._ball = self._ball_of(self._joints, self._links)
+        return self._ball
+
+    @staticmethod
+    def _reject(message: str) -> None:
+        warnings.warn(message + "; the chain is unchanged", PlacementWarning, stacklevel=3)
+
+    # --- building ----------------------------------------------------------------------------
+    def append(self, newJoint: Joint, relative: bool = True, safe: bool = True,
+               fixedPosition: bool = False, fixedOrientation: bool = False) -> int | None:
+        """Add ``newJoint`` after the last joint and return its index.
+
+        Parameters
+        ----------
+        newJoint : the joint; its Pose gives the axis of motion (z). It is copied.
+        relative : the Pose is relative to the last joint's Pose (True) or global (False).
+        safe : place with the safe algorithm (waypoints; never fails) rather than compact.
+        fixedPosition : keep the given position (requires safe=False).
+        fixedOrientation : keep the given orientation (requires safe=False).
+
+        Returns the new joint's index, or None (with a PlacementWarning, chain unchanged) when
+        no link with turns < pi reaches it.
+        """
+        relative = _check_bool("relative", relative)
+        safe = _check_bool("safe", safe)
+        fixedPosition = _check_bool("fixedPosition", fixedPosition)
+        fixedOrientation = _check_bool("fixedOrientation", fixedOrientation)
+        if safe and fixedPosition:
+            raise InvalidParameterError(
+                "safe=True and fixedPosition=True cannot be combined: safe placement moves the "
+                "joint along its axis; pass safe=False to keep the given position"
+            )
+        if safe and fixedOrientation:
+            raise InvalidParameterError(
+                "safe=True and fixedOrientation=True cannot be combined; pass safe=False to "
+                "keep the given orientation"
+            )
+        check_same_tube(newJoint, self.numSides, self.r)
+        if isinstance(newJoint, StartTip):
+            raise InvalidParameterError("a StartTip can only be the first joint of a chain")
+        parent = self._joints[-1]
+        if isinstance(parent, EndTip):
+            raise InvalidParameterError("nothing can be appended after an EndTip")
+
+        joint = newJoint._copy()
+        if relative:
+            joint = joint.with_pose(parent.pose_matrix @ joint.pose_matrix)
+
+        try:
+            if safe:
+                joints, links, ball = self._safe_extension(parent, joint)
+            else:
+                if not fixedPosition:
+                    lam = compact_lambda(parent.pose_matrix[:3, 3], joint.pose_matrix[:3, 3],
+                                         joint.pose_matrix[:3, 2], self._ball,
+                                         4.0 * self.r + self._ball.r + joint.bounding_radius(),
+                                         self.r)
+                    joint = joint.translated_along_z(lam)
+                if not fixedOrientation:
+                    joint = orient_by_common_normal(joint, parent.pose_matrix)
+                joints, links, ball = self._extended([joint])
+        except KinegamiError as error:
+            self._reject(f"append failed: {error}")
+            return None
+        self._commit(joints, links, ball)
+        return len(joints) - 1
+
+    def _extended(self, new_joints: list[Joint]):
+        """Lists and ball with ``new_joints`` appended (links solved); raises on failure."""
+        joints = list(self._joints)
+        links = list(self._links)
+        ball = self._ball
+        for joint in new_joints:
+            link = self._link(joints[-1], joint)
+            ball = self._merge_link_and_joint(ball, link, joint)
+            joints.append(joint)
+            links.append(link)
+        return joints, links, ball
+
+    def _safe_extension(self, parent: Joint, joint: Joint):
+        """Safe placement: the extended lists and ball (chain.md 4.3 and docs/placement.md).
+
+        The published rule is kept when it succeeds and either stays close (ball growth at most
+        SAFE_GROWTH_LIMIT r and new links at most SAFE_PATH_LIMIT r long) or is no worse than
+        the radial construction on both counts; otherwise (the cases in which it blows up or
+        fails) the radial construction is used.
+        """
+        distal = parent.distal_frame()
+        k = parent.pathIndex()
+        try:
+            published = self._extended(published_safe_placement(distal, k, joint, self._ball))
+        except KinegamiError:
+            published = None
+        if published is not None:
+            growth, path = self._cost(published)
+            if growth <= SAFE_GROWTH_LIMIT * self.r and path <= SAFE_PATH_LIMIT * self.r:
+                return published
+        try:
+            radial = self._extended(radial_safe_placement(distal, k, joint, self._ball))
+        except KinegamiError:
+            if published is not None:
+                return published
+            raise
+        if published is not None:
+            growth_r, path_r = self._cost(radial)
+            if growth <= max(growth_r, SAFE_GROWTH_LIMIT * self.r) and path <= max(
+                path_r, SAFE_PATH_LIMIT * self.r
+            ):
+                return published
+        return radial
+
+    def _cost(self, extended) -> tuple[float, float]:
+        """(growth of the ball radius, length of the new links) of an extension."""
+        _, links, ball = extended
+        added = links[len(self._links):]
+        return ball.r - self._ball.r, sum(link.path.length for link in added)
+
+    # --- edits ---------------------------------------------------------------------------------
+    def _moved(self, j: int, T: np.ndarray, propagate: bool):
+        """New joint and link lists with joint j moved by world transform T (chain.md 5.1)."""
+        joints = list(self._joints)
+        links = list(self._links)
+        joints[j] = joints[j].transformed(T)
+        if propagate:
+            for k in range(j + 1, len(joints)):
+                joints[k] = joints[k].transformed(T)
+                links[k] = links[k].transformed(T)
+        elif j + 1 < len(joints):
+            links[j + 1] = self._link(joints[j], joints[j + 1])
+        if j > 0:
+            links[j] = self._link(joints[j - 1], joints[j])
+        else:
+            links[0] = links[0].transformed(T)
+        return joints, links
+
+    def _try_edit(self, what: str, build) -> bool:
+        try:
+            joints, links = build()
+            ball = self._ball_of(joints, links)
+        except KinegamiError as error:
+            self._reject(f"{what} failed: {error}")
+            return False
+        self._commit(joints, links, ball)
+        return True
+
+    def transformJoint(self, jointIndex: int, Transformation, propogate: bool = True, *,
+                       propagate: bool | None = None) -> bool:
+        """Move joint ``jointIndex`` by the world transform ``Transformation``.
+
+        With propagation every later joint moves with it (only the link into the joint is
+        re-solved); without, only this joint moves (its two links are re-solved). Returns True,
+        or False with a PlacementWarning (chain unchanged) when a link cannot be built.
+        """
+        j = self._index(jointIndex)
+        T = pose_array(Transformation, "Transformation")
+        prop = _propagate_flag(propogate, propagate)
+        return self._try_edit("transformJoint", lambda: self._moved(j, T, prop))
+
+    def transformAll(self, Transformation) -> bool:
+        """Move the whole chain rigidly by ``Transformation`` (no link is re-solved)."""
+        T = pose_array(Transformation, "Transformation")
+        joints = [joint.transformed(T) for joint in self._joints]
+        links = [link.transformed(T) for link in self._links]
+        self._commit(joints, links, self._ball.transformed(T))
+        return True
+
+    def _axis_edit(self, what: str, jointIndex, T_of_joint, propogate, propagate,
+                   applyToPreviousWaypoint) -> bool:
+        j = self._index(jointIndex)
+        prop = _propagate_flag(propogate, propagate)
+        applyToPreviousWaypoint = _check_bool("applyToPreviousWaypoint", applyToPreviousWaypoint)
+        T = T_of_joint(self._joints[j])
+        if applyToPreviousWaypoint and j > 0 and isinstance(self._joints[j - 1], Waypoint):
+            w = j - 1
+            if prop:
+                return self._try_edit(what, lambda: self._moved(w, T, True))
+
+            def both():
+                joints = list(self._joints)
+                links = list(self._links)
+                joints[w] = joints[w].transformed(T)
+                joints[j] = joints[j].transformed(T)
+                for k in (w, j, j + 1):
+                    if k == 0:
+                        links[0] = links[0].transformed(T)
+                    elif k < len(joints):
+                        links[k] = self._link(joints[k - 1], joints[k])
+                return joints, links
+
+            return self._try_edit(what, both)
+        return self._try_edit(what, lambda: self._moved(j, T, prop))
+
+    def translateJointAlongAxisOfMotion(self, jointIndex: int, distance: float,
+                                        propogate: bool = True,
+                                        applyToPreviousWaypoint: bool = False, *,
+                                        propagate: bool | None = None) -> bool:
+        """Slide joint ``jointIndex`` by ``distance`` along its axis of motion (z).
+
+        The axis line is kept, so the chain's kinematics are unchanged. With
+        ``applyToPreviousWaypoint`` a waypoint just before the joint moves with it.
+        """
+        d = check_real("distance", distance)
+        return self._axis_edit(
+            "translateJointAlongAxisOfMotion", jointIndex,
+            lambda joint: translation(d * joint.pose_matrix[:3, 2]),
+            propogate, propagate, applyToPreviousWaypoint,
+        )
+
+    def rotateJointAboutAxisOfMotion(self, jointIndex: int, angle: float,
+                                     propogate: bool = True,
+                                     applyToPreviousWaypoint: bool = False, *,
+                                     propagate: bool | None = None) -> bool:
+        """Turn joint ``jointIndex`` by ``angle`` (radians) about its axis of motion."""
+        a = check_real("angle", angle)
+        return self._axis_edit(
+            "rotateJointAboutAxisOfMotion", jointIndex,
+            lambda joint: rotation_about_line(joint.pose_matrix[:3, 2],
+                                              joint.pose_matrix[:3, 3], a),
+            propogate, propagate, applyToPreviousWaypoint,
+        )
+
+    def delete(self, jointIndex: int) -> bool:
+        """Remove joint ``jointIndex`` and join its neighbours by a new link.
+
+        Deleting the last joint drops it; deleting joint 0 makes joint 1 the root. Returns True,
+        or False with a PlacementWarning (chain unchanged) when the new link cannot be built or
+        the chain has a single joint.
+        """
+        j = self._index(jointIndex)
+        if len(self._joints) == 1:
+            self._reject("delete failed: a chain must keep at least one joint")
+            return False
+
+        def build():
+            joints = self._joints[:j] + self._joints[j + 1:]
+            links = self._links[:j] + self._links[j + 1:]
+            if j == 0:
+                links[0] = self._root_link(joints[0])
+            elif j < len(joints):
+                links[j] = self._link(joints[j - 1], joints[j])
+            return joints, links
+
+        return self._try_edit("delete", build)
+
+    # --- states --------------------------------------------------------------------------------
+    def setJointState(self, jointIndex: int, newState: float) -> bool:
+        """Set joint ``jointIndex`` to ``newState`` (radians or length); later joints follow.
+
+        Returns False with a PlacementWarning (chain unchanged) if ``newState`` is outside the
+        joint's ``stateRange()``. Link shapes never change: downstream links move rigidly.
+        """
+        j = self._index(jointIndex)
+        s = check_real("newState", newState)
+        joint = self._joints[j]
+        lo, hi = joint.stateRange()
+        if not lo <= s <= hi:
+            self._reject(
+                f"setJointState failed: state {s!r} of joint {j} ({type(joint).__name__}) "
+                f"is outside its range [{lo:.6g}, {hi:.6g}]"
+            )
+            return False
+        G = joint.state_transform(s - joint.state)
+        joints = list(self._joints)
+        links = list(self._links)
+        joints[j] = joint.with_state(s)
+        for k in range(j + 1, len(joints)):
+            joints[k] = joints[k].transformed(G)
+            links[k] = links[k].transformed(G)
+        self._commit(joints, links)
+        return True
+
+    def setJointStates(self, states: Sequence[float]) -> bool:
+        """Set every joint's state at once (one value per joint); all-or-nothing."""
+        if len(states) != len(self._joints):
+            raise InvalidParameterError(
+                f"states must have one value per joint ({len(self._joints)}), got {len(states)}"
+            )
+        values = [check_real(f"states[{i}]", s) for i, s in enumerate(states)]
+        for i, (joint, s) in enumerate(zip(self._joints, values, strict=True)):
+            lo, hi = joint.stateRange()
+            if not lo <= s <= hi:
+                self._reject(
+                    f"setJointStates failed: state {s!r} of joint {i} is outside "
+                    f"[{lo:.6g}, {hi:.6g}]"
+                )
+                return False
+        joints = list(self._joints)
+        links = list(self._links)
+        accumulated = np.eye(4)
+        for k in range(len(joints)):
+            if k > 0 and not np.array_equal(accumulated, np.eye(4)):
+                joints[k] = joints[k].transformed(accumulated)
+                links[k] = links[k].transformed(accumulated)
+            joint = joints[k]
+            if values[k] != joint.state:
+                G = joint.state_transform(values[k] - joint.state)
+                joints[k] = joint.with_state(values[k])
+                accumulated = G @ accumulated
+        self._commit(joints, links)
+        return True
+
+    # --- output --------------------------------------------------------------------------------
+    def creasePattern(self, twistPortion: float = 0.2):
+        """The chain's tubular crease pattern (patterns.md 4.3) as a TubularPattern."""
+        from kinegami.pattern import TubularPattern
+
+        modules = [self._joints[0].pattern]
+        for link, joint in zip(self._links[1:], self._joints[1:], strict=True):
+            modules.append(link.creasePattern(self.numSides, twistPortion))
+            modules.append(joint.pattern)
+        return TubularPattern.concatenate(modules)
+
+    def show(self, **options):
+        """Draw the chain in 3D with matplotlib; returns (figure, axes). See kinegami.viz."""
+        from kinegami.viz.chain_plot import show_chain
+
+        return show_chain(self, **options)
+
+
+#: Safe placement keeps the published result when all new joints stay within this many r of
+#: the current ball's surface and its new links are at most SAFE_PATH_LIMIT r long.
+SAFE_GROWTH_LIMIT = 10.0
+SAFE_PATH_LIMIT = 40.0

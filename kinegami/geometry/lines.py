@@ -1,0 +1,33 @@
+"""Lines and the common normal of two axes (chain.md section 4.5)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def common_normal(p_from, z_from, p_to, z_to, tol: float) -> np.ndarray | None:
+    """Unit common normal from the line (p_from, z_from) to the line (p_to, z_to).
+
+    It points from the first line towards the second. Returns None when undefined:
+    coincident axes, or axes that intersect (the normal would have no preferred sign).
+    ``tol`` is a length tolerance (scaled by r by the caller); the direction tests use
+    1e-9 (chain.md 4.5 [FIX]: no exact-zero tests).
+    """
+    v = np.asarray(p_to, dtype=float) - np.asarray(p_from, dtype=float)
+    z1 = np.asarray(z_from, dtype=float)
+    c = np.cross(z1, np.asarray(z_to, dtype=float))
+    nc = float(np.linalg.norm(c))
+    if nc > 1e-9:
+        n = c / nc
+    else:
+        q = np.cross(z1, np.cross(v, z1))
+        nq = float(np.linalg.norm(q))
+        if nq <= tol:
+            return None
+        n = q / nq
+    side = float(v @ n)
+    if side > tol:
+        return n
+    if side < -tol:
+        return -n
+    return None

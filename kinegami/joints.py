@@ -1,0 +1,471 @@
+"""Joints of a tubular chain: revolute, prismatic, waypoints and tips (chain.md section 1).
+
+Every joint has a ``Pose`` (an SE3: origin at the joint centre in the state-0 configuration,
+z axis = axis of motion), a tube radius ``r``, a polygon side count ``numSides``, a
+``neutralLength`` (proximal-to-distal distance at state 0), a ``state`` (radians for revolute,
+length for prismatic joints, 0 at construction) and a path direction: column ``pathIndex()`` of
+the Pose, the tangent of the tube centreline through the joint.
+
+Joints are values: a chain never changes a joint in place, it swaps in modified copies
+(``with_pose``, ``with_state``), which is what makes its edits transactions.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from spatialmath import SE3
+
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.geometry.balls import Ball
+from kinegami.geometry.frames import (
+    dubins_frame,
+    is_rigid_transform,
+    rot_x,
+    rot_z,
+    rotation_about_line,
+    translation,
+    unit,
+)
+from kinegami.validation import (
+    check_in_range,
+    check_int,
+    check_num_sides,
+    check_positive,
+    check_radius,
+)
+
+__all__ = [
+    "Joint",
+    "RevoluteJoint",
+    "ExtendedRevoluteJoint",
+    "PrismaticJoint",
+    "Waypoint",
+    "Tip",
+    "StartTip",
+    "EndTip",
+    "pose_array",
+]
+
+
+def pose_array(Pose, name: str = "Pose") -> np.ndarray:
+    """A validated 4x4 float array from an SE3 or a 4x4 array-like (proper rigid, finite)."""
+    if isinstance(Pose, SE3):
+        if len(Pose) != 1:
+            raise InvalidParameterError(f"{name} must be a single SE3, got {len(Pose)} poses")
+        T = np.array(Pose.A, dtype=float)
+    else:
+        try:
+            T = np.array(Pose, dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidTypeError(
+                f"{name} must be an SE3 or a 4x4 array, got {type(Pose).__name__}"
+            ) from None
+    if T.shape != (4, 4):
+        raise InvalidParameterError(f"{name} must be a 4x4 rigid transform, got shape {T.shape}")
+    if not np.all(np.isfinite(T)):
+        raise InvalidParameterError(f"{name} must be finite, got a matrix containing NaN or inf")
+    if not is_rigid_transform(T, tol=1e-8):
+        raise InvalidParameterError(
+            f"{name} must be a proper rigid transform (orthonormal rotation with determinant +1 "
+            f"and last row 0 0 0 1), got\n{T}"
+        )
+    T.setflags(write=False)
+    return T
+
+
+def _frozen(T: np.ndarray) -> np.ndarray:
+    T = np.array(T, dtype=float)
+    T.setflags(write=False)
+    return T
+
+
+class Joint:
+    """Base class of all joints (abstract: use one of the subclasses)."""
+
+    #: Index of the Pose column that is the path direction (overridden by Waypoint).
+    _PATH_INDEX = 2
+
+    def __init__(self, numSides, r, neutralLength, Pose):
+        self._numSides = check_num_sides(numSides)
+        self._r = check_radius(r)
+        self._neutralLength = float(neutralLength)
+        self._T = pose_array(Pose)
+        self._state = 0.0
+        self._pose_se3 = None
+
+    # --- published attributes -------------------------------------------------------------
+    @property
+    def numSides(self) -> int:
+        """Number of sides of the tube's polygon cross-section (even, >= 4)."""
+        return self._numSides
+
+    @property
+    def r(self) -> float:
+        """Tube radius (circumradius of the polygon)."""
+        return self._r
+
+    @property
+    def neutralLength(self) -> float:
+        """Distance from the proximal to the distal frame at state 0."""
+        return self._neutralLength
+
+    @property
+    def state(self) -> float:
+        """Current state (0 at construction); change it with ``KinematicChain.setJointState``."""
+        return self._state
+
+    @property
+    def Pose(self) -> SE3:
+        """Pose of the joint centre at state 0; z is the axis of motion (world coordinates)."""
+        if self._pose_se3 is None:
+            self._pose_se3 = SE3(np.array(self._T), check=False)
+        return self._pose_se3
+
+    @property
+    def pose_matrix(self) -> np.ndarray:
+        """The Pose as a read-only 4x4 numpy array."""
+        return self._T
+
+    def pathIndex(self) -> int:
+        """Index (0 = x, 1 = y, 2 = z) of the Pose axis that is the path direction."""
+        return self._PATH_INDEX
+
+    def stateRange(self) -> tuple[float, float]:
+        """The closed interval of valid states."""
+        return (0.0, 0.0)
+
+    # --- frames (4x4 arrays) --------------------------------------------------------------
+    def path_direction(self) -> np.ndarray:
+        """Unit path direction (column ``pathIndex()`` of the Pose)."""
+        return self._T[:3, self.pathIndex()]
+
+    def state_transform(self, delta: float) -> np.ndarray:
+        """World motion G(delta) that a state change by ``delta`` applies downstream."""
+        return np.eye(4)
+
+    def proximal_frame(self) -> np.ndarray:
+        """Proximal frame (independent of the state) as a 4x4 array."""
+        T = np.array(self._T)
+        T[:3, 3] -= (self._neutralLength / 2.0) * self.path_direction()
+        return T
+
+    def distal_frame(self) -> np.ndarray:
+        """Distal frame at the current state as a 4x4 array."""
+        T = np.array(self._T)
+        T[:3, 3] += (self._neutralLength / 2.0) * self.path_direction()
+        if self._state != 0.0:
+            T = self.state_transform(self._state) @ T
+        return T
+
+    def proximal_dubins_frame(self) -> np.ndarray:
+        """Proximal frame with its axes permuted so x is the path direction."""
+        return dubins_frame(self.proximal_frame(), self.pathIndex())
+
+    def distal_dubins_frame(self) -> np.ndarray:
+        """Distal frame with its axes permuted so x is the path direction."""
+        return dubins_frame(self.distal_frame(), self.pathIndex())
+
+    # --- published frame accessors (SE3) ----------------------------------------------------
+    def ProximalFrame(self) -> SE3:
+        """Proximal frame (where the incoming link ends) as an SE3."""
+        return SE3(self.proximal_frame(), check=False)
+
+    def DistalFrame(self) -> SE3:
+        """Distal frame (where the outgoing link starts) at the current state, as an SE3."""
+        return SE3(self.distal_frame(), check=False)
+
+    def ProximalDubinsFrame(self) -> SE3:
+        """Proximal Dubins frame (x = path direction) as an SE3."""
+        return SE3(self.proximal_dubins_frame(), check=False)
+
+    def DistalDubinsFrame(self) -> SE3:
+        """Distal Dubins frame (x = path direction) at the current state, as an SE3."""
+        return SE3(self.distal_dubins_frame(), check=False)
+
+    # --- bounding ball --------------------------------------------------------------------
+    def boundingBall(self) -> Ball:
+        """A ball containing the joint at its current state (chain.md 1.3)."""
+        return Ball(self._T[:3, 3], math.hypot(self._r, self._neutralLength / 2.0))
+
+    def bounding_radius(self) -> float:
+        """Radius of ``boundingBall()``."""
+        return self.boundingBall().r
+
+    # --- value-style modifications (used by the chain) -------------------------------------
+    def _copy(self) -> Joint:
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new._pose_se3 = None
+        return new
+
+    def with_pose(self, T: np.ndarray) -> Joint:
+        """A copy with the Pose replaced by the 4x4 array ``T`` (state kept)."""
+        new = self._copy()
+        new._T = _frozen(T)
+        return new
+
+    def with_state(self, state: float) -> Joint:
+        """A copy with the state replaced (no range check: the chain checks)."""
+        new = self._copy()
+        new._state = float(state)
+        return new
+
+    def transformed(self, T: np.ndarray) -> Joint:
+        """A copy whose Pose is moved by the world transform ``T`` (Pose <- T Pose)."""
+        return self.with_pose(T @ self._T)
+
+    def with_reversed_path_direction(self) -> Joint:
+        """A copy whose path direction is reversed, keeping the axis-of-motion line (chain.md 1.4)."""
+        flip = rot_x(math.pi) if self.pathIndex() == 2 else rot_z(math.pi)
+        return self.with_pose(_exact_flip(self._T, flip))
+
+    def with_xhat_about_zhat(self, x) -> Joint:
+        """A copy with x set to ``x`` (orthogonalised against z), z and the origin kept."""
+        z = self._T[:3, 2]
+        x = np.asarray(x, dtype=float)
+        x = unit(x - (x @ z) * z)
+        T = np.array(self._T)
+        T[:3, 0] = x
+        T[:3, 1] = np.cross(z, x)
+        return self.with_pose(T)
+
+    def translated_along_z(self, distance: float) -> Joint:
+        """A copy moved by ``distance`` along its own z axis."""
+        T = np.array(self._T)
+        T[:3, 3] += distance * T[:3, 2]
+        return self.with_pose(T)
+
+    # --- pattern --------------------------------------------------------------------------
+    @property
+    def pattern(self):
+        """The joint's crease pattern (a TubularPattern), built on first use."""
+        cached = self.__dict__.get("_pattern_cache")
+        if cached is None:
+            cached = self._build_pattern()
+            self.__dict__["_pattern_cache"] = cached
+        return cached
+
+    def _build_pattern(self):
+        raise InvalidTypeError(f"{type(self).__name__} has no crease pattern")
+
+    def _describe(self) -> str:
+        return ""
+
+    def __repr__(self) -> str:
+        p = ", ".join(f"{v:.6g}" for v in self._T[:3, 3])
+        z = ", ".join(f"{v:.6g}" for v in self._T[:3, 2])
+        extra = self._describe()
+        return (
+            f"{type(self).__name__}(numSides={self._numSides}, r={self._r:.6g}{extra}, "
+            f"origin=({p}), z=({z}), state={self._state:.6g})"
+        )
+
+
+def _exact_flip(T: np.ndarray, flip: np.ndarray) -> np.ndarray:
+    """T @ flip for flip = Rx(pi) or Rz(pi), done by exact sign changes (no round-off)."""
+    out = np.array(T)
+    if flip[1, 1] < 0 and flip[2, 2] < 0:  # Rx(pi): y, z negated
+        out[:3, 1] = -T[:3, 1]
+        out[:3, 2] = -T[:3, 2]
+    else:  # Rz(pi): x, y negated
+        out[:3, 0] = -T[:3, 0]
+        out[:3, 1] = -T[:3, 1]
+    return out
+
+
+class RevoluteJoint(Joint):
+    """A revolute joint: rotation about the Pose z axis; the tube passes through along x.
+
+    Parameters
+    ----------
+    numSides : even number of polygon sides, >= 4.
+    r : tube radius, > 0.
+    totalBendingAngle : total range of rotation in (0, 2pi) radians; states lie in
+        [-totalBendingAngle/2, +totalBendingAngle/2].
+    Pose : SE3 (or 4x4 array) of the joint centre; z is the rotation axis.
+    numSinkLayers : number of recursive sink gadget layers in the pattern (>= 1; stiffness).
+    """
+
+    _PATH_INDEX = 0
+
+    def __init__(self, numSides, r, totalBendingAngle, Pose, numSinkLayers=1):
+        n = check_num_sides(numSides)
+        r = check_radius(r)
+        B = check_in_range("totalBendingAngle", totalBendingAngle, 0.0, 2.0 * math.pi,
+                           range_text="(0, 2pi)")
+        self.totalBendingAngle = B
+        self.numSinkLayers = check_int("numSinkLayers", numSinkLayers, minimum=1)
+        L = 2.0 * r * math.cos(math.pi / n) * math.tan(B / 4.0)
+        super().__init__(n, r, L, Pose)
+
+    def stateRange(self) -> tuple[float, float]:
+        return (-self.totalBendingAngle / 2.0, self.totalBendingAngle / 2.0)
+
+    def state_transform(self, delta: float) -> np.ndarray:
+        return rotation_about_line(self._T[:3, 2], self._T[:3, 3], delta)
+
+    def _build_pattern(self):
+        from kinegami.pattern import RevoluteJointPattern
+
+        return RevoluteJointPattern(
+            self.numSides, self.r, self.totalBendingAngle, self.numSinkLayers
+        )
+
+    def _describe(self) -> str:
+        return f", totalBendingAngle={self.totalBendingAngle:.6g}"
+
+
+class ExtendedRevoluteJoint(RevoluteJoint):
+    """A revolute joint with a straight tube of length ``tubeLength`` on each side."""
+
+    def __init__(self, numSides, r, totalBendingAngle, tubeLength, Pose, numSinkLayers=1):
+        self.tubeLength = check_positive("tubeLength", tubeLength)
+        super().__init__(numSides, r, totalBendingAngle, Pose, numSinkLayers)
+        self._neutralLength += 2.0 * self.tubeLength
+
+    def _build_pattern(self):
+        from kinegami.pattern import RevoluteJointPattern, TubeFittingPattern
+
+        tube = TubeFittingPattern(self.numSides, self.r, self.tubeLength)
+        joint = RevoluteJointPattern(
+            self.numSides, self.r, self.totalBendingAngle, self.numSinkLayers
+        )
+        return tube.append(joint).append(tube)
+
+
+class PrismaticJoint(Joint):
+    """A prismatic joint (REBO bellows in a sleeve): translation along the Pose z axis.
+
+    Parameters
+    ----------
+    numSides, r : as for every joint.
+    neutralLength : length d > 0 of the joint at state 0.
+    numLayers : number of REBO layers (integer >= 1).
+    coneAngle : REBO cone angle in [pi/6, pi/2) radians; the state range is
+        [d/(2 sin coneAngle) - d, d/sin coneAngle - d].
+    Pose : SE3 (or 4x4 array) of the joint centre at state 0; z is the axis of motion.
+    """
+
+    def __init__(self, numSides, r, neutralLength, numLayers, coneAngle, Pose):
+        n = check_num_sides(numSides)
+        r = check_radius(r)
+        d = check_positive("neutralLength", neutralLength)
+        self.numLayers = check_int("numLayers", numLayers, minimum=1)
+        self.coneAngle = check_in_range(
+            "coneAngle", coneAngle, math.pi / 6.0, math.pi / 2.0, low_inclusive=True,
+            range_text="[pi/6, pi/2)",
+        )
+        super().__init__(n, r, d, Pose)
+
+    def stateRange(self) -> tuple[float, float]:
+        d = self._neutralLength
+        s = math.sin(self.coneAngle)
+        return (d / (2.0 * s) - d, d / s - d)
+
+    def state_transform(self, delta: float) -> np.ndarray:
+        return translation(delta * self._T[:3, 2])
+
+    def distal_frame(self) -> np.ndarray:
+        T = np.array(self._T)
+        T[:3, 3] += (self._neutralLength / 2.0 + self._state) * T[:3, 2]
+        return T
+
+    def boundingBall(self) -> Ball:
+        s = self._state
+        return Ball(
+            self._T[:3, 3] + (s / 2.0) * self._T[:3, 2],
+            math.hypot(self._r, (self._neutralLength + s) / 2.0),
+        )
+
+    def _build_pattern(self):
+        from kinegami.pattern import PrismaticJointPattern
+
+        return PrismaticJointPattern(
+            self.numSides, self.r, self.neutralLength, self.numLayers, self.coneAngle
+        )
+
+    def _describe(self) -> str:
+        return (
+            f", neutralLength={self._neutralLength:.6g}, numLayers={self.numLayers}, "
+            f"coneAngle={self.coneAngle:.6g}"
+        )
+
+
+class Waypoint(Joint):
+    """A pose the tube passes through, with no structure and no state.
+
+    ``pathIndex`` (0, 1 or 2, default 2) says which Pose axis the tube follows.
+    """
+
+    def __init__(self, numSides, r, Pose, pathIndex=2):
+        n = check_num_sides(numSides)
+        r = check_radius(r)
+        k = check_int("pathIndex", pathIndex)
+        if k not in (0, 1, 2):
+            raise InvalidParameterError(f"pathIndex must be 0, 1 or 2, got {k}")
+        self._path_index = k
+        super().__init__(n, r, 0.0, Pose)
+
+    def pathIndex(self) -> int:
+        return self._path_index
+
+    def boundingBall(self) -> Ball:
+        return Ball(self._T[:3, 3], self._r)
+
+    def _build_pattern(self):
+        from kinegami.pattern import WaypointPattern
+
+        return WaypointPattern(self.numSides, self.r)
+
+    def _describe(self) -> str:
+        return f", pathIndex={self._path_index}"
+
+
+class Tip(Joint):
+    """Base of the closed tube ends; ``length`` is the axial length (> 0)."""
+
+    def __init__(self, numSides, r, Pose, length):
+        n = check_num_sides(numSides)
+        r = check_radius(r)
+        self.length = check_positive("length", length)
+        super().__init__(n, r, self.length, Pose)
+
+    def _describe(self) -> str:
+        return f", length={self.length:.6g}"
+
+
+class StartTip(Tip):
+    """The closed start of the tube (nothing may precede it). Path direction: Pose z."""
+
+    def _build_pattern(self):
+        from kinegami.pattern import StartTipPattern
+
+        return StartTipPattern(self.numSides, self.r, self.length)
+
+
+class EndTip(Tip):
+    """The closed end of the tube (nothing may follow it). Path direction: Pose z."""
+
+    def _build_pattern(self):
+        from kinegami.pattern import EndTipPattern
+
+        return EndTipPattern(self.numSides, self.r, self.length)
+
+
+def check_same_tube(joint: Joint, numSides: int, r: float) -> None:
+    """Raise IncompatibleJointError if ``joint`` has another numSides or r."""
+    from kinegami.errors import IncompatibleJointError
+
+    if not isinstance(joint, Joint):
+        raise InvalidTypeError(f"expected a Joint, got {type(joint).__name__}")
+    if joint.numSides != numSides:
+        raise IncompatibleJointError(
+            f"numSides of the new joint ({joint.numSides}) must equal the chain's ({numSides})"
+        )
+    if joint.r != r:
+        raise IncompatibleJointError(
+            f"r of the new joint ({joint.r!r}) must equal the chain's ({r!r})"
+        )
+

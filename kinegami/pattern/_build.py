@@ -1,0 +1,66 @@
+"""Small helpers shared by the catalog modules (not public)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from kinegami.pattern._prism import Prism
+from kinegami.pattern.tubular import ModuleRecord, TubularPattern
+
+
+def crease_block(first, second, label: str) -> tuple[np.ndarray, str]:
+    """A block of creases first[i]-second[i], all with the same label ("M" or "V")."""
+    return np.stack([np.asarray(first), np.asarray(second)], axis=1).reshape(-1, 2), label
+
+
+def assemble(
+    prism: Prism,
+    vertices: np.ndarray,
+    blocks: list[tuple[np.ndarray, str | np.ndarray]],
+    proximal: np.ndarray | None,
+    distal: np.ndarray | None,
+    height: float,
+    record: ModuleRecord,
+    distal_marker_x: float = 0.0,
+    drop_degenerate: bool = True,
+) -> TubularPattern:
+    """Build a module pattern from vertex coordinates and labelled crease blocks.
+
+    Each block is an (m, 2) array of vertex index pairs with one label or an array of m labels.
+
+    Creases joining a vertex to itself are dropped, and so are repeated creases (the first one
+    in block order is kept), so every module comes out without zero-length or duplicate creases.
+    The proximal marker is (0, 0) and the distal marker (``distal_marker_x``, ``height``).
+    """
+    edges = np.concatenate([b for b, _ in blocks]).astype(np.intp)
+    labels = np.concatenate(
+        [
+            np.full(b.shape[0], lab, dtype="<U1") if isinstance(lab, str) else np.asarray(lab)
+            for b, lab in blocks
+        ]
+    ).astype("<U1")
+    if drop_degenerate:
+        keep = edges[:, 0] != edges[:, 1]
+        lo = np.minimum(edges[:, 0], edges[:, 1])
+        hi = np.maximum(edges[:, 0], edges[:, 1])
+        key = lo.astype(np.int64) * vertices.shape[0] + hi
+        first = np.zeros(key.shape[0], dtype=bool)
+        first[np.unique(key, return_index=True)[1]] = True
+        keep &= first
+        edges, labels = edges[keep], labels[keep]
+    return TubularPattern._build(
+        prism.numSides,
+        prism.r,
+        np.ascontiguousarray(vertices, dtype=float),
+        np.ascontiguousarray(edges),
+        labels,
+        None if proximal is None else np.asarray(proximal, dtype=np.intp),
+        None if distal is None else np.asarray(distal, dtype=np.intp),
+        np.zeros(2),
+        np.array([distal_marker_x, height], dtype=float),
+        float(height),
+        (record,),
+        0,
+        None,
+        False,
+    )

@@ -1,0 +1,194 @@
+"""Elbow fitting: a bend of the tube by a tucked, flat-folded strip (spec section 3.3)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinegami.errors import InvalidParameterError
+from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._prism import Prism, make_prism, wrap_x
+from kinegami.pattern.tubular import ModuleRecord, TubularPattern
+from kinegami.validation import check_real
+
+__all__ = ["ELBOW_ANGLE_TOL", "ElbowFittingPattern", "ElbowGeometry", "elbow_geometry"]
+
+#: Angle tolerance (radians) on the bending angle: |theta| must lie in (tol, pi - tol) (fix B9;
+#: the reference compared the angle with the length tolerance 1e-4 b).
+ELBOW_ANGLE_TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class ElbowGeometry:
+    """Derived quantities of an elbow (section 3.3); lengths in units of r, angles in radians.
+
+    Attributes
+    ----------
+    bendingAngle, rotationalAxisAngle : float
+        The normalised theta in (0, pi) and phi in [0, 2 pi).
+    d_w : float
+        r tan(theta / 2).
+    h : ndarray, shape (n,)
+        Column heights h_k where tube edge k meets the bisecting plane.
+    H_m : float
+        max_k h_k (the midline height); the pattern height is 2 H_m.
+    tuck : ndarray, shape (n,)
+        Tuck angles eps_k (flat angle minus 3D angle at column k, halved).
+    collapsed : ndarray of bool, shape (n,)
+        Columns with h_k >= H_m - eps (one vertex Q_k instead of four).
+    low : ndarray of bool, shape (n,)
+        Columns with h_k < eps whose tuck boundary vertices reuse P_k and D_k (fix B6).
+    """
+
+    bendingAngle: float
+    rotationalAxisAngle: float
+    d_w: float
+    h: np.ndarray
+    H_m: float
+    tuck: np.ndarray
+    collapsed: np.ndarray
+    low: np.ndarray
+
+    @property
+    def height(self) -> float:
+        """Pattern height H = 2 H_m."""
+        return 2.0 * self.H_m
+
+
+def normalise_elbow_angles(bendingAngle: float, rotationalAxisAngle: float) -> tuple[float, float]:
+    """Reduce (theta, phi) to theta in (0, pi), phi in [0, 2 pi) (section 3.3 steps 1-2).
+
+    Raises
+    ------
+    InvalidParameterError
+        If |theta| (after reduction to [-pi, pi]) is not in (ELBOW_ANGLE_TOL, pi - ELBOW_ANGLE_TOL).
+    """
+    theta = check_real("bendingAngle", bendingAngle)
+    phi = check_real("rotationalAxisAngle", rotationalAxisAngle)
+    theta_n = theta - 2.0 * math.pi * round(theta / (2.0 * math.pi))
+    if not ELBOW_ANGLE_TOL < abs(theta_n) < math.pi - ELBOW_ANGLE_TOL:
+        raise InvalidParameterError(
+            f"bendingAngle must satisfy {ELBOW_ANGLE_TOL:g} < |theta| < pi - {ELBOW_ANGLE_TOL:g} "
+            f"(after reduction modulo 2 pi), got {theta!r}"
+        )
+    if theta_n < 0:
+        theta_n, phi = -theta_n, phi + math.pi
+    phi = phi % (2.0 * math.pi)
+    if phi >= 2.0 * math.pi:
+        phi = 0.0
+    return theta_n, phi
+
+
+def elbow_geometry(prism: Prism, bendingAngle: float, rotationalAxisAngle: float) -> ElbowGeometry:
+    """Column heights, tuck angles and collapsed columns of an elbow (section 3.3)."""
+    theta, phi = normalise_elbow_angles(bendingAngle, rotationalAxisAngle)
+    n, r, b, eps = prism.numSides, prism.r, prism.b, prism.eps
+    beta = prism.vertex_angles
+    d_w = r * math.tan(theta / 2.0)
+    h = d_w * (1.0 + np.sin(beta - phi))
+    H_m = float(h.max())
+    h_prev, h_next = np.roll(h, 1), np.roll(h, -1)
+    flat = math.pi - np.arctan((h_prev - h) / b) - np.arctan((h_next - h) / b)
+    q = np.stack([r * np.cos(beta), r * np.sin(beta), h], axis=1)
+    u = np.roll(q, -1, axis=0) - q
+    w = np.roll(q, 1, axis=0) - q
+    cos_b = np.einsum("ij,ij->i", u, w) / (np.linalg.norm(u, axis=1) * np.linalg.norm(w, axis=1))
+    polygon = np.arccos(np.clip(cos_b, -1.0, 1.0))
+    tuck = 0.5 * (flat - polygon)
+    collapsed = h >= H_m - eps
+    low = (h < eps) & ~collapsed
+    return ElbowGeometry(theta, phi, d_w, h, H_m, tuck, collapsed, low)
+
+
+def ElbowFittingPattern(
+    numSides: int, r: float, bendingAngle: float, rotationalAxisAngle: float
+) -> TubularPattern:
+    """A bend of the tube by ``bendingAngle`` about an axis at ``rotationalAxisAngle``.
+
+    The bend is a rotation by theta about the axis g = cos(phi) e_u + sin(phi) e_v through
+    r w (w = g x e_a, the direction the tube turns to); folded, it equals a circular arc of
+    radius r and angle theta. The strip between the two tuck boundaries is tucked inside and
+    folded flat in the bisecting plane (section 3.3).
+
+    Parameters
+    ----------
+    numSides : int
+        Number of sides n (even, >= 4).
+    r : float
+        Tube circumradius (> 0).
+    bendingAngle : float
+        theta, radians; reduced modulo 2 pi into [-pi, pi], then 1e-6 < |theta| < pi - 1e-6 is
+        required. (theta, phi) and (-theta, phi + pi) give the same pattern.
+    rotationalAxisAngle : float
+        phi, radians, angle of the bending axis from e_u towards e_v (any real value).
+
+    Raises
+    ------
+    InvalidParameterError
+        For a bending angle out of range, or one so small that more than two columns collapse
+        at the length tolerance eps = 1e-4 b (the pattern could not be resolved).
+    """
+    prism = make_prism(numSides, r)
+    geo = elbow_geometry(prism, bendingAngle, rotationalAxisAngle)
+    n = prism.numSides
+    c = int(np.count_nonzero(geo.collapsed))
+    adjacent = c == 1 or (c == 2 and np.any(geo.collapsed & np.roll(geo.collapsed, 1)))
+    if not adjacent:
+        raise InvalidParameterError(
+            f"bendingAngle {bendingAngle!r} is too small to resolve for numSides={n}, r={prism.r:g}: "
+            f"{c} columns lie within the tolerance {prism.eps:.3g} of the midline (at most two "
+            "adjacent ones are allowed)"
+        )
+    record = ModuleRecord(
+        "elbow", {"bendingAngle": float(bendingAngle), "rotationalAxisAngle": float(rotationalAxisAngle)}
+    )
+    return _build_elbow(prism, geo, record)
+
+
+def _build_elbow(prism: Prism, geo: ElbowGeometry, record: ModuleRecord) -> TubularPattern:
+    n = prism.numSides
+    x = prism.columns
+    h, H_m = geo.h, geo.H_m
+    H = 2.0 * H_m
+    k = np.arange(n)
+    P, D = k, n + k
+    full = ~geo.collapsed
+    low = geo.low
+    # vertex list: P, D, then per column Q (collapsed) or L, M, O, U (L/U omitted when low)
+    has_l = full & ~low
+    counts = np.where(geo.collapsed, 1, 2 + 2 * has_l.astype(int))
+    start = 2 * n + np.concatenate([[0], np.cumsum(counts)[:-1]])
+    M = start.copy()
+    L = np.where(has_l, start, np.where(low, P, start))
+    M = np.where(has_l, start + 1, np.where(low, start, start))
+    O = np.where(has_l, start + 2, np.where(low, start + 1, start))
+    U = np.where(has_l, start + 3, np.where(low, D, start))
+    total = 2 * n + int(counts.sum())
+    vertices = np.empty((total, 2))
+    vertices[P] = np.stack([x, np.zeros(n)], axis=1)
+    vertices[D] = np.stack([x, np.full(n, H)], axis=1)
+    offset = (H_m - h) * np.tan(geo.tuck)
+    vertices[M] = np.stack([x, np.full(n, H_m)], axis=1)
+    vertices[O[full]] = np.stack(
+        [wrap_x(x[full] + offset[full], prism.W, prism.eps), np.full(int(full.sum()), H_m)], axis=1
+    )
+    vertices[L[has_l]] = np.stack([x[has_l], h[has_l]], axis=1)
+    vertices[U[has_l]] = np.stack([x[has_l], H - h[has_l]], axis=1)
+    prev, nxt = (k - 1) % n, (k + 1) % n
+    # block order matters: where two collapsed columns are adjacent the lower boundary,
+    # upper boundary and midline coincide; the first (lower boundary, M) is kept (step 5)
+    blocks = [
+        crease_block(L[prev], L, "M"),  # lower tuck boundary
+        crease_block(P, L, "M"),  # proximal tube edge
+        crease_block(U[prev], U, "M"),  # upper tuck boundary
+        crease_block(U, D, "M"),  # distal tube edge
+        crease_block(M, O, "V"),  # midline
+        crease_block(O, M[nxt], "V"),  # midline
+        crease_block(L, M, "V"),  # lower half of the column line
+        crease_block(M, U, "M"),  # upper half of the column line
+        crease_block(L, O, "M"),  # lower tuck diagonal
+        crease_block(U, O, "V"),  # upper tuck diagonal
+    ]
+    return assemble(prism, vertices, blocks, P, D, H, record)

@@ -1,0 +1,200 @@
+"""REBO bellows and the prismatic joint built around it (spec sections 3.7, 3.8)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinegami.errors import InvalidParameterError
+from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._prism import Prism, make_prism, wrap_x
+from kinegami.pattern.checks import check_bool
+from kinegami.pattern.tube import _tube
+from kinegami.pattern.tubular import ModuleRecord, TubularPattern
+from kinegami.validation import check_in_range, check_int, check_positive
+
+__all__ = ["PrismaticJointPattern", "REBOGeometry", "REBOPattern", "rebo_geometry"]
+
+
+@dataclass(frozen=True)
+class REBOGeometry:
+    """Derived quantities of a REBO (section 3.7); lengths in units of r, angles in radians.
+
+    Attributes
+    ----------
+    l1 : float
+        Flat half-height of one layer, d / (2 N sin(beta)).
+    height : float
+        Pattern height 2 N l1 = d / sin(beta).
+    flat_cone_angle : float
+        alpha_f = (pi/2)(1 - 2 cos(beta) / n).
+    offset : float
+        o = l1 cot(alpha_f), x offset of the mid-layer pleat vertices.
+    """
+
+    l1: float
+    height: float
+    flat_cone_angle: float
+    offset: float
+
+
+def rebo_geometry(prism: Prism, d: float, N: int, beta: float) -> REBOGeometry:
+    """Layer height, flat cone angle and pleat offset of a REBO (section 3.7)."""
+    l1 = d / (2.0 * N * math.sin(beta))
+    alpha_f = 0.5 * math.pi * (1.0 - 2.0 * math.cos(beta) / prism.numSides)
+    return REBOGeometry(l1, 2.0 * N * l1, alpha_f, l1 / math.tan(alpha_f))
+
+
+def _check_rebo(numSides, r, neutralLength, numLayers, coneAngle, low: float):
+    prism = make_prism(numSides, r)
+    d = check_positive("neutralLength", neutralLength)
+    N = check_int("numLayers", numLayers, minimum=1)
+    if low > 0:
+        beta = check_in_range(
+            "coneAngle", coneAngle, low, 0.5 * math.pi, low_inclusive=True,
+            range_text="[pi/6, pi/2)",
+        )  # fmt: skip
+    else:
+        beta = check_in_range("coneAngle", coneAngle, 0.0, 0.5 * math.pi, range_text="(0, pi/2)")
+    geo = rebo_geometry(prism, d, N, beta)
+    if not geo.offset < prism.b - prism.eps:
+        raise InvalidParameterError(
+            f"REBO pleat offset o = l1 cot(alpha_f) = {geo.offset:.6g} must be < b = {prism.b:.6g} "
+            f"(else creases cross); got neutralLength={d!r}, numLayers={N}, coneAngle={beta!r}: "
+            "use more layers or a shorter neutralLength"
+        )
+    return prism, d, N, beta, geo
+
+
+def REBOPattern(
+    numSides: int,
+    r: float,
+    neutralLength: float,
+    numLayers: int,
+    coneAngle: float,
+    proximalValleys: bool = False,
+) -> TubularPattern:
+    """The REBO bellows of ``numLayers`` layers (section 3.7).
+
+    Each layer is a ring of pleats: layer rings (M) are the outer ridges and the long midline
+    segments (V) the waist. Flat, the pattern height is neutralLength / sin(coneAngle).
+
+    Parameters
+    ----------
+    numSides : int
+        Number of sides n (even, >= 4).
+    r : float
+        Tube circumradius (> 0).
+    neutralLength : float
+        Length d > 0 of the bellows with its faces at the cone angle.
+    numLayers : int
+        Number of layers N >= 1.
+    coneAngle : float
+        beta in (0, pi/2), radians.
+    proximalValleys : bool, optional
+        Label the first ring (at y = 0) V instead of M (used inside the prismatic joint).
+
+    Raises
+    ------
+    InvalidParameterError
+        Also when the pleat offset o = l1 cot(alpha_f) is not below b (fix B11).
+    """
+    prism, d, N, beta, geo = _check_rebo(numSides, r, neutralLength, numLayers, coneAngle, 0.0)
+    valleys = check_bool("proximalValleys", proximalValleys)
+    record = ModuleRecord(
+        "rebo",
+        {"neutralLength": d, "numLayers": N, "coneAngle": beta, "proximalValleys": valleys},
+    )
+    return _build_rebo(prism, geo, N, valleys, record)
+
+
+def _build_rebo(
+    prism: Prism, geo: REBOGeometry, N: int, valleys: bool, record: ModuleRecord
+) -> TubularPattern:
+    n = prism.numSides
+    x = prism.columns
+    l1 = geo.l1
+    k = np.arange(n)
+    rows = np.arange(N + 1)
+    layers = np.arange(N)
+    # indices: B[i, k] rows 0..N, then A[i, k], then O[i, k], layers 0..N-1
+    B = rows[:, None] * n + k[None, :]
+    A = (N + 1) * n + layers[:, None] * n + k[None, :]
+    O = (2 * N + 1) * n + layers[:, None] * n + k[None, :]
+    vertices = np.empty(((3 * N + 1) * n, 2))
+    vertices[B.ravel()] = np.stack(
+        [np.tile(x, N + 1), np.repeat(2.0 * l1 * rows, n)], axis=1
+    )
+    mid_y = np.repeat((2.0 * layers + 1.0) * l1, n)
+    vertices[A.ravel()] = np.stack([np.tile(x, N), mid_y], axis=1)
+    vertices[O.ravel()] = np.stack(
+        [np.tile(wrap_x(x - geo.offset, prism.W, prism.eps), N), mid_y], axis=1
+    )
+    nxt = (k + 1) % n
+    Bl, Bu = B[:-1], B[1:]
+    ring = np.full((N, n), "M")
+    if valleys:
+        ring[0] = "V"
+    blocks = [
+        crease_block(Bl.ravel(), Bl[:, nxt].ravel(), ring.ravel()),
+        crease_block(Bl.ravel(), A.ravel(), "M"),
+        crease_block(A.ravel(), Bu.ravel(), "M"),
+        crease_block(O.ravel(), A.ravel(), "M"),
+        crease_block(A.ravel(), O[:, nxt].ravel(), "V"),
+        crease_block(O.ravel(), Bl.ravel(), "V"),
+        crease_block(O.ravel(), Bu.ravel(), "V"),
+        crease_block(B[N], B[N][nxt], "M"),
+    ]
+    return assemble(prism, vertices, blocks, B[0], B[N], geo.height, record)
+
+
+def PrismaticJointPattern(
+    numSides: int, r: float, neutralLength: float, numLayers: int, coneAngle: float
+) -> TubularPattern:
+    """The prismatic joint: sleeve, folded-back lining, REBO and piston (section 3.8).
+
+    With L = neutralLength / sin(coneAngle): Tube(L), a mountain ring, a tube of height L with
+    valley edges, REBO(proximalValleys=True) and Tube(L); pattern height 4 L. (See note B7 on
+    the folded length, docs/patterns.md.)
+
+    Parameters
+    ----------
+    numSides : int
+        Number of sides n (even, >= 4).
+    r : float
+        Tube circumradius (> 0).
+    neutralLength : float
+        Length d > 0 of the joint at state 0.
+    numLayers : int
+        Number of REBO layers N >= 1.
+    coneAngle : float
+        REBO cone angle beta in [pi/6, pi/2), radians (below pi/6 the state 0 is not reachable).
+    """
+    prism, d, N, beta, geo = _check_rebo(
+        numSides, r, neutralLength, numLayers, coneAngle, math.pi / 6.0
+    )
+    L = geo.height
+    n = prism.numSides
+    sleeve = _tube(prism, L, "M", ModuleRecord("tube", {"height": L}))
+    lining = _tube(prism, L, "V", ModuleRecord("tube", {"height": L}))
+    k = np.arange(n)
+    lining = TubularPattern._build(
+        n, prism.r, lining.vertices_coords.copy(),
+        np.concatenate([np.stack([k, (k + 1) % n], axis=1), lining.edges_vertices]),
+        np.concatenate([np.full(n, "M"), lining.edges_assignment]),
+        lining.proximalBase.copy(), lining.distalBase.copy(), np.zeros(2),
+        lining.distalMarker.copy(), L, lining.modules, 0, None, False,
+    )  # fmt: skip
+    rebo = _build_rebo(prism, geo, N, True, ModuleRecord("rebo", {}))
+    piston = _tube(prism, L, "M", ModuleRecord("tube", {"height": L}))
+    whole = TubularPattern.concatenate([sleeve, lining, rebo, piston])
+    record = ModuleRecord(
+        "prismatic", {"neutralLength": d, "numLayers": N, "coneAngle": beta}
+    )
+    return TubularPattern._build(
+        n, prism.r, whole.vertices_coords.copy(), whole.edges_vertices.copy(),
+        whole.edges_assignment.copy(), whole.proximalBase.copy(), whole.distalBase.copy(),
+        np.zeros(2), np.array([0.0, 4.0 * L]), 4.0 * L, (record,), 0, None, False,
+    )  # fmt: skip

@@ -1,0 +1,388 @@
+"""Revolute joint with sink layers, and the tips made from its half (spec sections 3.4-3.6)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._prism import Prism, make_prism
+from kinegami.pattern.tubular import ModuleRecord, TubularPattern
+from kinegami.validation import check_in_range, check_int, check_positive
+
+__all__ = [
+    "EndTipPattern",
+    "RevoluteGeometry",
+    "RevoluteJointPattern",
+    "StartTipPattern",
+    "revolute_geometry",
+]
+
+
+@dataclass(frozen=True)
+class RevoluteGeometry:
+    """Derived quantities of a revolute joint or tip (sections 3.4, 3.6); lengths in units of r.
+
+    Attributes
+    ----------
+    h_r : float
+        Half the neutral length (joint centre above the proximal base); the tip length.
+    H : float
+        Half the revolute pattern height (the whole tip height), sqrt(a^2 + h_r^2).
+    psi : float
+        arctan(b / (2 H)), angle between a panel's X diagonal and the vertical, radians.
+    crimped : ndarray of bool, shape (n,)
+        Columns that carry a crimp (all but 0, n/2 - 1, n/2, n - 1).
+    t : ndarray, shape (n,)
+        Crimp height t_k of every column (equal to H on the flap-adjacent columns).
+    """
+
+    h_r: float
+    H: float
+    psi: float
+    crimped: np.ndarray
+    t: np.ndarray
+
+    @property
+    def flap_panels(self) -> tuple[int, int]:
+        """The two flap (non-sink) panels mp = n/2 - 1 and ep = n - 1."""
+        n = self.crimped.shape[0]
+        return n // 2 - 1, n - 1
+
+
+def revolute_geometry(prism: Prism, h_r: float) -> RevoluteGeometry:
+    """Crimp heights for joint centre height ``h_r`` (section 3.4, with psi of fix B1)."""
+    n, r, a, b = prism.numSides, prism.r, prism.a, prism.b
+    H = math.hypot(a, h_r)
+    psi = math.atan(b / (2.0 * H))
+    beta = prism.vertex_angles
+    lam = np.sqrt(h_r**2 + (r * np.cos(beta)) ** 2)
+    gamma = np.arctan2(lam, r * np.abs(np.sin(beta)))
+    t = lam / np.sin(gamma + psi)
+    crimped = np.ones(n, dtype=bool)
+    crimped[[0, n // 2 - 1, n // 2, n - 1]] = False
+    return RevoluteGeometry(h_r, H, psi, crimped, t)
+
+
+def RevoluteJointPattern(
+    numSides: int, r: float, totalBendingAngle: float, numSinkLayers: int = 1
+) -> TubularPattern:
+    """A revolute joint of total range ``totalBendingAngle`` with ``numSinkLayers`` sinks.
+
+    Two flaps (panels n/2 - 1 and n - 1, centred on -e_u and +e_u) fold about the rotation axis
+    along e_v at height h_r = a tan(theta_m / 4); the other n - 2 panels are sunk (one layer:
+    section 3.4; N >= 2 nested layers: section 3.5, with fixes B2 and B3). At state 0 the
+    distal frame is the proximal frame translated by 2 h_r along the tube axis.
+
+    Parameters
+    ----------
+    numSides : int
+        Number of sides n (even, >= 4).
+    r : float
+        Tube circumradius (> 0).
+    totalBendingAngle : float
+        theta_m in (0, 2 pi), radians; the joint's state range is [-theta_m/2, theta_m/2].
+    numSinkLayers : int, optional
+        Number N >= 1 of nested sink layers (default 1).
+    """
+    prism = make_prism(numSides, r)
+    theta = check_in_range(
+        "totalBendingAngle", totalBendingAngle, 0.0, 2.0 * math.pi, range_text="(0, 2 pi)"
+    )
+    layers = check_int("numSinkLayers", numSinkLayers, minimum=1)
+    h_r = prism.a * math.tan(theta / 4.0)
+    geo = revolute_geometry(prism, h_r)
+    record = ModuleRecord(
+        "revolute", {"totalBendingAngle": theta, "numSinkLayers": layers}
+    )
+    return _build_revolute(prism, geo, layers, record)
+
+
+def EndTipPattern(numSides: int, r: float, length: float) -> TubularPattern:
+    """The end tip: closes the tube on a segment of length b along e_v at ``length`` (3.6).
+
+    It is the proximal half of a revolute joint with h_r = length (with the crimp angle
+    psi = arctan(b / (2 H)) of fix B1). It has no distal base: nothing may follow it.
+
+    Parameters
+    ----------
+    numSides : int
+        Number of sides n (even, >= 4).
+    r : float
+        Tube circumradius (> 0).
+    length : float
+        Axial distance l > 0 from the base to the closing segment; pattern height
+        sqrt(a^2 + l^2).
+    """
+    prism = make_prism(numSides, r)
+    ell = check_positive("length", length)
+    geo = revolute_geometry(prism, ell)
+    return _build_end_tip(prism, geo, ModuleRecord("end_tip", {"length": ell}))
+
+
+def StartTipPattern(numSides: int, r: float, length: float) -> TubularPattern:
+    """The start tip: the end tip reversed (section 2.4); its base is the distal base at y = H.
+
+    Parameters
+    ----------
+    numSides : int
+        Number of sides n (even, >= 4).
+    r : float
+        Tube circumradius (> 0).
+    length : float
+        Axial distance l > 0 from the closing segment to the base.
+    """
+    return EndTipPattern(numSides, r, length).reversed()
+
+
+# --------------------------------------------------------------------------------------------
+# Revolute joint, one sink layer (section 3.4)
+
+
+class _Layout:
+    """Vertex indices of the revolute / tip pattern, vectorised over columns and panels."""
+
+    def __init__(self, prism: Prism, geo: RevoluteGeometry, with_distal: bool) -> None:
+        n = prism.numSides
+        self.n = n
+        k = np.arange(n)
+        self.P = k
+        nxt = n
+        if with_distal:
+            self.D = nxt + k
+            nxt += n
+        else:
+            self.D = None
+        self.M = nxt + k
+        self.C = nxt + n + k
+        nxt += 2 * n
+        crimped = np.flatnonzero(geo.crimped)
+        self.crimped = crimped
+        self.K = np.full(n, -1)
+        self.K[crimped] = nxt + np.arange(crimped.shape[0])
+        nxt += crimped.shape[0]
+        if with_distal:
+            self.U = np.full(n, -1)
+            self.U[crimped] = nxt + np.arange(crimped.shape[0])
+            nxt += crimped.shape[0]
+        self.total = nxt
+        mp, ep = geo.flap_panels
+        self.mp, self.ep = mp, ep
+        self.sink = np.array([p for p in range(n) if p not in (mp, ep)])
+        self.flap_columns = np.array([0, mp, mp + 1, ep])
+
+
+def _revolute_vertices(prism: Prism, geo: RevoluteGeometry, lay: _Layout) -> np.ndarray:
+    n = prism.numSides
+    x = prism.columns
+    H = geo.H
+    v = np.empty((lay.total, 2))
+    v[lay.P] = np.stack([x, np.zeros(n)], axis=1)
+    if lay.D is not None:
+        v[lay.D] = np.stack([x, np.full(n, 2.0 * H)], axis=1)
+        v[lay.U[lay.crimped]] = np.stack([x[lay.crimped], 2.0 * H - geo.t[lay.crimped]], axis=1)
+    v[lay.M] = np.stack([x, np.full(n, H)], axis=1)
+    v[lay.C] = np.stack([prism.panel_centres, np.full(n, H)], axis=1)
+    v[lay.K[lay.crimped]] = np.stack([x[lay.crimped], geo.t[lay.crimped]], axis=1)
+    return v
+
+
+def _common_blocks(lay: _Layout, half_midlines: bool) -> list:
+    """Creases shared by the revolute joint (any N) and the lower half used by the tip."""
+    n, P, M, C = lay.n, lay.P, lay.M, lay.C
+    k = np.arange(n)
+    nxt = (k + 1) % n
+    mp, ep = lay.mp, lay.ep
+    F = lay.flap_columns
+    blocks = [crease_block(P, P[nxt], "M")]
+    if lay.D is not None:
+        blocks.append(crease_block(lay.D, lay.D[nxt], "M"))
+    blocks.append(crease_block(P[F], M[F], "M"))
+    if lay.D is not None:
+        blocks.append(crease_block(M[F], lay.D[F], "M"))
+    if half_midlines:
+        blocks.append(
+            crease_block(
+                [M[0], C[mp - 1], M[mp + 1], C[ep - 1]], [C[0], M[mp], C[mp + 1], M[ep]], "M"
+            )
+        )
+    blocks.append(
+        crease_block([M[mp], C[mp], M[ep], C[ep]], [C[mp], M[mp + 1], C[ep], M[0]], "V")
+    )
+    cr = lay.crimped
+    K = lay.K
+    blocks.append(crease_block(P[cr], K[cr], "M"))
+    blocks.append(crease_block(K[cr], M[cr], "V"))
+    if lay.D is not None:
+        U = lay.U
+        blocks.append(crease_block(M[cr], U[cr], "M"))
+        blocks.append(crease_block(U[cr], lay.D[cr], "M"))
+    return blocks
+
+
+def _single_sink_blocks(lay: _Layout) -> list:
+    """The N = 1 sink folds: the X of every sink panel and the crimp-to-centre creases."""
+    n, P, M, C, K = lay.n, lay.P, lay.M, lay.C, lay.K
+    s = lay.sink
+    cr = lay.crimped
+    prev = (cr - 1) % n
+    blocks = [
+        crease_block(P[s], C[s], "V"),
+        crease_block(C[s], P[(s + 1) % n], "V"),
+    ]
+    if lay.D is not None:
+        blocks.insert(1, crease_block(lay.D[s], C[s], "V"))
+        blocks.append(crease_block(C[s], lay.D[(s + 1) % n], "V"))
+    blocks += [
+        crease_block(C[prev], M[cr], "V"),
+        crease_block(M[cr], C[cr], "V"),
+        crease_block(C[prev], K[cr], "M"),
+        crease_block(K[cr], C[cr], "M"),
+    ]
+    if lay.D is not None:
+        blocks.append(crease_block(C[prev], lay.U[cr], "V"))
+        blocks.append(crease_block(lay.U[cr], C[cr], "M"))
+    return blocks
+
+
+def _build_revolute(
+    prism: Prism, geo: RevoluteGeometry, layers: int, record: ModuleRecord
+) -> TubularPattern:
+    lay = _Layout(prism, geo, with_distal=True)
+    vertices = _revolute_vertices(prism, geo, lay)
+    if layers == 1:
+        blocks = _common_blocks(lay, half_midlines=True) + _single_sink_blocks(lay)
+    else:
+        blocks = _common_blocks(lay, half_midlines=False)  # fix B2: the chains cover them
+        vertices, sink_blocks = _sink_gadget(prism, lay, vertices, layers)
+        blocks += sink_blocks
+    return assemble(prism, vertices, blocks, lay.P, lay.D, 2.0 * geo.H, record)
+
+
+def _build_end_tip(prism: Prism, geo: RevoluteGeometry, record: ModuleRecord) -> TubularPattern:
+    lay = _Layout(prism, geo, with_distal=False)
+    vertices = _revolute_vertices(prism, geo, lay)
+    blocks = _common_blocks(lay, half_midlines=True) + _single_sink_blocks(lay)
+    return assemble(prism, vertices, blocks, lay.P, None, geo.H, record)
+
+
+# --------------------------------------------------------------------------------------------
+# Recursive sink gadget, N >= 2 layers (section 3.5)
+
+
+def _plain_chain(S: np.ndarray, C: np.ndarray, N: int) -> np.ndarray:
+    j = np.arange(N + 1)[:, None] / N
+    return S + j * (C - S)
+
+
+def _crimp_chain(G: np.ndarray, C: np.ndarray, N: int, d: float) -> np.ndarray:
+    u = (G - C) / np.linalg.norm(G - C)
+    j = np.arange(N + 1)[:, None]
+    chain = C + (N - j) * d * u
+    chain[0] = G
+    return chain
+
+
+def _projected_chain(Y: np.ndarray, C: np.ndarray, inner: np.ndarray, N: int) -> np.ndarray:
+    u = (Y - C) / np.linalg.norm(Y - C)
+    g = inner - C
+    rho = float(g @ g) / float(u @ g)
+    j = np.arange(N + 1)[:, None]
+    chain = C + ((N - j) / (N - 1)) * rho * u
+    chain[0] = Y
+    return chain
+
+
+def _alternating(N: int, first: str) -> np.ndarray:
+    other = "V" if first == "M" else "M"
+    return np.array([first if j % 2 == 0 else other for j in range(N)])
+
+
+def _sink_gadget(
+    prism: Prism, lay: _Layout, vertices: np.ndarray, N: int
+) -> tuple[np.ndarray, list]:
+    """Vertices and creases of the N nested sinks of every sink panel (section 3.5)."""
+    n, b = prism.numSides, prism.b
+    d = b / (2.0 * N)
+    crimped = np.zeros(n, dtype=bool)
+    crimped[lay.crimped] = True
+    new_points: list[np.ndarray] = []
+    next_index = vertices.shape[0]
+    edges: list[np.ndarray] = []
+    labels: list[np.ndarray] = []
+    ring_labels = np.array(["V" if j % 2 else "M" for j in range(N)])
+
+    def add_chain(points: np.ndarray, outer: int, centre: int, radial: np.ndarray) -> np.ndarray:
+        """Register the inner points of a chain; return the indices of S_0 .. S_N."""
+        nonlocal next_index
+        idx = np.empty(N + 1, dtype=np.intp)
+        idx[0], idx[N] = outer, centre
+        idx[1:N] = next_index + np.arange(N - 1)
+        next_index += N - 1
+        new_points.append(points[1:N])
+        edges.append(np.stack([idx[:-1], idx[1:]], axis=1))
+        labels.append(radial)
+        return idx
+
+    for p in lay.sink:
+        q = (p + 1) % n
+        c_idx = lay.C[p]
+        # unwrapped coordinates of the panel (sink panels never straddle the seam)
+        Cxy = np.array([(p + 1) * b, vertices[c_idx, 1]])
+        xl, xr = (p + 0.5) * b, (p + 1.5) * b
+
+        def at(index: int, x: float) -> np.ndarray:
+            return np.array([x, vertices[index, 1]])
+
+        cl, cr = bool(crimped[p]), bool(crimped[q])
+        side = {}
+        for name, col, x, is_c in (("L", p, xl, cl), ("R", q, xr, cr)):
+            T, B, Mid = lay.D[col], lay.P[col], lay.M[col]
+            if is_c:
+                Up, Lo = lay.U[col], lay.K[col]
+                up = _crimp_chain(at(Up, x), Cxy, N, d)
+                lo = _crimp_chain(at(Lo, x), Cxy, N, d)
+                top = _projected_chain(at(T, x), Cxy, up[1], N)
+                bot = _projected_chain(at(B, x), Cxy, lo[1], N)
+                mid = _projected_chain(at(Mid, x), Cxy, lo[1], N)
+                first_up = "M" if name == "L" else "V"
+                side[name] = {
+                    "up": add_chain(up, Up, c_idx, _alternating(N, first_up)),
+                    "lo": add_chain(lo, Lo, c_idx, _alternating(N, "M")),
+                    "top": add_chain(top, T, c_idx, _alternating(N, "V")),
+                    "bot": add_chain(bot, B, c_idx, _alternating(N, "V")),
+                    "mid": add_chain(mid, Mid, c_idx, np.full(N, "V")),
+                }
+            else:
+                side[name] = {
+                    "top": add_chain(_plain_chain(at(T, x), Cxy, N), T, c_idx, _alternating(N, "V")),
+                    "bot": add_chain(_plain_chain(at(B, x), Cxy, N), B, c_idx, _alternating(N, "V")),
+                    # fix B3: the uncrimped horizontal chain is M, V, M, ... on both sides
+                    "mid": add_chain(
+                        _plain_chain(at(Mid, x), Cxy, N), Mid, c_idx, _alternating(N, "M")
+                    ),
+                }
+        left, right = side["L"], side["R"]
+        for j in range(1, N):
+            for ring in ("top", "bot"):
+                chain = [left["mid"]]
+                if cl:
+                    chain.append(left["up" if ring == "top" else "lo"])
+                chain += [left[ring], right[ring]]
+                if cr:
+                    chain.append(right["up" if ring == "top" else "lo"])
+                chain.append(right["mid"])
+                pts = np.array([c[j] for c in chain])
+                lab = np.full(pts.shape[0] - 1, ring_labels[j])
+                if ring == "bot":  # the "diamond" rule (kept as in the reference, B4)
+                    flip = {"M": "V", "V": "M"}[ring_labels[j]]
+                    if cl:
+                        lab[0] = flip
+                    if cr:
+                        lab[-1] = flip
+                edges.append(np.stack([pts[:-1], pts[1:]], axis=1))
+                labels.append(lab)
+    vertices = np.concatenate([vertices, *new_points])
+    return vertices, list(zip(edges, labels, strict=True))

@@ -1,0 +1,70 @@
+"""Tube fitting (a straight tube) and the empty waypoint pattern (spec sections 3.1, 3.9)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._prism import make_prism
+from kinegami.pattern.tubular import ModuleRecord, TubularPattern
+from kinegami.validation import check_nonnegative
+
+__all__ = ["TubeFittingPattern", "WaypointPattern"]
+
+
+def WaypointPattern(numSides: int, r: float) -> TubularPattern:
+    """The empty pattern: the n base vertices at y = 0, no creases, height 0 (section 3.9).
+
+    Its proximal and distal bases are the same vertices; appending it changes nothing.
+
+    Parameters
+    ----------
+    numSides : int
+        Number of sides n (even, >= 4).
+    r : float
+        Tube circumradius (> 0).
+    """
+    prism = make_prism(numSides, r)
+    return _empty(prism, ModuleRecord("waypoint", {}))
+
+
+def _empty(prism, record: ModuleRecord) -> TubularPattern:
+    n = prism.numSides
+    vertices = np.stack([prism.columns, np.zeros(n)], axis=1)
+    base = np.arange(n)
+    return assemble(prism, vertices, [(np.zeros((0, 2), int), "M")], base, base, 0.0, record)
+
+
+def TubeFittingPattern(numSides: int, r: float, height: float) -> TubularPattern:
+    """A straight tube of axial length ``height`` (section 3.1).
+
+    Vertices P_k = (x_k, 0) and D_k = (x_k, height); creases P_k-D_k mountain (the tube
+    edges). Folded, the distal frame is the proximal frame translated by ``height`` along the
+    tube axis.
+
+    Parameters
+    ----------
+    numSides : int
+        Number of sides n (even, >= 4).
+    r : float
+        Tube circumradius (> 0).
+    height : float
+        Length of the tube along its axis, >= 0, in units of r. A height below the tolerance
+        eps = 1e-4 b (including 0) gives the empty pattern, which adds nothing when appended
+        (fix B6: no coincident vertices or zero-length creases).
+    """
+    prism = make_prism(numSides, r)
+    h = check_nonnegative("height", height)
+    return _tube(prism, h, "M", ModuleRecord("tube", {"height": h}))
+
+
+def _tube(prism, h: float, label: str, record: ModuleRecord) -> TubularPattern:
+    n = prism.numSides
+    if h < prism.eps:
+        return _empty(prism, record)
+    x = prism.columns
+    vertices = np.concatenate(
+        [np.stack([x, np.zeros(n)], axis=1), np.stack([x, np.full(n, h)], axis=1)]
+    )
+    k = np.arange(n)
+    return assemble(prism, vertices, [crease_block(k, n + k, label)], k, n + k, h, record)

@@ -1,0 +1,655 @@
+"""The tubular crease pattern: plain data in the spirit of FOLD, and its composition.
+
+A :class:`TubularPattern` is a graph drawn on the surface of a regular n-gonal prism, unrolled
+into the strip 0 <= x < W (spec/patterns.md section 1.4). It is immutable: every operation
+returns a new pattern and the stored arrays are read-only.
+
+Composition (section 2.2) is implemented once, in :func:`_compose_step`, which works on the
+running state of the composite (its distal base, distal marker and the creases lying on the
+distal base) and on the next module only. :meth:`TubularPattern.append` applies one step to two
+patterns; :meth:`TubularPattern.concatenate` applies the steps to a whole list and concatenates
+the arrays once, so composing m modules costs O(total size) instead of O(m * total size).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.pattern._prism import EPS_FACTOR, make_prism, periodic_dx, wrap_x
+from kinegami.validation import check_nonnegative
+
+_KEY_SHIFT = np.int64(1) << np.int64(32)
+_ASSIGNMENT_DTYPE = np.dtype("<U1")
+
+__all__ = ["ModuleRecord", "TubularPattern", "ValidationReport"]
+
+
+@dataclass(frozen=True)
+class ModuleRecord:
+    """Which catalog module (and with which parameters) a piece of a pattern came from.
+
+    Attributes
+    ----------
+    kind : str
+        One of ``"tube"``, ``"twist"``, ``"elbow"``, ``"revolute"``, ``"rebo"``,
+        ``"prismatic"``, ``"start_tip"``, ``"end_tip"``, ``"waypoint"``.
+    params : Mapping[str, Any]
+        The validated parameters the module was built with (same names as the constructor).
+    """
+
+    kind: str
+    params: Mapping[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class ValidationReport:
+    """Result of :meth:`TubularPattern.validate`: every problem found (empty when fine)."""
+
+    problems: tuple[str, ...] = ()
+
+    @property
+    def ok(self) -> bool:
+        """True when no problem was found."""
+        return not self.problems
+
+    def __str__(self) -> str:
+        if self.ok:
+            return "pattern OK"
+        return f"{len(self.problems)} problem(s):\n" + "\n".join(f"- {p}" for p in self.problems)
+
+
+def _readonly(array: np.ndarray) -> np.ndarray:
+    array.flags.writeable = False
+    return array
+
+
+def _edge_keys(edges: np.ndarray) -> np.ndarray:
+    """One int64 per crease identifying its unordered vertex pair."""
+    lo = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64)
+    hi = np.maximum(edges[:, 0], edges[:, 1]).astype(np.int64)
+    return lo * _KEY_SHIFT + hi
+
+
+def _first_occurrence_mask(keys: np.ndarray) -> np.ndarray:
+    """Boolean mask keeping the first crease of every group of equal keys."""
+    mask = np.zeros(keys.shape[0], dtype=bool)
+    if keys.shape[0]:
+        mask[np.unique(keys, return_index=True)[1]] = True
+    return mask
+
+
+class TubularPattern:
+    """A crease pattern on the surface of a regular n-gonal tube (spec section 1.4).
+
+    Parameters
+    ----------
+    numSides : int
+        Number of sides n of the tube, even and >= 4.
+    r : float
+        Circumradius of the tube's polygon (the length unit of everything else).
+    vertices_coords : array_like, shape (N, 2)
+        Vertex positions (x, y) in pattern coordinates: x is the arc length around the tube from
+        the reference point, in [0, W); y is the distance along the tube axis.
+    edges_vertices : array_like of int, shape (M, 2)
+        The creases as pairs of vertex indices. A crease is the shortest path on the tube between
+        its two vertices (horizontal displacement taken in (-W/2, W/2]).
+    edges_assignment : array_like of str, shape (M,)
+        ``"M"`` (mountain, convex seen from outside) or ``"V"`` (valley) for each crease.
+    proximalBase, distalBase : array_like of int, shape (n,), or None
+        Indices of the start and end polygon vertices, in order k = 0 .. n-1; None for a start
+        tip's proximal side or an end tip's distal side.
+    proximalMarker, distalMarker : array_like, shape (2,)
+        Position (x, y) of the reference point of the proximal and distal boundary frames.
+    height : float
+        Extent H of the pattern along the tube axis (>= 0).
+    modules : iterable of ModuleRecord, optional
+        The catalog modules this pattern is made of, in order (used by :meth:`validate`).
+
+    Notes
+    -----
+    Everything is stored as read-only numpy arrays; patterns are values. ``show()`` and
+    ``save()`` (plotting and export) are thin delegates to :mod:`kinegami.viz` and
+    :mod:`kinegami.export`, kept out of this module.
+
+    Examples
+    --------
+    >>> from kinegami.pattern import TubeFittingPattern, ElbowFittingPattern
+    >>> import numpy as np
+    >>> p = TubeFittingPattern(4, 1.0, 1.0).append(ElbowFittingPattern(4, 1.0, np.pi / 2, 0.0))
+    >>> p.numVertices, p.numEdges, round(p.height, 6)
+    (22, 32, 4.414214)
+    """
+
+    __slots__ = (
+        "numSides",
+        "r",
+        "width",
+        "height",
+        "vertices_coords",
+        "edges_vertices",
+        "edges_assignment",
+        "proximalBase",
+        "distalBase",
+        "proximalMarker",
+        "distalMarker",
+        "modules",
+        "removedDuplicates",
+        "_distal_keys",
+        "_has_internal_duplicates",
+    )
+
+    def __init__(
+        self,
+        numSides: int,
+        r: float,
+        vertices_coords,
+        edges_vertices,
+        edges_assignment,
+        proximalBase,
+        distalBase,
+        proximalMarker,
+        distalMarker,
+        height: float,
+        modules: Iterable[ModuleRecord] = (),
+    ) -> None:
+        prism = make_prism(numSides, r)
+        n = prism.numSides
+        vertices = np.array(vertices_coords, dtype=float)
+        if vertices.size == 0:
+            vertices = vertices.reshape(0, 2)
+        if vertices.ndim != 2 or vertices.shape[1] != 2:
+            raise InvalidParameterError(
+                f"vertices_coords must have shape (N, 2), got {vertices.shape}"
+            )
+        if not np.all(np.isfinite(vertices)):
+            raise InvalidParameterError("vertices_coords must be finite")
+        edges = np.array(edges_vertices)
+        if edges.size == 0:
+            edges = edges.reshape(0, 2).astype(np.intp)
+        if not np.issubdtype(edges.dtype, np.integer):
+            raise InvalidTypeError(f"edges_vertices must be integers, got dtype {edges.dtype}")
+        if edges.ndim != 2 or edges.shape[1] != 2:
+            raise InvalidParameterError(f"edges_vertices must have shape (M, 2), got {edges.shape}")
+        edges = edges.astype(np.intp)
+        if edges.size and (edges.min() < 0 or edges.max() >= vertices.shape[0]):
+            raise InvalidParameterError(
+                f"edges_vertices must index the {vertices.shape[0]} vertices, "
+                f"got indices in [{edges.min()}, {edges.max()}]"
+            )
+        assignment = np.array(edges_assignment, dtype=_ASSIGNMENT_DTYPE).reshape(-1)
+        if assignment.shape[0] != edges.shape[0]:
+            raise InvalidParameterError(
+                f"edges_assignment must have one label per crease ({edges.shape[0]}), "
+                f"got {assignment.shape[0]}"
+            )
+        bad = ~np.isin(assignment, ("M", "V"))
+        if bad.any():
+            raise InvalidParameterError(
+                f"edges_assignment must be 'M' or 'V', got {sorted(set(assignment[bad]))}"
+            )
+        bases = []
+        for name, base in (("proximalBase", proximalBase), ("distalBase", distalBase)):
+            if base is not None:
+                base = np.array(base)
+                if not np.issubdtype(base.dtype, np.integer) or base.shape != (n,):
+                    raise InvalidParameterError(
+                        f"{name} must be None or {n} vertex indices, got {base!r}"
+                    )
+                if base.min() < 0 or base.max() >= vertices.shape[0]:
+                    raise InvalidParameterError(f"{name} indices out of range: {base!r}")
+                base = base.astype(np.intp)
+            bases.append(base)
+        markers = []
+        for name, marker in (("proximalMarker", proximalMarker), ("distalMarker", distalMarker)):
+            marker = np.array(marker, dtype=float)
+            if marker.shape != (2,) or not np.all(np.isfinite(marker)):
+                raise InvalidParameterError(f"{name} must be a finite point (x, y), got {marker!r}")
+            markers.append(marker)
+        height = check_nonnegative("height", height)
+        modules = tuple(modules)
+        if not all(isinstance(m, ModuleRecord) for m in modules):
+            raise InvalidTypeError("modules must be ModuleRecord objects")
+        self._init(
+            n, prism.r, vertices, edges, assignment, bases[0], bases[1], markers[0], markers[1],
+            height, modules, 0, None, None,
+        )  # fmt: skip
+
+    def _init(
+        self,
+        n: int,
+        r: float,
+        vertices: np.ndarray,
+        edges: np.ndarray,
+        assignment: np.ndarray,
+        proximal: np.ndarray | None,
+        distal: np.ndarray | None,
+        proximal_marker: np.ndarray,
+        distal_marker: np.ndarray,
+        height: float,
+        modules: tuple[ModuleRecord, ...],
+        removed: int,
+        distal_keys: np.ndarray | None,
+        internal_duplicates: bool | None,
+    ) -> None:
+        s = object.__setattr__
+        s(self, "numSides", int(n))
+        s(self, "r", float(r))
+        s(self, "width", float(n * 2.0 * r * np.sin(np.pi / n)))
+        s(self, "height", float(height))
+        s(self, "vertices_coords", _readonly(vertices))
+        s(self, "edges_vertices", _readonly(edges))
+        s(self, "edges_assignment", _readonly(assignment))
+        s(self, "proximalBase", None if proximal is None else _readonly(proximal))
+        s(self, "distalBase", None if distal is None else _readonly(distal))
+        s(self, "proximalMarker", _readonly(proximal_marker))
+        s(self, "distalMarker", _readonly(distal_marker))
+        s(self, "modules", modules)
+        s(self, "removedDuplicates", int(removed))
+        s(self, "_distal_keys", None if distal_keys is None else _readonly(distal_keys))
+        s(self, "_has_internal_duplicates", internal_duplicates)
+
+    @classmethod
+    def _build(cls, n, r, vertices, edges, assignment, proximal, distal, pm, dm, height, modules,
+               removed=0, distal_keys=None, internal_duplicates=None) -> TubularPattern:  # fmt: skip
+        """Internal constructor from arrays that are already valid (no checks, no copies)."""
+        self = object.__new__(cls)
+        self._init(n, r, vertices, edges, assignment, proximal, distal, pm, dm, height, modules,
+                   removed, distal_keys, internal_duplicates)  # fmt: skip
+        return self
+
+    def __setattr__(self, name: str, value) -> None:
+        raise AttributeError(f"TubularPattern is immutable (cannot set {name!r})")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"TubularPattern is immutable (cannot delete {name!r})")
+
+    # ----------------------------------------------------------------------------------------
+    # Derived quantities
+
+    @property
+    def sideLength(self) -> float:
+        """Side length b = 2 r sin(pi/n) of the polygon (width of one panel)."""
+        return 2.0 * self.r * float(np.sin(np.pi / self.numSides))
+
+    @property
+    def eps(self) -> float:
+        """Length tolerance 1e-4 b used to identify points (spec section 1.1)."""
+        return EPS_FACTOR * self.sideLength
+
+    @property
+    def numVertices(self) -> int:
+        """Number of vertices N."""
+        return int(self.vertices_coords.shape[0])
+
+    @property
+    def numEdges(self) -> int:
+        """Number of creases M."""
+        return int(self.edges_vertices.shape[0])
+
+    @property
+    def numMountains(self) -> int:
+        """Number of mountain creases."""
+        return int(np.count_nonzero(self.edges_assignment == "M"))
+
+    @property
+    def numValleys(self) -> int:
+        """Number of valley creases."""
+        return int(np.count_nonzero(self.edges_assignment == "V"))
+
+    @property
+    def kind(self) -> str:
+        """The module kind when the pattern is one catalog module, else ``"composite"``
+        (or ``"custom"`` for a pattern built without module records)."""
+        if len(self.modules) == 1:
+            return self.modules[0].kind
+        return "composite" if self.modules else "custom"
+
+    @property
+    def isEmpty(self) -> bool:
+        """True for a pattern that only consists of its base polygon (e.g. a waypoint)."""
+        return (
+            self.numEdges == 0
+            and self.numVertices == self.numSides
+            and self.proximalBase is not None
+            and self.distalBase is not None
+            and np.array_equal(self.proximalBase, self.distalBase)
+            and np.array_equal(self.proximalMarker, self.distalMarker)
+        )
+
+    def crease_vectors(self) -> np.ndarray:
+        """Flat displacement (dx, dy) from the first to the second vertex of every crease.
+
+        dx is the representative in (-W/2, W/2] of the x difference, i.e. the crease's shortest
+        path on the tube (section 1.4). Shape (M, 2), pattern units.
+        """
+        v = self.vertices_coords
+        d = v[self.edges_vertices[:, 1]] - v[self.edges_vertices[:, 0]]
+        d[:, 0] = periodic_dx(d[:, 0], self.width)
+        return d
+
+    def edge_lengths(self) -> np.ndarray:
+        """Flat length of every crease (its shortest path on the tube), shape (M,)."""
+        return np.hypot(*self.crease_vectors().T)
+
+    def __repr__(self) -> str:
+        return (
+            f"TubularPattern(kind={self.kind!r}, numSides={self.numSides}, r={self.r:g}, "
+            f"numVertices={self.numVertices}, numEdges={self.numEdges}, "
+            f"height={self.height:.6g})"
+        )
+
+    # ----------------------------------------------------------------------------------------
+    # Operations
+
+    def append(self, other: TubularPattern) -> TubularPattern:
+        """Return this pattern followed by ``other`` (spec section 2.2).
+
+        ``other`` is translated so that its proximal marker lands on this pattern's distal
+        marker, its proximal base is identified with this pattern's distal base (for the cyclic
+        shift that makes them coincide), and duplicate creases are dropped keeping this
+        pattern's. The cost is proportional to the size of ``other`` plus one copy of the
+        arrays.
+
+        Raises
+        ------
+        InvalidParameterError
+            If numSides or r differ, if this pattern has no distal base (end tip), if ``other``
+            has no proximal base (start tip) or if the bases cannot be matched.
+        """
+        _check_composable(self, other, 1)
+        state = _ComposeState.after(self)
+        step = _compose_step(state, other, 1)
+        if step is None:
+            return self
+        vertices = np.concatenate([self.vertices_coords, step.vertices])
+        edges = np.concatenate([self.edges_vertices, step.edges])
+        assignment = np.concatenate([self.edges_assignment, step.assignment])
+        return TubularPattern._build(
+            self.numSides, self.r, vertices, edges, assignment,
+            None if self.proximalBase is None else self.proximalBase,
+            step.state.distal_idx, self.proximalMarker, step.state.marker,
+            self.height + other.height, self.modules + other.modules,
+            self.removedDuplicates + other.removedDuplicates + step.removed,
+            step.state.distal_keys, self._has_internal_duplicates,
+        )  # fmt: skip
+
+    @classmethod
+    def concatenate(cls, patterns: Iterable[TubularPattern]) -> TubularPattern:
+        """Compose many patterns in one pass; same result as ``p0.append(p1).append(p2)...``.
+
+        The arrays are concatenated once at the end, so a chain of m modules is composed in
+        O(total size) time.
+
+        Raises
+        ------
+        InvalidParameterError
+            For an empty list, or for any pair that :meth:`append` would reject.
+        """
+        patterns = list(patterns)
+        if not patterns:
+            raise InvalidParameterError("concatenate needs at least one pattern, got none")
+        for i, p in enumerate(patterns):
+            if not isinstance(p, TubularPattern):
+                raise InvalidTypeError(f"patterns[{i}] must be a TubularPattern, got {p!r}")
+        first = patterns[0]
+        for i in range(1, len(patterns)):
+            _check_composable(first, patterns[i], i, previous=patterns[i - 1])
+        if len(patterns) == 1:
+            return first
+        state = _ComposeState.after(first)
+        vertices = [first.vertices_coords]
+        edges = [first.edges_vertices]
+        assignment = [first.edges_assignment]
+        height = first.height
+        removed = first.removedDuplicates
+        modules = list(first.modules)
+        for i, p in enumerate(patterns[1:], start=1):
+            step = _compose_step(state, p, i)
+            if step is None:
+                continue
+            vertices.append(step.vertices)
+            edges.append(step.edges)
+            assignment.append(step.assignment)
+            height += p.height
+            removed += p.removedDuplicates + step.removed
+            modules.extend(p.modules)
+            state = step.state
+        return cls._build(
+            first.numSides, first.r, np.concatenate(vertices), np.concatenate(edges),
+            np.concatenate(assignment), first.proximalBase, state.distal_idx,
+            first.proximalMarker, state.marker, height, tuple(modules), removed,
+            state.distal_keys, first._has_internal_duplicates,
+        )  # fmt: skip
+
+    def reversed(self) -> TubularPattern:
+        """The pattern read from the other end (spec section 2.4).
+
+        y is mapped to 2 y0 + H - y (y0 = proximal marker y), the two bases are swapped, the x
+        coordinates of the two markers are swapped and labels are kept. The mirror image of the
+        folded tube through a cross-section plane; used to make the start tip from the end tip.
+        """
+        y0 = float(self.proximalMarker[1])
+        vertices = self.vertices_coords.copy()
+        vertices[:, 1] = 2.0 * y0 + self.height - vertices[:, 1]
+        swap = {"end_tip": "start_tip", "start_tip": "end_tip"}
+        modules = tuple(
+            ModuleRecord(swap.get(m.kind, m.kind), m.params) for m in reversed(self.modules)
+        )
+        return TubularPattern._build(
+            self.numSides, self.r, vertices, self.edges_vertices.copy(),
+            self.edges_assignment.copy(), _copy_or_none(self.distalBase),
+            _copy_or_none(self.proximalBase),
+            np.array([self.distalMarker[0], y0]), np.array([self.proximalMarker[0], y0 + self.height]),
+            self.height, modules, self.removedDuplicates, None, self._has_internal_duplicates,
+        )  # fmt: skip
+
+    def validate(self) -> ValidationReport:
+        """Check the pattern and return a report listing every problem found.
+
+        Checks: vertices with x outside [0, W), duplicate vertices (closer than eps), zero-length
+        creases, duplicate creases, collinear overlapping creases, vertices lying inside a crease
+        they do not end on, creases wider than one panel (|dx| > b + eps), bases that do not
+        match their markers (section 7.1 item 1) and, for patterns made of catalog modules,
+        vertex / crease counts that differ from the formulas of section 7.1 item 4.
+        """
+        from kinegami.pattern._audit import audit_pattern
+
+        return ValidationReport(tuple(audit_pattern(self)))
+
+    # ----------------------------------------------------------------------------------------
+    # Internal helpers for composition
+
+    def _get_distal_keys(self) -> np.ndarray:
+        """Keys of the creases whose two ends are both distal base vertices (cached)."""
+        if self._distal_keys is None:
+            if self.distalBase is None:
+                keys = np.zeros(0, dtype=np.int64)
+            else:
+                keys = _keys_within(_edge_keys(self.edges_vertices), self.distalBase)
+            object.__setattr__(self, "_distal_keys", _readonly(keys))
+        return self._distal_keys
+
+    def _get_internal_duplicates(self) -> bool:
+        """Whether two of this pattern's own creases join the same two vertices (cached)."""
+        if self._has_internal_duplicates is None:
+            keys = _edge_keys(self.edges_vertices)
+            value = bool(np.unique(keys).shape[0] != keys.shape[0])
+            object.__setattr__(self, "_has_internal_duplicates", value)
+        return self._has_internal_duplicates
+
+
+# Documented extension points (implemented elsewhere, attached as thin delegates):
+#   TubularPattern.show(...)  -> kinegami.viz       (2D plot of the pattern)
+#   TubularPattern.save(...)  -> kinegami.export    (DXF and other formats)
+
+
+def _copy_or_none(array: np.ndarray | None) -> np.ndarray | None:
+    return None if array is None else array.copy()
+
+
+def _keys_within(keys: np.ndarray, vertex_set: np.ndarray) -> np.ndarray:
+    """The keys whose two vertices both belong to ``vertex_set``."""
+    if keys.shape[0] == 0:
+        return keys[:0]
+    lo = keys // _KEY_SHIFT
+    hi = keys % _KEY_SHIFT
+    return keys[np.isin(lo, vertex_set) & np.isin(hi, vertex_set)]
+
+
+def _check_composable(
+    first: TubularPattern, other: TubularPattern, index: int, previous: TubularPattern | None = None
+) -> None:
+    """Raise unless ``other`` may follow ``previous`` (default ``first``) in a composite."""
+    if not isinstance(other, TubularPattern):
+        raise InvalidTypeError(f"can only append a TubularPattern, got {other!r}")
+    previous = first if previous is None else previous
+    if other.numSides != first.numSides:
+        raise InvalidParameterError(
+            f"cannot append a pattern with numSides={other.numSides} to one with "
+            f"numSides={first.numSides} (they must be equal)"
+        )
+    if not math.isclose(other.r, first.r, rel_tol=1e-12, abs_tol=0.0):
+        raise InvalidParameterError(
+            f"cannot append a pattern with r={other.r!r} to one with r={first.r!r} "
+            "(they must be equal)"
+        )
+    if previous.distalBase is None:
+        raise InvalidParameterError(
+            f"cannot append pattern {index} after a pattern without a distal base "
+            f"(kind={previous.kind!r}); nothing may follow an end tip"
+        )
+    if other.proximalBase is None:
+        raise InvalidParameterError(
+            f"cannot append pattern {index} (kind={other.kind!r}): it has no proximal base; "
+            "a start tip may only begin a pattern"
+        )
+
+
+@dataclass(frozen=True)
+class _ComposeState:
+    """What composition needs to know about the pattern built so far."""
+
+    n: int
+    W: float
+    eps: float
+    marker: np.ndarray  # distal marker (2,)
+    distal_idx: np.ndarray | None  # global indices of the distal base, in order
+    distal_xy: np.ndarray | None  # their coordinates (n, 2)
+    distal_keys: np.ndarray  # keys of creases with both ends on the distal base
+    next_index: int  # number of vertices so far
+
+    @classmethod
+    def after(cls, pattern: TubularPattern) -> _ComposeState:
+        distal = pattern.distalBase
+        return cls(
+            pattern.numSides,
+            pattern.width,
+            pattern.eps,
+            pattern.distalMarker,
+            distal,
+            None if distal is None else pattern.vertices_coords[distal],
+            pattern._get_distal_keys(),
+            pattern.numVertices,
+        )
+
+
+@dataclass(frozen=True)
+class _Step:
+    vertices: np.ndarray
+    edges: np.ndarray
+    assignment: np.ndarray
+    removed: int
+    state: _ComposeState
+
+
+def _find_shift(state: _ComposeState, base_xy: np.ndarray, index: int) -> int:
+    """Cyclic shift j with base vertex k of the new module on distal vertex k + j (section 2.2)."""
+    n, W, eps = state.n, state.W, state.eps
+    target = state.distal_xy
+    dx = periodic_dx(target[:, 0] - base_xy[0, 0], W)
+    dy = target[:, 1] - base_xy[0, 1]
+    candidates = np.flatnonzero((np.abs(dx) < eps) & (np.abs(dy) < eps))
+    for j in candidates.tolist():
+        rolled = target[(np.arange(n) + j) % n] - base_xy
+        if (np.abs(periodic_dx(rolled[:, 0], W)) < eps).all() and (
+            np.abs(rolled[:, 1]) < eps
+        ).all():
+            return j
+    raise InvalidParameterError(
+        f"cannot append pattern {index}: its proximal base does not coincide with the previous "
+        f"distal base for any cyclic shift (proximal base starts at {base_xy[0]}, distal base at "
+        f"{target[0]}, tolerance {eps:.3g})"
+    )
+
+
+def _compose_step(state: _ComposeState, other: TubularPattern, index: int) -> _Step | None:
+    """Append ``other`` to the composite described by ``state`` (spec section 2.2, steps 1-6).
+
+    Returns the new vertices, the re-indexed creases that survive duplicate removal and the new
+    state, or None when ``other`` is empty (a waypoint: nothing changes). The work is
+    proportional to the size of ``other``.
+    """
+    if other.isEmpty:
+        return None
+    n, W, eps = state.n, state.W, state.eps
+    # 1. translate by mu_d(A) - mu_p(B) and wrap
+    offset = state.marker - other.proximalMarker
+    coords = other.vertices_coords + offset
+    coords[:, 0] = wrap_x(coords[:, 0], W, eps)
+    marker = other.distalMarker + offset
+    marker[0] = wrap_x(marker[0:1], W, eps)[0]
+    # 3. cyclic shift
+    base = other.proximalBase
+    j = _find_shift(state, coords[base], index)
+    # 4. identify the base vertices, number the others after the existing ones
+    local_edges = other.edges_vertices
+    is_new = np.ones(other.numVertices, dtype=bool)
+    is_new[base] = False
+    mapping = np.empty(other.numVertices, dtype=np.intp)
+    mapping[base] = state.distal_idx[(np.arange(n) + j) % n]
+    num_new = other.numVertices - n
+    mapping[is_new] = np.arange(state.next_index, state.next_index + num_new)
+    edges = mapping[local_edges]
+    keys = _edge_keys(edges)
+    # 5. drop creases already present (only creases joining two shared base vertices can
+    #    repeat one of the composite's) and repeats inside the new module; the first one wins
+    keep = np.ones(keys.shape[0], dtype=bool)
+    if state.distal_keys.shape[0]:
+        on_base = ~is_new[local_edges]
+        candidates = np.flatnonzero(on_base[:, 0] & on_base[:, 1])
+        if candidates.shape[0]:
+            repeated = (keys[candidates, None] == state.distal_keys[None, :]).any(axis=1)
+            keep[candidates[repeated]] = False
+    if other._get_internal_duplicates():
+        keep &= _first_occurrence_mask(keys)
+    removed = int(keep.shape[0] - np.count_nonzero(keep))
+    if removed:
+        edges, keys = edges[keep], keys[keep]
+        assignment = other.edges_assignment[keep]
+    else:
+        assignment = other.edges_assignment
+    # 6. new distal base and marker, and the creases lying on the new distal base
+    if other.distalBase is None:
+        distal_idx, distal_xy, distal_keys = None, None, np.zeros(0, dtype=np.int64)
+    else:
+        distal_idx = mapping[other.distalBase]
+        distal_xy = coords[other.distalBase]
+        on_distal = np.zeros(other.numVertices, dtype=bool)
+        on_distal[other.distalBase] = True
+        on_distal = on_distal[local_edges]
+        if removed:
+            on_distal = on_distal[keep]
+        distal_keys = keys[on_distal[:, 0] & on_distal[:, 1]]
+        if state.distal_keys.shape[0] and not is_new[other.distalBase].all():
+            # degenerate module whose distal base reuses vertices of the previous distal base
+            distal_keys = np.concatenate([_keys_within(state.distal_keys, distal_idx), distal_keys])
+    new_state = _ComposeState(
+        n, W, eps, marker, distal_idx, distal_xy, distal_keys, state.next_index + num_new
+    )
+    return _Step(coords[is_new], edges, assignment, removed, new_state)

@@ -1,0 +1,213 @@
+"""Joint placement along the axis of motion (chain.md sections 4.3-4.5).
+
+These functions only compute poses; the chain builds and checks the links. All frames are 4x4
+world arrays. A joint placed here keeps its axis-of-motion line: it only slides along its z
+axis, turns about it (common-normal rule) or reverses its path direction (a half turn that
+keeps the line).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from kinegami.errors import NoPathError
+from kinegami.geometry.balls import Ball
+from kinegami.geometry.frames import rotation_matrix, unit
+from kinegami.geometry.lines import common_normal
+from kinegami.joints import Joint, Waypoint
+
+#: Plane side tests and line/plane parallelism (chain.md 0, eps_plane).
+PLANE_TOLERANCE = 1e-8
+
+
+def slide_to_plane(p: np.ndarray, z: np.ndarray, target: np.ndarray, plane_point: np.ndarray,
+                   plane_normal: np.ndarray) -> float:
+    """lambda minimising |target - (p + lambda z)| with (p + lambda z) on or beyond the plane.
+
+    Closed form of chain.md 4.3 step 5.
+    """
+    lam_star = float((target - p) @ z)
+    a = float(plane_normal @ z)
+    b = float(plane_normal @ (p - plane_point))
+    if abs(a) < PLANE_TOLERANCE:
+        return lam_star
+    if a > 0:
+        return max(lam_star, -b / a)
+    return min(lam_star, -b / a)
+
+
+def compact_lambda(p_parent: np.ndarray, p: np.ndarray, z: np.ndarray, ball: Ball,
+                   clearance: float, r: float) -> float:
+    """Slide for compact placement (chain.md 4.4): nearest to the parent with
+    |c - (p + lambda z)| >= clearance, staying on the side of the ball the user chose."""
+    lam_star = float((p_parent - p) @ z)
+    lam_c = float((ball.c - p) @ z)
+    h2 = float((ball.c - p) @ (ball.c - p)) - lam_c * lam_c
+    D2 = clearance * clearance
+    if D2 <= h2:
+        return lam_star
+    w = math.sqrt(D2 - max(h2, 0.0))
+    if lam_c <= 1e-9 * r:
+        return max(lam_star, lam_c + w)
+    return min(lam_star, lam_c - w)
+
+
+def orient_by_common_normal(joint: Joint, parent_pose: np.ndarray) -> Joint:
+    """chain.md 4.5: x along the common normal from the parent's axis, path pointing away."""
+    T = joint.pose_matrix
+    tol = 1e-9 * joint.r
+    n = common_normal(parent_pose[:3, 3], parent_pose[:3, 2], T[:3, 3], T[:3, 2], tol)
+    if n is not None:
+        joint = joint.with_xhat_about_zhat(n)
+    if float(joint.path_direction() @ (joint.pose_matrix[:3, 3] - parent_pose[:3, 3])) < -tol:
+        joint = joint.with_reversed_path_direction()
+    return joint
+
+
+def point_away(joint: Joint, origin: np.ndarray) -> Joint:
+    """Reverse the joint's path direction if it points back towards ``origin``
+    (chain.md 4.3 step 6 [FIX])."""
+    v = joint.pose_matrix[:3, 3] - origin
+    if float(joint.path_direction() @ v) < -1e-9 * joint.r:
+        return joint.with_reversed_path_direction()
+    return joint
+
+
+def _waypoint(template: Joint, R: np.ndarray, origin: np.ndarray, path_index: int) -> Waypoint:
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = origin
+    return Waypoint(template.numSides, template.r, T, pathIndex=path_index)
+
+
+def published_safe_placement(parent_distal: np.ndarray, parent_path_index: int, joint: Joint,
+                             ball: Ball) -> list[Joint]:
+    """The published safe placement (T-RO Algorithm 9, chain.md 4.3) with the [FIX] path rule.
+
+    ``parent_distal`` is the parent's distal frame (4x4, not permuted); its column
+    ``parent_path_index`` is the direction n1 in which the tube leaves the parent. Returns the
+    waypoints and the placed joint, in order.
+    """
+    r = joint.r
+    n1 = parent_distal[:3, parent_path_index]
+    A = parent_distal[:3, 3]
+    R_parent = parent_distal[:3, :3]
+    rho = joint.bounding_radius()
+    T = joint.pose_matrix
+    p, z = T[:3, 3], T[:3, 2]
+
+    s1 = ball.c + ball.r * n1
+    o1 = A + float((s1 - A) @ n1) * n1
+    w1 = _waypoint(joint, R_parent, o1, parent_path_index)
+    far1 = s1 + (4.0 * r + rho) * n1
+    dist_far1 = float((p - far1) @ n1)
+    if abs(dist_far1) < PLANE_TOLERANCE:
+        dist_far1 = 0.0
+    waypoints = [w1]
+    if abs(float(n1 @ z)) < PLANE_TOLERANCE and dist_far1 < 0.0:
+        n2 = z
+        s2 = ball.c + ball.r * n2
+        b = o1 + r * n1
+        o2 = b + float((s2 - b) @ n2) * n2
+        R2 = rotation_matrix(np.cross(n1, n2), math.pi / 2.0) @ R_parent
+        waypoints.append(_waypoint(joint, R2, o2, parent_path_index))
+        target, plane_point, plane_normal = o2, s2 + (4.0 * r + rho) * n2, n2
+    else:
+        target, plane_point, plane_normal = o1, far1, n1
+    lam = slide_to_plane(p, z, target, plane_point, plane_normal)
+    placed = joint.translated_along_z(lam)
+    placed = point_away(placed, waypoints[-1].pose_matrix[:3, 3])
+    return waypoints + [placed]
+
+
+def _turn_frame(R: np.ndarray, d: np.ndarray, target: np.ndarray):
+    """Rotation axis and angle carrying direction d onto target (any perpendicular axis for
+    opposite directions)."""
+    angle = math.atan2(float(np.linalg.norm(np.cross(d, target))), float(d @ target))
+    axis = np.cross(d, target)
+    if float(np.linalg.norm(axis)) < 1e-12:
+        axis = np.cross(d, _least_aligned_axis(d))
+    return unit(axis), angle
+
+
+def _arc_displacement(r: float, d: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
+    """Displacement along an arc of radius r turning d by ``angle`` about ``axis``."""
+    w = np.cross(axis, d)
+    return r * math.sin(angle) * d + r * (1.0 - math.cos(angle)) * w
+
+
+def radial_safe_placement(parent_distal: np.ndarray, parent_path_index: int, joint: Joint,
+                          ball: Ball) -> list[Joint]:
+    """Safe placement whose parts stay within a fixed distance of the ball (docs/placement.md).
+
+    With c, R the ball, A and d1 the parent's distal point and direction:
+
+    1. The joint goes to the point x of its axis line at distance R' from c (the one nearest to
+       A), with R' = max(R + 4r + rho_N, |A - c| + L_N/2 + 9r); if the line misses that sphere,
+       to the point of the line nearest to A. m = unit(x - c) is the outward normal there, and
+       the joint's path direction is reversed if it points inwards (a . m < 0).
+    2. Waypoint W_b sits 4r straight behind the joint's proximal point B along m, facing m.
+       W_b -> joint: the end lies straight ahead at >= 4r and a . m >= 0, so a CSC path with
+       turns <= pi/3 and <= 5pi/6 exists (Lemma D of the docs).
+    3. Waypoint W_a: from (A, d1) turn onto m (one arc, or two equal arcs for turns > 2pi/3)
+       and run r straight: a CSC path by construction. W_a -> W_b: parallel directions with
+       W_b at least 2r ahead, an S-curve with both turns <= pi/2 (Lemma S).
+
+    Every link therefore exists with turns < pi; the joint lies at distance R' from c and every
+    part within R' + 2 rho_N + 2r, so the ball grows by a bounded amount per joint.
+    """
+    r = joint.r
+    c, R = ball.c, ball.r
+    A = parent_distal[:3, 3]
+    d1 = parent_distal[:3, parent_path_index]
+    R_parent = parent_distal[:3, :3]
+    rho = joint.bounding_radius()
+    L = joint.neutralLength
+    T = joint.pose_matrix
+    p, z = T[:3, 3], T[:3, 2]
+    radius = max(R + 4.0 * r + rho, float(np.linalg.norm(A - c)) + L / 2.0 + 9.0 * r)
+
+    for _ in range(8):
+        lam_c = float((c - p) @ z)
+        foot = p + lam_c * z
+        h2 = float((foot - c) @ (foot - c))
+        if h2 >= radius * radius:
+            lam = float((A - p) @ z)
+        else:
+            w = math.sqrt(radius * radius - h2)
+            lam = min((lam_c - w, lam_c + w),
+                      key=lambda t: float(np.linalg.norm(p + t * z - A)))
+        x = p + lam * z
+        m = unit(x - c)
+        placed = joint.translated_along_z(lam)
+        if float(placed.path_direction() @ m) < 0.0:
+            placed = placed.with_reversed_path_direction()
+        B = placed.proximal_frame()[:3, 3]
+        wb = B - 4.0 * r * m
+
+        axis, psi = _turn_frame(R_parent, d1, m)
+        if psi <= 2.0 * math.pi / 3.0:
+            ea = A + _arc_displacement(r, d1, axis, psi)
+        else:
+            half = psi / 2.0
+            u_mid = rotation_matrix(axis, half) @ d1
+            ea = (A + _arc_displacement(r, d1, axis, half) + 0.5 * r * u_mid
+                  + _arc_displacement(r, u_mid, axis, half))
+        wa = ea + r * m
+        if float((wb - wa) @ m) >= 2.0 * r:
+            R_turned = rotation_matrix(axis, psi) @ R_parent
+            return [
+                _waypoint(joint, R_turned, wa, parent_path_index),
+                _waypoint(joint, R_turned, wb, parent_path_index),
+                placed,
+            ]
+        radius += 4.0 * r
+    raise NoPathError("radial safe placement found no waypoint layout (degenerate input)")
+
+
+def _least_aligned_axis(v: np.ndarray) -> np.ndarray:
+    axis = np.zeros(3)
+    axis[int(np.argmin(np.abs(v)))] = 1.0
+    return axis
