@@ -251,33 +251,38 @@ class KinematicChain:
     def _safe_extension(self, parent: Joint, joint: Joint):
         """Safe placement: the extended lists and ball (chain.md 4.3 and docs/placement.md).
 
-        The published rule is kept when it succeeds and either stays close (ball growth at most
-        SAFE_GROWTH_LIMIT r and new links at most SAFE_PATH_LIMIT r long) or is no worse than
-        the radial construction on both counts; otherwise (the cases in which it blows up or
-        fails) the radial construction is used.
+        Candidates, in order: the published rule with the joint's path direction as given, then
+        reversed (chain.md 4.3 step 6). The first that succeeds and stays close (ball growth
+        at most SAFE_GROWTH_LIMIT r, new links at most SAFE_PATH_LIMIT r long) is kept, so the
+        published results are reproduced wherever the published rule works. Otherwise the
+        radial construction, which always succeeds and grows the ball by a bounded amount, is
+        used unless a published candidate is no worse on both counts.
         """
         distal = parent.distal_frame()
         k = parent.pathIndex()
-        try:
-            published = self._extended(published_safe_placement(distal, k, joint, self._ball))
-        except KinegamiError:
-            published = None
-        if published is not None:
-            growth, path = self._cost(published)
-            if growth <= SAFE_GROWTH_LIMIT * self.r and path <= SAFE_PATH_LIMIT * self.r:
-                return published
+        limits = (SAFE_GROWTH_LIMIT * self.r, SAFE_PATH_LIMIT * self.r)
+        fallbacks = []
+        for reverse in (False, True):
+            try:
+                extended = self._extended(
+                    published_safe_placement(distal, k, joint, self._ball, reverse=reverse)
+                )
+            except KinegamiError:
+                continue
+            cost = self._cost(extended)
+            if cost[0] <= limits[0] and cost[1] <= limits[1]:
+                return extended
+            fallbacks.append((cost, extended))
         try:
             radial = self._extended(radial_safe_placement(distal, k, joint, self._ball))
         except KinegamiError:
-            if published is not None:
-                return published
+            if fallbacks:
+                return fallbacks[0][1]
             raise
-        if published is not None:
-            growth_r, path_r = self._cost(radial)
-            if growth <= max(growth_r, SAFE_GROWTH_LIMIT * self.r) and path <= max(
-                path_r, SAFE_PATH_LIMIT * self.r
-            ):
-                return published
+        growth_r, path_r = self._cost(radial)
+        for (growth, path), extended in fallbacks:
+            if growth <= max(growth_r, limits[0]) and path <= max(path_r, limits[1]):
+                return extended
         return radial
 
     def _cost(self, extended) -> tuple[float, float]:

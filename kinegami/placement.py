@@ -66,15 +66,6 @@ def orient_by_common_normal(joint: Joint, parent_pose: np.ndarray) -> Joint:
     return joint
 
 
-def point_away(joint: Joint, origin: np.ndarray) -> Joint:
-    """Reverse the joint's path direction if it points back towards ``origin``
-    (chain.md 4.3 step 6 [FIX])."""
-    v = joint.pose_matrix[:3, 3] - origin
-    if float(joint.path_direction() @ v) < -1e-9 * joint.r:
-        return joint.with_reversed_path_direction()
-    return joint
-
-
 def _waypoint(template: Joint, R: np.ndarray, origin: np.ndarray, path_index: int) -> Waypoint:
     T = np.eye(4)
     T[:3, :3] = R
@@ -83,12 +74,13 @@ def _waypoint(template: Joint, R: np.ndarray, origin: np.ndarray, path_index: in
 
 
 def published_safe_placement(parent_distal: np.ndarray, parent_path_index: int, joint: Joint,
-                             ball: Ball) -> list[Joint]:
-    """The published safe placement (T-RO Algorithm 9, chain.md 4.3) with the [FIX] path rule.
+                             ball: Ball, reverse: bool = False) -> list[Joint]:
+    """The published safe placement (T-RO Algorithm 9, chain.md 4.3).
 
     ``parent_distal`` is the parent's distal frame (4x4, not permuted); its column
-    ``parent_path_index`` is the direction n1 in which the tube leaves the parent. Returns the
-    waypoints and the placed joint, in order.
+    ``parent_path_index`` is the direction n1 in which the tube leaves the parent. The joint
+    keeps its path direction, or has it reversed when ``reverse`` is True (the caller tries
+    both: chain.md 4.3 step 6). Returns the waypoints and the placed joint, in order.
     """
     r = joint.r
     n1 = parent_distal[:3, parent_path_index]
@@ -118,7 +110,8 @@ def published_safe_placement(parent_distal: np.ndarray, parent_path_index: int, 
         target, plane_point, plane_normal = o1, far1, n1
     lam = slide_to_plane(p, z, target, plane_point, plane_normal)
     placed = joint.translated_along_z(lam)
-    placed = point_away(placed, waypoints[-1].pose_matrix[:3, 3])
+    if reverse:
+        placed = placed.with_reversed_path_direction()
     return waypoints + [placed]
 
 
