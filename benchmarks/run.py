@@ -1,0 +1,140 @@
+"""Speed and scale measurements for kinegami. Run: ``python benchmarks/run.py``.
+
+Prints one table: what was measured, the median time (and the scale numbers for the 48-joint
+safe chains). Goals (from the issues) are printed beside the measurements; they are goals,
+not assertions: tests never time anything.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+import warnings
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from kinegami import (
+    KinematicChain,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+)
+from kinegami.geometry.csc import solve_csc
+
+
+def _median_seconds(fn, repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def random_pose(rng: np.random.Generator, r: float, reach: float = 4.0) -> np.ndarray:
+    """A random rotation and a translation uniform in [-reach r, reach r]^3."""
+    T = np.eye(4)
+    T[:3, :3] = Rotation.random(random_state=int(rng.integers(1 << 31))).as_matrix()
+    T[:3, 3] = rng.uniform(-reach * r, reach * r, 3)
+    return T
+
+
+def random_joint(i: int, T: np.ndarray, numSides: int = 4, r: float = 1.0):
+    """Alternating revolute and prismatic joints (the issue's test case)."""
+    if i % 2 == 0:
+        return RevoluteJoint(numSides, r, np.pi, T)
+    return PrismaticJoint(numSides, r, 3 * r, 3, np.pi / 4, T)
+
+
+def safe_chain(seed: int, n: int = 48, r: float = 1.0) -> tuple[KinematicChain, int]:
+    """A random n-joint chain built with safe placement; returns it and the failure count."""
+    rng = np.random.default_rng(seed)
+    chain = KinematicChain(StartTip(4, r, np.eye(4), r))
+    failures = 0
+    for i in range(n):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            if chain.append(random_joint(i, random_pose(rng, r), r=r)) is None:
+                failures += 1
+    return chain, failures
+
+
+def compact_chain(n: int = 32, seed: int = 0, r: float = 1.0) -> KinematicChain:
+    """A 32-joint chain built with compact placement (joints whose link fails are skipped)."""
+    rng = np.random.default_rng(seed)
+    chain = KinematicChain(StartTip(4, r, np.eye(4), r))
+    while len(chain.Joints) < n:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            chain.append(random_joint(len(chain.Joints), random_pose(rng, r)), safe=False)
+    return chain
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--seeds", type=int, default=10, help="random 48-joint safe chains")
+    args = parser.parse_args(argv)
+    rows: list[tuple[str, str, str]] = []
+
+    rng = np.random.default_rng(1)
+    pairs = []
+    while len(pairs) < 200:
+        p2 = rng.uniform(-8, 8, 3)
+        d1, d2 = rng.normal(size=3), rng.normal(size=3)
+        if solve_csc(np.zeros(3), d1, p2, d2, 1.0) is not None:
+            pairs.append((p2, d1, d2))
+    t = _median_seconds(lambda: [solve_csc(np.zeros(3), d1, p2, d2, 1.0)
+                                 for p2, d1, d2 in pairs], 5) / len(pairs)
+    rows.append(("CSC solve, one link", f"{t * 1e6:.0f} us", "well under 1 ms"))
+
+    t = _median_seconds(lambda: compact_chain(), 3)
+    rows.append(("32-joint compact build", f"{t * 1e3:.1f} ms", "-"))
+
+    chain = compact_chain()
+    movable = [i for i, j in enumerate(chain.Joints) if j.stateRange() != (0.0, 0.0)]
+    mid = len(chain.Joints) // 2
+
+    def edits():
+        for k in range(10):
+            chain.translateJointAlongAxisOfMotion(mid, 0.5 if k % 2 == 0 else -0.5)
+            chain.rotateJointAboutAxisOfMotion(mid, 0.1 if k % 2 == 0 else -0.1)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        t = _median_seconds(edits, 5) / 20
+    rows.append(("propagated edit, 32 joints (mean of 20)", f"{t * 1e3:.2f} ms", "< 5 ms"))
+
+    def states():
+        for k in range(20):
+            j = movable[k % len(movable)]
+            lo, hi = chain.Joints[j].stateRange()
+            chain.setJointState(j, lo + (hi - lo) * ((k * 0.37) % 1.0))
+
+    t = _median_seconds(states, 5) / 20
+    rows.append(("state change, 32 joints (mean of 20)", f"{t * 1e3:.2f} ms", "< 5 ms"))
+
+    balls, paths, fails, times = [], [], 0, []
+    for seed in range(args.seeds):
+        t0 = time.perf_counter()
+        built, failures = safe_chain(seed)
+        times.append(time.perf_counter() - t0)
+        fails += failures
+        balls.append(built.boundingBall.r / 48)
+        paths.append(built.totalPathLength() / 48)
+    rows.append((f"48-joint safe chain ({args.seeds} seeds), time",
+                 f"{statistics.median(times) * 1e3:.0f} ms", "-"))
+    rows.append(("  failed appends", str(fails), "0"))
+    rows.append(("  ball radius per joint (max)", f"{max(balls):.2f} r", "<= 10 r"))
+    rows.append(("  path length per joint (max)", f"{max(paths):.2f} r", "<= 60 r"))
+
+    width = max(len(r[0]) for r in rows)
+    print(f"{'measurement':<{width}}  {'result':>12}  goal")
+    print("-" * (width + 28))
+    for name, value, goal in rows:
+        print(f"{name:<{width}}  {value:>12}  {goal}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,81 @@
+"""The paper's running example (Kinegami, Origami 8, section 5): Example 1A, 1B and 1C.
+
+The listing below is the paper's, line for line, after ``from kinegami import *``. Each
+``chain.show(...)`` draws a figure; this script saves them (and the pattern) under
+``examples/output/`` and prints where they went. Run: ``python examples/example1.py``.
+"""
+
+import os
+from pathlib import Path
+
+import matplotlib
+
+if not os.environ.get("DISPLAY") and not os.environ.get("MPLBACKEND"):
+    matplotlib.use("Agg")  # no screen: draw to files only
+import matplotlib.pyplot as plt  # noqa: E402
+
+from kinegami import *  # noqa: E402, F403
+
+OUTPUT = Path(__file__).resolve().parent / "output"
+OUTPUT.mkdir(parents=True, exist_ok=True)
+os.chdir(OUTPUT)  # the listing writes "examplePatterns/example1.dxf" relative to here
+written = []
+
+
+def save_figure(name):
+    """Save the figure that the last chain.show() drew."""
+    path = OUTPUT / name
+    plt.gcf().savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(plt.gcf())
+    written.append(path)
+
+
+# ---- Example 1A ------------------------------------------------------------------------
+r = 1
+numSides = 4
+chain = KinematicChain(StartTip(numSides, r, Pose=SE3.Trans(3, 3, 0),
+                                 length=1.5))
+prismatic = PrismaticJoint(numSides, r, neutralLength=3,
+                            numLayers=3, coneAngle=np.pi/4, Pose=SE3.Trans([5, 5, 0]))
+prismaticIndex = chain.append(prismatic)
+revolute = RevoluteJoint(numSides, r, np.pi, SE3.Ry(np.pi/4))
+revoluteIndex = chain.append(revolute)
+end = EndTip(numSides, r, Pose=SE3.Ry(np.pi/2), length=1.5)
+endIndex = chain.append(end)
+chain.show(showGlobalFrame=True) #Figure 5(a)
+save_figure("figure5a_example1A.png")
+
+# ---- Example 1B ------------------------------------------------------------------------
+chain.translateJointAlongAxisOfMotion(revoluteIndex, -7)
+chain.show(showGlobalFrame=True) #Figure 5(b)
+save_figure("figure5b_translate_revolute.png")
+chain.translateJointAlongAxisOfMotion(endIndex, -10,
+                                      applyToPreviousWaypoint=True)
+chain.show(showGlobalFrame=True) #Figure 5(c)
+save_figure("figure5c_translate_end.png")
+chain.rotateJointAboutAxisOfMotion(revoluteIndex, -np.pi/3)
+chain.show(showGlobalFrame=True)
+save_figure("figure5_rotate_revolute.png")
+chain.translateJointAlongAxisOfMotion(prismaticIndex, -2,
+                                      propogate=False)
+chain.show(showGlobalFrame=True) #Figure 5(d)
+save_figure("figure5d_example1B.png")
+pattern = chain.creasePattern()
+pattern.save(dxfName="examplePatterns/example1.dxf")
+written.append(OUTPUT / "examplePatterns" / "example1.dxf")
+
+# ---- Example 1C ------------------------------------------------------------------------
+minPrismaticState, maxPrismaticState = chain.Joints[prismaticIndex].stateRange()
+chain.setJointState(prismaticIndex, maxPrismaticState)
+chain.setJointState(revoluteIndex, np.pi/2)
+chain.show(showGlobalFrame=True) # Figure 5(f)
+save_figure("figure5f_example1C.png")
+
+pattern.show()
+save_figure("figure5g_pattern.png")
+
+print(f"Example 1: {len(chain.Joints)} joints, total path length "
+      f"{chain.totalPathLength():.6f}, pattern {pattern.width:.4f} x {pattern.height:.4f}")
+print("wrote:")
+for path in written:
+    print(f"  {path}")
