@@ -85,8 +85,9 @@ def main(argv: list[str] | None = None) -> None:
         d1, d2 = rng.normal(size=3), rng.normal(size=3)
         if solve_csc(np.zeros(3), d1, p2, d2, 1.0) is not None:
             pairs.append((p2, d1, d2))
-    t = _median_seconds(lambda: [solve_csc(np.zeros(3), d1, p2, d2, 1.0)
-                                 for p2, d1, d2 in pairs], 5) / len(pairs)
+    t = _median_seconds(
+        lambda: [solve_csc(np.zeros(3), d1, p2, d2, 1.0) for p2, d1, d2 in pairs], 5
+    ) / len(pairs)
     rows.append(("CSC solve, one link", f"{t * 1e6:.0f} us", "well under 1 ms"))
 
     t = _median_seconds(lambda: compact_chain(), 3)
@@ -123,8 +124,13 @@ def main(argv: list[str] | None = None) -> None:
         fails += failures
         balls.append(built.boundingBall.r / 48)
         paths.append(built.totalPathLength() / 48)
-    rows.append((f"48-joint safe chain ({args.seeds} seeds), time",
-                 f"{statistics.median(times) * 1e3:.0f} ms", "-"))
+    rows.append(
+        (
+            f"48-joint safe chain ({args.seeds} seeds), time",
+            f"{statistics.median(times) * 1e3:.0f} ms",
+            "-",
+        )
+    )
     rows.append(("  failed appends", str(fails), "0"))
     rows.append(("  ball radius per joint (max)", f"{max(balls):.2f} r", "<= 10 r"))
     rows.append(("  path length per joint (max)", f"{max(paths):.2f} r", "<= 60 r"))

@@ -74,9 +74,7 @@ class KinematicChain:
 
     def __init__(self, startJoint: Joint, maxAnglePerElbow: float = np.pi / 2):
         if not isinstance(startJoint, Joint):
-            raise InvalidTypeError(
-                f"startJoint must be a Joint, got {type(startJoint).__name__}"
-            )
+            raise InvalidTypeError(f"startJoint must be a Joint, got {type(startJoint).__name__}")
         if isinstance(startJoint, EndTip):
             raise InvalidParameterError("startJoint cannot be an EndTip (nothing may follow it)")
         self.maxAnglePerElbow = check_max_angle_per_elbow(maxAnglePerElbow)
@@ -131,8 +129,12 @@ class KinematicChain:
         return LinkCSC(self.r, frame, frame, self.maxAnglePerElbow)
 
     def _link(self, parent: Joint, child: Joint) -> LinkCSC:
-        return LinkCSC(self.r, parent.distal_dubins_frame(), child.proximal_dubins_frame(),
-                       self.maxAnglePerElbow)
+        return LinkCSC(
+            self.r,
+            parent.distal_dubins_frame(),
+            child.proximal_dubins_frame(),
+            self.maxAnglePerElbow,
+        )
 
     def _index(self, jointIndex) -> int:
         if isinstance(jointIndex, bool) or not isinstance(jointIndex, int | np.integer):
@@ -177,8 +179,14 @@ class KinematicChain:
         warnings.warn(message + "; the chain is unchanged", PlacementWarning, stacklevel=3)
 
     # --- building ----------------------------------------------------------------------------
-    def append(self, newJoint: Joint, relative: bool = True, safe: bool = True,
-               fixedPosition: bool = False, fixedOrientation: bool = False) -> int | None:
+    def append(
+        self,
+        newJoint: Joint,
+        relative: bool = True,
+        safe: bool = True,
+        fixedPosition: bool = False,
+        fixedOrientation: bool = False,
+    ) -> int | None:
         """Add ``newJoint`` after the last joint and return its index.
 
         Parameters
@@ -222,10 +230,14 @@ class KinematicChain:
                 joints, links, ball = self._safe_extension(parent, joint)
             else:
                 if not fixedPosition:
-                    lam = compact_lambda(parent.pose_matrix[:3, 3], joint.pose_matrix[:3, 3],
-                                         joint.pose_matrix[:3, 2], self._ball,
-                                         4.0 * self.r + self._ball.r + joint.bounding_radius(),
-                                         self.r)
+                    lam = compact_lambda(
+                        parent.pose_matrix[:3, 3],
+                        joint.pose_matrix[:3, 3],
+                        joint.pose_matrix[:3, 2],
+                        self._ball,
+                        4.0 * self.r + self._ball.r + joint.bounding_radius(),
+                        self.r,
+                    )
                     joint = joint.translated_along_z(lam)
                 if not fixedOrientation:
                     joint = orient_by_common_normal(joint, parent.pose_matrix)
@@ -288,7 +300,7 @@ class KinematicChain:
     def _cost(self, extended) -> tuple[float, float]:
         """(growth of the ball radius, length of the new links) of an extension."""
         _, links, ball = extended
-        added = links[len(self._links):]
+        added = links[len(self._links) :]
         return ball.r - self._ball.r, sum(link.path.length for link in added)
 
     # --- edits ---------------------------------------------------------------------------------
@@ -319,8 +331,14 @@ class KinematicChain:
         self._commit(joints, links, ball)
         return True
 
-    def transformJoint(self, jointIndex: int, Transformation, propogate: bool = True, *,
-                       propagate: bool | None = None) -> bool:
+    def transformJoint(
+        self,
+        jointIndex: int,
+        Transformation,
+        propogate: bool = True,
+        *,
+        propagate: bool | None = None,
+    ) -> bool:
         """Move joint ``jointIndex`` by the world transform ``Transformation``.
 
         With propagation every later joint moves with it (only the link into the joint is
@@ -340,8 +358,9 @@ class KinematicChain:
         self._commit(joints, links, self._ball.transformed(T))
         return True
 
-    def _axis_edit(self, what: str, jointIndex, T_of_joint, propogate, propagate,
-                   applyToPreviousWaypoint) -> bool:
+    def _axis_edit(
+        self, what: str, jointIndex, T_of_joint, propogate, propagate, applyToPreviousWaypoint
+    ) -> bool:
         j = self._index(jointIndex)
         prop = _propagate_flag(propogate, propagate)
         applyToPreviousWaypoint = _check_bool("applyToPreviousWaypoint", applyToPreviousWaypoint)
@@ -366,10 +385,15 @@ class KinematicChain:
             return self._try_edit(what, both)
         return self._try_edit(what, lambda: self._moved(j, T, prop))
 
-    def translateJointAlongAxisOfMotion(self, jointIndex: int, distance: float,
-                                        propogate: bool = True,
-                                        applyToPreviousWaypoint: bool = False, *,
-                                        propagate: bool | None = None) -> bool:
+    def translateJointAlongAxisOfMotion(
+        self,
+        jointIndex: int,
+        distance: float,
+        propogate: bool = True,
+        applyToPreviousWaypoint: bool = False,
+        *,
+        propagate: bool | None = None,
+    ) -> bool:
         """Slide joint ``jointIndex`` by ``distance`` along its axis of motion (z).
 
         The axis line is kept, so the chain's kinematics are unchanged. With
@@ -377,22 +401,34 @@ class KinematicChain:
         """
         d = check_real("distance", distance)
         return self._axis_edit(
-            "translateJointAlongAxisOfMotion", jointIndex,
+            "translateJointAlongAxisOfMotion",
+            jointIndex,
             lambda joint: translation(d * joint.pose_matrix[:3, 2]),
-            propogate, propagate, applyToPreviousWaypoint,
+            propogate,
+            propagate,
+            applyToPreviousWaypoint,
         )
 
-    def rotateJointAboutAxisOfMotion(self, jointIndex: int, angle: float,
-                                     propogate: bool = True,
-                                     applyToPreviousWaypoint: bool = False, *,
-                                     propagate: bool | None = None) -> bool:
+    def rotateJointAboutAxisOfMotion(
+        self,
+        jointIndex: int,
+        angle: float,
+        propogate: bool = True,
+        applyToPreviousWaypoint: bool = False,
+        *,
+        propagate: bool | None = None,
+    ) -> bool:
         """Turn joint ``jointIndex`` by ``angle`` (radians) about its axis of motion."""
         a = check_real("angle", angle)
         return self._axis_edit(
-            "rotateJointAboutAxisOfMotion", jointIndex,
-            lambda joint: rotation_about_line(joint.pose_matrix[:3, 2],
-                                              joint.pose_matrix[:3, 3], a),
-            propogate, propagate, applyToPreviousWaypoint,
+            "rotateJointAboutAxisOfMotion",
+            jointIndex,
+            lambda joint: rotation_about_line(
+                joint.pose_matrix[:3, 2], joint.pose_matrix[:3, 3], a
+            ),
+            propogate,
+            propagate,
+            applyToPreviousWaypoint,
         )
 
     def delete(self, jointIndex: int) -> bool:
@@ -408,8 +444,8 @@ class KinematicChain:
             return False
 
         def build():
-            joints = self._joints[:j] + self._joints[j + 1:]
-            links = self._links[:j] + self._links[j + 1:]
+            joints = self._joints[:j] + self._joints[j + 1 :]
+            links = self._links[:j] + self._links[j + 1 :]
             if j == 0:
                 links[0] = self._root_link(joints[0])
             elif j < len(joints):

@@ -217,7 +217,7 @@ class Joint:
         return self.with_pose(T @ self._T)
 
     def with_reversed_path_direction(self) -> Joint:
-        """A copy whose path direction is reversed, keeping the axis-of-motion line (chain.md 1.4)."""
+        """A copy with the path direction reversed, axis-of-motion line kept (chain.md 1.4)."""
         flip = rot_x(math.pi) if self.pathIndex() == 2 else rot_z(math.pi)
         return self.with_pose(_exact_flip(self._T, flip))
 
@@ -293,8 +293,9 @@ class RevoluteJoint(Joint):
     def __init__(self, numSides, r, totalBendingAngle, Pose, numSinkLayers=1):
         n = check_num_sides(numSides)
         r = check_radius(r)
-        B = check_in_range("totalBendingAngle", totalBendingAngle, 0.0, 2.0 * math.pi,
-                           range_text="(0, 2pi)")
+        B = check_in_range(
+            "totalBendingAngle", totalBendingAngle, 0.0, 2.0 * math.pi, range_text="(0, 2pi)"
+        )
         self.totalBendingAngle = B
         self.numSinkLayers = check_int("numSinkLayers", numSinkLayers, minimum=1)
         L = 2.0 * r * math.cos(math.pi / n) * math.tan(B / 4.0)
@@ -354,7 +355,11 @@ class PrismaticJoint(Joint):
         d = check_positive("neutralLength", neutralLength)
         self.numLayers = check_int("numLayers", numLayers, minimum=1)
         self.coneAngle = check_in_range(
-            "coneAngle", coneAngle, math.pi / 6.0, math.pi / 2.0, low_inclusive=True,
+            "coneAngle",
+            coneAngle,
+            math.pi / 6.0,
+            math.pi / 2.0,
+            low_inclusive=True,
             range_text="[pi/6, pi/2)",
         )
         super().__init__(n, r, d, Pose)
@@ -468,4 +473,3 @@ def check_same_tube(joint: Joint, numSides: int, r: float) -> None:
         raise IncompatibleJointError(
             f"r of the new joint ({joint.r!r}) must equal the chain's ({r!r})"
         )
-

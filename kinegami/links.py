@@ -77,8 +77,9 @@ class ElbowArc:
         return ElbowArc(self.angle, self.count, self.rotationalAxisAngle, T @ self.frames, self.r)
 
 
-def _elbow_arc(start: np.ndarray, theta: float, axis: np.ndarray, max_angle: float,
-               r: float) -> ElbowArc:
+def _elbow_arc(
+    start: np.ndarray, theta: float, axis: np.ndarray, max_angle: float, r: float
+) -> ElbowArc:
     """Split a turn of ``theta`` about world ``axis`` starting at frame ``start`` into elbows."""
     if theta <= ELBOW_MIN_ANGLE:
         return ElbowArc(0.0 if theta <= 0 else theta, 0, 0.0, start[None].copy(), r)
@@ -190,20 +191,23 @@ class LinkCSC:
     @cached_property
     def elbows1(self) -> ElbowArc:
         """Arc 1 as elbows."""
-        return _elbow_arc(self._start, self.path.theta1, self.path.k1, self.maxAnglePerElbow,
-                          self.r)
+        return _elbow_arc(
+            self._start, self.path.theta1, self.path.k1, self.maxAnglePerElbow, self.r
+        )
 
     @cached_property
     def elbows2(self) -> ElbowArc:
         """Arc 2 as elbows (starting at ``arc2_start_frame``)."""
-        return _elbow_arc(self.arc2_start_frame, self.path.theta2, self.path.k2,
-                          self.maxAnglePerElbow, self.r)
+        return _elbow_arc(
+            self.arc2_start_frame, self.path.theta2, self.path.k2, self.maxAnglePerElbow, self.r
+        )
 
     @cached_property
     def twistAngle(self) -> float:
         """Roll tau (radians) that the straight part must add: y of F1 to y of F2 about u."""
-        return signed_angle(self.arc1_end_frame[:3, 1], self.arc2_start_frame[:3, 1],
-                            self.path.tUnit)
+        return signed_angle(
+            self.arc1_end_frame[:3, 1], self.arc2_start_frame[:3, 1], self.path.tUnit
+        )
 
     @property
     def hasTwist(self) -> bool:
@@ -230,8 +234,15 @@ class LinkCSC:
         y1 = b_s if p.theta1 <= TWIST_MIN_ANGLE else (p.c1 - p.q1) / self.r
         y2 = (p.c2 - p.q2) / self.r
         second = math.degrees(signed_angle(y1, y2, p.tUnit))
-        return [first, math.degrees(p.theta1), self.r, p.tMag, second, math.degrees(p.theta2),
-                self.r]
+        return [
+            first,
+            math.degrees(p.theta1),
+            self.r,
+            p.tMag,
+            second,
+            math.degrees(p.theta2),
+            self.r,
+        ]
 
     # --- rigid motion ------------------------------------------------------------------------
     def transformed(self, T: np.ndarray) -> LinkCSC:
@@ -240,8 +251,9 @@ class LinkCSC:
         end = T @ self._end
         start.setflags(write=False)
         end.setflags(write=False)
-        link = LinkCSC._from_parts(self.r, self.maxAnglePerElbow, start, end,
-                                   self.path.transformed(T))
+        link = LinkCSC._from_parts(
+            self.r, self.maxAnglePerElbow, start, end, self.path.transformed(T)
+        )
         cache = self.__dict__
         for name in ("elbows1", "elbows2"):
             if name in cache:
@@ -267,12 +279,14 @@ class LinkCSC:
         )
         from kinegami.validation import check_in_range
 
-        twistPortion = check_in_range("twistPortion", twistPortion, 0.0, 1.0,
-                                      low_inclusive=True, range_text="[0, 1)")
+        twistPortion = check_in_range(
+            "twistPortion", twistPortion, 0.0, 1.0, low_inclusive=True, range_text="[0, 1)"
+        )
         modules = []
         for arc in (self.elbows1,):
-            modules += [ElbowFittingPattern(numSides, self.r, arc.elbowAngle,
-                                            arc.rotationalAxisAngle)] * arc.count
+            modules += [
+                ElbowFittingPattern(numSides, self.r, arc.elbowAngle, arc.rotationalAxisAngle)
+            ] * arc.count
         s = self.path.tMag
         tube = s
         if self.hasTwist:
@@ -282,8 +296,9 @@ class LinkCSC:
         if tube > 0.0:
             modules.append(TubeFittingPattern(numSides, self.r, tube))
         arc = self.elbows2
-        modules += [ElbowFittingPattern(numSides, self.r, arc.elbowAngle,
-                                        arc.rotationalAxisAngle)] * arc.count
+        modules += [
+            ElbowFittingPattern(numSides, self.r, arc.elbowAngle, arc.rotationalAxisAngle)
+        ] * arc.count
         pattern = WaypointPattern(numSides, self.r)
         for module in modules:
             pattern = pattern.append(module)

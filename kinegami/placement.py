@@ -22,8 +22,13 @@ from kinegami.joints import Joint, Waypoint
 PLANE_TOLERANCE = 1e-8
 
 
-def slide_to_plane(p: np.ndarray, z: np.ndarray, target: np.ndarray, plane_point: np.ndarray,
-                   plane_normal: np.ndarray) -> float:
+def slide_to_plane(
+    p: np.ndarray,
+    z: np.ndarray,
+    target: np.ndarray,
+    plane_point: np.ndarray,
+    plane_normal: np.ndarray,
+) -> float:
     """lambda minimising |target - (p + lambda z)| with (p + lambda z) on or beyond the plane.
 
     Closed form of chain.md 4.3 step 5.
@@ -38,8 +43,9 @@ def slide_to_plane(p: np.ndarray, z: np.ndarray, target: np.ndarray, plane_point
     return min(lam_star, -b / a)
 
 
-def compact_lambda(p_parent: np.ndarray, p: np.ndarray, z: np.ndarray, ball: Ball,
-                   clearance: float, r: float) -> float:
+def compact_lambda(
+    p_parent: np.ndarray, p: np.ndarray, z: np.ndarray, ball: Ball, clearance: float, r: float
+) -> float:
     """Slide for compact placement (chain.md 4.4): nearest to the parent with
     |c - (p + lambda z)| >= clearance, staying on the side of the ball the user chose."""
     lam_star = float((p_parent - p) @ z)
@@ -73,8 +79,13 @@ def _waypoint(template: Joint, R: np.ndarray, origin: np.ndarray, path_index: in
     return Waypoint(template.numSides, template.r, T, pathIndex=path_index)
 
 
-def published_safe_placement(parent_distal: np.ndarray, parent_path_index: int, joint: Joint,
-                             ball: Ball, reverse: bool = False) -> list[Joint]:
+def published_safe_placement(
+    parent_distal: np.ndarray,
+    parent_path_index: int,
+    joint: Joint,
+    ball: Ball,
+    reverse: bool = False,
+) -> list[Joint]:
     """The published safe placement (T-RO Algorithm 9, chain.md 4.3).
 
     ``parent_distal`` is the parent's distal frame (4x4, not permuted); its column
@@ -131,8 +142,9 @@ def _arc_displacement(r: float, d: np.ndarray, axis: np.ndarray, angle: float) -
     return r * math.sin(angle) * d + r * (1.0 - math.cos(angle)) * w
 
 
-def radial_safe_placement(parent_distal: np.ndarray, parent_path_index: int, joint: Joint,
-                          ball: Ball) -> list[Joint]:
+def radial_safe_placement(
+    parent_distal: np.ndarray, parent_path_index: int, joint: Joint, ball: Ball
+) -> list[Joint]:
     """Safe placement whose parts stay within a fixed distance of the ball (docs/placement.md).
 
     With c, R the ball, A and d1 the parent's distal point and direction:
@@ -170,8 +182,7 @@ def radial_safe_placement(parent_distal: np.ndarray, parent_path_index: int, joi
             lam = float((A - p) @ z)
         else:
             w = math.sqrt(radius * radius - h2)
-            lam = min((lam_c - w, lam_c + w),
-                      key=lambda t: float(np.linalg.norm(p + t * z - A)))
+            lam = min((lam_c - w, lam_c + w), key=lambda t: float(np.linalg.norm(p + t * z - A)))
         x = p + lam * z
         m = unit(x - c)
         placed = joint.translated_along_z(lam)
@@ -186,8 +197,12 @@ def radial_safe_placement(parent_distal: np.ndarray, parent_path_index: int, joi
         else:
             half = psi / 2.0
             u_mid = rotation_matrix(axis, half) @ d1
-            ea = (A + _arc_displacement(r, d1, axis, half) + 0.5 * r * u_mid
-                  + _arc_displacement(r, u_mid, axis, half))
+            ea = (
+                A
+                + _arc_displacement(r, d1, axis, half)
+                + 0.5 * r * u_mid
+                + _arc_displacement(r, u_mid, axis, half)
+            )
         wa = ea + r * m
         if float((wb - wa) @ m) >= 2.0 * r:
             R_turned = rotation_matrix(axis, psi) @ R_parent
