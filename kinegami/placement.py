@@ -156,8 +156,9 @@ def radial_safe_placement(
     2. Waypoint W_b sits 4r straight behind the joint's proximal point B along m, facing m.
        W_b -> joint: the end lies straight ahead at >= 4r and a . m >= 0, so a CSC path with
        turns <= pi/3 and <= 5pi/6 exists (Lemma D of the docs).
-    3. Waypoint W_a: from (A, d1) turn onto m (one arc, or two equal arcs for turns > 2pi/3)
-       and run r straight: a CSC path by construction. W_a -> W_b: parallel directions with
+    3. Waypoint W_a: from (A, d1) turn onto m: one arc and r straight, or for turns > 2pi/3
+       two equal arcs with 0.5 r straight between them (a CSC path either way). W_a -> W_b:
+       parallel directions with
        W_b at least 2r ahead, an S-curve with both turns <= pi/2 (Lemma S).
 
     Every link therefore exists with turns < pi; the joint lies at distance R' from c and every
@@ -192,18 +193,17 @@ def radial_safe_placement(
         wb = B - 4.0 * r * m
 
         axis, psi = _turn_frame(R_parent, d1, m)
-        if psi <= 2.0 * math.pi / 3.0:
-            ea = A + _arc_displacement(r, d1, axis, psi)
-        else:
+        if psi <= 2.0 * math.pi / 3.0:  # arc, then r straight: a CSC path with theta2 = 0
+            wa = A + _arc_displacement(r, d1, axis, psi) + r * m
+        else:  # arc, 0.5 r straight, arc: a CSC path
             half = psi / 2.0
             u_mid = rotation_matrix(axis, half) @ d1
-            ea = (
+            wa = (
                 A
                 + _arc_displacement(r, d1, axis, half)
                 + 0.5 * r * u_mid
                 + _arc_displacement(r, u_mid, axis, half)
             )
-        wa = ea + r * m
         if float((wb - wa) @ m) >= 2.0 * r:
             R_turned = rotation_matrix(axis, psi) @ R_parent
             return [

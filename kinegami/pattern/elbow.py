@@ -37,7 +37,8 @@ class ElbowGeometry:
     tuck : ndarray, shape (n,)
         Tuck angles eps_k (flat angle minus 3D angle at column k, halved).
     collapsed : ndarray of bool, shape (n,)
-        Columns with h_k >= H_m - eps (one vertex Q_k instead of four).
+        Columns with h_k >= H_m - eps, or whose tuck offset (H_m - h_k) tan(eps_k) is below eps
+        (one vertex Q_k at (x_k, H_m) instead of four; fix B6).
     low : ndarray of bool, shape (n,)
         Columns with h_k < eps whose tuck boundary vertices reuse P_k and D_k (fix B6).
     """
@@ -97,7 +98,9 @@ def elbow_geometry(prism: Prism, bendingAngle: float, rotationalAxisAngle: float
     cos_b = np.einsum("ij,ij->i", u, w) / (np.linalg.norm(u, axis=1) * np.linalg.norm(w, axis=1))
     polygon = np.arccos(np.clip(cos_b, -1.0, 1.0))
     tuck = 0.5 * (flat - polygon)
-    collapsed = h >= H_m - eps
+    # a column collapses when its tuck vertices L, M, O would lie within eps of each other:
+    # h_k >= H_m - eps (spec), or the offset (H_m - h_k) tan(eps_k) of O_k below eps (fix B6)
+    collapsed = (h >= H_m - eps) | ((H_m - h) * np.tan(tuck) < eps)
     low = (h < eps) & ~collapsed
     return ElbowGeometry(theta, phi, d_w, h, H_m, tuck, collapsed, low)
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinegami.errors import InvalidParameterError
 from kinegami.pattern._build import assemble, crease_block
 from kinegami.pattern._prism import Prism, make_prism
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
@@ -256,7 +257,16 @@ def _build_revolute(
         blocks = _common_blocks(lay, half_midlines=True) + _single_sink_blocks(lay)
     else:
         blocks = _common_blocks(lay, half_midlines=False)  # fix B2: the chains cover them
-        vertices, sink_blocks = _sink_gadget(prism, lay, vertices, layers)
+        try:
+            vertices, sink_blocks = _sink_gadget(prism, lay, vertices, layers)
+        except _ChainOutsidePanel:
+            theta = record.params["totalBendingAngle"]
+            raise InvalidParameterError(
+                f"numSinkLayers={layers} cannot be folded with totalBendingAngle={theta!r} for "
+                f"numSides={prism.numSides}: the crimp is so low that a projected sink chain "
+                "(spec 3.5) leaves its panel and the creases would overlap; use "
+                "numSinkLayers=1 or a larger totalBendingAngle"
+            ) from None
         blocks += sink_blocks
     return assemble(prism, vertices, blocks, lay.P, lay.D, 2.0 * geo.H, record)
 
@@ -285,10 +295,20 @@ def _crimp_chain(G: np.ndarray, C: np.ndarray, N: int, d: float) -> np.ndarray:
     return chain
 
 
-def _projected_chain(Y: np.ndarray, C: np.ndarray, inner: np.ndarray, N: int) -> np.ndarray:
-    u = (Y - C) / np.linalg.norm(Y - C)
+class _ChainOutsidePanel(Exception):
+    """A projected sink chain's first inner point is not between its outer point and C."""
+
+
+def _projected_chain(
+    Y: np.ndarray, C: np.ndarray, inner: np.ndarray, N: int, eps: float
+) -> np.ndarray:
+    span = float(np.linalg.norm(Y - C))
+    u = (Y - C) / span
     g = inner - C
-    rho = float(g @ g) / float(u @ g)
+    along = float(u @ g)
+    rho = float(g @ g) / along if along > 0 else math.inf
+    if not eps < rho < span - eps:
+        raise _ChainOutsidePanel
     j = np.arange(N + 1)[:, None]
     chain = C + ((N - j) / (N - 1)) * rho * u
     chain[0] = Y
@@ -344,9 +364,9 @@ def _sink_gadget(
                 Up, Lo = lay.U[col], lay.K[col]
                 up = _crimp_chain(at(Up, x), Cxy, N, d)
                 lo = _crimp_chain(at(Lo, x), Cxy, N, d)
-                top = _projected_chain(at(T, x), Cxy, up[1], N)
-                bot = _projected_chain(at(B, x), Cxy, lo[1], N)
-                mid = _projected_chain(at(Mid, x), Cxy, lo[1], N)
+                top = _projected_chain(at(T, x), Cxy, up[1], N, prism.eps)
+                bot = _projected_chain(at(B, x), Cxy, lo[1], N, prism.eps)
+                mid = _projected_chain(at(Mid, x), Cxy, lo[1], N, prism.eps)
                 first_up = "M" if name == "L" else "V"
                 side[name] = {
                     "up": add_chain(up, Up, c_idx, _alternating(N, first_up)),

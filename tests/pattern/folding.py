@@ -78,8 +78,14 @@ def elbow_numbers(n: int, r: float, theta: float, phi: float) -> dict:
         u, w = q[(k + 1) % n] - q[k], q[k - 1] - q[k]
         B[k] = math.acos(u @ w / (np.linalg.norm(u) * np.linalg.norm(w)))
     eps = 1e-4 * b
-    return {"theta": theta, "phi": phi, "d_w": d_w, "h": h, "H_m": H_m, "tuck": (A - B) / 2,
-            "q": q, "collapsed": h >= H_m - eps, "low": h < eps, "eps": eps}  # fmt: skip
+    tuck = (A - B) / 2
+    collapsed = (h >= H_m - eps) | ((H_m - h) * np.tan(tuck) < eps)  # with the B6 extension
+    low = (h < eps) & ~collapsed
+    # exact: no column was moved by the eps rules (else lengths agree to within a few eps)
+    moved = np.concatenate([H_m - h[collapsed], h[low]])
+    return {"theta": theta, "phi": phi, "d_w": d_w, "h": h, "H_m": H_m, "tuck": tuck, "q": q,
+            "collapsed": collapsed, "low": low, "eps": eps,
+            "exact": bool(moved.max(initial=0.0) < 1e-12)}  # fmt: skip
 
 
 def elbow_transform(r: float, theta: float, phi: float):
@@ -126,7 +132,8 @@ def fold_elbow(pattern, theta: float, phi: float) -> np.ndarray:
             rel[0] = periodic(rel[0], pattern.width)
             return qk + (rel @ e1) * f1 + (rel @ e2) * f2
 
-        O = (x[k] + (H_m - h[k]) * math.tan(e["tuck"][k]), H_m)
+        offset = 0.0 if e["collapsed"][k] else (H_m - h[k]) * math.tan(e["tuck"][k])
+        O = ((x[k] + offset) % pattern.width, H_m)
         M1 = (x[k1], H_m)
         pos.at(O, F(O))
         pos.at(M1, F(M1))

@@ -61,8 +61,8 @@ def test_elbow_is_isometric_including_tucked_strip(n, theta, phi):
     X = fold_elbow(p, theta, phi)
     assert not np.isnan(X).any()
     e = elbow_numbers(n, 1.0, theta, phi)
-    # fix B6 moves L_k onto P_k when 0 < h_k < eps: lengths then agree to within eps only
-    tol = TOL if e["h"][e["low"]].max(initial=0.0) < 1e-12 else e["eps"]
+    # fix B6 moves tuck vertices by less than eps (P_k reused, columns collapsed)
+    tol = TOL if e["exact"] else 10 * e["eps"]
     assert crease_length_errors(p, X).max() < tol
 
 

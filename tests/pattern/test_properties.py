@@ -103,7 +103,7 @@ def test_elbow_invariants_height_and_isometry(n, r, theta, phi, negative):
     assert len(collapsed) in (1, 2)
     if len(collapsed) == 2:
         assert (collapsed[1] - collapsed[0]) % n in (1, n - 1)
-    tol = 1e-9 * max(1.0, r) if e["h"][e["low"]].max(initial=0.0) < 1e-12 else e["eps"]
+    tol = 1e-9 * max(1.0, r) if e["exact"] else 10 * e["eps"]
     assert crease_length_errors(p, fold_elbow(p, theta, phi)).max() < tol
 
 
@@ -118,7 +118,12 @@ def test_elbow_opposite_angle_is_identical(n, r, theta, phi):
 @SETTINGS
 @given(sides, radii, st.floats(0.1, 2 * math.pi - 0.1), st.integers(1, 3))
 def test_revolute_invariants(n, r, theta_m, N):
-    p = RevoluteJointPattern(n, r, theta_m, numSinkLayers=N)
+    try:
+        p = RevoluteJointPattern(n, r, theta_m, numSinkLayers=N)
+    except InvalidParameterError as error:
+        # nested sinks need a high enough crimp (see docs/patterns.md); one layer always works
+        assert N >= 2 and "cannot be folded" in str(error)
+        return
     _check_invariants(p)
     _, a, _ = prism_numbers(n, r)
     assert_allclose(p.height, 2 * a / math.cos(theta_m / 4), rtol=1e-12)
@@ -185,7 +190,9 @@ def _module(draw, n, r):
     if kind == "elbow":
         return ElbowFittingPattern(n, r, draw(elbow_angles), draw(angles))
     if kind == "revolute":
-        return RevoluteJointPattern(n, r, draw(st.floats(0.3, 6.0)), draw(st.integers(1, 2)))
+        if draw(st.booleans()):
+            return RevoluteJointPattern(n, r, draw(st.floats(0.3, 6.0)))
+        return RevoluteJointPattern(n, r, draw(st.floats(2.0, 6.0)), numSinkLayers=2)
     if kind == "rebo":
         return REBOPattern(n, r, 0.2 * r, 2, 1.0)
     return WaypointPattern(n, r)

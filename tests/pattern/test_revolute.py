@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
+from kinegami.errors import InvalidParameterError
 from kinegami.pattern import EndTipPattern, RevoluteJointPattern, StartTipPattern
 from kinegami.pattern._prism import make_prism
 from kinegami.pattern.revolute import revolute_geometry
@@ -178,3 +179,14 @@ def test_start_tip_is_reversed_end_tip():
     assert_allclose(start.vertices_coords[start.distalBase][:, 1], start.height)
     assert_allclose(start.proximalMarker, [0.0, 0.0])
     assert_allclose(start.distalMarker, [0.0, start.height])
+
+
+def test_sink_layers_with_too_low_a_crimp_are_rejected():
+    """A projected chain (3.5) leaving its panel would make overlapping creases."""
+    with pytest.raises(InvalidParameterError, match="numSinkLayers=3 cannot be folded"):
+        RevoluteJointPattern(6, 1.0, 1.0, numSinkLayers=3)
+
+
+@pytest.mark.parametrize("n", [4, 6, 8, 10, 12, 16, 20])
+def test_two_sink_layers_fold_at_pi(n):
+    assert RevoluteJointPattern(n, 1.0, math.pi, numSinkLayers=2).validate().ok

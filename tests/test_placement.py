@@ -1,0 +1,91 @@
+"""The radial safe placement on its own: every link it asks for exists (docs/placement.md)."""
+
+import warnings
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from kinegami import (
+    KinematicChain,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+from kinegami.geometry.balls import Ball
+from kinegami.placement import radial_safe_placement
+
+
+def _pose(rotvec, translation):
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_rotvec(rotvec).as_matrix()
+    T[:3, 3] = translation
+    return T
+
+
+vectors = st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array)
+
+
+@settings(deadline=None, max_examples=150)
+@given(
+    r=st.sampled_from([0.05, 1.0, 20.0]),
+    numSides=st.sampled_from([4, 6, 8]),
+    kind=st.integers(0, 2),
+    path_index=st.integers(0, 2),
+    rotvec=vectors.map(lambda v: 3.0 * v),
+    offset=vectors.map(lambda v: 6.0 * v),
+    parent_rotvec=vectors.map(lambda v: 3.0 * v),
+    parent_offset=vectors,
+    ball_radius=st.floats(1.5, 40.0),
+)
+def test_radial_placement_links_always_exist(
+    r, numSides, kind, path_index, rotvec, offset, parent_rotvec, parent_offset, ball_radius
+):
+    # a parent inside a ball of radius R, anywhere within it, in any orientation
+    R = ball_radius * r
+    parent_T = _pose(parent_rotvec, parent_offset * (R - 1.5 * r) / np.sqrt(3.0))
+    parent = RevoluteJoint(numSides, r, np.pi, parent_T)
+    T = parent_T @ _pose(rotvec, offset * r)
+    joint = [
+        RevoluteJoint(numSides, r, 2.0, T),
+        PrismaticJoint(numSides, r, 3 * r, 3, np.pi / 3, T),
+        Waypoint(numSides, r, T, pathIndex=path_index),
+    ][kind]
+    chain = KinematicChain(parent)
+    ball = Ball(np.zeros(3), R)
+    chain._ball = ball  # the placement only reads the ball
+    new = radial_safe_placement(parent.distal_frame(), parent.pathIndex(), joint, ball)
+    joints, links, _ = chain._extended(new)  # raises NoPathError if any link is missing
+    placed = new[-1]
+    # the joint keeps its axis line and lies at least 4r + rho beyond the ball
+    z_old, z_new = T[:3, 2], placed.pose_matrix[:3, 2]
+    assert np.linalg.norm(np.cross(z_old, z_new)) < 1e-12
+    assert np.linalg.norm(np.cross(placed.pose_matrix[:3, 3] - T[:3, 3], z_old)) < 1e-9 * r
+    assert (
+        np.linalg.norm(placed.pose_matrix[:3, 3]) >= R + 4 * r + placed.bounding_radius() - 1e-9 * r
+    )
+    for link in links[1:]:
+        assert link.path.theta1 < np.pi and link.path.theta2 < np.pi
+
+
+def test_safe_appends_on_long_random_chain_never_fail():
+    rng = np.random.default_rng(7)
+    r = 1.0
+    chain = KinematicChain(StartTip(4, r, np.eye(4), r))
+    for i in range(48):
+        T = _pose(
+            Rotation.random(random_state=int(rng.integers(1 << 31))).as_rotvec(),
+            rng.uniform(-4 * r, 4 * r, 3),
+        )
+        joint = (
+            RevoluteJoint(4, r, np.pi, T)
+            if i % 2 == 0
+            else PrismaticJoint(4, r, 3 * r, 3, np.pi / 4, T)
+        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            assert chain.append(joint) is not None
+    assert chain.boundingBall.r <= 10 * r * 48
+    assert chain.totalPathLength() <= 60 * r * 48
