@@ -39,17 +39,17 @@ __all__ = [
     "CHAIN_PLOT_DEFAULTS",
 ]
 
-# --- frame axes (every drawn frame: joint frames and the world frame) -------------------------
+# --- frame axes (every drawn frame: joint frames and the world frame) ---
 xColor = "orangered"
 yColor = "lightgreen"
 zColor = "darkblue"
 
-# --- origin markers of a joint's frames --------------------------------------------------------
+# --- origin markers of a joint's frames ---
 proximalColor = "c"
 centerColor = "m"
 distalColor = "y"
 
-# --- bodies and surfaces -------------------------------------------------------------------------
+# --- bodies and surfaces ---
 jointColor = "darkblue"
 linkColor = "lightgray"
 #: Alpha of joint and link surfaces.
@@ -57,13 +57,13 @@ surfaceOpacity = 0.5
 #: Straight tubes and elbows are drawn with this many sides (smooth, independent of numSides).
 linkSurfaceSides = 32
 
-# --- axes of motion -------------------------------------------------------------------------------
+# --- axes of motion ---
 #: Revolute and prismatic axes are drawn from p - jointAxisScale*r*z to p + jointAxisScale*r*z.
 jointAxisScale = 10
 jointAxisColor = "silver"
 jointAxisLineStyle = "--"
 
-# --- link centreline and construction geometry ----------------------------------------------------
+# --- link centreline and construction geometry ---
 pathColor = "black"
 #: Marker at the ends q1, q2 of each straight segment.
 pathMarker = "*"
@@ -73,12 +73,12 @@ pathCircleColors = ("red", "blue")
 linkPoseColors = ("darkred", "darkblue", "darkgreen")
 rotationAxisColor = "dimgray"
 
-# --- bounding spheres -------------------------------------------------------------------------------
+# --- bounding spheres ---
 sphereColor = "black"
 #: Alpha of each joint's bounding ball (the chain's ball is a wireframe).
 jointSphereOpacity = 0.05
 
-# --- world frame and ground plane -----------------------------------------------------------------
+# --- world frame and ground plane ---
 #: The world frame's arrows have length globalAxisScale*r.
 globalAxisScale = 10
 #: The ground plane z = 0 spans [-groundPlaneScale*r, groundPlaneScale*r] in x and y.

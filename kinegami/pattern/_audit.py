@@ -10,6 +10,7 @@ from kinegami.pattern.counts import expected_counts
 from kinegami.pattern.tubular import TubularPattern
 
 _SHOWN = 8  # how many offending indices a message lists
+_TIGHT = 1.0 - 1e-6  # points exactly eps apart (up to rounding) are distinct, as in composition
 
 
 def _listing(indices) -> str:
@@ -61,7 +62,7 @@ def _vertex_tree(p: TubularPattern) -> tuple[cKDTree, np.ndarray]:
 
 
 def _check_duplicate_vertices(p: TubularPattern, tree: cKDTree) -> list[str]:
-    pairs = tree.query_pairs(p.eps, output_type="ndarray")
+    pairs = tree.query_pairs(p.eps * _TIGHT, output_type="ndarray")
     if not pairs.shape[0]:
         return []
     listed = "; ".join(f"{i}-{j}" for i, j in pairs[:_SHOWN])
@@ -78,7 +79,7 @@ def _check_creases(p: TubularPattern) -> list[str]:
         return out
     vectors = p.crease_vectors()
     lengths = np.hypot(vectors[:, 0], vectors[:, 1])
-    bad = np.flatnonzero(lengths < p.eps)
+    bad = np.flatnonzero(lengths < p.eps * _TIGHT)
     if bad.size:
         out.append(f"{bad.size} zero-length creases (shorter than eps): creases {_listing(bad)}")
     e = p.edges_vertices

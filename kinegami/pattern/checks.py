@@ -1,4 +1,4 @@
-"""Parameter checks used only by the pattern catalog (the shared ones are in kinegami.validation)."""
+"""Parameter checks used only by the pattern catalog (shared ones: kinegami.validation)."""
 
 from __future__ import annotations
 

@@ -85,7 +85,7 @@ def normalise_elbow_angles(bendingAngle: float, rotationalAxisAngle: float) -> t
 def elbow_geometry(prism: Prism, bendingAngle: float, rotationalAxisAngle: float) -> ElbowGeometry:
     """Column heights, tuck angles and collapsed columns of an elbow (section 3.3)."""
     theta, phi = normalise_elbow_angles(bendingAngle, rotationalAxisAngle)
-    n, r, b, eps = prism.numSides, prism.r, prism.b, prism.eps
+    r, b, eps = prism.r, prism.b, prism.eps
     beta = prism.vertex_angles
     d_w = r * math.tan(theta / 2.0)
     h = d_w * (1.0 + np.sin(beta - phi))
@@ -140,12 +140,13 @@ def ElbowFittingPattern(
     adjacent = c == 1 or (c == 2 and np.any(geo.collapsed & np.roll(geo.collapsed, 1)))
     if not adjacent:
         raise InvalidParameterError(
-            f"bendingAngle {bendingAngle!r} is too small to resolve for numSides={n}, r={prism.r:g}: "
-            f"{c} columns lie within the tolerance {prism.eps:.3g} of the midline (at most two "
-            "adjacent ones are allowed)"
+            f"bendingAngle {bendingAngle!r} is too small to resolve for numSides={n}, "
+            f"r={prism.r:g}: {c} columns lie within the tolerance {prism.eps:.3g} of the midline "
+            "(at most two adjacent ones are allowed)"
         )
     record = ModuleRecord(
-        "elbow", {"bendingAngle": float(bendingAngle), "rotationalAxisAngle": float(rotationalAxisAngle)}
+        "elbow",
+        {"bendingAngle": float(bendingAngle), "rotationalAxisAngle": float(rotationalAxisAngle)},
     )
     return _build_elbow(prism, geo, record)
 
@@ -159,14 +160,14 @@ def _build_elbow(prism: Prism, geo: ElbowGeometry, record: ModuleRecord) -> Tubu
     P, D = k, n + k
     full = ~geo.collapsed
     low = geo.low
-    # vertex list: P, D, then per column Q (collapsed) or L, M, O, U (L/U omitted when low)
+    # vertices: P, D, then per column Q (collapsed) or L, M, O (array Of), U (no L, U when low)
     has_l = full & ~low
     counts = np.where(geo.collapsed, 1, 2 + 2 * has_l.astype(int))
     start = 2 * n + np.concatenate([[0], np.cumsum(counts)[:-1]])
     M = start.copy()
     L = np.where(has_l, start, np.where(low, P, start))
     M = np.where(has_l, start + 1, np.where(low, start, start))
-    O = np.where(has_l, start + 2, np.where(low, start + 1, start))
+    Of = np.where(has_l, start + 2, np.where(low, start + 1, start))
     U = np.where(has_l, start + 3, np.where(low, D, start))
     total = 2 * n + int(counts.sum())
     vertices = np.empty((total, 2))
@@ -174,7 +175,7 @@ def _build_elbow(prism: Prism, geo: ElbowGeometry, record: ModuleRecord) -> Tubu
     vertices[D] = np.stack([x, np.full(n, H)], axis=1)
     offset = (H_m - h) * np.tan(geo.tuck)
     vertices[M] = np.stack([x, np.full(n, H_m)], axis=1)
-    vertices[O[full]] = np.stack(
+    vertices[Of[full]] = np.stack(
         [wrap_x(x[full] + offset[full], prism.W, prism.eps), np.full(int(full.sum()), H_m)], axis=1
     )
     vertices[L[has_l]] = np.stack([x[has_l], h[has_l]], axis=1)
@@ -187,11 +188,11 @@ def _build_elbow(prism: Prism, geo: ElbowGeometry, record: ModuleRecord) -> Tubu
         crease_block(P, L, "M"),  # proximal tube edge
         crease_block(U[prev], U, "M"),  # upper tuck boundary
         crease_block(U, D, "M"),  # distal tube edge
-        crease_block(M, O, "V"),  # midline
-        crease_block(O, M[nxt], "V"),  # midline
+        crease_block(M, Of, "V"),  # midline
+        crease_block(Of, M[nxt], "V"),  # midline
         crease_block(L, M, "V"),  # lower half of the column line
         crease_block(M, U, "M"),  # upper half of the column line
-        crease_block(L, O, "M"),  # lower tuck diagonal
-        crease_block(U, O, "V"),  # upper tuck diagonal
+        crease_block(L, Of, "M"),  # lower tuck diagonal
+        crease_block(U, Of, "V"),  # upper tuck diagonal
     ]
     return assemble(prism, vertices, blocks, P, D, H, record)

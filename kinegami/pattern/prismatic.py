@@ -59,11 +59,17 @@ def _check_rebo(numSides, r, neutralLength, numLayers, coneAngle, low: float):
     else:
         beta = check_in_range("coneAngle", coneAngle, 0.0, 0.5 * math.pi, range_text="(0, pi/2)")
     geo = rebo_geometry(prism, d, N, beta)
+    given = f"neutralLength={d!r}, numLayers={N}, coneAngle={beta!r}"
     if not geo.offset < prism.b - prism.eps:
         raise InvalidParameterError(
             f"REBO pleat offset o = l1 cot(alpha_f) = {geo.offset:.6g} must be < b = {prism.b:.6g} "
-            f"(else creases cross); got neutralLength={d!r}, numLayers={N}, coneAngle={beta!r}: "
-            "use more layers or a shorter neutralLength"
+            f"(else creases cross); got {given}: use more layers or a shorter neutralLength"
+        )
+    if not min(geo.offset, geo.l1) > prism.eps:
+        raise InvalidParameterError(
+            f"REBO pleat offset o = {geo.offset:.6g} and layer half-height l1 = {geo.l1:.6g} "
+            f"must exceed the tolerance eps = {prism.eps:.3g} (else creases have zero length); "
+            f"got {given}: use fewer layers or a coneAngle further from pi/2"
         )
     return prism, d, N, beta, geo
 
@@ -99,7 +105,8 @@ def REBOPattern(
     Raises
     ------
     InvalidParameterError
-        Also when the pleat offset o = l1 cot(alpha_f) is not below b (fix B11).
+        Also when the pleat offset o = l1 cot(alpha_f) is not below b (fix B11), or when o or
+        the layer half-height l1 is below eps = 1e-4 b (the creases would have zero length).
     """
     prism, d, N, beta, geo = _check_rebo(numSides, r, neutralLength, numLayers, coneAngle, 0.0)
     valleys = check_bool("proximalValleys", proximalValleys)
@@ -119,17 +126,15 @@ def _build_rebo(
     k = np.arange(n)
     rows = np.arange(N + 1)
     layers = np.arange(N)
-    # indices: B[i, k] rows 0..N, then A[i, k], then O[i, k], layers 0..N-1
+    # indices: B[i, k] rows 0..N, then A[i, k], then O[i, k] (array Of), layers 0..N-1
     B = rows[:, None] * n + k[None, :]
     A = (N + 1) * n + layers[:, None] * n + k[None, :]
-    O = (2 * N + 1) * n + layers[:, None] * n + k[None, :]
+    Of = (2 * N + 1) * n + layers[:, None] * n + k[None, :]
     vertices = np.empty(((3 * N + 1) * n, 2))
-    vertices[B.ravel()] = np.stack(
-        [np.tile(x, N + 1), np.repeat(2.0 * l1 * rows, n)], axis=1
-    )
+    vertices[B.ravel()] = np.stack([np.tile(x, N + 1), np.repeat(2.0 * l1 * rows, n)], axis=1)
     mid_y = np.repeat((2.0 * layers + 1.0) * l1, n)
     vertices[A.ravel()] = np.stack([np.tile(x, N), mid_y], axis=1)
-    vertices[O.ravel()] = np.stack(
+    vertices[Of.ravel()] = np.stack(
         [np.tile(wrap_x(x - geo.offset, prism.W, prism.eps), N), mid_y], axis=1
     )
     nxt = (k + 1) % n
@@ -141,10 +146,10 @@ def _build_rebo(
         crease_block(Bl.ravel(), Bl[:, nxt].ravel(), ring.ravel()),
         crease_block(Bl.ravel(), A.ravel(), "M"),
         crease_block(A.ravel(), Bu.ravel(), "M"),
-        crease_block(O.ravel(), A.ravel(), "M"),
-        crease_block(A.ravel(), O[:, nxt].ravel(), "V"),
-        crease_block(O.ravel(), Bl.ravel(), "V"),
-        crease_block(O.ravel(), Bu.ravel(), "V"),
+        crease_block(Of.ravel(), A.ravel(), "M"),
+        crease_block(A.ravel(), Of[:, nxt].ravel(), "V"),
+        crease_block(Of.ravel(), Bl.ravel(), "V"),
+        crease_block(Of.ravel(), Bu.ravel(), "V"),
         crease_block(B[N], B[N][nxt], "M"),
     ]
     return assemble(prism, vertices, blocks, B[0], B[N], geo.height, record)
@@ -190,9 +195,7 @@ def PrismaticJointPattern(
     rebo = _build_rebo(prism, geo, N, True, ModuleRecord("rebo", {}))
     piston = _tube(prism, L, "M", ModuleRecord("tube", {"height": L}))
     whole = TubularPattern.concatenate([sleeve, lining, rebo, piston])
-    record = ModuleRecord(
-        "prismatic", {"neutralLength": d, "numLayers": N, "coneAngle": beta}
-    )
+    record = ModuleRecord("prismatic", {"neutralLength": d, "numLayers": N, "coneAngle": beta})
     return TubularPattern._build(
         n, prism.r, whole.vertices_coords.copy(), whole.edges_vertices.copy(),
         whole.edges_assignment.copy(), whole.proximalBase.copy(), whole.distalBase.copy(),

@@ -67,6 +67,18 @@ def revolute_geometry(prism: Prism, h_r: float) -> RevoluteGeometry:
     return RevoluteGeometry(h_r, H, psi, crimped, t)
 
 
+def _check_resolvable(prism: Prism, geo: RevoluteGeometry, name: str, value: float) -> None:
+    """Reject parameters so extreme that a crimp vertex lands within eps of P_k or M_k."""
+    t = geo.t[geo.crimped]
+    if t.size and not (t.min() > prism.eps and (geo.H - t).min() > prism.eps):
+        raise InvalidParameterError(
+            f"{name}={value!r} is too close to the end of its range for numSides="
+            f"{prism.numSides}, r={prism.r:g}: a crimp vertex would lie within the tolerance "
+            f"eps = {prism.eps:.3g} of a base or midline vertex (crimp heights in "
+            f"[{t.min():.3g}, {t.max():.3g}], half height {geo.H:.6g})"
+        )
+
+
 def RevoluteJointPattern(
     numSides: int, r: float, totalBendingAngle: float, numSinkLayers: int = 1
 ) -> TubularPattern:
@@ -87,6 +99,13 @@ def RevoluteJointPattern(
         theta_m in (0, 2 pi), radians; the joint's state range is [-theta_m/2, theta_m/2].
     numSinkLayers : int, optional
         Number N >= 1 of nested sink layers (default 1).
+
+    Raises
+    ------
+    InvalidParameterError
+        For out-of-range parameters; for an angle so close to 0 or 2 pi that a crimp vertex
+        would coincide (within eps = 1e-4 b) with a base or midline vertex; for N >= 2 when the
+        crimps are too low for the nested sink chains to stay inside their panels.
     """
     prism = make_prism(numSides, r)
     theta = check_in_range(
@@ -95,9 +114,8 @@ def RevoluteJointPattern(
     layers = check_int("numSinkLayers", numSinkLayers, minimum=1)
     h_r = prism.a * math.tan(theta / 4.0)
     geo = revolute_geometry(prism, h_r)
-    record = ModuleRecord(
-        "revolute", {"totalBendingAngle": theta, "numSinkLayers": layers}
-    )
+    _check_resolvable(prism, geo, "totalBendingAngle", theta)
+    record = ModuleRecord("revolute", {"totalBendingAngle": theta, "numSinkLayers": layers})
     return _build_revolute(prism, geo, layers, record)
 
 
@@ -115,11 +133,13 @@ def EndTipPattern(numSides: int, r: float, length: float) -> TubularPattern:
         Tube circumradius (> 0).
     length : float
         Axial distance l > 0 from the base to the closing segment; pattern height
-        sqrt(a^2 + l^2).
+        sqrt(a^2 + l^2). Extreme lengths whose crimp vertex would lie within eps = 1e-4 b of a
+        base or midline vertex are rejected.
     """
     prism = make_prism(numSides, r)
     ell = check_positive("length", length)
     geo = revolute_geometry(prism, ell)
+    _check_resolvable(prism, geo, "length", ell)
     return _build_end_tip(prism, geo, ModuleRecord("end_tip", {"length": ell}))
 
 
@@ -209,9 +229,7 @@ def _common_blocks(lay: _Layout, half_midlines: bool) -> list:
                 [M[0], C[mp - 1], M[mp + 1], C[ep - 1]], [C[0], M[mp], C[mp + 1], M[ep]], "M"
             )
         )
-    blocks.append(
-        crease_block([M[mp], C[mp], M[ep], C[ep]], [C[mp], M[mp + 1], C[ep], M[0]], "V")
-    )
+    blocks.append(crease_block([M[mp], C[mp], M[ep], C[ep]], [C[mp], M[mp + 1], C[ep], M[0]], "V"))
     cr = lay.crimped
     K = lay.K
     blocks.append(crease_block(P[cr], K[cr], "M"))
@@ -259,7 +277,7 @@ def _build_revolute(
         blocks = _common_blocks(lay, half_midlines=False)  # fix B2: the chains cover them
         try:
             vertices, sink_blocks = _sink_gadget(prism, lay, vertices, layers)
-        except _ChainOutsidePanel:
+        except _ChainOutsidePanelError:
             theta = record.params["totalBendingAngle"]
             raise InvalidParameterError(
                 f"numSinkLayers={layers} cannot be folded with totalBendingAngle={theta!r} for "
@@ -295,7 +313,7 @@ def _crimp_chain(G: np.ndarray, C: np.ndarray, N: int, d: float) -> np.ndarray:
     return chain
 
 
-class _ChainOutsidePanel(Exception):
+class _ChainOutsidePanelError(Exception):
     """A projected sink chain's first inner point is not between its outer point and C."""
 
 
@@ -308,7 +326,7 @@ def _projected_chain(
     along = float(u @ g)
     rho = float(g @ g) / along if along > 0 else math.inf
     if not eps < rho < span - eps:
-        raise _ChainOutsidePanel
+        raise _ChainOutsidePanelError
     j = np.arange(N + 1)[:, None]
     chain = C + ((N - j) / (N - 1)) * rho * u
     chain[0] = Y
@@ -377,8 +395,12 @@ def _sink_gadget(
                 }
             else:
                 side[name] = {
-                    "top": add_chain(_plain_chain(at(T, x), Cxy, N), T, c_idx, _alternating(N, "V")),
-                    "bot": add_chain(_plain_chain(at(B, x), Cxy, N), B, c_idx, _alternating(N, "V")),
+                    "top": add_chain(
+                        _plain_chain(at(T, x), Cxy, N), T, c_idx, _alternating(N, "V")
+                    ),
+                    "bot": add_chain(
+                        _plain_chain(at(B, x), Cxy, N), B, c_idx, _alternating(N, "V")
+                    ),
                     # fix B3: the uncrimped horizontal chain is M, V, M, ... on both sides
                     "mid": add_chain(
                         _plain_chain(at(Mid, x), Cxy, N), Mid, c_idx, _alternating(N, "M")

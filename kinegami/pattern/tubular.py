@@ -256,7 +256,7 @@ class TubularPattern:
 
     @classmethod
     def _build(cls, n, r, vertices, edges, assignment, proximal, distal, pm, dm, height, modules,
-               removed=0, distal_keys=None, internal_duplicates=None) -> TubularPattern:  # fmt: skip
+               removed=0, distal_keys=None, internal_duplicates=None):  # fmt: skip
         """Internal constructor from arrays that are already valid (no checks, no copies)."""
         self = object.__new__(cls)
         self._init(n, r, vertices, edges, assignment, proximal, distal, pm, dm, height, modules,
@@ -372,8 +372,7 @@ class TubularPattern:
         assignment = np.concatenate([self.edges_assignment, step.assignment])
         return TubularPattern._build(
             self.numSides, self.r, vertices, edges, assignment,
-            None if self.proximalBase is None else self.proximalBase,
-            step.state.distal_idx, self.proximalMarker, step.state.marker,
+            self.proximalBase, step.state.distal_idx, self.proximalMarker, step.state.marker,
             self.height + other.height, self.modules + other.modules,
             self.removedDuplicates + other.removedDuplicates + step.removed,
             step.state.distal_keys, self._has_internal_duplicates,
@@ -445,7 +444,8 @@ class TubularPattern:
             self.numSides, self.r, vertices, self.edges_vertices.copy(),
             self.edges_assignment.copy(), _copy_or_none(self.distalBase),
             _copy_or_none(self.proximalBase),
-            np.array([self.distalMarker[0], y0]), np.array([self.proximalMarker[0], y0 + self.height]),
+            np.array([self.distalMarker[0], y0]),
+            np.array([self.proximalMarker[0], y0 + self.height]),
             self.height, modules, self.removedDuplicates, None, self._has_internal_duplicates,
         )  # fmt: skip
 

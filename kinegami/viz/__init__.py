@@ -1,0 +1,1 @@
+"""Plotting backends (matplotlib); the model imports them lazily from ``show()``."""

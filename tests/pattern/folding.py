@@ -17,18 +17,21 @@ from .helpers import find_vertex, periodic, polygon_point, prism_numbers, rotati
 class _Positions:
     """Collects 3D positions, checking that a vertex given twice gets the same point."""
 
-    def __init__(self, pattern):
+    def __init__(self, pattern, tol: float = 1e-9):
         self.pattern = pattern
+        self.tol = tol
         self.X = np.full((pattern.numVertices, 3), np.nan)
 
     def set(self, index: int, point) -> None:
         point = np.asarray(point, dtype=float)
         if not np.isnan(self.X[index, 0]):
-            assert np.allclose(self.X[index], point, atol=1e-9), (index, self.X[index], point)
+            assert np.allclose(self.X[index], point, atol=self.tol), (index, self.X[index], point)
         self.X[index] = point
 
     def at(self, xy, point) -> int:
-        index = find_vertex(self.pattern, xy)
+        # vertices moved by the eps rules (section 2.1 snapping, fix B6) are within eps
+        tol = max(1e-6, 1.5e-4 * self.pattern.sideLength)
+        index = find_vertex(self.pattern, xy, tol=tol, nearest=True)
         self.set(index, point)
         return index
 
@@ -83,9 +86,15 @@ def elbow_numbers(n: int, r: float, theta: float, phi: float) -> dict:
     low = (h < eps) & ~collapsed
     # exact: no column was moved by the eps rules (else lengths agree to within a few eps)
     moved = np.concatenate([H_m - h[collapsed], h[low]])
+    # offset vertices within eps of the seam are snapped onto it (section 2.1)
+    O_x = np.mod((np.arange(n) + 0.5) * b + (H_m - h) * np.tan(tuck), n * b)[~collapsed]
+    seam = np.minimum(O_x, n * b - O_x)
+    moved = np.concatenate([moved, seam[(seam < eps) & (seam > 1e-12)]])
     return {"theta": theta, "phi": phi, "d_w": d_w, "h": h, "H_m": H_m, "tuck": tuck, "q": q,
             "collapsed": collapsed, "low": low, "eps": eps,
-            "exact": bool(moved.max(initial=0.0) < 1e-12)}  # fmt: skip
+            "exact": bool(moved.max(initial=0.0) < 1e-12),
+            # a vertex moved by up to eps tilts the tucked strip: lever arm H_m / b
+            "approx_tol": 10 * eps * (1 + H_m / b)}  # fmt: skip
 
 
 def elbow_transform(r: float, theta: float, phi: float):
@@ -106,7 +115,7 @@ def fold_elbow(pattern, theta: float, phi: float) -> np.ndarray:
     n_pi = rotation(g, theta / 2) @ np.array([0.0, 0.0, 1.0])
     p = vertex_points(n, r)
     x = (np.arange(n) + 0.5) * b
-    pos = _Positions(pattern)
+    pos = _Positions(pattern, 1e-9 if e["exact"] else e["approx_tol"])
     L = [None] * n
     for k in range(n):
         pos.set(pattern.proximalBase[k], p[k])
@@ -133,9 +142,9 @@ def fold_elbow(pattern, theta: float, phi: float) -> np.ndarray:
             return qk + (rel @ e1) * f1 + (rel @ e2) * f2
 
         offset = 0.0 if e["collapsed"][k] else (H_m - h[k]) * math.tan(e["tuck"][k])
-        O = ((x[k] + offset) % pattern.width, H_m)
+        O_k = ((x[k] + offset) % pattern.width, H_m)
         M1 = (x[k1], H_m)
-        pos.at(O, F(O))
+        pos.at(O_k, F(O_k))
         pos.at(M1, F(M1))
     return pos.X
 
@@ -163,7 +172,7 @@ def fold_revolute_half(pattern, h_r: float, with_distal: bool):
     n, r = pattern.numSides, pattern.r
     d = revolute_numbers(n, r, h_r)
     b, H, beta = d["b"], d["H"], d["beta"]
-    O = np.array([0.0, 0.0, h_r])
+    centre = np.array([0.0, 0.0, h_r])
     ev = np.array([0.0, 1.0, 0.0])
     p = vertex_points(n, r)
     x = (np.arange(n) + 0.5) * b
@@ -173,12 +182,12 @@ def fold_revolute_half(pattern, h_r: float, with_distal: bool):
         pos.set(pattern.proximalBase[k], p[k])
         if with_distal:
             pos.set(pattern.distalBase[k], p[k] + [0.0, 0.0, 2 * h_r])
-        pos.at((((k + 1) * b) % pattern.width, H), O)  # C_k
+        pos.at((((k + 1) * b) % pattern.width, H), centre)  # C_k
         if k in d["flap"]:
-            pos.at((x[k], H), O + np.sign(math.sin(beta[k])) * (b / 2) * ev)
+            pos.at((x[k], H), centre + np.sign(math.sin(beta[k])) * (b / 2) * ev)
         else:
             skipped.append(find_vertex(pattern, (x[k], H)))
-            pos.at((x[k], d["t"][k]), O + d["s"][k] * ev)
+            pos.at((x[k], d["t"][k]), centre + d["s"][k] * ev)
             if with_distal:
-                pos.at((x[k], 2 * H - d["t"][k]), O + d["s"][k] * ev)
+                pos.at((x[k], 2 * H - d["t"][k]), centre + d["s"][k] * ev)
     return pos.X, skipped

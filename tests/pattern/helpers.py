@@ -19,11 +19,15 @@ def periodic(dx, W):
     return dx - W * np.round(dx / W)
 
 
-def find_vertex(pattern, xy, tol: float = 1e-6) -> int:
-    """Index of the unique vertex at ``xy`` (x compared modulo W)."""
+def find_vertex(pattern, xy, tol: float = 1e-6, nearest: bool = False) -> int:
+    """Index of the unique vertex at ``xy`` (x compared modulo W), or the nearest one within
+    ``tol`` when ``nearest`` is set."""
     v = pattern.vertices_coords
     dx = periodic(v[:, 0] - xy[0], pattern.width)
-    hits = np.flatnonzero((np.abs(dx) < tol) & (np.abs(v[:, 1] - xy[1]) < tol))
+    dy = v[:, 1] - xy[1]
+    hits = np.flatnonzero((np.abs(dx) < tol) & (np.abs(dy) < tol))
+    if nearest and hits.size > 1:
+        hits = hits[[np.argmin(np.hypot(dx[hits], dy[hits]))]]
     assert hits.size == 1, f"expected one vertex at {xy}, found {hits.size}"
     return int(hits[0])
 

@@ -44,7 +44,9 @@ def test_example_a_collapsed_pair_is_one_mountain():
     p = ElbowFittingPattern(4, 1.0, ELBOW_A["theta"], ELBOW_A["phi"])
     q0, q1 = (find_vertex(p, q) for q in ELBOW_A["Q"])
     e = p.edges_vertices
-    joined = np.flatnonzero(((e[:, 0] == q0) & (e[:, 1] == q1)) | ((e[:, 0] == q1) & (e[:, 1] == q0)))
+    joined = np.flatnonzero(
+        ((e[:, 0] == q0) & (e[:, 1] == q1)) | ((e[:, 0] == q1) & (e[:, 1] == q0))
+    )
     assert joined.size == 1 and p.edges_assignment[joined[0]] == "M"
 
 
@@ -104,9 +106,9 @@ def test_tuck_angles_positive_and_sum_to_pi():
 def test_labels_of_a_generic_column():
     """Column 2 of example A: the ten creases at L, M, O, U with the table's labels."""
     p = ElbowFittingPattern(4, 1.0, ELBOW_A["theta"], ELBOW_A["phi"])
-    L, M, O, U = (tuple(np.round(v, 5)) for v in ELBOW_A["columns"][2])
+    L, M, Ok, U = (tuple(np.round(v, 5)) for v in ELBOW_A["columns"][2])
     creases = crease_set(p, decimals=5)
-    for a, b, lab in ((L, M, "V"), (M, U, "M"), (L, O, "M"), (U, O, "V"), (M, O, "V")):
+    for a, b, lab in ((L, M, "V"), (M, U, "M"), (L, Ok, "M"), (U, Ok, "V"), (M, Ok, "V")):
         assert (min(a, b), max(a, b), lab) in creases
 
 

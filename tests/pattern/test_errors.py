@@ -46,7 +46,9 @@ def test_good_arguments_build(fn):
 @pytest.mark.parametrize("fn", list(GOOD))
 @pytest.mark.parametrize("n", [3, 5, 2, 0])
 def test_bad_num_sides(fn, n):
-    with pytest.raises(InvalidParameterError, match=rf"numSides must be an even integer >= 4, got {n}"):
+    with pytest.raises(
+        InvalidParameterError, match=rf"numSides must be an even integer >= 4, got {n}"
+    ):
         _call(fn, 0, n)
 
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from kinegami.pattern import EndTipPattern, ElbowFittingPattern, REBOPattern, RevoluteJointPattern
+from kinegami.pattern import ElbowFittingPattern, EndTipPattern, REBOPattern, RevoluteJointPattern
 
 from .folding import elbow_numbers, revolute_numbers
 from .helpers import find_vertex, incident, kawasaki_defect, maekawa_ok, mv_counts
@@ -29,10 +29,10 @@ def test_elbow_mid_and_offset_vertices(n, theta, phi):
     b = p.sideLength
     for k in np.flatnonzero(~e["collapsed"]):
         M = find_vertex(p, ((k + 0.5) * b, e["H_m"]))
-        O = find_vertex(p, ((k + 0.5) * b + (e["H_m"] - e["h"][k]) * math.tan(e["tuck"][k]),
+        Ok = find_vertex(p, ((k + 0.5) * b + (e["H_m"] - e["h"][k]) * math.tan(e["tuck"][k]),
                             e["H_m"]))  # fmt: skip
         _assert_flat_foldable(p, M, 4, 1)
-        _assert_flat_foldable(p, O, 4, 1)
+        _assert_flat_foldable(p, Ok, 4, 1)
 
 
 @pytest.mark.parametrize("n, d, N, beta", [(4, 2.0, 2, math.pi / 4), (6, 1.0, 3, 1.0),

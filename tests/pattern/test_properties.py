@@ -1,6 +1,7 @@
 """Property tests (hypothesis) of section 7.1 over random valid parameters."""
 
 import math
+import os
 
 import numpy as np
 from hypothesis import HealthCheck, assume, given, settings
@@ -24,7 +25,12 @@ from kinegami.pattern import (
 from .folding import elbow_numbers, fold_elbow, fold_revolute_half, fold_twist
 from .helpers import crease_length_errors, crease_set, prism_numbers
 
-SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# KINEGAMI_HYPOTHESIS_EXAMPLES raises the number of examples for a longer search
+SETTINGS = settings(
+    max_examples=int(os.environ.get("KINEGAMI_HYPOTHESIS_EXAMPLES", "40")),
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
 
 sides = st.sampled_from([4, 6, 8, 10, 12, 16])
 radii = st.floats(0.1, 10.0)
@@ -63,7 +69,13 @@ def test_twist_invariants_and_isometry(n, r, alpha, h):
         e = r * (math.cos(math.pi / n - beta) - math.cos(math.pi / n))
         assert_allclose(p.height, math.hypot(h * r, e), rtol=1e-12)
         X = fold_twist(p, alpha, h * r)
-        assert crease_length_errors(p, X).max() < 1e-9 * max(1.0, r)
+        b, _, W = prism_numbers(n, r)
+        s = r * (math.sin(math.pi / n) + math.sin(beta - math.pi / n))
+        raw = np.mod((np.arange(n) + 0.5) * b + s, W)
+        seam = np.minimum(raw, W - raw)
+        snapped = np.any((seam < p.eps) & (seam > 1e-12))  # moved onto the seam (2.1)
+        tol = p.eps if snapped else 1e-9 * max(1.0, r)
+        assert crease_length_errors(p, X).max() < tol
 
 
 @SETTINGS
@@ -103,7 +115,7 @@ def test_elbow_invariants_height_and_isometry(n, r, theta, phi, negative):
     assert len(collapsed) in (1, 2)
     if len(collapsed) == 2:
         assert (collapsed[1] - collapsed[0]) % n in (1, n - 1)
-    tol = 1e-9 * max(1.0, r) if e["exact"] else 10 * e["eps"]
+    tol = 1e-9 * max(1.0, r) if e["exact"] else e["approx_tol"]
     assert crease_length_errors(p, fold_elbow(p, theta, phi)).max() < tol
 
 
@@ -158,11 +170,11 @@ def test_rebo_invariants_or_clear_error(n, r, d, N, beta, valleys):
     b, _, _ = prism_numbers(n, r)
     l1 = d * r / (2 * N * math.sin(beta))
     o = l1 / math.tan(math.pi / 2 * (1 - 2 * math.cos(beta) / n))
-    if o >= b - 1e-4 * b:
+    if not (1e-4 * b < min(o, l1) and o < b - 1e-4 * b):
         try:
             REBOPattern(n, r, d * r, N, beta, valleys)
         except InvalidParameterError as error:
-            assert "offset" in str(error)
+            assert "offset" in str(error) and "coneAngle=" in str(error)
             return
         raise AssertionError("expected the offset check to fail")
     p = REBOPattern(n, r, d * r, N, beta, valleys)

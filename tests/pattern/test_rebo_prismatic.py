@@ -21,8 +21,8 @@ def _rebo():
 
 def test_rebo_geometry_reference_values():
     geo = rebo_geometry(make_prism(4, 1.0), REBO_4["d"], REBO_4["N"], REBO_4["beta"])
-    assert_allclose([geo.l1, geo.flat_cone_angle, geo.offset, geo.height],
-                    [REBO_4["l1"], REBO_4["alpha_f"], REBO_4["o"], REBO_4["H"]], atol=ATOL)  # fmt: skip
+    computed = [geo.l1, geo.flat_cone_angle, geo.offset, geo.height]
+    assert_allclose(computed, [REBO_4[k] for k in ("l1", "alpha_f", "o", "H")], atol=ATOL)
 
 
 def test_rebo_counts_and_height():
@@ -106,3 +106,9 @@ def test_prismatic_rejects_cone_angle_outside_pi6_pi2(beta):
 
 def test_prismatic_accepts_pi6():
     assert PrismaticJointPattern(4, 1.0, 0.5, 2, math.pi / 6).validate().ok
+
+
+def test_rebo_rejects_vanishing_offset():
+    """A cone angle very close to pi/2 makes o = l1 cot(alpha_f) shorter than eps."""
+    with pytest.raises(InvalidParameterError, match="must exceed the tolerance"):
+        REBOPattern(4, 1.0, 0.0625, 3, 1.5546875)

@@ -79,8 +79,11 @@ def test_revolute_crimp_labels():
     P, K, M, U, D = (1.5, 0.0), (1.5, t), (1.5, H), (1.5, u), (1.5, 2 * H)
     C0, C1 = (1.0, H), (2.0, H)
     creases = crease_set(p, decimals=5)
-    for a, b, lab in ((P, K, "M"), (K, M, "V"), (M, U, "M"), (U, D, "M"), (C0, K, "M"),
-                      (K, C1, "M"), (C0, U, "V"), (U, C1, "M"), (C0, M, "V"), (M, C1, "V")):  # fmt: skip
+    expected = [
+        (P, K, "M"), (K, M, "V"), (M, U, "M"), (U, D, "M"), (C0, K, "M"),
+        (K, C1, "M"), (C0, U, "V"), (U, C1, "M"), (C0, M, "V"), (M, C1, "V"),
+    ]  # fmt: skip
+    for a, b, lab in expected:
         a, b = tuple(np.round(a, 5)), tuple(np.round(b, 5))
         assert (min(a, b), max(a, b), lab) in creases
 
@@ -190,3 +193,15 @@ def test_sink_layers_with_too_low_a_crimp_are_rejected():
 @pytest.mark.parametrize("n", [4, 6, 8, 10, 12, 16, 20])
 def test_two_sink_layers_fold_at_pi(n):
     assert RevoluteJointPattern(n, 1.0, math.pi, numSinkLayers=2).validate().ok
+
+
+@pytest.mark.parametrize("theta_m", [1e-9, 2 * math.pi - 1e-6])
+def test_revolute_angle_too_close_to_range_end_is_rejected(theta_m):
+    with pytest.raises(InvalidParameterError, match="totalBendingAngle=.* too close to the end"):
+        RevoluteJointPattern(6, 1.0, theta_m)
+
+
+@pytest.mark.parametrize("ell", [1e-9, 1e5])
+def test_tip_length_too_extreme_is_rejected(ell):
+    with pytest.raises(InvalidParameterError, match="length=.* too close to the end"):
+        EndTipPattern(6, 1.0, ell)

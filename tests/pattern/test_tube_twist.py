@@ -7,8 +7,8 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from kinegami.pattern import TubeFittingPattern, TwistFittingPattern, WaypointPattern
-from kinegami.pattern.twist import twist_geometry
 from kinegami.pattern._prism import make_prism
+from kinegami.pattern.twist import twist_geometry
 
 from .helpers import crease_set, find_vertex, prism_numbers
 from .reference_values import ATOL, PRISM, TWIST, TWIST_ALPHA, TWIST_H
@@ -30,7 +30,8 @@ def test_tube_vertices_creases_and_markers(n):
 def test_tube_creases_are_the_tube_edges():
     p = TubeFittingPattern(6, 1.0, 1.0)
     pairs = {tuple(sorted(e)) for e in p.edges_vertices.tolist()}
-    assert pairs == {tuple(sorted((int(a), int(b)))) for a, b in zip(p.proximalBase, p.distalBase)}
+    bases = zip(p.proximalBase.tolist(), p.distalBase.tolist(), strict=True)
+    assert pairs == {tuple(sorted(pair)) for pair in bases}
 
 
 @pytest.mark.parametrize("height", [0.0, 1e-6])

@@ -119,7 +119,10 @@ def test_counts_differing_from_the_formula_are_reported():
 
 
 def test_count_check_uses_module_records():
-    p = _with(_tube(), modules=(ModuleRecord("tube", {"height": 1.0}), ModuleRecord("tube", {"height": 1.0})))
+    p = _with(
+        _tube(),
+        modules=(ModuleRecord("tube", {"height": 1.0}),) * 2,
+    )
     assert any("composite of 2 modules" in q for q in _problems(p))
 
 

@@ -1,0 +1,487 @@
+"""3D matplotlib view of a kinematic chain: ``KinematicChain.show`` (chain.md section 6).
+
+The geometry comes from :mod:`kinegami.viz.chain_geometry`; this module only turns it into
+matplotlib artists, one collection per kind of thing (joint bodies, elbows, tubes, ...), each
+tagged with a ``gid`` (see :data:`ARTIST_GIDS`) so scripts and tests can find it. Defaults come
+from :mod:`kinegami.style`. matplotlib is imported only when a chain is drawn.
+"""
+
+from __future__ import annotations
+
+import math
+from numbers import Real
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from kinegami import style
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.viz import chain_geometry as geo
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d.axes3d import Axes3D
+
+    from kinegami.chain import KinematicChain
+
+__all__ = ["show_chain", "resolve_chain_options", "ARTIST_GIDS", "CHAIN_PLOT_OPTIONS"]
+
+#: Names of all options accepted by ``show_chain`` (and ``KinematicChain.show``).
+CHAIN_PLOT_OPTIONS = tuple(style.CHAIN_PLOT_DEFAULTS)
+
+#: The ``gid`` given to each kind of artist drawn.
+ARTIST_GIDS = {
+    "joint-bodies": "joint surfaces (revolute hulls, prismatic prisms, tips)",
+    "joint-axes": "dashed axes of motion of revolute and prismatic joints",
+    "joint-frame-x": "x arrows of joint frames",
+    "joint-frame-y": "y arrows of joint frames",
+    "joint-frame-z": "z arrows of joint frames",
+    "joint-origins-proximal": "proximal frame origins",
+    "joint-origins-center": "Pose origins",
+    "joint-origins-distal": "distal frame origins",
+    "link-elbows": "elbow surfaces (2 * sides quadrilaterals per elbow)",
+    "link-tubes": "straight tubes (sides quadrilaterals per tube)",
+    "link-path": "link centrelines (NaN between links)",
+    "link-path-markers": "q1, q2 of every link",
+    "path-circles-start": "turning circles of arc 1",
+    "path-circles-end": "turning circles of arc 2",
+    "link-pose-a": "a arrows of elbow frames",
+    "link-pose-b": "b arrows of elbow frames",
+    "link-pose-c": "c arrows of elbow frames",
+    "link-rotation-axes": "rotation axes of the elbows",
+    "link-tangents": "start and end tangents of each link",
+    "joint-spheres": "bounding balls of the joints",
+    "chain-sphere": "bounding ball of the chain (wireframe)",
+    "global-frame-x": "world x arrow",
+    "global-frame-y": "world y arrow",
+    "global-frame-z": "world z arrow",
+    "ground-plane": "the plane z = 0",
+}
+
+_BOOL_OPTIONS = (
+    "showJointPoses",
+    "showJointSurface",
+    "showLinkSurface",
+    "showLinkPath",
+    "showPathCircles",
+    "showLinkPoses",
+    "showSpheres",
+    "showGlobalFrame",
+    "showGroundPlane",
+    "showAxisGrids",
+)
+_COLOR_OPTIONS = (
+    "xColor",
+    "yColor",
+    "zColor",
+    "proximalColor",
+    "centerColor",
+    "distalColor",
+    "jointColor",
+    "linkColor",
+    "pathColor",
+    "sphereColor",
+    "groundPlaneColor",
+)
+_SCALE_OPTIONS = ("jointAxisScale", "globalAxisScale", "groundPlaneScale")
+
+
+def resolve_chain_options(options: dict[str, Any]) -> dict[str, Any]:
+    """All options of ``show_chain``: the defaults of :mod:`kinegami.style` updated by
+    ``options``, checked.
+
+    Raises InvalidTypeError for an unknown option name or a value of the wrong type, and
+    InvalidParameterError for a value out of range.
+    """
+    unknown = sorted(set(options) - set(CHAIN_PLOT_OPTIONS))
+    if unknown:
+        raise InvalidTypeError(
+            f"show() got unknown option{'s' if len(unknown) > 1 else ''} "
+            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(CHAIN_PLOT_OPTIONS)}"
+        )
+    opts = dict(style.CHAIN_PLOT_DEFAULTS)
+    opts.update(options)
+    for name in _BOOL_OPTIONS:
+        if not isinstance(opts[name], bool | np.bool_):
+            raise InvalidTypeError(f"{name} must be True or False, got {opts[name]!r}")
+        opts[name] = bool(opts[name])
+    if opts["block"] is not None and not isinstance(opts["block"], bool | np.bool_):
+        raise InvalidTypeError(f"block must be None, True or False, got {opts['block']!r}")
+    from matplotlib.colors import is_color_like
+
+    for name in _COLOR_OPTIONS:
+        if not is_color_like(opts[name]):
+            raise InvalidParameterError(f"{name} must be a matplotlib colour, got {opts[name]!r}")
+    for name in _SCALE_OPTIONS:
+        value = opts[name]
+        if isinstance(value, bool) or not isinstance(value, Real):
+            raise InvalidTypeError(f"{name} must be a number, got {value!r}")
+        if not (math.isfinite(value) and value > 0):
+            raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
+    alpha = opts["surfaceOpacity"]
+    if isinstance(alpha, bool) or not isinstance(alpha, Real):
+        raise InvalidTypeError(f"surfaceOpacity must be a number, got {alpha!r}")
+    if not 0.0 <= alpha <= 1.0:
+        raise InvalidParameterError(f"surfaceOpacity must be in [0, 1], got {alpha!r}")
+    ax = opts["ax"]
+    if ax is not None and getattr(ax, "name", None) != "3d":
+        raise InvalidTypeError(
+            f"ax must be a 3D matplotlib Axes (projection='3d'), got {type(ax).__name__}"
+        )
+    return opts
+
+
+class _Scene:
+    """Adds artists to a 3D axes and remembers the extent of everything added."""
+
+    def __init__(self, ax):
+        from mpl_toolkits.mplot3d import art3d
+
+        self.ax = ax
+        self.art3d = art3d
+        self.points: list[np.ndarray] = []
+
+    def _extent(self, pts) -> None:
+        pts = np.asarray(pts, dtype=float).reshape(-1, 3)
+        pts = pts[np.all(np.isfinite(pts), axis=1)]
+        if len(pts):
+            self.points.append(np.stack([pts.min(axis=0), pts.max(axis=0)]))
+
+    def polygons(self, polys, gid, facecolor, alpha, edgecolor="none", linewidth=0.0, shade=False):
+        """One Poly3DCollection of a list of (k, 3) polygons (or a (q, k, 3) array)."""
+        from matplotlib.colors import to_rgba
+
+        if len(polys) == 0:
+            return None
+        for poly in polys if isinstance(polys, list) else [polys]:
+            self._extent(poly)
+        kwargs = {"facecolors": to_rgba(facecolor, alpha), "linewidths": linewidth}
+        if edgecolor != "none":
+            kwargs["edgecolors"] = to_rgba(edgecolor, min(1.0, 2.0 * alpha))
+        elif not shade:
+            kwargs["edgecolors"] = "none"
+        collection = self.art3d.Poly3DCollection(list(polys), shade=shade, **kwargs)
+        collection.set_gid(gid)
+        self.ax.add_collection3d(collection)
+        return collection
+
+    def segments(self, segs, gid, color, linewidth=1.0, linestyle="-"):
+        """One Line3DCollection of (k, 3) polylines."""
+        if len(segs) == 0:
+            return None
+        for seg in segs:
+            self._extent(seg)
+        collection = self.art3d.Line3DCollection(
+            list(segs), colors=color, linewidths=linewidth, linestyles=linestyle
+        )
+        collection.set_gid(gid)
+        self.ax.add_collection3d(collection)
+        return collection
+
+    def polyline(self, pieces, gid, color, **kwargs):
+        """One Line3D through the (k, 3) pieces, separated by NaN rows."""
+        pieces = [np.asarray(p, dtype=float) for p in pieces if p is not None and len(p)]
+        if not pieces:
+            return None
+        gap = np.full((1, 3), np.nan)
+        pts = np.vstack([row for p in pieces for row in (p, gap)][:-1])
+        self._extent(pts)
+        (line,) = self.ax.plot(pts[:, 0], pts[:, 1], pts[:, 2], color=color, **kwargs)
+        line.set_gid(gid)
+        return line
+
+    def arrows(self, origins, vectors, gid, color, linewidth=1.0):
+        """One quiver of arrows from ``origins`` (k, 3) along ``vectors`` (k, 3)."""
+        if len(origins) == 0:
+            return None
+        self._extent(origins)
+        self._extent(origins + vectors)
+        o, v = origins, vectors
+        quiver = self.ax.quiver(
+            o[:, 0],
+            o[:, 1],
+            o[:, 2],
+            v[:, 0],
+            v[:, 1],
+            v[:, 2],
+            color=color,
+            arrow_length_ratio=0.25,
+            linewidths=linewidth,
+        )
+        quiver.set_gid(gid)
+        return quiver
+
+    def markers(self, pts, gid, color, marker="o", size=4.0):
+        """One Line3D of unconnected markers."""
+        pts = np.asarray(pts, dtype=float).reshape(-1, 3)
+        if len(pts) == 0:
+            return None
+        self._extent(pts)
+        (line,) = self.ax.plot(
+            pts[:, 0],
+            pts[:, 1],
+            pts[:, 2],
+            linestyle="",
+            marker=marker,
+            color=color,
+            markersize=size,
+        )
+        line.set_gid(gid)
+        return line
+
+
+# --- the parts of the picture ---
+def _draw_joint_bodies(scene, chain, opts):
+    faces = [face for joint in chain.Joints for face in geo.joint_body_faces(joint)]
+    scene.polygons(
+        faces,
+        "joint-bodies",
+        opts["jointColor"],
+        opts["surfaceOpacity"],
+        edgecolor=opts["jointColor"],
+        linewidth=0.5,
+        shade=True,
+    )
+    axes = [
+        seg
+        for joint in chain.Joints
+        if (seg := geo.joint_axis_segment(joint, opts["jointAxisScale"])) is not None
+    ]
+    scene.segments(
+        axes, "joint-axes", style.jointAxisColor, linewidth=1.0, linestyle=style.jointAxisLineStyle
+    )
+
+
+def _draw_joint_poses(scene, chain, opts):
+    kinds = ("proximal", "center", "distal")
+    frames: dict[str, list[np.ndarray]] = {kind: [] for kind in kinds}
+    lengths: dict[str, list[float]] = {kind: [] for kind in kinds}
+    for joint in chain.Joints:
+        for kind, frame in geo.joint_frames(joint).items():
+            frames[kind].append(frame)
+            lengths[kind].append(joint.r)
+    all_frames = np.array([f for kind in kinds for f in frames[kind]])
+    all_lengths = np.array([v for kind in kinds for v in lengths[kind]])
+    origins, arrows = geo.frame_axes(all_frames, 1.0)
+    arrows = arrows * all_lengths[None, :, None]
+    for axis, name in enumerate("xyz"):
+        scene.arrows(origins, arrows[axis], f"joint-frame-{name}", opts[f"{name}Color"])
+    for kind in kinds:
+        if frames[kind]:
+            pts = np.array(frames[kind])[:, :3, 3]
+            scene.markers(pts, f"joint-origins-{kind}", opts[f"{kind}Color"])
+
+
+def _drawn_links(chain):
+    """Links with a non-empty path (the root's empty link is skipped)."""
+    return [link for link in chain.Links if link.path.length > 0.0]
+
+
+def _draw_link_surfaces(scene, chain, opts):
+    sides = style.linkSurfaceSides
+    links = _drawn_links(chain)
+    grids = [geo.link_elbow_grids(link, sides) for link in links]
+    grids = [g for g in grids if len(g)]
+    if grids:
+        quads = geo.grid_quads(np.concatenate(grids))
+        scene.polygons(quads, "link-elbows", opts["linkColor"], opts["surfaceOpacity"], shade=True)
+    tubes = [t for link in links if (t := geo.tube_grid(link, sides)) is not None]
+    if tubes:
+        quads = geo.grid_quads(np.stack(tubes))
+        scene.polygons(quads, "link-tubes", opts["linkColor"], opts["surfaceOpacity"], shade=True)
+
+
+def _draw_link_path(scene, chain, opts):
+    links = _drawn_links(chain)
+    scene.polyline(
+        [geo.link_centreline(link) for link in links], "link-path", opts["pathColor"], linewidth=1.0
+    )
+    ends = [q for link in links for q in (link.path.q1, link.path.q2)]
+    scene.markers(ends, "link-path-markers", opts["pathColor"], marker=style.pathMarker, size=6)
+
+
+def _draw_path_circles(scene, chain):
+    circles = [geo.turning_circles(link) for link in _drawn_links(chain)]
+    start_color, end_color = style.pathCircleColors
+    scene.polyline([c[0] for c in circles], "path-circles-start", start_color, linewidth=0.8)
+    scene.polyline([c[1] for c in circles], "path-circles-end", end_color, linewidth=0.8)
+
+
+def _draw_link_poses(scene, chain, opts) -> bool:
+    """Elbow frames, rotation axes and tangents; True if any elbow frame was drawn."""
+    links = _drawn_links(chain)
+    arcs = [arc for link in links for arc in (link.elbows1, link.elbows2) if arc.count]
+    if arcs:
+        frames = np.concatenate([geo.elbow_pose_frames(arc) for arc in arcs])
+        lengths = np.concatenate([np.full(4 * arc.count, arc.r) for arc in arcs])
+        origins, arrows = geo.frame_axes(frames, 1.0)
+        arrows = arrows * lengths[None, :, None]
+        for axis, (name, color) in enumerate(zip("abc", style.linkPoseColors, strict=True)):
+            scene.arrows(origins, arrows[axis], f"link-pose-{name}", color)
+        axes = np.concatenate([geo.elbow_rotation_axes(arc) for arc in arcs])
+        scene.segments(
+            list(axes), "link-rotation-axes", style.rotationAxisColor, linewidth=1.0, linestyle=":"
+        )
+    if links:
+        origins = np.array([p for link in links for p in (link.path.p1, link.path.p2)])
+        tangents = np.array([link.r * d for link in links for d in (link.path.d1, link.path.d2)])
+        scene.arrows(origins, tangents, "link-tangents", opts["pathColor"])
+    return bool(arcs)
+
+
+def _draw_spheres(scene, chain, opts):
+    grids = [geo.sphere_grid(ball.c, ball.r) for ball in (j.boundingBall() for j in chain.Joints)]
+    scene.polygons(
+        geo.grid_quads(np.stack(grids)),
+        "joint-spheres",
+        opts["sphereColor"],
+        style.jointSphereOpacity,
+    )
+    ball = chain.boundingBall
+    grid = geo.sphere_grid(ball.c, ball.r, parallels=12, meridians=24)
+    parallels = [np.vstack([row, row[:1]]) for row in grid[1:-1]]
+    meridians = [grid[:, j] for j in range(grid.shape[1])]
+    scene.segments(parallels + meridians, "chain-sphere", opts["sphereColor"], linewidth=0.3)
+
+
+def _draw_global_frame(scene, chain, opts):
+    length = opts["globalAxisScale"] * chain.r
+    origin = np.zeros((1, 3))
+    for axis, name in enumerate("xyz"):
+        vector = np.zeros((1, 3))
+        vector[0, axis] = length
+        scene.arrows(origin, vector, f"global-frame-{name}", opts[f"{name}Color"], linewidth=1.5)
+
+
+def _draw_ground_plane(scene, chain, opts):
+    half = opts["groundPlaneScale"] * chain.r
+    quads = geo.ground_plane_quads(half, chain.r)
+    alpha = opts["surfaceOpacity"] * style.groundPlaneOpacityFactor
+    scene.polygons(
+        quads,
+        "ground-plane",
+        opts["groundPlaneColor"],
+        alpha,
+        edgecolor=opts["groundPlaneColor"],
+        linewidth=0.2,
+    )
+
+
+def _legend(ax, opts, frame_axes: bool, link_axes: bool):
+    from matplotlib.lines import Line2D
+
+    handles = []
+    if frame_axes:
+        handles += [Line2D([], [], color=opts[f"{n}Color"], label=rf"$\hat{{{n}}}$") for n in "xyz"]
+    if link_axes:
+        handles += [
+            Line2D([], [], color=color, label=rf"$\hat{{{n}}}$")
+            for n, color in zip("abc", style.linkPoseColors, strict=True)
+        ]
+    if handles:
+        ax.legend(handles=handles, loc="upper right")
+
+
+def _set_equal_limits(ax, scene, had_data: bool, r: float):
+    """Limits around everything drawn and a box aspect equal to the data ranges."""
+    boxes = list(scene.points)
+    if had_data:
+        limits = np.array([ax.get_xlim3d(), ax.get_ylim3d(), ax.get_zlim3d()]).T
+        boxes.append(limits)
+    if not boxes:
+        return
+    stacked = np.vstack(boxes)
+    low, high = stacked.min(axis=0), stacked.max(axis=0)
+    pad = 0.02 * float((high - low).max()) + 0.1 * r
+    low, high = low - pad, high + pad
+    ax.set_xlim3d(low[0], high[0])
+    ax.set_ylim3d(low[1], high[1])
+    ax.set_zlim3d(low[2], high[2])
+    ax.set_box_aspect(tuple(high - low), zoom=1.15)
+
+
+def _backend_is_interactive() -> bool:
+    """False for the file-only backends (Agg, PDF, SVG, ...), where plt.show cannot show."""
+    import matplotlib
+
+    backend = matplotlib.get_backend().lower()
+    try:
+        from matplotlib.backends import BackendFilter, backend_registry
+
+        non_interactive = backend_registry.list_builtin(BackendFilter.NON_INTERACTIVE)
+    except ImportError:  # matplotlib < 3.9
+        from matplotlib.rcsetup import non_interactive_bk as non_interactive
+    return backend not in {name.lower() for name in non_interactive}
+
+
+def show_chain(chain: KinematicChain, **options) -> tuple[Figure, Axes3D]:
+    """Draw a chain in 3D with matplotlib (chain.md section 6).
+
+    Parameters
+    ----------
+    chain : the KinematicChain to draw.
+    **options : see :data:`kinegami.style.CHAIN_PLOT_DEFAULTS` for names and defaults.
+        Lengths scale with the tube radius r: frames are r long, axes of motion
+        p -+ jointAxisScale r z, the world frame globalAxisScale r, the ground plane
+        [-groundPlaneScale r, groundPlaneScale r]^2 in cells of r. ``ax`` draws into an existing
+        3D axes; ``block`` is passed to ``plt.show``.
+
+    Returns
+    -------
+    (fig, ax) : the matplotlib Figure and the Axes3D drawn into. ``plt.show`` is called only
+        when this function created the figure and the backend is interactive.
+
+    Examples
+    --------
+    >>> fig, ax = chain.show(showGlobalFrame=True)  # doctest: +SKIP
+    >>> fig.savefig("chain.png")  # doctest: +SKIP
+    """
+    opts = resolve_chain_options(options)
+    import matplotlib.pyplot as plt
+
+    ax = opts["ax"]
+    created = ax is None
+    if created:
+        fig = plt.figure(figsize=(8, 7))
+        if opts["showAxisGrids"]:
+            ax = fig.add_subplot(projection="3d")
+        else:  # no tick labels to make room for: use the whole figure
+            ax = fig.add_axes((0.0, 0.0, 1.0, 1.0), projection="3d")
+    fig = ax.figure
+    had_data = ax.has_data()
+    ax.set_autoscale_on(False)  # the limits are set once, from everything drawn
+    scene = _Scene(ax)
+
+    if opts["showJointSurface"]:
+        _draw_joint_bodies(scene, chain, opts)
+    if opts["showLinkSurface"]:
+        _draw_link_surfaces(scene, chain, opts)
+    if opts["showLinkPath"]:
+        _draw_link_path(scene, chain, opts)
+    if opts["showPathCircles"]:
+        _draw_path_circles(scene, chain)
+    if opts["showJointPoses"]:
+        _draw_joint_poses(scene, chain, opts)
+    link_axes = opts["showLinkPoses"] and _draw_link_poses(scene, chain, opts)
+    if opts["showSpheres"]:
+        _draw_spheres(scene, chain, opts)
+    if opts["showGlobalFrame"]:
+        _draw_global_frame(scene, chain, opts)
+    if opts["showGroundPlane"]:
+        _draw_ground_plane(scene, chain, opts)
+
+    _legend(ax, opts, opts["showJointPoses"] or opts["showGlobalFrame"], link_axes)
+    _set_equal_limits(ax, scene, had_data, chain.r)
+    if opts["showAxisGrids"]:
+        ax.set_axis_on()
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_zlabel("z")
+    else:
+        ax.set_axis_off()
+    if created and _backend_is_interactive():
+        if opts["block"] is None:
+            plt.show()
+        else:
+            plt.show(block=bool(opts["block"]))
+    return fig, ax

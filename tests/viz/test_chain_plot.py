@@ -1,0 +1,297 @@
+"""KinematicChain.show(): what ends up on the matplotlib axes (chain.md section 6)."""
+
+import time
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.colors import to_rgba
+from matplotlib.figure import Figure
+from mpl_toolkits.mplot3d.axes3d import Axes3D
+from numpy.testing import assert_allclose
+
+from kinegami import style
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.viz import chain_plot
+from kinegami.viz.chain_plot import CHAIN_PLOT_OPTIONS, show_chain
+
+from .conftest import build_long_chain
+
+
+def _artist(ax, gid):
+    found = [a for a in (*ax.collections, *ax.lines) if a.get_gid() == gid]
+    assert len(found) == 1, f"expected one artist with gid {gid!r}, found {len(found)}"
+    return found[0]
+
+
+def _gids(ax):
+    return {a.get_gid() for a in (*ax.collections, *ax.lines)}
+
+
+def _axes_shown(ax) -> bool:
+    """Axes3D keeps its own on/off flag for the panes, ticks and labels."""
+    return bool(getattr(ax, "_axis3don", ax.axison))
+
+
+def _legend_labels(ax):
+    legend = ax.get_legend()
+    return [] if legend is None else [t.get_text() for t in legend.get_texts()]
+
+
+def test_show_returns_figure_and_axes3d(example_1a):
+    fig, ax = example_1a.show()
+    assert isinstance(fig, Figure)
+    assert isinstance(ax, Axes3D)
+    assert ax.figure is fig
+
+
+def test_default_drawing_has_joints_links_and_path(example_1a):
+    _, ax = example_1a.show()
+    assert {
+        "joint-bodies",
+        "joint-axes",
+        "link-elbows",
+        "link-tubes",
+        "link-path",
+        "link-path-markers",
+        "joint-frame-x",
+    } <= _gids(ax)
+    assert "global-frame-x" not in _gids(ax)
+    assert not _axes_shown(ax)
+
+
+BOOLEAN_FLIPS = [
+    {"showJointPoses": False},
+    {"showJointSurface": False},
+    {"showLinkSurface": False},
+    {"showLinkPath": False},
+    {"showPathCircles": True},
+    {"showLinkPoses": True},
+    {"showSpheres": True},
+    {"showGlobalFrame": True},
+    {"showGroundPlane": True},
+    {"showAxisGrids": True},
+    {"block": False},
+    {
+        "xColor": "red",
+        "yColor": "green",
+        "zColor": "blue",
+        "proximalColor": "k",
+        "centerColor": "k",
+        "distalColor": "k",
+        "jointColor": "purple",
+        "linkColor": "orange",
+        "pathColor": "gray",
+        "sphereColor": "navy",
+        "groundPlaneColor": "brown",
+    },
+    {"surfaceOpacity": 1.0, "jointAxisScale": 3, "globalAxisScale": 2.5, "groundPlaneScale": 4},
+]
+
+
+@pytest.mark.parametrize("options", BOOLEAN_FLIPS, ids=lambda o: ",".join(o))
+def test_every_option_draws(example_1a, options):
+    fig, ax = example_1a.show(**options)
+    fig.canvas.draw()
+    assert isinstance(ax, Axes3D)
+
+
+def test_every_option_is_covered_by_the_style_module():
+    assert set(CHAIN_PLOT_OPTIONS) == set(style.CHAIN_PLOT_DEFAULTS)
+    assert style.CHAIN_PLOT_DEFAULTS["xColor"] == "orangered"
+    assert style.CHAIN_PLOT_DEFAULTS["surfaceOpacity"] == 0.5
+    assert style.CHAIN_PLOT_DEFAULTS["showJointPoses"] is True
+    assert style.CHAIN_PLOT_DEFAULTS["block"] is None
+
+
+@pytest.mark.parametrize(
+    ("option", "gids"),
+    [
+        ("showPathCircles", {"path-circles-start", "path-circles-end"}),
+        ("showLinkPoses", {"link-pose-a", "link-rotation-axes", "link-tangents"}),
+        ("showSpheres", {"joint-spheres", "chain-sphere"}),
+        ("showGlobalFrame", {"global-frame-x", "global-frame-y", "global-frame-z"}),
+        ("showGroundPlane", {"ground-plane"}),
+    ],
+)
+def test_optional_parts_appear_only_when_asked(example_1a, option, gids):
+    _, ax = example_1a.show()
+    assert not gids & _gids(ax)
+    _, ax = example_1a.show(**{option: True})
+    assert gids <= _gids(ax)
+
+
+def test_hidden_parts_are_not_drawn(example_1a):
+    _, ax = example_1a.show(showJointPoses=False, showJointSurface=False, showLinkSurface=False)
+    assert _gids(ax) == {"link-path", "link-path-markers"}
+
+
+def test_data_limits_contain_every_joint_origin(example_1a):
+    _, ax = example_1a.show()
+    low = np.array([ax.get_xlim3d()[0], ax.get_ylim3d()[0], ax.get_zlim3d()[0]])
+    high = np.array([ax.get_xlim3d()[1], ax.get_ylim3d()[1], ax.get_zlim3d()[1]])
+    for joint in example_1a.Joints:
+        for frame in (joint.proximal_frame(), joint.distal_frame()):
+            assert np.all(low <= frame[:3, 3]) and np.all(frame[:3, 3] <= high)
+
+
+def test_box_aspect_is_equal(example_1a):
+    _, ax = example_1a.show()
+    ranges = np.array([np.ptp(ax.get_xlim3d()), np.ptp(ax.get_ylim3d()), np.ptp(ax.get_zlim3d())])
+    aspect = np.asarray(ax.get_box_aspect())
+    assert_allclose(aspect / aspect.max(), ranges / ranges.max())
+
+
+def test_number_of_elbow_surfaces_equals_elbow_count(example_1a):
+    fig, ax = example_1a.show()
+    fig.canvas.draw()
+    elbows = sum(link.elbows1.count + link.elbows2.count for link in example_1a.Links)
+    quads_per_elbow = 2 * style.linkSurfaceSides
+    assert len(_artist(ax, "link-elbows").get_paths()) == elbows * quads_per_elbow
+    tubes = sum(link.path.tMag > 0.01 * link.r for link in example_1a.Links)
+    assert len(_artist(ax, "link-tubes").get_paths()) == tubes * style.linkSurfaceSides
+
+
+def test_link_path_passes_through_q1_and_q2(example_1a):
+    _, ax = example_1a.show()
+    pts = np.column_stack(_artist(ax, "link-path").get_data_3d())
+    pts = pts[np.all(np.isfinite(pts), axis=1)]
+    markers = np.column_stack(_artist(ax, "link-path-markers").get_data_3d())
+    assert _artist(ax, "link-path-markers").get_marker() == "*"
+    for link in example_1a.Links[1:]:
+        for q in (link.path.q1, link.path.q2):
+            assert np.linalg.norm(pts - q, axis=1).min() < 1e-9
+            assert np.linalg.norm(markers - q, axis=1).min() < 1e-9
+
+
+def test_joint_axes_are_dashed_silver_lines(example_1a):
+    fig, ax = example_1a.show()
+    fig.canvas.draw()
+    axes = _artist(ax, "joint-axes")
+    moving = [
+        j for j in example_1a.Joints if type(j).__name__ in ("RevoluteJoint", "PrismaticJoint")
+    ]
+    assert len(axes.get_segments()) == len(moving) == 2
+    assert axes.get_linestyle()[0][1] is not None  # a dash pattern
+    assert_allclose(axes.get_colors()[0], to_rgba("silver"))
+
+
+def test_savefig_png(example_1a, tmp_path):
+    fig, _ = example_1a.show(showGlobalFrame=True)
+    path = tmp_path / "example1A.png"
+    fig.savefig(path)
+    assert path.stat().st_size > 1000
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_unknown_option_is_a_type_error_naming_it(example_1a):
+    with pytest.raises(TypeError) as info:
+        example_1a.show(showJointPose=True)
+    assert isinstance(info.value, InvalidTypeError)
+    message = str(info.value)
+    assert "'showJointPose'" in message
+    assert "showJointPoses" in message and "groundPlaneScale" in message
+
+
+@pytest.mark.parametrize(
+    ("options", "error"),
+    [
+        ({"showSpheres": "yes"}, InvalidTypeError),
+        ({"block": 1}, InvalidTypeError),
+        ({"surfaceOpacity": 2.0}, InvalidParameterError),
+        ({"jointAxisScale": -1}, InvalidParameterError),
+        ({"globalAxisScale": "big"}, InvalidTypeError),
+        ({"xColor": "not-a-colour"}, InvalidParameterError),
+    ],
+)
+def test_bad_option_values(example_1a, options, error):
+    with pytest.raises(error):
+        example_1a.show(**options)
+
+
+def test_no_elbow_chain_with_link_poses(straight_chain):
+    assert all(link.elbows1.count + link.elbows2.count == 0 for link in straight_chain.Links)
+    _, ax = straight_chain.show(showLinkPoses=True)
+    assert "link-pose-a" not in _gids(ax)
+    assert "link-tangents" in _gids(ax)
+    assert _legend_labels(ax) == [r"$\hat{x}$", r"$\hat{y}$", r"$\hat{z}$"]
+
+
+def test_single_joint_chain_draws():
+    from kinegami import SE3, KinematicChain, StartTip
+
+    chain = KinematicChain(StartTip(4, 1, Pose=SE3(), length=1.5))
+    fig, ax = chain.show(showLinkPoses=True, showPathCircles=True, showSpheres=True)
+    fig.canvas.draw()
+    assert "joint-bodies" in _gids(ax)
+
+
+def test_legend_entries(example_1a):
+    _, ax = example_1a.show(showJointPoses=False)
+    assert _legend_labels(ax) == []
+    _, ax = example_1a.show(showJointPoses=False, showGlobalFrame=True)
+    assert len(_legend_labels(ax)) == 3
+    _, ax = example_1a.show(showLinkPoses=True)
+    assert len(_legend_labels(ax)) == 6
+
+
+def test_axis_grids(example_1a):
+    _, ax = example_1a.show(showAxisGrids=True)
+    assert _axes_shown(ax)
+    _, ax = example_1a.show()
+    assert not _axes_shown(ax)
+
+
+def test_draws_into_given_axes(example_1a):
+    fig = plt.figure()
+    ax = fig.add_subplot(projection="3d")
+    ax.plot([100.0], [0.0], [0.0], "o")
+    fig2, ax2 = example_1a.show(ax=ax)
+    assert fig2 is fig and ax2 is ax
+    assert ax.get_xlim3d()[1] >= 100.0  # the existing data stays in view
+    assert "joint-bodies" in _gids(ax)
+
+
+def test_2d_axes_rejected(example_1a):
+    _, ax = plt.subplots()
+    with pytest.raises(InvalidTypeError, match="3D"):
+        example_1a.show(ax=ax)
+
+
+def test_headless_never_calls_plt_show(example_1a, monkeypatch):
+    def forbidden(*args, **kwargs):
+        raise AssertionError("plt.show called under a non-interactive backend")
+
+    monkeypatch.setattr(plt, "show", forbidden)
+    example_1a.show(block=True)
+
+
+@pytest.mark.parametrize(("block", "expected"), [(None, {}), (False, {"block": False})])
+def test_interactive_backend_calls_plt_show(example_1a, monkeypatch, block, expected):
+    calls = []
+    monkeypatch.setattr(chain_plot, "_backend_is_interactive", lambda: True)
+    monkeypatch.setattr(plt, "show", lambda **kwargs: calls.append(kwargs))
+    example_1a.show(block=block)
+    assert calls == [expected]
+    # Drawing into the caller's axes leaves showing to the caller.
+    ax = plt.figure().add_subplot(projection="3d")
+    example_1a.show(ax=ax)
+    assert len(calls) == 1
+
+
+def test_agg_is_not_interactive():
+    assert chain_plot._backend_is_interactive() is False
+
+
+def test_show_chain_is_the_delegate(example_1a):
+    fig, ax = show_chain(example_1a, showLinkPath=False)
+    assert "link-path" not in _gids(ax)
+
+
+def test_fifty_joint_chain_draws_quickly():
+    chain = build_long_chain(50)
+    assert len(chain) >= 50
+    start = time.perf_counter()
+    fig, _ = chain.show()
+    fig.canvas.draw()
+    assert time.perf_counter() - start < 5.0
