@@ -29,6 +29,8 @@ __all__ = ["LinkCSC", "ElbowArc", "ELBOW_MIN_ANGLE", "TWIST_MIN_ANGLE"]
 ELBOW_MIN_ANGLE = 1e-9
 #: A straight part gets a twist fitting when |twist| exceeds this (chain.md 2.5, patterns 4.2).
 TWIST_MIN_ANGLE = 0.01
+#: Arcs and twists up to this angle are left out of the crease pattern (patterns.md 4.2).
+PATTERN_MIN_ANGLE = 0.01
 
 
 @dataclass(frozen=True, eq=False)
@@ -270,39 +272,43 @@ class LinkCSC:
 
     # --- pattern -----------------------------------------------------------------------------
     def creasePattern(self, numSides: int, twistPortion: float = 0.2):
-        """The link's crease pattern: elbows, (twist), tube, elbows (patterns.md 4.2)."""
+        """The link's crease pattern (patterns.md 4.2): elbows, twist, tube, elbows.
+
+        Arcs turning more than 0.01 rad get ``count`` elbow modules; the straight part gets a
+        twist of height ``twistPortion * tMag`` when |twistAngle| > 0.01, and a tube for the
+        rest. Smaller turns are exact in the chain's frames but below what the pattern
+        resolves, and are left out of the pattern as in the reference (patterns.md 4.2).
+        """
         from kinegami.pattern import (
             ElbowFittingPattern,
             TubeFittingPattern,
+            TubularPattern,
             TwistFittingPattern,
             WaypointPattern,
         )
-        from kinegami.validation import check_in_range
+        from kinegami.validation import check_in_range, check_num_sides
 
+        numSides = check_num_sides(numSides)
         twistPortion = check_in_range(
             "twistPortion", twistPortion, 0.0, 1.0, low_inclusive=True, range_text="[0, 1)"
         )
-        modules = []
-        for arc in (self.elbows1,):
-            modules += [
-                ElbowFittingPattern(numSides, self.r, arc.elbowAngle, arc.rotationalAxisAngle)
-            ] * arc.count
-        s = self.path.tMag
-        tube = s
+        modules = [WaypointPattern(numSides, self.r)]
+
+        def elbows(arc: ElbowArc) -> list:
+            if arc.angle <= PATTERN_MIN_ANGLE:
+                return []
+            elbow = ElbowFittingPattern(numSides, self.r, arc.elbowAngle, arc.rotationalAxisAngle)
+            return [elbow] * arc.count
+
+        modules += elbows(self.elbows1)
+        tube = self.path.tMag
         if self.hasTwist:
-            twist_height = twistPortion * s
+            twist_height = twistPortion * tube
             modules.append(TwistFittingPattern(numSides, self.r, self.twistAngle, twist_height))
-            tube = s - twist_height
-        if tube > 0.0:
-            modules.append(TubeFittingPattern(numSides, self.r, tube))
-        arc = self.elbows2
-        modules += [
-            ElbowFittingPattern(numSides, self.r, arc.elbowAngle, arc.rotationalAxisAngle)
-        ] * arc.count
-        pattern = WaypointPattern(numSides, self.r)
-        for module in modules:
-            pattern = pattern.append(module)
-        return pattern
+            tube -= twist_height
+        modules.append(TubeFittingPattern(numSides, self.r, tube))
+        modules += elbows(self.elbows2)
+        return TubularPattern.concatenate(modules)
 
     def __repr__(self) -> str:
         p = self.path
