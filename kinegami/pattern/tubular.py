@@ -462,6 +462,23 @@ class TubularPattern:
 
         return ValidationReport(tuple(audit_pattern(self)))
 
+    def show(self, **options):
+        """Draw the flattened pattern with matplotlib (valley folds red, mountain folds blue,
+        boundary, glue tab and cut outline); returns (figure, axes). See kinegami.viz."""
+        from kinegami.viz.pattern_plot import show_pattern
+
+        return show_pattern(self, **options)
+
+    def save(self, dxfName=None, **options):
+        """Write the flattened sheet for fabrication: DXF, or SVG when the name ends in .svg.
+
+        Written atomically; missing folders are created. See docs/fabrication.md for layers,
+        colours, units (1 pattern unit = 1 mm unless ``units``/``scale``) and perforation.
+        """
+        from kinegami.export import save_pattern
+
+        return save_pattern(self, dxfName, **options)
+
     # ----------------------------------------------------------------------------------------
     # Internal helpers for composition
 
@@ -483,10 +500,6 @@ class TubularPattern:
             object.__setattr__(self, "_has_internal_duplicates", value)
         return self._has_internal_duplicates
 
-
-# Documented extension points (implemented elsewhere, attached as thin delegates):
-#   TubularPattern.show(...)  -> kinegami.viz       (2D plot of the pattern)
-#   TubularPattern.save(...)  -> kinegami.export    (DXF and other formats)
 
 
 def _copy_or_none(array: np.ndarray | None) -> np.ndarray | None:
