@@ -30,7 +30,7 @@ from kinegami.geometry.frames import any_perpendicular, rotation_matrix
 ANGLE_TOLERANCE = 1e-13
 #: A converged root is accepted only if its angle residuals are below this (radians).
 ACCEPT_TOLERANCE = 1e-10
-_MAX_ITERATIONS = 60
+_MAX_ITERATIONS = 40
 _MAX_TAN = 1e6  # tan(theta/2) cap: theta within 2e-6 of pi
 
 
@@ -194,12 +194,36 @@ def _newton(D, d1, d2, a, b):
     return None
 
 
-def _grid_starts():
-    halves = (0.05, 0.3, 0.6, 0.9, 1.2, 1.45)
-    return [(math.tan(p), math.tan(q)) for p in halves for q in halves]
+_HALF_ANGLES = np.linspace(0.02, 1.52, 16)
+_GRID_A, _GRID_B = (np.tan(g).ravel() for g in np.meshgrid(_HALF_ANGLES, _HALF_ANGLES))
+#: Newton restarts tried from the best grid points when the reference's start fails.
+_RESTARTS = 6
 
 
-_GRID = _grid_starts()
+def _grid_starts(D: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> list[tuple[float, float]]:
+    """Grid points (a, b) ordered by residual, evaluated in one vectorised pass."""
+    V = D[None, :] - _GRID_A[:, None] * d1[None, :] - _GRID_B[:, None] * d2[None, :]
+    nV = np.linalg.norm(V, axis=1)
+    nV[nV == 0.0] = 1e-300
+    u = V / nV[:, None]
+    g1 = np.arctan2(np.linalg.norm(np.cross(d1[None, :], u), axis=1), u @ d1)
+    g2 = np.arctan2(np.linalg.norm(np.cross(u, d2[None, :]), axis=1), u @ d2)
+    res = np.maximum(np.abs(g1 - 2 * np.arctan(_GRID_A)), np.abs(g2 - 2 * np.arctan(_GRID_B)))
+    # a straight part of negative length cannot be a solution: push those points back
+    res = res + np.where(nV - _GRID_A - _GRID_B < 0.0, 10.0, 0.0)
+    best = np.argsort(res, kind="stable")[:_RESTARTS]
+    return [(float(_GRID_A[i]), float(_GRID_B[i])) for i in best]
+
+
+def _accepted(root):
+    """(length / r, a, b, |V|) of a Newton root that is a path (s >= 0), else None."""
+    if root is None:
+        return None
+    a, b, residual, nV = root
+    s_over_r = nV - a - b
+    if residual > ACCEPT_TOLERANCE or s_over_r < -1e-12:
+        return None  # not converged, or a root of the reduced equations with s < 0
+    return 2.0 * math.atan(a) + max(s_over_r, 0.0) + 2.0 * math.atan(b), a, b, nV
 
 
 def solve_csc(p1, d1, p2, d2, r: float) -> CSCPath | None:
@@ -225,28 +249,17 @@ def solve_csc(p1, d1, p2, d2, r: float) -> CSCPath | None:
         # Identical frames: the empty path (the root's link).
         return _build(r, p1, d1, p2, d2, 0.0, 0.0, d1.copy())
 
+    # The reference's initial guess: u along p2 - p1 (chain.md 2.2). Its root is unique in
+    # practice; only when it fails are the best points of a grid tried as restarts.
     u0 = D / nD if nD > 0.0 else d1
     g1 = math.atan2(float(np.linalg.norm(np.cross(d1, u0))), float(d1 @ u0))
     g2 = math.atan2(float(np.linalg.norm(np.cross(u0, d2))), float(u0 @ d2))
-    starts = [(min(math.tan(g1 / 2.0), 1e3), min(math.tan(g2 / 2.0), 1e3))]
-    best = None
-    for attempt, (a0, b0) in enumerate(starts + _GRID):
-        root = _newton(Dt, d1t, d2t, a0, b0)
-        if root is None:
-            continue
-        a, b, residual, nV = root
-        if residual > ACCEPT_TOLERANCE:
-            continue
-        s_over_r = nV - a - b
-        if s_over_r < -1e-12:
-            continue  # a root of the reduced equations with a negative straight part
-        theta1 = 2.0 * math.atan(a)
-        theta2 = 2.0 * math.atan(b)
-        length = theta1 + max(s_over_r, 0.0) + theta2
-        if best is None or length < best[0] - 1e-12:
-            best = (length, a, b, nV)
-        if attempt == 0:
-            break  # the reference's own start converged: the root is unique in practice
+    best = _accepted(_newton(Dt, d1t, d2t, min(math.tan(g1 / 2), 1e3), min(math.tan(g2 / 2), 1e3)))
+    if best is None:
+        for a0, b0 in _grid_starts(D, d1, d2):
+            found = _accepted(_newton(Dt, d1t, d2t, a0, b0))
+            if found is not None and (best is None or found[0] < best[0] - 1e-12):
+                best = found
     if best is None:
         return None
     _, a, b, nV = best
