@@ -9,6 +9,8 @@ append, edit or state change leaves the chain bit-identical.
 
 from __future__ import annotations
 
+import os
+import sys
 import warnings
 from collections.abc import Sequence
 
@@ -33,6 +35,19 @@ from kinegami.placement import (
 from kinegami.validation import check_max_angle_per_elbow, check_real
 
 __all__ = ["KinematicChain", "PlacementWarning"]
+
+
+_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
+
+
+def _caller_level() -> int:
+    """Stack level of the first frame outside the kinegami package (for warnings)."""
+    frame = sys._getframe(1)
+    level = 1
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE_DIR):
+        frame = frame.f_back
+        level += 1
+    return level
 
 
 class PlacementWarning(UserWarning):
@@ -176,7 +191,9 @@ class KinematicChain:
 
     @staticmethod
     def _reject(message: str) -> None:
-        warnings.warn(message + "; the chain is unchanged", PlacementWarning, stacklevel=3)
+        warnings.warn(
+            message + "; the chain is unchanged", PlacementWarning, stacklevel=_caller_level()
+        )
 
     # --- building ----------------------------------------------------------------------------
     def append(

@@ -367,7 +367,8 @@ class PrismaticJoint(Joint):
     def stateRange(self) -> tuple[float, float]:
         d = self._neutralLength
         s = math.sin(self.coneAngle)
-        return (d / (2.0 * s) - d, d / s - d)
+        # at coneAngle = pi/6 the lower bound is 0 exactly; sin rounds it to +4e-16
+        return (min(d / (2.0 * s) - d, 0.0), d / s - d)
 
     def state_transform(self, delta: float) -> np.ndarray:
         return translation(delta * self._T[:3, 2])

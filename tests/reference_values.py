@@ -23,8 +23,12 @@ REVOLUTE_PI = {
 
 # --- chain.md 11.2: Example 1A ---------------------------------------------------------------
 EXAMPLE_1A_START = {"origin": (3, 3, 0), "length": 1.5}
-EXAMPLE_1A_PRISMATIC = {"neutralLength": 3, "numLayers": 3, "coneAngle": PI / 4,
-                        "translation": (5, 5, 0)}
+EXAMPLE_1A_PRISMATIC = {
+    "neutralLength": 3,
+    "numLayers": 3,
+    "coneAngle": PI / 4,
+    "translation": (5, 5, 0),
+}
 EXAMPLE_1A_REVOLUTE = {"totalBendingAngle": PI, "ry": PI / 4}
 EXAMPLE_1A_END = {"ry": PI / 2, "length": 1.5}
 EXAMPLE_1A_APPEND_RESULTS = (2, 4, 6)
@@ -171,12 +175,20 @@ SPIRAL_NUM_SIDES = 6
 SPIRAL_PRISMATIC = {"neutralLength": 3, "numLayers": 5, "coneAngle": PI / 4}
 SPIRAL_RY = PI / 4
 SPIRAL_APPENDS = 4
-SPIRAL_ORIGINS = ((5.377937, 0, 5.377937), (13.775869, 0, 5.377937),
-                  (20.665221, 0, -1.511414), (20.665221, 0, -13.240251))
+SPIRAL_ORIGINS = (
+    (5.377937, 0, 5.377937),
+    (13.775869, 0, 5.377937),
+    (20.665221, 0, -1.511414),
+    (20.665221, 0, -13.240251),
+)
 SPIRAL_Z = ((0.707107, 0, 0.707107), (1, 0, 0), (0.707107, 0, -0.707107), (0, 0, -1))
 SPIRAL_X = ((0.707107, 0, -0.707107), (0, 0, -1), (-0.707107, 0, -0.707107), (-1, 0, 0))
-SPIRAL_LINKS = ((1.110988, 3.903110, 0.325590), (1.057200, 4.768280, 0.271802),
-                (0.998292, 6.192473, 0.212893), (0.947072, 8.246672, 0.161674))
+SPIRAL_LINKS = (
+    (1.110988, 3.903110, 0.325590),
+    (1.057200, 4.768280, 0.271802),
+    (0.998292, 6.192473, 0.212893),
+    (0.947072, 8.246672, 0.161674),
+)
 SPIRAL_TOTAL_LENGTH = 28.196046
 SPIRAL_BALL = {"c": (12.221380, 0, -0.581604), "r": 17.019208}
 

@@ -27,8 +27,9 @@ from kinegami import (
 
 
 def assert_close(actual, expected, atol=ref.ATOL):
-    np.testing.assert_allclose(np.asarray(actual, dtype=float), np.asarray(expected, float),
-                               rtol=0.0, atol=atol)
+    np.testing.assert_allclose(
+        np.asarray(actual, dtype=float), np.asarray(expected, float), rtol=0.0, atol=atol
+    )
 
 
 def origin(joint):
@@ -67,8 +68,10 @@ def test_example_1a_joint(example_1a, i):
 def test_example_1a_link(example_1a, i):
     theta1, s, theta2, length, elbows, phis, twist = ref.EXAMPLE_1A_LINKS[i - 1]
     link = example_1a.Links[i]
-    assert_close([link.path.theta1, link.path.tMag, link.path.theta2, link.path.length],
-                 [theta1, s, theta2, length])
+    assert_close(
+        [link.path.theta1, link.path.tMag, link.path.theta2, link.path.length],
+        [theta1, s, theta2, length],
+    )
     assert (link.elbows1.count, link.elbows2.count) == elbows
     if phis is not None:
         assert_close([link.elbows1.rotationalAxisAngle, link.elbows2.rotationalAxisAngle], phis)
@@ -79,8 +82,7 @@ def test_example_1a_root_link_is_empty(example_1a):
     root = example_1a.Links[0]
     assert (root.path.theta1, root.path.tMag, root.path.theta2) == (0.0, 0.0, 0.0)
     assert (root.elbows1.count, root.elbows2.count) == (0, 0)
-    np.testing.assert_array_equal(root.start_frame,
-                                  example_1a.Joints[0].proximal_dubins_frame())
+    np.testing.assert_array_equal(root.start_frame, example_1a.Joints[0].proximal_dubins_frame())
 
 
 def test_example_1a_total_path_length(example_1a):
@@ -99,10 +101,21 @@ def test_example_1a_recomputed_ball(example_1a):
         assert_close(ball.r, ref.EXAMPLE_1A_BALL_RECOMPUTED["r"])
 
 
+def test_incremental_ball_leaves_out_the_root_links_arc_balls():
+    """chain.md 3.3: the first ball is the root joint's; the root's empty link only enters on
+    recompute. Its arc ball (root proximal origin, r) then sticks out of the incremental ball
+    (a spec-level inconsistency with 11.1 item 9, kept for the reference numbers)."""
+    chain = KinematicChain(StartTip(4, 1, SE3(), 1.5))
+    root_ball = chain.Links[0].arc1Ball
+    assert_close(root_ball.c, (0, 0, -0.75), atol=1e-15)
+    assert root_ball.r == 1.0
+    assert not chain.boundingBall.contains(root_ball)
+    assert chain.recomputeBoundingBall().contains(root_ball)
+
+
 def test_example_1a_first_ball_is_the_start_tips():
     start = ref.EXAMPLE_1A_START
-    chain = KinematicChain(StartTip(4, 1, Pose=SE3.Trans(*start["origin"]),
-                                    length=start["length"]))
+    chain = KinematicChain(StartTip(4, 1, Pose=SE3.Trans(*start["origin"]), length=start["length"]))
     assert_close(chain.boundingBall.c, ref.EXAMPLE_1A_FIRST_BALL["c"])
     assert_close(chain.boundingBall.r, ref.EXAMPLE_1A_FIRST_BALL["r"])
 
@@ -191,8 +204,7 @@ def snapshot_joint(joint):
 
 def set_example_1c_states(chain):
     lo, hi = chain.Joints[2].stateRange()
-    return (chain.setJointState(2, hi),
-            chain.setJointState(4, ref.EXAMPLE_1C_REVOLUTE_STATE))
+    return (chain.setJointState(2, hi), chain.setJointState(4, ref.EXAMPLE_1C_REVOLUTE_STATE))
 
 
 def test_example_1c_prismatic_state_range(example_1b):
@@ -313,11 +325,16 @@ def test_cylindrical_variant(planar, chain_checker):
     chain = KinematicChain(RevoluteJoint(n, 1, math.pi, SE3()))
     p = ref.CYLINDRICAL_PRISMATIC
     with no_warnings():
-        assert chain.append(PrismaticJoint(n, 1, p["neutralLength"], p["numLayers"],
-                                           p["coneAngle"], SE3())) == 3
+        assert (
+            chain.append(
+                PrismaticJoint(n, 1, p["neutralLength"], p["numLayers"], p["coneAngle"], SE3())
+            )
+            == 3
+        )
     for i in (1, 2):  # the same two waypoints as the planar example
-        np.testing.assert_allclose(chain.Joints[i].pose_matrix, planar.Joints[i].pose_matrix,
-                                   rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            chain.Joints[i].pose_matrix, planar.Joints[i].pose_matrix, rtol=0, atol=1e-12
+        )
     assert_close(origin(chain.Joints[3]), ref.CYLINDRICAL_PRISMATIC_ORIGIN)
     assert_close(chain.totalPathLength(), ref.CYLINDRICAL_TOTAL_LENGTH)
     chain_checker(chain)
@@ -351,8 +368,7 @@ def test_spiral_joints():
     chain = build_spiral()
     joints = chain.Joints[1:]
     assert len(joints) == ref.SPIRAL_APPENDS
-    for joint, o, z, x in zip(joints, ref.SPIRAL_ORIGINS, ref.SPIRAL_Z, ref.SPIRAL_X,
-                              strict=True):
+    for joint, o, z, x in zip(joints, ref.SPIRAL_ORIGINS, ref.SPIRAL_Z, ref.SPIRAL_X, strict=True):
         assert_close(origin(joint), o)
         assert_close(joint.pose_matrix[:3, 2], z)
         assert_close(joint.pose_matrix[:3, 0], x)
@@ -378,16 +394,17 @@ def test_spiral_compact_clearance():
 def test_rejected_rotation_is_bit_identical(example_1a, snapshot):
     before = snapshot(example_1a)
     with pytest.warns(PlacementWarning):
-        assert example_1a.rotateJointAboutAxisOfMotion(*ref.REJECT_ROTATE,
-                                                       propagate=False) is False
+        assert example_1a.rotateJointAboutAxisOfMotion(*ref.REJECT_ROTATE, propagate=False) is False
     assert snapshot(example_1a) == before
 
 
 def test_rejected_translation_is_bit_identical(example_1a, snapshot):
     before = snapshot(example_1a)
     with pytest.warns(PlacementWarning):
-        assert example_1a.translateJointAlongAxisOfMotion(*ref.REJECT_TRANSLATE,
-                                                          propagate=False) is False
+        assert (
+            example_1a.translateJointAlongAxisOfMotion(*ref.REJECT_TRANSLATE, propagate=False)
+            is False
+        )
     assert snapshot(example_1a) == before
 
 
@@ -405,13 +422,58 @@ def test_rejected_append_is_bit_identical(snapshot):
 
 @pytest.mark.parametrize("joint, distance", [(4, -1), (2, -1)])
 @pytest.mark.parametrize("propagate", [True, False])
-def test_rejected_waypoint_edit_is_bit_identical(example_1a, snapshot, joint, distance,
-                                                 propagate):
+def test_rejected_waypoint_edit_is_bit_identical(example_1a, snapshot, joint, distance, propagate):
     before = snapshot(example_1a)
     with pytest.warns(PlacementWarning):
-        assert example_1a.translateJointAlongAxisOfMotion(
-            joint, distance, propagate=propagate, applyToPreviousWaypoint=True) is False
+        assert (
+            example_1a.translateJointAlongAxisOfMotion(
+                joint, distance, propagate=propagate, applyToPreviousWaypoint=True
+            )
+            is False
+        )
     assert snapshot(example_1a) == before
+
+
+def detour_chain():
+    """StartTip -> Waypoint -> EndTip, where the tip sits straight above the start pointing
+    down: without the waypoint the link would need a U-turn (deleting it must fail)."""
+    chain = KinematicChain(StartTip(4, 1, SE3(), 1.5))
+    exact = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
+    with no_warnings():
+        assert chain.append(Waypoint(4, 1, SE3.Trans(5, 0, 10) * SE3.Ry(math.pi / 2)), **exact)
+        assert chain.append(EndTip(4, 1, SE3.Trans(0, 0, 5) * SE3.Rx(math.pi), 1.5), **exact)
+    return chain
+
+
+#: Rejected operations (most on Example 1A), each expected to warn once.
+REJECTED_CALLS = {
+    "append": lambda c: KinematicChain(StartTip(4, 1, SE3(), 1.5)).append(
+        RevoluteJoint(4, 1, math.pi, SE3.Trans(0, 0, 10) * SE3.Ry(math.pi / 2)),
+        safe=False,
+        fixedPosition=True,
+        fixedOrientation=True,
+    ),
+    "setJointState": lambda c: c.setJointState(4, math.pi),
+    "setJointStates": lambda c: c.setJointStates([0, 0, 0, 0, math.pi, 0, 0]),
+    "delete single joint": lambda c: KinematicChain(StartTip(4, 1, SE3(), 1.5)).delete(0),
+    "translateJointAlongAxisOfMotion": lambda c: c.translateJointAlongAxisOfMotion(
+        *ref.REJECT_TRANSLATE, propagate=False
+    ),
+    "rotateJointAboutAxisOfMotion": lambda c: c.rotateJointAboutAxisOfMotion(
+        *ref.REJECT_ROTATE, propagate=False
+    ),
+    "transformJoint": lambda c: c.transformJoint(2, SE3.Trans(0, 0, 20), propagate=False),
+    "delete without path": lambda c: detour_chain().delete(1),
+}
+
+
+@pytest.mark.parametrize("call", list(REJECTED_CALLS))
+def test_rejection_warns_once_at_the_callers_line(example_1a, call):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        REJECTED_CALLS[call](example_1a)
+    assert [w.category for w in caught] == [PlacementWarning]
+    assert caught[0].filename == __file__
 
 
 # --- edits (chain.md 5) ----------------------------------------------------------------------
@@ -426,8 +488,7 @@ def test_delete_first_joint_makes_joint_1_the_root(example_1a, chain_checker):
         assert snapshot_joint(new) == snapshot_joint(old)
     root = example_1a.Links[0]
     assert (root.path.theta1, root.path.tMag, root.path.theta2) == (0.0, 0.0, 0.0)
-    np.testing.assert_array_equal(root.start_frame,
-                                  example_1a.Joints[0].proximal_dubins_frame())
+    np.testing.assert_array_equal(root.start_frame, example_1a.Joints[0].proximal_dubins_frame())
     np.testing.assert_array_equal(root.end_frame, root.start_frame)
     for new, old in zip(example_1a.Links[1:], old_links[2:], strict=True):
         assert new is old
@@ -454,7 +515,10 @@ def test_delete_middle_joint_joins_its_neighbours(example_1a, chain_checker):
     expected = LinkCSC(1, old_joints[2].DistalDubinsFrame(), old_joints[4].ProximalDubinsFrame())
     new = example_1a.Links[3]
     assert (new.path.theta1, new.path.tMag, new.path.theta2) == (
-        expected.path.theta1, expected.path.tMag, expected.path.theta2)
+        expected.path.theta1,
+        expected.path.tMag,
+        expected.path.theta2,
+    )
     chain_checker(example_1a)
 
 
@@ -467,11 +531,7 @@ def test_delete_on_a_single_joint_chain_is_rejected(snapshot):
 
 
 def test_delete_without_a_path_is_rejected(snapshot):
-    chain = KinematicChain(StartTip(4, 1, SE3(), 1.5))
-    exact = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
-    with no_warnings():
-        assert chain.append(Waypoint(4, 1, SE3.Trans(5, 0, 10) * SE3.Ry(math.pi / 2)), **exact)
-        assert chain.append(EndTip(4, 1, SE3.Trans(0, 0, 5) * SE3.Rx(math.pi), 1.5), **exact)
+    chain = detour_chain()
     before = snapshot(chain)
     with pytest.warns(PlacementWarning):  # start and end would need a U-turn
         assert chain.delete(1) is False
@@ -503,8 +563,7 @@ TRANSFORM = SE3.Trans(0.1, 0.2, 0) * SE3.Rz(0.05)
 
 
 def assert_moved(new_joint, old_joint, T):
-    np.testing.assert_allclose(new_joint.pose_matrix, T @ old_joint.pose_matrix, rtol=0,
-                               atol=1e-12)
+    np.testing.assert_allclose(new_joint.pose_matrix, T @ old_joint.pose_matrix, rtol=0, atol=1e-12)
     assert new_joint.state == old_joint.state
 
 
@@ -522,7 +581,10 @@ def test_transform_joint_propagating_moves_the_rest_rigidly(example_1a, chain_ch
     for new, old in zip(example_1a.Links[5:], old_links[5:], strict=True):
         # moved rigidly, not re-solved: same shape to the bit
         assert (new.path.theta1, new.path.tMag, new.path.theta2) == (
-            old.path.theta1, old.path.tMag, old.path.theta2)
+            old.path.theta1,
+            old.path.tMag,
+            old.path.theta2,
+        )
         np.testing.assert_allclose(new.start_frame, T @ old.start_frame, rtol=0, atol=1e-12)
     chain_checker(example_1a)
 
@@ -568,10 +630,14 @@ def test_transform_all_moves_everything_rigidly(example_1a, chain_checker):
         assert_moved(new, old, TRANSFORM.A)
     for new, old in zip(example_1a.Links, old_links, strict=True):
         assert (new.path.theta1, new.path.tMag, new.path.theta2) == (
-            old.path.theta1, old.path.tMag, old.path.theta2)
+            old.path.theta1,
+            old.path.tMag,
+            old.path.theta2,
+        )
     assert example_1a.boundingBall.r == old_ball.r
-    assert_close(example_1a.boundingBall.c, TRANSFORM.A[:3, :3] @ old_ball.c
-                 + TRANSFORM.A[:3, 3], atol=1e-12)
+    assert_close(
+        example_1a.boundingBall.c, TRANSFORM.A[:3, :3] @ old_ball.c + TRANSFORM.A[:3, 3], atol=1e-12
+    )
     chain_checker(example_1a)
 
 
@@ -580,8 +646,12 @@ def test_apply_to_previous_waypoint_propagating(example_1a, chain_checker):
     old_joints, old_links = example_1a.Joints, example_1a.Links
     z = old_joints[4].pose_matrix[:3, 2]
     with no_warnings():
-        assert example_1a.translateJointAlongAxisOfMotion(
-            4, 1.0, propagate=True, applyToPreviousWaypoint=True) is True
+        assert (
+            example_1a.translateJointAlongAxisOfMotion(
+                4, 1.0, propagate=True, applyToPreviousWaypoint=True
+            )
+            is True
+        )
     T = SE3.Trans(*(1.0 * z)).A
     for i, (new, old) in enumerate(zip(example_1a.Joints, old_joints, strict=True)):
         if i < 3:
@@ -591,7 +661,10 @@ def test_apply_to_previous_waypoint_propagating(example_1a, chain_checker):
     assert example_1a.Links[:3] == old_links[:3]
     for new, old in zip(example_1a.Links[4:], old_links[4:], strict=True):
         assert (new.path.theta1, new.path.tMag, new.path.theta2) == (
-            old.path.theta1, old.path.tMag, old.path.theta2)
+            old.path.theta1,
+            old.path.tMag,
+            old.path.theta2,
+        )
     chain_checker(example_1a)
 
 
@@ -600,8 +673,12 @@ def test_apply_to_previous_waypoint_not_propagating(example_1a, chain_checker):
     old_joints, old_links = example_1a.Joints, example_1a.Links
     z = old_joints[4].pose_matrix[:3, 2]
     with no_warnings():
-        assert example_1a.translateJointAlongAxisOfMotion(
-            4, 1.0, propagate=False, applyToPreviousWaypoint=True) is True
+        assert (
+            example_1a.translateJointAlongAxisOfMotion(
+                4, 1.0, propagate=False, applyToPreviousWaypoint=True
+            )
+            is True
+        )
     T = SE3.Trans(*(1.0 * z)).A
     for i, (new, old) in enumerate(zip(example_1a.Joints, old_joints, strict=True)):
         if i in (3, 4):
@@ -614,18 +691,23 @@ def test_apply_to_previous_waypoint_not_propagating(example_1a, chain_checker):
     np.testing.assert_allclose(
         [links[4].path.theta1, links[4].path.tMag, links[4].path.theta2],
         [old_links[4].path.theta1, old_links[4].path.tMag, old_links[4].path.theta2],
-        rtol=0, atol=1e-9)
+        rtol=0,
+        atol=1e-9,
+    )
     chain_checker(example_1a)
 
 
 @pytest.mark.parametrize("propagate", [True, False])
-def test_apply_to_previous_waypoint_ignores_a_non_waypoint(example_1a_factory, snapshot,
-                                                           propagate):
+def test_apply_to_previous_waypoint_ignores_a_non_waypoint(example_1a_factory, snapshot, propagate):
     """Joint 1's predecessor is the StartTip, so only joint 1 moves."""
     flagged, plain = example_1a_factory(), example_1a_factory()
     with no_warnings():
-        assert flagged.translateJointAlongAxisOfMotion(
-            1, 0.5, propagate=propagate, applyToPreviousWaypoint=True) is True
+        assert (
+            flagged.translateJointAlongAxisOfMotion(
+                1, 0.5, propagate=propagate, applyToPreviousWaypoint=True
+            )
+            is True
+        )
         assert plain.translateJointAlongAxisOfMotion(1, 0.5, propagate=propagate) is True
     assert snapshot(flagged) == snapshot(plain)
 
@@ -673,7 +755,10 @@ def test_waypoint_state_zero_is_accepted(example_1a, joint):
         np.testing.assert_array_equal(new.start_frame, old.start_frame)
         np.testing.assert_array_equal(new.end_frame, old.end_frame)
         assert (new.path.theta1, new.path.tMag, new.path.theta2) == (
-            old.path.theta1, old.path.tMag, old.path.theta2)
+            old.path.theta1,
+            old.path.tMag,
+            old.path.theta2,
+        )
     recomputed = example_1a.recomputeBoundingBall()
     np.testing.assert_array_equal(example_1a.boundingBall.c, recomputed.c)
 

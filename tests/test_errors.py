@@ -1,0 +1,453 @@
+"""Bad input: every check raises a KinegamiError subclass that is also the matching builtin,
+with a message naming the parameter and the value, and leaves the chain bit-identical."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pytest
+from spatialmath import SE3
+
+from kinegami import (
+    EndTip,
+    IncompatibleJointError,
+    InvalidParameterError,
+    InvalidTypeError,
+    JointIndexError,
+    KinegamiError,
+    KinematicChain,
+    LinkCSC,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+
+NAN, INF = math.nan, math.inf
+
+
+def check_error(excinfo, builtin, name, value=None):
+    """The error is a KinegamiError and ``builtin``; its message names ``name`` and ``value``."""
+    error = excinfo.value
+    assert isinstance(error, KinegamiError)
+    assert isinstance(error, builtin)
+    message = str(error)
+    assert re.search(rf"(?<![A-Za-z_]){re.escape(name)}(?![A-Za-z_])", message), message
+    if value is not None:
+        assert str(value) in message, message
+
+
+def test_hierarchy():
+    assert issubclass(InvalidParameterError, ValueError)
+    assert issubclass(InvalidTypeError, TypeError)
+    assert issubclass(JointIndexError, IndexError)
+    assert issubclass(IncompatibleJointError, ValueError)
+    for cls in (InvalidParameterError, InvalidTypeError, JointIndexError, IncompatibleJointError):
+        assert issubclass(cls, KinegamiError)
+
+
+# --- joint constructors ----------------------------------------------------------------------
+
+CONSTRUCTORS = {
+    "RevoluteJoint": lambda n=4, r=1.0, **kw: RevoluteJoint(
+        n, r, kw.get("bend", math.pi), kw.get("pose", SE3())
+    ),
+    "PrismaticJoint": lambda n=4, r=1.0, **kw: PrismaticJoint(
+        n, r, 3.0, 3, kw.get("cone", math.pi / 4), kw.get("pose", SE3())
+    ),
+    "Waypoint": lambda n=4, r=1.0, **kw: Waypoint(n, r, kw.get("pose", SE3())),
+    "StartTip": lambda n=4, r=1.0, **kw: StartTip(n, r, kw.get("pose", SE3()), 1.5),
+    "EndTip": lambda n=4, r=1.0, **kw: EndTip(n, r, kw.get("pose", SE3()), 1.5),
+}
+
+
+@pytest.mark.parametrize("kind", CONSTRUCTORS)
+@pytest.mark.parametrize("n", [5, 7, 3, 2, 0, -4])
+def test_num_sides_odd_or_too_small(kind, n):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        CONSTRUCTORS[kind](n=n)
+    check_error(excinfo, ValueError, "numSides", n)
+
+
+@pytest.mark.parametrize("kind", CONSTRUCTORS)
+@pytest.mark.parametrize("n", [4.5, "4", None, True])
+def test_num_sides_not_an_integer(kind, n):
+    with pytest.raises(InvalidTypeError) as excinfo:
+        CONSTRUCTORS[kind](n=n)
+    check_error(excinfo, TypeError, "numSides", n)
+
+
+@pytest.mark.parametrize("kind", CONSTRUCTORS)
+@pytest.mark.parametrize("r", [0, -1, -1e-300, NAN, INF, -INF])
+def test_radius_not_positive_and_finite(kind, r):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        CONSTRUCTORS[kind](r=r)
+    check_error(excinfo, ValueError, "r", r)
+
+
+@pytest.mark.parametrize("kind", CONSTRUCTORS)
+def test_radius_not_a_number(kind):
+    with pytest.raises(InvalidTypeError) as excinfo:
+        CONSTRUCTORS[kind](r="1")
+    check_error(excinfo, TypeError, "r", "1")
+
+
+@pytest.mark.parametrize("cone", [math.pi / 6 - 1e-6, 0.0, -0.5, math.pi / 2, 2.0, NAN, INF])
+def test_cone_angle_outside_range(cone):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        CONSTRUCTORS["PrismaticJoint"](cone=cone)
+    check_error(excinfo, ValueError, "coneAngle", cone)
+
+
+@pytest.mark.parametrize("bend", [0.0, -1.0, 2 * math.pi, 7.0, NAN, INF])
+def test_total_bending_angle_outside_range(bend):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        CONSTRUCTORS["RevoluteJoint"](bend=bend)
+    check_error(excinfo, ValueError, "totalBendingAngle", bend)
+
+
+def reflected():
+    return np.diag([1.0, 1.0, -1.0, 1.0])
+
+
+def scaled():
+    T = 2 * np.eye(4)
+    T[3, 3] = 1
+    return T
+
+
+def slightly_scaled():
+    T = np.eye(4)
+    T[:3, :3] *= 1.0001
+    return T
+
+
+def sheared():
+    T = np.eye(4)
+    T[0, 1] = 0.3
+    return T
+
+
+def with_nan():
+    T = np.eye(4)
+    T[1, 3] = NAN
+    return T
+
+
+def with_inf():
+    T = np.eye(4)
+    T[0, 0] = INF
+    return T
+
+
+def bad_last_row():
+    T = np.eye(4)
+    T[3, 0] = 1.0
+    return T
+
+
+#: name -> (bad pose, expected error, a fragment of the message showing the value)
+BAD_POSES = {
+    "reflection": (reflected, InvalidParameterError, "-1."),
+    "scaled": (scaled, InvalidParameterError, "2."),
+    "slightly scaled": (slightly_scaled, InvalidParameterError, "1.0001"),
+    "sheared": (sheared, InvalidParameterError, "0.3"),
+    "contains NaN": (with_nan, InvalidParameterError, "NaN"),
+    "contains inf": (with_inf, InvalidParameterError, "inf"),
+    "last row": (bad_last_row, InvalidParameterError, None),
+    "3x3": (lambda: np.eye(3), InvalidParameterError, "(3, 3)"),
+    "4x3": (lambda: np.eye(4)[:, :3], InvalidParameterError, "(4, 3)"),
+    "vector": (lambda: np.zeros(16), InvalidParameterError, "(16,)"),
+    "text": (lambda: "identity", InvalidTypeError, "str"),
+}
+
+
+@pytest.mark.parametrize("kind", CONSTRUCTORS)
+@pytest.mark.parametrize("case", BAD_POSES)
+def test_joint_pose_not_a_rigid_transform(kind, case):
+    make, error, fragment = BAD_POSES[case]
+    with pytest.raises(error) as excinfo:
+        CONSTRUCTORS[kind](pose=make())
+    check_error(
+        excinfo, ValueError if error is InvalidParameterError else TypeError, "Pose", fragment
+    )
+
+
+@pytest.mark.parametrize("kind", CONSTRUCTORS)
+def test_valid_array_pose_is_accepted(kind):
+    T = (SE3.Trans(1, 2, 3) * SE3.RPY(0.1, 0.2, 0.3)).A
+    joint = CONSTRUCTORS[kind](pose=T)
+    np.testing.assert_array_equal(joint.pose_matrix, T)
+
+
+@pytest.mark.parametrize("k", [3, -1, 0.5])
+def test_waypoint_path_index(k):
+    with pytest.raises((InvalidParameterError, InvalidTypeError)) as excinfo:
+        Waypoint(4, 1, SE3(), pathIndex=k)
+    check_error(excinfo, (ValueError, TypeError), "pathIndex", k)
+
+
+# --- LinkCSC ---------------------------------------------------------------------------------
+
+BAD_MAX_ANGLES = [0.0, -0.1, math.pi + 1e-9, 4.0, NAN, INF]
+
+
+@pytest.mark.parametrize("max_angle", BAD_MAX_ANGLES)
+def test_link_max_angle_per_elbow(max_angle):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        LinkCSC(1.0, SE3(), SE3.Trans(5, 0, 0), max_angle)
+    check_error(excinfo, ValueError, "maxAnglePerElbow", max_angle)
+
+
+def test_link_max_angle_pi_is_accepted():
+    link = LinkCSC(1.0, SE3(), SE3.Trans(0, 10, 5) * SE3.Ry(-math.pi / 2), math.pi)
+    assert link.elbows1.count == 1 and link.elbows2.count == 1
+
+
+@pytest.mark.parametrize("r", [0, -2.0, NAN, INF])
+def test_link_radius(r):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        LinkCSC(r, SE3(), SE3.Trans(5, 0, 0))
+    check_error(excinfo, ValueError, "r", r)
+
+
+@pytest.mark.parametrize("which", ["StartDubinsPose", "EndDubinsPose"])
+@pytest.mark.parametrize("case", BAD_POSES)
+def test_link_frames(which, case):
+    make, error, fragment = BAD_POSES[case]
+    frames = {"StartDubinsPose": SE3(), "EndDubinsPose": SE3.Trans(5, 0, 0)}
+    frames[which] = make()
+    with pytest.raises(error) as excinfo:
+        LinkCSC(1.0, frames["StartDubinsPose"], frames["EndDubinsPose"])
+    check_error(
+        excinfo, ValueError if error is InvalidParameterError else TypeError, which, fragment
+    )
+
+
+# --- chain construction ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("max_angle", BAD_MAX_ANGLES)
+def test_chain_max_angle_per_elbow(max_angle):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        KinematicChain(StartTip(4, 1, SE3(), 1.5), max_angle)
+    check_error(excinfo, ValueError, "maxAnglePerElbow", max_angle)
+
+
+def test_chain_root_must_be_a_joint():
+    with pytest.raises(InvalidTypeError) as excinfo:
+        KinematicChain(SE3())
+    check_error(excinfo, TypeError, "startJoint", "SE3")
+
+
+def test_chain_root_cannot_be_an_end_tip():
+    with pytest.raises(InvalidParameterError) as excinfo:
+        KinematicChain(EndTip(4, 1, SE3(), 1.5))
+    check_error(excinfo, ValueError, "startJoint", "EndTip")
+
+
+# --- chain methods: each error leaves the chain bit-identical --------------------------------
+
+
+@pytest.fixture
+def chain_and_snapshot(example_1a, snapshot):
+    return example_1a, snapshot(example_1a), snapshot
+
+
+def assert_unchanged(chain_and_snapshot):
+    chain, before, snapshot = chain_and_snapshot
+    assert snapshot(chain) == before
+
+
+@pytest.mark.parametrize(
+    "n, r, name, value", [(6, 1.0, "numSides", 6), (4, 1.5, "r", 1.5), (8, 2.0, "numSides", 8)]
+)
+@pytest.mark.parametrize("safe", [True, False])
+def test_append_joint_with_another_tube(chain_and_snapshot, n, r, name, value, safe):
+    chain = chain_and_snapshot[0]
+    chain.delete(-1)  # drop the EndTip so appending is otherwise allowed
+    chain_and_snapshot = (chain, chain_and_snapshot[2](chain), chain_and_snapshot[2])
+    with pytest.raises(IncompatibleJointError) as excinfo:
+        chain.append(RevoluteJoint(n, r, math.pi, SE3()), safe=safe)
+    check_error(excinfo, ValueError, name, value)
+    assert_unchanged(chain_and_snapshot)
+
+
+@pytest.mark.parametrize("flag", ["fixedPosition", "fixedOrientation"])
+def test_append_safe_with_fixed_pose(chain_and_snapshot, flag):
+    chain = chain_and_snapshot[0]
+    chain.delete(-1)
+    chain_and_snapshot = (chain, chain_and_snapshot[2](chain), chain_and_snapshot[2])
+    with pytest.raises(InvalidParameterError) as excinfo:
+        chain.append(RevoluteJoint(4, 1, math.pi, SE3()), safe=True, **{flag: True})
+    check_error(excinfo, ValueError, flag, True)
+    assert_unchanged(chain_and_snapshot)
+
+
+def test_append_after_an_end_tip(chain_and_snapshot):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        chain_and_snapshot[0].append(RevoluteJoint(4, 1, math.pi, SE3()))
+    check_error(excinfo, ValueError, "EndTip")
+    assert_unchanged(chain_and_snapshot)
+
+
+def test_append_a_start_tip(snapshot):
+    chain = KinematicChain(StartTip(4, 1, SE3(), 1.5))
+    before = snapshot(chain)
+    with pytest.raises(InvalidParameterError) as excinfo:
+        chain.append(StartTip(4, 1, SE3(), 1.5))
+    check_error(excinfo, ValueError, "StartTip")
+    assert snapshot(chain) == before
+
+
+def test_append_not_a_joint(snapshot):
+    chain = KinematicChain(StartTip(4, 1, SE3(), 1.5))
+    before = snapshot(chain)
+    with pytest.raises(InvalidTypeError) as excinfo:
+        chain.append(SE3.Trans(1, 0, 0))
+    check_error(excinfo, TypeError, "Joint", "SE3")
+    assert snapshot(chain) == before
+
+
+@pytest.mark.parametrize("flag", ["relative", "safe", "fixedPosition", "fixedOrientation"])
+def test_append_flags_must_be_booleans(snapshot, flag):
+    chain = KinematicChain(StartTip(4, 1, SE3(), 1.5))
+    before = snapshot(chain)
+    with pytest.raises(InvalidTypeError) as excinfo:
+        chain.append(RevoluteJoint(4, 1, math.pi, SE3()), **{flag: "yes"})
+    check_error(excinfo, TypeError, flag, "yes")
+    assert snapshot(chain) == before
+
+
+#: method name -> call with a joint index
+INDEXED_CALLS = {
+    "transformJoint": lambda c, j: c.transformJoint(j, SE3.Trans(0, 0, 0.1)),
+    "translateJointAlongAxisOfMotion": lambda c, j: c.translateJointAlongAxisOfMotion(j, 0.1),
+    "rotateJointAboutAxisOfMotion": lambda c, j: c.rotateJointAboutAxisOfMotion(j, 0.1),
+    "delete": lambda c, j: c.delete(j),
+    "setJointState": lambda c, j: c.setJointState(j, 0.0),
+}
+
+
+@pytest.mark.parametrize("method", INDEXED_CALLS)
+@pytest.mark.parametrize("index", [7, 8, 1000, -8, -100])
+def test_joint_index_out_of_range(chain_and_snapshot, method, index):
+    with pytest.raises(JointIndexError) as excinfo:
+        INDEXED_CALLS[method](chain_and_snapshot[0], index)
+    check_error(excinfo, IndexError, "jointIndex", index)
+    assert_unchanged(chain_and_snapshot)
+
+
+@pytest.mark.parametrize("method", INDEXED_CALLS)
+@pytest.mark.parametrize("index", [1.0, "2", None])
+def test_joint_index_not_an_integer(chain_and_snapshot, method, index):
+    with pytest.raises(InvalidTypeError) as excinfo:
+        INDEXED_CALLS[method](chain_and_snapshot[0], index)
+    check_error(excinfo, TypeError, "jointIndex", index)
+    assert_unchanged(chain_and_snapshot)
+
+
+@pytest.mark.parametrize("method", INDEXED_CALLS)
+def test_negative_index_counts_from_the_end(example_1a_factory, snapshot, method):
+    a, b = example_1a_factory(), example_1a_factory()
+    assert INDEXED_CALLS[method](a, -3) == INDEXED_CALLS[method](b, 4)
+    assert snapshot(a) == snapshot(b)
+
+
+@pytest.mark.parametrize("value", [NAN, INF, -INF])
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda c, v: c.translateJointAlongAxisOfMotion(4, v), "distance"),
+        (lambda c, v: c.rotateJointAboutAxisOfMotion(4, v), "angle"),
+        (lambda c, v: c.setJointState(4, v), "newState"),
+        (lambda c, v: c.setJointStates([0, 0, v, 0, 0, 0, 0]), "states[2]"),
+    ],
+    ids=["distance", "angle", "state", "states"],
+)
+def test_non_finite_numbers(chain_and_snapshot, call, name, value):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        call(chain_and_snapshot[0], value)
+    check_error(excinfo, ValueError, name, value)
+    assert_unchanged(chain_and_snapshot)
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda c: c.translateJointAlongAxisOfMotion(4, "1"), "distance"),
+        (lambda c: c.rotateJointAboutAxisOfMotion(4, None), "angle"),
+        (lambda c: c.setJointState(4, True), "newState"),
+    ],
+    ids=["distance", "angle", "state"],
+)
+def test_numbers_of_the_wrong_type(chain_and_snapshot, call, name):
+    with pytest.raises(InvalidTypeError) as excinfo:
+        call(chain_and_snapshot[0])
+    check_error(excinfo, TypeError, name)
+    assert_unchanged(chain_and_snapshot)
+
+
+@pytest.mark.parametrize("states", [[0.0] * 6, [0.0] * 8, []])
+def test_set_joint_states_needs_one_value_per_joint(chain_and_snapshot, states):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        chain_and_snapshot[0].setJointStates(states)
+    check_error(excinfo, ValueError, "states", len(states))
+    assert_unchanged(chain_and_snapshot)
+
+
+@pytest.mark.parametrize("case", BAD_POSES)
+@pytest.mark.parametrize("method", ["transformJoint", "transformAll"])
+def test_transformation_not_a_rigid_transform(chain_and_snapshot, case, method):
+    make, error, fragment = BAD_POSES[case]
+    chain = chain_and_snapshot[0]
+    with pytest.raises(error) as excinfo:
+        if method == "transformJoint":
+            chain.transformJoint(4, make())
+        else:
+            chain.transformAll(make())
+    check_error(
+        excinfo,
+        ValueError if error is InvalidParameterError else TypeError,
+        "Transformation",
+        fragment,
+    )
+    assert_unchanged(chain_and_snapshot)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda c: c.translateJointAlongAxisOfMotion(4, 0.1, propogate=False, propagate=True),
+        lambda c: c.rotateJointAboutAxisOfMotion(4, 0.1, propogate=False, propagate=True),
+        lambda c: c.transformJoint(4, SE3(), propogate=False, propagate=True),
+    ],
+    ids=["translate", "rotate", "transform"],
+)
+def test_contradicting_propagate_spellings(chain_and_snapshot, call):
+    with pytest.raises(InvalidParameterError) as excinfo:
+        call(chain_and_snapshot[0])
+    check_error(excinfo, ValueError, "propagate", True)
+    check_error(excinfo, ValueError, "propogate", False)
+    assert_unchanged(chain_and_snapshot)
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda c: c.translateJointAlongAxisOfMotion(4, 0.1, propogate="no"), "propogate"),
+        (lambda c: c.rotateJointAboutAxisOfMotion(4, 0.1, propagate=0), "propagate"),
+        (
+            lambda c: c.translateJointAlongAxisOfMotion(4, 0.1, applyToPreviousWaypoint=1),
+            "applyToPreviousWaypoint",
+        ),
+    ],
+    ids=["propogate", "propagate", "applyToPreviousWaypoint"],
+)
+def test_edit_flags_must_be_booleans(chain_and_snapshot, call, name):
+    with pytest.raises(InvalidTypeError) as excinfo:
+        call(chain_and_snapshot[0])
+    check_error(excinfo, TypeError, name)
+    assert_unchanged(chain_and_snapshot)
