@@ -210,3 +210,7 @@ REJECT_ROTATE = (4, PI)  # rotateJointAboutAxisOfMotion(4, pi, propagate=False)
 REJECT_TRANSLATE = (2, 20)  # translateJointAlongAxisOfMotion(2, 20, propagate=False)
 #: RevoluteJoint(4, 1, pi, Trans(0, 0, 10) Ry(pi/2)) after StartTip(4, 1, SE3(), 1.5).
 REJECT_APPEND = {"start_length": 1.5, "translation": (0, 0, 10), "ry": PI / 2}
+
+# --- the chain's crease pattern (patterns.md 4.3, informational values of example 1 after 1B)
+EXAMPLE_1_PATTERN_HEIGHT = 52.767303
+EXAMPLE_1_PATTERN_DISTAL_MARKER_X = 0.258638
