@@ -1,0 +1,199 @@
+"""Options shared by the sheet exporters (DXF, SVG): units, scale, perforation, B10 skipping."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from numbers import Real
+from typing import Any
+
+import numpy as np
+
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+
+__all__ = [
+    "UNITS_IN_MM",
+    "DEFAULT_DASH",
+    "DEFAULT_GAP",
+    "SheetOptions",
+    "resolve_sheet_options",
+    "dash_segments",
+    "format_numbers",
+]
+
+#: Length of one pattern unit in millimetres for each accepted ``units`` value.
+UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
+
+#: Default perforation: cut length and bridge length along fold lines, millimetres.
+DEFAULT_DASH = 1.0
+DEFAULT_GAP = 1.0
+
+_COMMON = ("units", "scale", "perforate", "dash", "gap", "skip_creases_on_cut")
+
+
+@dataclass(frozen=True)
+class SheetOptions:
+    """Validated exporter options.
+
+    Attributes
+    ----------
+    factor : float
+        Millimetres per pattern unit (units times scale).
+    perforate : bool
+        Draw the fold lines as dashes.
+    dash, gap : float
+        Dash and gap lengths in millimetres (used when ``perforate``).
+    skip_creases_on_cut : bool
+        Drop creases lying on the top or bottom edge of the sheet (spec B10).
+    extra : dict
+        The exporter-specific options, unchecked.
+    """
+
+    factor: float
+    perforate: bool
+    dash: float
+    gap: float
+    skip_creases_on_cut: bool
+    extra: dict
+
+
+def _positive(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer):
+        raise InvalidTypeError(f"{name} must be a number, got {value!r}")
+    value = float(value)
+    if not (math.isfinite(value) and value > 0.0):
+        raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
+    return value
+
+
+def _flag(name: str, value: Any) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidTypeError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def resolve_sheet_options(options: dict[str, Any], extra: dict[str, Any], fmt: str) -> SheetOptions:
+    """Check the options of a sheet exporter.
+
+    Parameters
+    ----------
+    options : dict
+        The keyword arguments given by the user.
+    extra : dict
+        Defaults of the exporter-specific options (their names are accepted too).
+    fmt : str
+        Format name for messages, e.g. ``"DXF"``.
+
+    Raises
+    ------
+    InvalidTypeError
+        For an unknown option name or a value of the wrong type.
+    InvalidParameterError
+        For a value out of range, an unknown unit, or ``dash``/``gap`` with ``perforate=False``.
+    """
+    valid = _COMMON + tuple(extra)
+    unknown = sorted(set(options) - set(valid))
+    if unknown:
+        raise InvalidTypeError(
+            f"{fmt} export got unknown option{'s' if len(unknown) > 1 else ''} "
+            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(valid)}"
+        )
+    units = options.get("units", "mm")
+    if units not in UNITS_IN_MM:
+        raise InvalidParameterError(
+            f"units must be one of {', '.join(map(repr, UNITS_IN_MM))} (the length of one "
+            f"pattern unit), got {units!r}"
+        )
+    scale = _positive("scale", options.get("scale", 1.0))
+    dash, gap = options.get("dash"), options.get("gap")
+    perforate = options.get("perforate")
+    if perforate is None:
+        perforate = dash is not None or gap is not None
+    perforate = _flag("perforate", perforate)
+    if not perforate and (dash is not None or gap is not None):
+        raise InvalidParameterError(
+            f"dash={dash!r} and gap={gap!r} only apply with perforate=True, got perforate=False"
+        )
+    dash = DEFAULT_DASH if dash is None else _positive("dash", dash)
+    gap = DEFAULT_GAP if gap is None else _positive("gap", gap)
+    skip = _flag("skip_creases_on_cut", options.get("skip_creases_on_cut", False))
+    values = dict(extra)
+    values.update({k: v for k, v in options.items() if k in extra})
+    return SheetOptions(UNITS_IN_MM[units] * scale, perforate, dash, gap, skip, values)
+
+
+def dash_segments(segments: np.ndarray, dash: float, gap: float) -> tuple[np.ndarray, np.ndarray]:
+    """Cut every segment into dashes of length ``dash`` separated by gaps of length ``gap``.
+
+    Each segment starts with a full dash at its first point; the last dash is shorter when the
+    segment ends inside it.
+
+    Parameters
+    ----------
+    segments : numpy.ndarray, shape (K, 2, 2)
+    dash, gap : float
+        Lengths, same unit as the segments (> 0).
+
+    Returns
+    -------
+    dashes : numpy.ndarray, shape (D, 2, 2)
+        The dashes, in the order of the segments.
+    source : numpy.ndarray of int, shape (D,)
+        Index of the segment each dash comes from.
+    """
+    segments = np.asarray(segments, dtype=float).reshape(-1, 2, 2)
+    p0 = segments[:, 0]
+    d = segments[:, 1] - p0
+    length = np.hypot(d[:, 0], d[:, 1])
+    period = dash + gap
+    tiny = 1e-9 * dash
+    # dash k starts at k * period; keep the starts that leave a dash longer than tiny
+    counts = np.where(length > tiny, np.ceil((length - tiny) / period), 0).astype(np.intp)
+    source = np.repeat(np.arange(segments.shape[0]), counts)
+    first = np.cumsum(counts) - counts
+    k = np.arange(source.shape[0]) - np.repeat(first, counts)
+    s = k * period
+    e = np.minimum(s + dash, length[source])
+    unit = d[source] / length[source, None]
+    start = p0[source] + s[:, None] * unit
+    end = p0[source] + e[:, None] * unit
+    return np.stack([start, end], axis=1), source
+
+
+def format_numbers(values: np.ndarray, extent: float) -> list[str]:
+    """Shortest round-trip text of ``values`` rounded to 12 significant digits of ``extent``.
+
+    Rounding removes float noise such as 1e-17 (written as 0.0) so files stay readable.
+    """
+    values = np.asarray(values, dtype=float)
+    digits = 12 - math.ceil(math.log10(extent)) if extent > 0 else 12
+    rounded = np.round(values, digits) + 0.0  # + 0.0 turns -0.0 into 0.0
+    return [repr(v) for v in rounded.ravel().tolist()]
+
+
+def sheet_lines(
+    pattern, opts: SheetOptions
+) -> tuple[np.ndarray, np.ndarray, tuple[float, float, float, float]]:
+    """The lines to export, in millimetres: flattened, scaled and (optionally) perforated.
+
+    Returns
+    -------
+    segments : numpy.ndarray, shape (K, 2, 2)
+        Lines in mm; creases (or their dashes) first, then boundary and cut.
+    kinds : numpy.ndarray of str, shape (K,)
+        ``"M"``, ``"V"``, ``"B"`` or ``"C"``.
+    bounds : tuple of float
+        The cut rectangle (xmin, ymin, xmax, ymax) in mm.
+    """
+    from kinegami.pattern.sheet import flatten
+
+    sheet = flatten(pattern, skip_creases_on_cut=opts.skip_creases_on_cut)
+    segments = sheet.segments * opts.factor
+    kinds = sheet.kinds
+    if opts.perforate:
+        folds = np.isin(kinds, ("M", "V"))
+        dashes, source = dash_segments(segments[folds], opts.dash, opts.gap)
+        segments = np.concatenate([dashes, segments[~folds]])
+        kinds = np.concatenate([kinds[folds][source], kinds[~folds]])
+    bounds = tuple(float(v) * opts.factor for v in sheet.bounds)
+    return segments, kinds, bounds

@@ -1,0 +1,42 @@
+"""Reference numbers of spec/patterns.md section 7.4 used by the export tests (r = 1)."""
+
+import math
+
+#: (catalog function, arguments) and the clipped Mountain / Valley line counts.
+CLIPPED_COUNTS = {
+    "tube n=4 h=1": (("TubeFittingPattern", (4, 1.0, 1.0)), (4, 0)),
+    "tube n=6 h=1": (("TubeFittingPattern", (6, 1.0, 1.0)), (6, 0)),
+    "twist n=6 a=0.5 h=0.5": (("TwistFittingPattern", (6, 1.0, 0.5, 0.5)), (14, 15)),
+    "elbow n=4 pi/2 0": (("ElbowFittingPattern", (4, 1.0, math.pi / 2, 0.0)), (22, 12)),
+    "revolute n=6 pi N=1": (("RevoluteJointPattern", (6, 1.0, math.pi, 1)), (38, 30)),
+}
+
+#: Lines of the boundary and of the cut outline.
+OUTLINE_LINES = 4
+
+#: The composite of section 7.4 (the first argument n is prepended).
+COMPOSITE_MODULES = (
+    ("TubeFittingPattern", (1.0, 1.0)),
+    ("TwistFittingPattern", (1.0, 0.5, 0.5)),
+    ("ElbowFittingPattern", (1.0, math.pi / 2, math.pi / 3)),
+    ("RevoluteJointPattern", (1.0, math.pi)),
+    ("TubeFittingPattern", (1.0, 1.0)),
+)
+
+#: Creases lying on the top/bottom sheet edge (B10) in the single modules above: (M, V).
+CREASES_ON_CUT = {
+    "twist n=6 a=0.5 h=0.5": (0, 15),
+    "revolute n=6 pi N=1": (14, 0),
+}
+
+#: DXF header values and layer colours (ACI).
+DXF_INSUNITS_MM = 4
+DXF_MEASUREMENT_METRIC = 1
+DXF_VERSION_CODE = "AC1027"  # R2013
+DXF_LAYER_COLORS = {"Mountain": 5, "Valley": 1, "Boundary": 2, "Cut": 3}
+
+#: Origami Simulator colours written to SVG.
+SVG_COLORS = {"Mountain": "#ff0000", "Valley": "#0000ff", "Boundary": "#000000", "Cut": "#00ff00"}
+
+#: Millimetres per pattern unit for each ``units`` value.
+UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
