@@ -532,10 +532,14 @@ class KinematicChain:
     def creasePattern(self, twistPortion: float = 0.2):
         """The chain's tubular crease pattern (patterns.md 4.3) as a TubularPattern."""
         from kinegami.pattern import TubularPattern
+        from kinegami.validation import check_in_range
 
+        twistPortion = check_in_range(
+            "twistPortion", twistPortion, 0.0, 1.0, low_inclusive=True, range_text="[0, 1)"
+        )
         modules = [self._joints[0].pattern]
         for link, joint in zip(self._links[1:], self._joints[1:], strict=True):
-            modules.append(link.creasePattern(self.numSides, twistPortion))
+            modules += link.pattern_modules(self.numSides, twistPortion)
             modules.append(joint.pattern)
         return TubularPattern.concatenate(modules)
 

@@ -279,13 +279,7 @@ class LinkCSC:
         rest. Smaller turns are exact in the chain's frames but below what the pattern
         resolves, and are left out of the pattern as in the reference (patterns.md 4.2).
         """
-        from kinegami.pattern import (
-            ElbowFittingPattern,
-            TubeFittingPattern,
-            TubularPattern,
-            TwistFittingPattern,
-            WaypointPattern,
-        )
+        from kinegami.pattern import TubularPattern, WaypointPattern
         from kinegami.validation import check_in_range, check_num_sides
 
         numSides = check_num_sides(numSides)
@@ -293,6 +287,18 @@ class LinkCSC:
             "twistPortion", twistPortion, 0.0, 1.0, low_inclusive=True, range_text="[0, 1)"
         )
         modules = [WaypointPattern(numSides, self.r)]
+        modules += self.pattern_modules(numSides, twistPortion)
+        return TubularPattern.concatenate(modules)
+
+    def pattern_modules(self, numSides: int, twistPortion: float) -> list:
+        """The catalog modules of the link's pattern, in order (arguments already checked)."""
+        from kinegami.pattern import (
+            ElbowFittingPattern,
+            TubeFittingPattern,
+            TwistFittingPattern,
+        )
+
+        modules = []
 
         def elbows(arc: ElbowArc) -> list:
             if arc.angle <= PATTERN_MIN_ANGLE:
@@ -308,7 +314,7 @@ class LinkCSC:
             tube -= twist_height
         modules.append(TubeFittingPattern(numSides, self.r, tube))
         modules += elbows(self.elbows2)
-        return TubularPattern.concatenate(modules)
+        return modules
 
     def __repr__(self) -> str:
         p = self.path

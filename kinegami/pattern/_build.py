@@ -10,7 +10,11 @@ from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 
 def crease_block(first, second, label: str) -> tuple[np.ndarray, str]:
     """A block of creases first[i]-second[i], all with the same label ("M" or "V")."""
-    return np.stack([np.asarray(first), np.asarray(second)], axis=1).reshape(-1, 2), label
+    first = np.asarray(first)
+    block = np.empty((first.shape[0], 2), dtype=np.intp)
+    block[:, 0] = first
+    block[:, 1] = second
+    return block, label
 
 
 def assemble(

@@ -90,12 +90,18 @@ def elbow_geometry(prism: Prism, bendingAngle: float, rotationalAxisAngle: float
     d_w = r * math.tan(theta / 2.0)
     h = d_w * (1.0 + np.sin(beta - phi))
     H_m = float(h.max())
-    h_prev, h_next = np.roll(h, 1), np.roll(h, -1)
-    flat = math.pi - np.arctan((h_prev - h) / b) - np.arctan((h_next - h) / b)
-    q = np.stack([r * np.cos(beta), r * np.sin(beta), h], axis=1)
-    u = np.roll(q, -1, axis=0) - q
-    w = np.roll(q, 1, axis=0) - q
-    cos_b = np.einsum("ij,ij->i", u, w) / (np.linalg.norm(u, axis=1) * np.linalg.norm(w, axis=1))
+    n = beta.shape[0]
+    prev, nxt = np.arange(-1, n - 1), np.arange(1, n + 1) % n
+    flat = math.pi - np.arctan((h[prev] - h) / b) - np.arctan((h[nxt] - h) / b)
+    q = np.empty((n, 3))
+    q[:, 0] = r * np.cos(beta)
+    q[:, 1] = r * np.sin(beta)
+    q[:, 2] = h
+    u = q[nxt] - q
+    w = q[prev] - q
+    cos_b = np.einsum("ij,ij->i", u, w) / np.sqrt(
+        np.einsum("ij,ij->i", u, u) * np.einsum("ij,ij->i", w, w)
+    )
     polygon = np.arccos(np.clip(cos_b, -1.0, 1.0))
     tuck = 0.5 * (flat - polygon)
     # a column collapses when its tuck vertices L, M, O would lie within eps of each other:
@@ -171,15 +177,14 @@ def _build_elbow(prism: Prism, geo: ElbowGeometry, record: ModuleRecord) -> Tubu
     U = np.where(has_l, start + 3, np.where(low, D, start))
     total = 2 * n + int(counts.sum())
     vertices = np.empty((total, 2))
-    vertices[P] = np.stack([x, np.zeros(n)], axis=1)
-    vertices[D] = np.stack([x, np.full(n, H)], axis=1)
+    vertices[P, 0], vertices[P, 1] = x, 0.0
+    vertices[D, 0], vertices[D, 1] = x, H
     offset = (H_m - h) * np.tan(geo.tuck)
-    vertices[M] = np.stack([x, np.full(n, H_m)], axis=1)
-    vertices[Of[full]] = np.stack(
-        [wrap_x(x[full] + offset[full], prism.W, prism.eps), np.full(int(full.sum()), H_m)], axis=1
-    )
-    vertices[L[has_l]] = np.stack([x[has_l], h[has_l]], axis=1)
-    vertices[U[has_l]] = np.stack([x[has_l], H - h[has_l]], axis=1)
+    vertices[M, 0], vertices[M, 1] = x, H_m
+    vertices[Of[full], 0] = wrap_x(x[full] + offset[full], prism.W, prism.eps)
+    vertices[Of[full], 1] = H_m
+    vertices[L[has_l], 0], vertices[L[has_l], 1] = x[has_l], h[has_l]
+    vertices[U[has_l], 0], vertices[U[has_l], 1] = x[has_l], H - h[has_l]
     prev, nxt = (k - 1) % n, (k + 1) % n
     # block order matters: where two collapsed columns are adjacent the lower boundary,
     # upper boundary and midline coincide; the first (lower boundary, M) is kept (step 5)
