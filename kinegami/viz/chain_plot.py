@@ -17,6 +17,7 @@ import numpy as np
 from kinegami import style
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.viz import chain_geometry as geo
+from kinegami.viz._backend import backend_is_interactive as _backend_is_interactive
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -398,20 +399,6 @@ def _set_equal_limits(ax, scene, had_data: bool, r: float):
     ax.set_ylim3d(low[1], high[1])
     ax.set_zlim3d(low[2], high[2])
     ax.set_box_aspect(tuple(high - low), zoom=1.15)
-
-
-def _backend_is_interactive() -> bool:
-    """False for the file-only backends (Agg, PDF, SVG, ...), where plt.show cannot show."""
-    import matplotlib
-
-    backend = matplotlib.get_backend().lower()
-    try:
-        from matplotlib.backends import BackendFilter, backend_registry
-
-        non_interactive = backend_registry.list_builtin(BackendFilter.NON_INTERACTIVE)
-    except ImportError:  # matplotlib < 3.9
-        from matplotlib.rcsetup import non_interactive_bk as non_interactive
-    return backend not in {name.lower() for name in non_interactive}
 
 
 def show_chain(chain: KinematicChain, **options) -> tuple[Figure, Axes3D]:

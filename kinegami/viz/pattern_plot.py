@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.viz._backend import backend_is_interactive as _backend_is_interactive
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -98,20 +99,6 @@ def _resolve_options(options: dict[str, Any]) -> dict[str, Any]:
         if not isinstance(ax, Axes) or getattr(ax, "name", None) == "3d":
             raise InvalidTypeError(f"ax must be a 2D matplotlib Axes, got {type(ax).__name__}")
     return opts
-
-
-def _backend_is_interactive() -> bool:
-    """False for the file-only backends (Agg, PDF, SVG, ...), where plt.show cannot show."""
-    import matplotlib
-
-    backend = matplotlib.get_backend().lower()
-    try:
-        from matplotlib.backends import BackendFilter, backend_registry
-
-        non_interactive = backend_registry.list_builtin(BackendFilter.NON_INTERACTIVE)
-    except ImportError:  # matplotlib < 3.9
-        from matplotlib.rcsetup import non_interactive_bk as non_interactive
-    return backend not in {name.lower() for name in non_interactive}
 
 
 def show_pattern(pattern: TubularPattern, **options: Any) -> tuple[Figure, Axes]:

@@ -1,0 +1,17 @@
+"""What the drawing functions share about matplotlib's backend."""
+
+from __future__ import annotations
+
+
+def backend_is_interactive() -> bool:
+    """False for the file-only backends (Agg, PDF, SVG, ...), where plt.show cannot show."""
+    import matplotlib
+
+    backend = matplotlib.get_backend().lower()
+    try:
+        from matplotlib.backends import BackendFilter, backend_registry
+
+        non_interactive = backend_registry.list_builtin(BackendFilter.NON_INTERACTIVE)
+    except ImportError:  # matplotlib < 3.9
+        from matplotlib.rcsetup import non_interactive_bk as non_interactive
+    return backend not in {name.lower() for name in non_interactive}
