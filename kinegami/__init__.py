@@ -27,11 +27,7 @@ from kinegami.joints import (
     Waypoint,
 )
 from kinegami.links import LinkCSC
-
-try:  # the pattern package is built alongside; keep the chain importable without it
-    from kinegami.pattern import TubularPattern
-except ImportError:  # pragma: no cover
-    TubularPattern = None
+from kinegami.pattern import TubularPattern
 
 __version__ = "0.1.0"
 
