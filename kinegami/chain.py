@@ -60,14 +60,30 @@ def _check_bool(name: str, value) -> bool:
     return bool(value)
 
 
+class _DefaultTrue:
+    """The default of ``propogate``: True, but distinguishable from an explicit True."""
+
+    def __bool__(self) -> bool:
+        return True
+
+    def __repr__(self) -> str:
+        return "True"
+
+
+_PROPAGATE_DEFAULT = _DefaultTrue()
+
+
 def _propagate_flag(propogate, propagate) -> bool:
-    """Accept the paper's spelling ``propogate`` and the correct ``propagate``."""
+    """Accept the paper's spelling ``propogate`` and the correct ``propagate`` (not both)."""
     if propagate is None:
+        if propogate is _PROPAGATE_DEFAULT:
+            return True
         return _check_bool("propogate", propogate)
     propagate = _check_bool("propagate", propagate)
-    if propogate is not True and bool(propogate) != propagate:
+    if propogate is not _PROPAGATE_DEFAULT:
         raise InvalidParameterError(
-            f"propogate={propogate!r} and propagate={propagate!r} disagree; give only one"
+            f"give only one of propogate (the paper's spelling) and propagate, got "
+            f"propogate={propogate!r} and propagate={propagate!r}"
         )
     return propagate
 
@@ -352,7 +368,7 @@ class KinematicChain:
         self,
         jointIndex: int,
         Transformation,
-        propogate: bool = True,
+        propogate: bool = _PROPAGATE_DEFAULT,
         *,
         propagate: bool | None = None,
     ) -> bool:
@@ -406,7 +422,7 @@ class KinematicChain:
         self,
         jointIndex: int,
         distance: float,
-        propogate: bool = True,
+        propogate: bool = _PROPAGATE_DEFAULT,
         applyToPreviousWaypoint: bool = False,
         *,
         propagate: bool | None = None,
@@ -430,7 +446,7 @@ class KinematicChain:
         self,
         jointIndex: int,
         angle: float,
-        propogate: bool = True,
+        propogate: bool = _PROPAGATE_DEFAULT,
         applyToPreviousWaypoint: bool = False,
         *,
         propagate: bool | None = None,

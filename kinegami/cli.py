@@ -15,7 +15,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--version", action="version", version=f"kinegami {__version__}")
     parser.parse_args(argv)
-    print(f"kinegami {__version__}")
+    parser.print_help()
     return 0
 
 

@@ -12,6 +12,7 @@ Joints are values: a chain never changes a joint in place, it swaps in modified 
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -93,7 +94,6 @@ class Joint:
         self._neutralLength = float(neutralLength)
         self._T = pose_array(Pose)
         self._state = 0.0
-        self._pose_se3 = None
 
     # --- published attributes -------------------------------------------------------------
     @property
@@ -118,10 +118,11 @@ class Joint:
 
     @property
     def Pose(self) -> SE3:
-        """Pose of the joint centre at state 0; z is the axis of motion (world coordinates)."""
-        if self._pose_se3 is None:
-            self._pose_se3 = SE3(np.array(self._T), check=False)
-        return self._pose_se3
+        """Pose of the joint centre at state 0; z is the axis of motion (world coordinates).
+
+        A new SE3 each time: changing it does not change the joint (edit through the chain).
+        """
+        return SE3(np.array(self._T), check=False)
 
     @property
     def pose_matrix(self) -> np.ndarray:
@@ -197,7 +198,6 @@ class Joint:
     def _copy(self) -> Joint:
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
-        new._pose_se3 = None
         return new
 
     def with_pose(self, T: np.ndarray) -> Joint:
@@ -240,14 +240,14 @@ class Joint:
     # --- pattern --------------------------------------------------------------------------
     @property
     def pattern(self):
-        """The joint's crease pattern (a TubularPattern), built on first use."""
-        cached = self.__dict__.get("_pattern_cache")
-        if cached is None:
-            cached = self._build_pattern()
-            self.__dict__["_pattern_cache"] = cached
-        return cached
+        """The joint's crease pattern (a TubularPattern).
 
-    def _build_pattern(self):
+        Patterns are values, so joints with the same parameters share one (built on first use).
+        """
+        return _catalog_pattern(*self._pattern_recipe())
+
+    def _pattern_recipe(self) -> tuple:
+        """(catalog function name, its arguments) of this joint's pattern."""
         raise InvalidTypeError(f"{type(self).__name__} has no crease pattern")
 
     def _describe(self) -> str:
@@ -307,11 +307,12 @@ class RevoluteJoint(Joint):
     def state_transform(self, delta: float) -> np.ndarray:
         return rotation_about_line(self._T[:3, 2], self._T[:3, 3], delta)
 
-    def _build_pattern(self):
-        from kinegami.pattern import RevoluteJointPattern
-
-        return RevoluteJointPattern(
-            self.numSides, self.r, self.totalBendingAngle, self.numSinkLayers
+    def _pattern_recipe(self) -> tuple:
+        return "RevoluteJointPattern", (
+            self.numSides,
+            self.r,
+            self.totalBendingAngle,
+            self.numSinkLayers,
         )
 
     def _describe(self) -> str:
@@ -326,14 +327,14 @@ class ExtendedRevoluteJoint(RevoluteJoint):
         super().__init__(numSides, r, totalBendingAngle, Pose, numSinkLayers)
         self._neutralLength += 2.0 * self.tubeLength
 
-    def _build_pattern(self):
-        from kinegami.pattern import RevoluteJointPattern, TubeFittingPattern
-
-        tube = TubeFittingPattern(self.numSides, self.r, self.tubeLength)
-        joint = RevoluteJointPattern(
-            self.numSides, self.r, self.totalBendingAngle, self.numSinkLayers
+    def _pattern_recipe(self) -> tuple:
+        return "ExtendedRevoluteJointPattern", (
+            self.numSides,
+            self.r,
+            self.totalBendingAngle,
+            self.numSinkLayers,
+            self.tubeLength,
         )
-        return tube.append(joint).append(tube)
 
 
 class PrismaticJoint(Joint):
@@ -385,11 +386,13 @@ class PrismaticJoint(Joint):
             math.hypot(self._r, (self._neutralLength + s) / 2.0),
         )
 
-    def _build_pattern(self):
-        from kinegami.pattern import PrismaticJointPattern
-
-        return PrismaticJointPattern(
-            self.numSides, self.r, self.neutralLength, self.numLayers, self.coneAngle
+    def _pattern_recipe(self) -> tuple:
+        return "PrismaticJointPattern", (
+            self.numSides,
+            self.r,
+            self.neutralLength,
+            self.numLayers,
+            self.coneAngle,
         )
 
     def _describe(self) -> str:
@@ -420,10 +423,8 @@ class Waypoint(Joint):
     def boundingBall(self) -> Ball:
         return Ball(self._T[:3, 3], self._r)
 
-    def _build_pattern(self):
-        from kinegami.pattern import WaypointPattern
-
-        return WaypointPattern(self.numSides, self.r)
+    def _pattern_recipe(self) -> tuple:
+        return "WaypointPattern", (self.numSides, self.r)
 
     def _describe(self) -> str:
         return f", pathIndex={self._path_index}"
@@ -445,19 +446,28 @@ class Tip(Joint):
 class StartTip(Tip):
     """The closed start of the tube (nothing may precede it). Path direction: Pose z."""
 
-    def _build_pattern(self):
-        from kinegami.pattern import StartTipPattern
-
-        return StartTipPattern(self.numSides, self.r, self.length)
+    def _pattern_recipe(self) -> tuple:
+        return "StartTipPattern", (self.numSides, self.r, self.length)
 
 
 class EndTip(Tip):
     """The closed end of the tube (nothing may follow it). Path direction: Pose z."""
 
-    def _build_pattern(self):
-        from kinegami.pattern import EndTipPattern
+    def _pattern_recipe(self) -> tuple:
+        return "EndTipPattern", (self.numSides, self.r, self.length)
 
-        return EndTipPattern(self.numSides, self.r, self.length)
+
+@functools.lru_cache(maxsize=256)
+def _catalog_pattern(name: str, args: tuple):
+    """A catalog pattern by function name and arguments (patterns are immutable: cached)."""
+    import kinegami.pattern as catalog
+
+    if name == "ExtendedRevoluteJointPattern":
+        n, r, bending, sinks, tube_length = args
+        tube = catalog.TubeFittingPattern(n, r, tube_length)
+        joint = catalog.RevoluteJointPattern(n, r, bending, sinks)
+        return catalog.TubularPattern.concatenate([tube, joint, tube])
+    return getattr(catalog, name)(*args)
 
 
 def check_same_tube(joint: Joint, numSides: int, r: float) -> None:

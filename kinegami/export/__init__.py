@@ -191,7 +191,12 @@ def save_pattern(
     path = _target_path(dxfName)
     exporter = EXPORTERS[path.suffix.lower()]
     buffer = io.StringIO()
-    exporter(pattern, buffer, **options)
+    try:
+        exporter(pattern, buffer, **options)
+    except OSError as exc:  # e.g. ezdxf cannot read its configuration on import
+        if isinstance(exc, KinegamiError):
+            raise
+        raise _export_error(exc, path, "the exporter failed") from exc
     write_atomic(path, buffer.getvalue())
     return path
 

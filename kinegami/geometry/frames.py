@@ -63,8 +63,7 @@ def rot_z(angle: float) -> np.ndarray:
 
 
 def rotation_about_line(axis, point, angle: float) -> np.ndarray:
-    """RotLine(k, q, angle): rotation by ``angle`` about the line through ``point``, along ``axis``.
-    """
+    """RotLine(k, q, angle): rotation by ``angle`` about the line through q along k."""
     T = rotation(axis, angle)
     q = np.asarray(point, dtype=float)
     T[:3, 3] = q - T[:3, :3] @ q

@@ -501,7 +501,6 @@ class TubularPattern:
         return self._has_internal_duplicates
 
 
-
 def _copy_or_none(array: np.ndarray | None) -> np.ndarray | None:
     return None if array is None else array.copy()
 
