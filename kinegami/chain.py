@@ -32,7 +32,7 @@ from kinegami.placement import (
     published_safe_placement,
     radial_safe_placement,
 )
-from kinegami.validation import check_max_angle_per_elbow, check_real
+from kinegami.validation import check_max_angle_per_elbow, check_real, check_twist_portion
 
 __all__ = ["KinematicChain", "PlacementWarning"]
 
@@ -531,16 +531,16 @@ class KinematicChain:
                 return False
         joints = list(self._joints)
         links = list(self._links)
-        accumulated = np.eye(4)
+        accumulated = None  # world motion of everything after the joints changed so far
         for k in range(len(joints)):
-            if k > 0 and not np.array_equal(accumulated, np.eye(4)):
+            if accumulated is not None:
                 joints[k] = joints[k].transformed(accumulated)
                 links[k] = links[k].transformed(accumulated)
             joint = joints[k]
             if values[k] != joint.state:
                 G = joint.state_transform(values[k] - joint.state)
                 joints[k] = joint.with_state(values[k])
-                accumulated = G @ accumulated
+                accumulated = G if accumulated is None else G @ accumulated
         self._commit(joints, links)
         return True
 
@@ -548,11 +548,8 @@ class KinematicChain:
     def creasePattern(self, twistPortion: float = 0.2):
         """The chain's tubular crease pattern (patterns.md 4.3) as a TubularPattern."""
         from kinegami.pattern import TubularPattern
-        from kinegami.validation import check_in_range
 
-        twistPortion = check_in_range(
-            "twistPortion", twistPortion, 0.0, 1.0, low_inclusive=True, range_text="[0, 1)"
-        )
+        twistPortion = check_twist_portion(twistPortion)
         modules = [self._joints[0].pattern]
         for link, joint in zip(self._links[1:], self._joints[1:], strict=True):
             modules += link.pattern_modules(self.numSides, twistPortion)

@@ -18,7 +18,7 @@ import math
 import numpy as np
 from spatialmath import SE3
 
-from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.errors import IncompatibleJointError, InvalidParameterError, InvalidTypeError
 from kinegami.geometry.balls import Ball
 from kinegami.geometry.frames import (
     dubins_frame,
@@ -472,8 +472,6 @@ def _catalog_pattern(name: str, args: tuple):
 
 def check_same_tube(joint: Joint, numSides: int, r: float) -> None:
     """Raise IncompatibleJointError if ``joint`` has another numSides or r."""
-    from kinegami.errors import IncompatibleJointError
-
     if not isinstance(joint, Joint):
         raise InvalidTypeError(f"expected a Joint, got {type(joint).__name__}")
     if joint.numSides != numSides:

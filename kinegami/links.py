@@ -21,7 +21,12 @@ from kinegami.geometry.balls import Ball, merge_balls
 from kinegami.geometry.csc import CSCPath, solve_csc
 from kinegami.geometry.frames import rotation_matrix, signed_angle
 from kinegami.joints import pose_array
-from kinegami.validation import check_max_angle_per_elbow, check_radius
+from kinegami.validation import (
+    check_max_angle_per_elbow,
+    check_num_sides,
+    check_radius,
+    check_twist_portion,
+)
 
 __all__ = ["LinkCSC", "ElbowArc", "ELBOW_MIN_ANGLE", "TWIST_MIN_ANGLE"]
 
@@ -280,12 +285,9 @@ class LinkCSC:
         resolves, and are left out of the pattern as in the reference (patterns.md 4.2).
         """
         from kinegami.pattern import TubularPattern, WaypointPattern
-        from kinegami.validation import check_in_range, check_num_sides
 
         numSides = check_num_sides(numSides)
-        twistPortion = check_in_range(
-            "twistPortion", twistPortion, 0.0, 1.0, low_inclusive=True, range_text="[0, 1)"
-        )
+        twistPortion = check_twist_portion(twistPortion)
         modules = [WaypointPattern(numSides, self.r)]
         modules += self.pattern_modules(numSides, twistPortion)
         return TubularPattern.concatenate(modules)

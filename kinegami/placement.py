@@ -14,7 +14,7 @@ import numpy as np
 
 from kinegami.errors import NoPathError
 from kinegami.geometry.balls import Ball
-from kinegami.geometry.frames import rotation_matrix, unit
+from kinegami.geometry.frames import angle_between, any_perpendicular, rotation_matrix, unit
 from kinegami.geometry.lines import common_normal
 from kinegami.joints import Joint, Waypoint
 
@@ -126,14 +126,10 @@ def published_safe_placement(
     return waypoints + [placed]
 
 
-def _turn_frame(R: np.ndarray, d: np.ndarray, target: np.ndarray):
-    """Rotation axis and angle carrying direction d onto target (any perpendicular axis for
-    opposite directions)."""
-    angle = math.atan2(float(np.linalg.norm(np.cross(d, target))), float(d @ target))
-    axis = np.cross(d, target)
-    if float(np.linalg.norm(axis)) < 1e-12:
-        axis = np.cross(d, _least_aligned_axis(d))
-    return unit(axis), angle
+def _turn(d: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, float]:
+    """Unit rotation axis and angle carrying direction d onto target (for opposite directions,
+    any axis perpendicular to d)."""
+    return any_perpendicular(d, target), angle_between(d, target)
 
 
 def _arc_displacement(r: float, d: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
@@ -192,7 +188,7 @@ def radial_safe_placement(
         B = placed.proximal_frame()[:3, 3]
         wb = B - 4.0 * r * m
 
-        axis, psi = _turn_frame(R_parent, d1, m)
+        axis, psi = _turn(d1, m)
         if psi <= 2.0 * math.pi / 3.0:  # arc, then r straight: a CSC path with theta2 = 0
             wa = A + _arc_displacement(r, d1, axis, psi) + r * m
         else:  # arc, 0.5 r straight, arc: a CSC path
@@ -213,9 +209,3 @@ def radial_safe_placement(
             ]
         radius += 4.0 * r
     raise NoPathError("radial safe placement found no waypoint layout (degenerate input)")
-
-
-def _least_aligned_axis(v: np.ndarray) -> np.ndarray:
-    axis = np.zeros(3)
-    axis[int(np.argmin(np.abs(v)))] = 1.0
-    return axis

@@ -97,3 +97,8 @@ def check_max_angle_per_elbow(value) -> float:
     return check_in_range(
         "maxAnglePerElbow", value, 0.0, math.pi, high_inclusive=True, range_text="(0, pi]"
     )
+
+
+def check_twist_portion(value) -> float:
+    """twistPortion (share of a link's straight part given to its twist) in [0, 1)."""
+    return check_in_range("twistPortion", value, 0.0, 1.0, low_inclusive=True, range_text="[0, 1)")

@@ -17,7 +17,7 @@ import numpy as np
 from kinegami import style
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.viz import chain_geometry as geo
-from kinegami.viz._backend import backend_is_interactive as _backend_is_interactive
+from kinegami.viz._backend import show_if_interactive
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -466,9 +466,5 @@ def show_chain(chain: KinematicChain, **options) -> tuple[Figure, Axes3D]:
         ax.set_zlabel("z")
     else:
         ax.set_axis_off()
-    if created and _backend_is_interactive():
-        if opts["block"] is None:
-            plt.show()
-        else:
-            plt.show(block=bool(opts["block"]))
+    show_if_interactive(created, opts["block"])
     return fig, ax

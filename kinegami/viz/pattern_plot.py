@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.viz._backend import backend_is_interactive as _backend_is_interactive
+from kinegami.viz._backend import show_if_interactive
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -213,9 +213,5 @@ def show_pattern(pattern: TubularPattern, **options: Any) -> tuple[Figure, Axes]
     ax.set_ylabel("y (along the tube)")
     if opts["title"] is not None:
         ax.set_title(opts["title"])
-    if created and _backend_is_interactive():
-        if opts["block"] is None:
-            plt.show()
-        else:
-            plt.show(block=bool(opts["block"]))
+    show_if_interactive(created, opts["block"])
     return fig, ax

@@ -10,7 +10,7 @@ from matplotlib.patches import Rectangle
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.pattern.sheet import flatten
-from kinegami.viz import pattern_plot
+from kinegami.viz import _backend
 from kinegami.viz.pattern_plot import PATTERN_ARTIST_GIDS, show_pattern
 
 
@@ -108,7 +108,7 @@ def test_show_not_called_on_headless_backend(revolute6, monkeypatch):
 def test_show_called_on_interactive_backend_only_for_own_figure(revolute6, monkeypatch):
     calls = []
     monkeypatch.setattr(plt, "show", lambda *a, **k: calls.append(k))
-    monkeypatch.setattr(pattern_plot, "_backend_is_interactive", lambda: True)
+    monkeypatch.setattr(_backend, "backend_is_interactive", lambda: True)
     show_pattern(revolute6, block=False)
     assert calls == [{"block": False}]
     show_pattern(revolute6)

@@ -12,7 +12,7 @@ from numpy.testing import assert_allclose
 
 from kinegami import style
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.viz import chain_plot
+from kinegami.viz import _backend
 from kinegami.viz.chain_plot import CHAIN_PLOT_OPTIONS, show_chain
 
 from .conftest import build_long_chain
@@ -269,7 +269,7 @@ def test_headless_never_calls_plt_show(example_1a, monkeypatch):
 @pytest.mark.parametrize(("block", "expected"), [(None, {}), (False, {"block": False})])
 def test_interactive_backend_calls_plt_show(example_1a, monkeypatch, block, expected):
     calls = []
-    monkeypatch.setattr(chain_plot, "_backend_is_interactive", lambda: True)
+    monkeypatch.setattr(_backend, "backend_is_interactive", lambda: True)
     monkeypatch.setattr(plt, "show", lambda **kwargs: calls.append(kwargs))
     example_1a.show(block=block)
     assert calls == [expected]
@@ -280,7 +280,7 @@ def test_interactive_backend_calls_plt_show(example_1a, monkeypatch, block, expe
 
 
 def test_agg_is_not_interactive():
-    assert chain_plot._backend_is_interactive() is False
+    assert _backend.backend_is_interactive() is False
 
 
 def test_show_chain_is_the_delegate(example_1a):
