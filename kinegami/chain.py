@@ -28,6 +28,7 @@ from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube, 
 from kinegami.links import LinkCSC
 from kinegami.placement import (
     compact_lambda,
+    compact_lambda_other_side,
     orient_by_common_normal,
     published_safe_placement,
     radial_safe_placement,
@@ -118,6 +119,66 @@ class KinematicChain:
         if ball.r < self.r:
             ball = Ball(root.pose_matrix[:3, 3], self.r)
         self._ball = ball
+
+    @classmethod
+    def from_dh(
+        cls,
+        table,
+        numSides: int,
+        r: float,
+        convention: str = "standard",
+        jointTypes=None,
+        *,
+        placement: str = "compact",
+        totalBendingAngle: float = np.pi,
+        numSinkLayers: int = 1,
+        neutralLength: float | None = None,
+        numLayers: int = 3,
+        coneAngle: float = np.pi / 4,
+        endTip: bool = True,
+        tipLength: float | None = None,
+        maxAnglePerElbow: float = np.pi / 2,
+    ) -> KinematicChain:
+        """A chain whose joints move about the axes of a Denavit-Hartenberg table.
+
+        Parameters
+        ----------
+        table : rows (theta, alpha, a, d), one per joint; radians and the chain's length unit.
+        numSides, r : the tube (polygon sides >= 3, radius > 0).
+        convention : ``"standard"`` (joint i moves about z of frame i-1; frame 0 = world) or
+            ``"modified"`` (Craig: joint i moves about z of frame i). See :mod:`kinegami.dh`.
+        jointTypes : None (all revolute), a string such as ``"RRP"``, or a sequence of
+            ``"revolute"``/``"prismatic"``, one per row.
+        placement : ``"compact"`` (default; chain.md 4.4, DH roll kept) or ``"safe"``
+            (chain.md 4.3; never fails). Joints only slide along their DH axes.
+        totalBendingAngle, numSinkLayers : of every revolute joint (default pi, 1).
+        neutralLength, numLayers, coneAngle : of every prismatic joint (default 3r, 3, pi/4).
+        endTip : add an EndTip on the tool frame (standard: frame n; modified: frame n
+            turned so that the tip points along its x axis), placed like the joints.
+        tipLength : the end tip's length (default 1.5 r).
+        maxAnglePerElbow : largest turn of one elbow fitting (default pi/2).
+
+        Raises
+        ------
+        NoPathError
+            When compact placement finds no link to a joint (the message suggests 'safe').
+
+        Examples
+        --------
+        >>> puma = KinematicChain.from_dh(
+        ...     [(np.pi/2, -np.pi/2, 0, 0), (0, 0, 431.8, 149.09), (np.pi/2, np.pi/2, -20.32, 0),
+        ...      (0, -np.pi/2, 0, 433.07), (0, np.pi/2, 0, 0), (0, 0, 0, 56.25)], 6, 100)
+        >>> len(puma.Joints)
+        7
+        """
+        from kinegami.dh import chain_from_dh
+
+        return chain_from_dh(
+            cls, table, numSides, r, convention, jointTypes, placement=placement,
+            totalBendingAngle=totalBendingAngle, numSinkLayers=numSinkLayers,
+            neutralLength=neutralLength, numLayers=numLayers, coneAngle=coneAngle,
+            endTip=endTip, tipLength=tipLength, maxAnglePerElbow=maxAnglePerElbow,
+        )  # fmt: skip
 
     # --- published read-only views -----------------------------------------------------------
     @property
@@ -261,25 +322,42 @@ class KinematicChain:
         try:
             if safe:
                 joints, links, ball = self._safe_extension(parent, joint)
-            else:
-                if not fixedPosition:
-                    lam = compact_lambda(
-                        parent.pose_matrix[:3, 3],
-                        joint.pose_matrix[:3, 3],
-                        joint.pose_matrix[:3, 2],
-                        self._ball,
-                        4.0 * self.r + self._ball.r + joint.bounding_radius(),
-                        self.r,
-                    )
-                    joint = joint.translated_along_z(lam)
+            elif fixedPosition:
                 if not fixedOrientation:
                     joint = orient_by_common_normal(joint, parent.pose_matrix)
                 joints, links, ball = self._extended([joint])
+            else:
+                joints, links, ball = self._compact_extension(parent, joint, fixedOrientation)
         except KinegamiError as error:
             self._reject(f"append failed: {error}")
             return None
         self._commit(joints, links, ball)
         return len(joints) - 1
+
+    def _compact_extension(self, parent: Joint, joint: Joint, fixedOrientation: bool):
+        """Compact placement (chain.md 4.4): the extended lists and ball; raises on failure.
+
+        The joint slides along its axis to the point the published rule picks. If no link
+        reaches it there, the clearance boundary on the other side of the ball is tried
+        before giving up (the rule's side choice is arbitrary in the tie case).
+        """
+        p = joint.pose_matrix[:3, 3]
+        z = joint.pose_matrix[:3, 2]
+        clearance = 4.0 * self.r + self._ball.r + joint.bounding_radius()
+        lam = compact_lambda(parent.pose_matrix[:3, 3], p, z, self._ball, clearance, self.r)
+        other = compact_lambda_other_side(p, z, self._ball, clearance, self.r)
+        error = None
+        for slide in (lam, other):
+            if slide is None:
+                continue
+            placed = joint.translated_along_z(slide)
+            if not fixedOrientation:
+                placed = orient_by_common_normal(placed, parent.pose_matrix)
+            try:
+                return self._extended([placed])
+            except KinegamiError as failure:
+                error = error or failure
+        raise error
 
     def _extended(self, new_joints: list[Joint]):
         """Lists and ball with ``new_joints`` appended (links solved); raises on failure."""

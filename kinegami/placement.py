@@ -60,6 +60,24 @@ def compact_lambda(
     return min(lam_star, lam_c - w)
 
 
+def compact_lambda_other_side(
+    p: np.ndarray, z: np.ndarray, ball: Ball, clearance: float, r: float
+) -> float | None:
+    """The clearance boundary point on the other side of the ball from :func:`compact_lambda`.
+
+    Tried when the link to the rule's choice needs a turn >= pi (e.g. the tie case, where the
+    joint's axis passes through the ball's centre, sends it to +z). None when the clearance
+    bound is inactive (the axis misses the clearance sphere).
+    """
+    lam_c = float((ball.c - p) @ z)
+    h2 = float((ball.c - p) @ (ball.c - p)) - lam_c * lam_c
+    D2 = clearance * clearance
+    if D2 <= h2:
+        return None
+    w = math.sqrt(D2 - max(h2, 0.0))
+    return lam_c - w if lam_c <= 1e-9 * r else lam_c + w
+
+
 def orient_by_common_normal(joint: Joint, parent_pose: np.ndarray) -> Joint:
     """chain.md 4.5: x along the common normal from the parent's axis, path pointing away."""
     T = joint.pose_matrix
