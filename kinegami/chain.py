@@ -144,7 +144,7 @@ class KinematicChain:
         Parameters
         ----------
         table : rows (theta, alpha, a, d), one per joint; radians and the chain's length unit.
-        numSides, r : the tube (polygon sides >= 3, radius > 0).
+        numSides, r : the tube (an even number of sides >= 4, radius > 0).
         convention : ``"standard"`` (joint i moves about z of frame i-1; frame 0 = world) or
             ``"modified"`` (Craig: joint i moves about z of frame i). See :mod:`kinegami.dh`.
         jointTypes : None (all revolute), a string such as ``"RRP"``, or a sequence of

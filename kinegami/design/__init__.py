@@ -1,0 +1,110 @@
+"""Design files: a kinematic chain as a JSON document (format "kinegami-design", version 1).
+
+A design file lists the tube (``numSides``, ``r``), the joints as they would be appended in
+Python (or a DH table), optional edits and joint states; see docs/design-format.md and the JSON
+Schema shipped as ``kinegami/design/schema.json`` (:func:`design_schema`).
+
+>>> chain = load_design("tests/design/data/example1.json")  # doctest: +SKIP
+>>> save_design(chain, "out/example1.json", name="Example 1")  # doctest: +SKIP
+
+Every problem (unreadable file, invalid JSON, schema violation, infeasible placement or edit)
+raises :class:`DesignError`, whose one-line message names the file, the JSON path of the
+problem (e.g. ``joints[2].totalBendingAngle``), what is allowed and the value found.
+"""
+
+from __future__ import annotations
+
+import os
+
+from kinegami.chain import KinematicChain
+from kinegami.design.errors import DesignError
+from kinegami.design.poses import pose_from_json
+from kinegami.design.reader import (
+    FORMAT,
+    UNITS,
+    VERSIONS,
+    DesignInfo,
+    build_chain,
+    check_document,
+    parse_design_text,
+    read_design_file,
+)
+from kinegami.design.schema import design_schema
+from kinegami.design.writer import design_to_dict, dumps_design, save_design
+
+__all__ = [
+    "DesignError",
+    "DesignInfo",
+    "FORMAT",
+    "VERSIONS",
+    "UNITS",
+    "load_design",
+    "load_design_with_info",
+    "loads_design",
+    "chain_from_dict",
+    "read_design",
+    "validate_design",
+    "save_design",
+    "design_to_dict",
+    "dumps_design",
+    "design_schema",
+    "pose_from_json",
+]
+
+
+def _with_info(document, file) -> tuple[KinematicChain, DesignInfo]:
+    plan = check_document(document, file)
+    return build_chain(plan, file), DesignInfo.of(document, file)
+
+
+def load_design_with_info(path: str | os.PathLike) -> tuple[KinematicChain, DesignInfo]:
+    """The chain of the design file ``path`` and the file's metadata (units, name, ...).
+
+    Raises
+    ------
+    DesignError
+        If the file cannot be read, is not valid JSON, violates the format, or describes a
+        chain that cannot be built (infeasible placement, edit or state).
+    """
+    document, file = read_design_file(path)
+    return _with_info(document, file)
+
+
+def load_design(path: str | os.PathLike) -> KinematicChain:
+    """The chain described by the design file ``path`` (lengths in the file's units).
+
+    Raises DesignError for any problem (see :func:`load_design_with_info`).
+    """
+    return load_design_with_info(path)[0]
+
+
+def loads_design(text: str, file: str | os.PathLike | None = None) -> KinematicChain:
+    """The chain described by the design JSON ``text``; ``file`` only names it in errors."""
+    return _with_info(parse_design_text(text, file), file)[0]
+
+
+def chain_from_dict(data: dict, file: str | os.PathLike | None = None) -> KinematicChain:
+    """The chain described by an already parsed design document (a dict)."""
+    return _with_info(data, file)[0]
+
+
+def read_design(path: str | os.PathLike) -> dict:
+    """The parsed design document of ``path``, checked like :func:`validate_design`.
+
+    The dict is the file's content as written (angles in its ``angleUnits``, no defaults
+    filled in); ``DesignInfo.of(document)`` gives units, name and twistPortion with defaults.
+    """
+    document, file = read_design_file(path)
+    check_document(document, file)
+    return document
+
+
+def validate_design(path: str | os.PathLike) -> None:
+    """Check the design file ``path`` without building the chain.
+
+    Parses the JSON, validates it against the schema and runs the checks the schema cannot
+    express (rigid matrices, axes, joint order, placement options, joint parameters). Whether
+    every joint can be placed and every edit and state applied is only known by building the
+    chain: use :func:`load_design` for the full check. Raises DesignError; returns None.
+    """
+    read_design(path)

@@ -1,0 +1,107 @@
+"""DesignError: every problem found in a design file, located by a JSON path."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+
+from kinegami.errors import KinegamiError
+
+__all__ = ["DesignError", "json_path"]
+
+#: Marker for "no offending value" (``None`` is a valid JSON value: ``null``).
+_NO_VALUE = object()
+
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+
+
+def json_path(parts) -> str:
+    """``("joints", 2, "pose")`` -> ``"joints[2].pose"``; the empty path is ``"$"``."""
+    text = ""
+    for part in parts:
+        if isinstance(part, int):
+            text += f"[{part}]"
+        elif _IDENTIFIER.match(str(part)):
+            text += f".{part}" if text else str(part)
+        else:
+            text += f"[{json.dumps(str(part))}]"
+    return text or "$"
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def format_value(value, limit: int = 100) -> str:
+    """A short one-line JSON-like rendering of ``value`` for messages."""
+    try:
+        text = json.dumps(value, ensure_ascii=False, allow_nan=True, default=_default)
+    except (TypeError, ValueError):
+        text = repr(value)
+    text = _one_line(text)
+    if len(text) > limit:
+        text = text[: limit - 3] + "..."
+    return text
+
+
+def _default(value):
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    raise TypeError(type(value).__name__)
+
+
+class DesignError(KinegamiError, ValueError):
+    """A design file cannot be read, is invalid, or describes an infeasible chain.
+
+    Attributes
+    ----------
+    file : str or None
+        The design file (None for a design given as text or as a dict without a file name).
+    field : str
+        JSON path of the problem, e.g. ``joints[2].totalBendingAngle``; ``$`` is the document.
+    value : object
+        The offending value (None if there is none; see ``has_value``).
+    reason : str
+        What is wrong and what is allowed.
+
+    ``str(error)`` is one line: ``<file>: <field>: <reason> (got <value>)``.
+    """
+
+    def __init__(
+        self,
+        reason: str,
+        *,
+        field: str = "$",
+        value=_NO_VALUE,
+        file: str | os.PathLike | None = None,
+    ):
+        self.reason = _one_line(reason)
+        self.field = field
+        self.has_value = value is not _NO_VALUE
+        self.value = value if self.has_value else None
+        self.file = None if file is None else os.fspath(file)
+        super().__init__(str(self))
+
+    def with_file(self, file) -> DesignError:
+        """The same error attributed to ``file`` (used when a file name becomes known)."""
+        value = self.value if self.has_value else _NO_VALUE
+        return DesignError(self.reason, field=self.field, value=value, file=file)
+
+    def __str__(self) -> str:
+        text = f"{self.field}: {self.reason}"
+        if self.has_value:
+            text += f" (got {format_value(self.value)})"
+        if self.file is not None:
+            text = f"{self.file}: {text}"
+        return text
+
+    def __reduce__(self):
+        return (_rebuild, (self.reason, self.field, self.has_value, self.value, self.file))
+
+
+def _rebuild(reason, field, has_value, value, file):
+    return DesignError(reason, field=field, value=value if has_value else _NO_VALUE, file=file)

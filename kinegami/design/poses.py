@@ -1,0 +1,156 @@
+"""The three spellings of a pose in a design file, turned into 4x4 rigid transforms.
+
+1. A 4x4 matrix (list of 4 rows of 4 numbers), used exactly as written (what saving writes);
+   it must be rigid to within :data:`RIGID_TOL`.
+2. A list of steps composed left to right like spatialmath products:
+   ``[{"Trans": [5, 5, 0]}, {"Ry": 45}]`` is ``SE3.Trans(5, 5, 0) * SE3.Ry(pi/4)``, computed with
+   the same spatialmath calls, so a design reproduces the Python listing bit for bit.
+3. An axis ``{"point": p, "axis": z, "xhat": x}``: origin p, z = axis / |axis|, x = xhat made
+   perpendicular to z (Gram-Schmidt; default :func:`default_xhat`), y = z cross x.
+
+The input has already passed the JSON schema (shapes and types); these functions check what the
+schema cannot (rigidity, zero and parallel vectors) and raise :class:`DesignError`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from spatialmath import SE3
+
+from kinegami.design.errors import DesignError, json_path
+
+__all__ = ["RIGID_TOL", "PARALLEL_TOL", "pose_from_json", "default_xhat", "rigidity_problem"]
+
+#: Largest deviation of a matrix pose from a rigid transform (orthonormality, det, last row).
+RIGID_TOL = 1e-9
+#: ``xhat`` is parallel to ``axis`` when its perpendicular part is below this times |xhat|.
+PARALLEL_TOL = 1e-9
+
+_STEPS = {
+    "Trans": lambda v: SE3.Trans(float(v[0]), float(v[1]), float(v[2])),
+    "Tx": lambda v: SE3.Tx(float(v)),
+    "Ty": lambda v: SE3.Ty(float(v)),
+    "Tz": lambda v: SE3.Tz(float(v)),
+    "Rx": lambda a: SE3.Rx(a),
+    "Ry": lambda a: SE3.Ry(a),
+    "Rz": lambda a: SE3.Rz(a),
+}
+_ROTATIONS = ("Rx", "Ry", "Rz")
+
+
+def to_radians(value: float, angle_units: str) -> float:
+    """An angle of the file in radians (``angle_units`` is ``"rad"`` or ``"deg"``)."""
+    value = float(value)
+    return math.radians(value) if angle_units == "deg" else value
+
+
+def rigidity_problem(T: np.ndarray, tol: float = RIGID_TOL) -> str | None:
+    """Why ``T`` is not a proper rigid transform (None if it is one within ``tol``)."""
+    if not np.all(np.isfinite(T)):
+        return "the matrix must be finite"
+    bottom = float(np.max(np.abs(T[3] - (0.0, 0.0, 0.0, 1.0))))
+    if bottom > tol:
+        return "the last row must be [0, 0, 0, 1]"
+    R = T[:3, :3]
+    ortho = float(np.max(np.abs(R.T @ R - np.eye(3))))
+    if ortho > tol:
+        return (
+            f"the rotation part (first 3 rows and columns) must be orthonormal to {tol:g} "
+            f"(max |R^T R - I| is {ortho:.3g})"
+        )
+    det = float(np.linalg.det(R))
+    if abs(det - 1.0) > tol:
+        return f"the rotation part must have determinant +1 (a reflection has -1), got {det:.6g}"
+    return None
+
+
+def default_xhat(axis: np.ndarray) -> np.ndarray:
+    """The x direction used when an axis pose has no ``xhat``.
+
+    The world axis (x, then y, then z on ties) least aligned with ``axis``, before Gram-Schmidt;
+    for ``axis = z`` this is world x, giving the identity rotation.
+    """
+    k = int(np.argmin(np.abs(axis)))
+    e = np.zeros(3)
+    e[k] = 1.0
+    return e
+
+
+def _matrix_pose(rows, path) -> np.ndarray:
+    T = np.array(rows, dtype=float)
+    problem = rigidity_problem(T)
+    if problem is not None:
+        raise DesignError(f"not a rigid transform: {problem}", field=json_path(path), value=rows)
+    return T
+
+
+def _steps_pose(steps, angle_units: str) -> np.ndarray:
+    pose = None
+    for step in steps:
+        ((key, value),) = step.items()
+        if key in _ROTATIONS:
+            value = to_radians(value, angle_units)
+        factor = _STEPS[key](value)
+        pose = factor if pose is None else pose * factor
+    if pose is None:
+        return np.eye(4)
+    return np.array(pose.A, dtype=float)
+
+
+def _axis_pose(spec, path) -> np.ndarray:
+    point = np.array(spec.get("point", (0.0, 0.0, 0.0)), dtype=float)
+    axis = np.array(spec["axis"], dtype=float)
+    norm = math.sqrt(float(axis @ axis))
+    if norm == 0.0 or not math.isfinite(norm):
+        raise DesignError(
+            "the axis must be a non-zero vector", field=json_path([*path, "axis"]),
+            value=spec["axis"],
+        )  # fmt: skip
+    z = axis / norm
+    if "xhat" in spec:
+        xhat = np.array(spec["xhat"], dtype=float)
+    else:
+        xhat = default_xhat(z)
+    x = xhat - float(xhat @ z) * z
+    size = math.sqrt(float(x @ x))
+    if not size > PARALLEL_TOL * math.sqrt(float(xhat @ xhat)):
+        raise DesignError(
+            f"xhat must not be zero or parallel to the axis {_format_vector(spec['axis'])}",
+            field=json_path([*path, "xhat"]),
+            value=spec.get("xhat"),
+        )
+    x = x / size
+    T = np.eye(4)
+    T[:3, 0] = x
+    T[:3, 1] = np.cross(z, x)
+    T[:3, 2] = z
+    T[:3, 3] = point
+    return T
+
+
+def _format_vector(v) -> str:
+    return "[" + ", ".join(repr(float(c)) if isinstance(c, float) else repr(c) for c in v) + "]"
+
+
+def pose_from_json(spec, path=(), angle_units: str = "rad") -> np.ndarray:
+    """The 4x4 transform of a schema-valid pose ``spec`` found at JSON ``path``.
+
+    Parameters
+    ----------
+    spec : a 4x4 matrix (rows), a list of steps, or an axis object (see the module docstring).
+    path : JSON path of ``spec`` (a sequence of keys and indices), used in error messages.
+    angle_units : ``"rad"`` or ``"deg"``, the unit of the ``Rx``/``Ry``/``Rz`` steps.
+
+    Raises
+    ------
+    DesignError
+        For a matrix that is not rigid, a zero axis or an ``xhat`` parallel to the axis.
+    """
+    path = tuple(path)
+    if isinstance(spec, dict):
+        return _axis_pose(spec, path)
+    if spec and isinstance(spec[0], list):
+        return _matrix_pose(spec, path)
+    return _steps_pose(spec, angle_units)

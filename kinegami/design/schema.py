@@ -1,0 +1,246 @@
+"""The JSON Schema of design files (schema.json) and its errors turned into DesignErrors.
+
+jsonschema finds every violation; :func:`check_schema` reports the first one in document order
+(ties: the most basic keyword first) as a one-line :class:`DesignError` naming the JSON path,
+the value and what is allowed.
+"""
+
+from __future__ import annotations
+
+import difflib
+import functools
+import json
+from importlib import resources
+
+import jsonschema
+
+from kinegami.design.errors import DesignError, format_value, json_path
+
+__all__ = ["design_schema", "check_schema", "JOINT_TYPES", "EDIT_OPS", "PLACEMENT_KEYS"]
+
+JOINT_TYPES = (
+    "StartTip",
+    "EndTip",
+    "RevoluteJoint",
+    "ExtendedRevoluteJoint",
+    "PrismaticJoint",
+    "Waypoint",
+)
+EDIT_OPS = (
+    "translateJointAlongAxisOfMotion",
+    "rotateJointAboutAxisOfMotion",
+    "transformJoint",
+    "transformAll",
+    "delete",
+    "setJointState",
+)
+PLACEMENT_KEYS = ("relative", "safe", "fixedPosition", "fixedOrientation")
+
+#: Valid ranges of numeric fields as the messages state them (radians / degrees for angles).
+_RANGES = {
+    "numSides": "an even integer >= 4",
+    "r": "> 0",
+    "twistPortion": "in [0, 1)",
+    "length": "> 0",
+    "tubeLength": "> 0",
+    "neutralLength": "> 0",
+    "tipLength": "> 0",
+    "numSinkLayers": "an integer >= 1",
+    "numLayers": "an integer >= 1",
+    "pathIndex": "0, 1 or 2",
+}
+_ANGLE_RANGES = {
+    "maxAnglePerElbow": {"rad": "in (0, pi] radians", "deg": "in (0, 180] degrees"},
+    "totalBendingAngle": {"rad": "in (0, 2pi) radians", "deg": "in (0, 360) degrees"},
+    "coneAngle": {"rad": "in [pi/6, pi/2) radians", "deg": "in [30, 90) degrees"},
+}
+_TYPE_NAMES = {
+    "number": "a number",
+    "integer": "an integer",
+    "string": "a string",
+    "boolean": "true or false",
+    "object": "an object {...}",
+    "array": "a list [...]",
+    "null": "null",
+}
+_POSE_TEXT = (
+    "a pose: a 4x4 matrix (list of 4 rows), a list of steps such as "
+    '[{"Trans": [x, y, z]}, {"Ry": angle}], or an axis object {"point", "axis", "xhat"}'
+)
+#: Keyword order among several errors at the same place (most basic first).
+_PRIORITY = {
+    "type": 0,
+    "additionalProperties": 1,  # before "required": a typo also makes a key go missing
+    "propertyNames": 2,
+    "required": 3,
+    "const": 4,
+    "enum": 4,
+    "minProperties": 5,
+    "maxProperties": 5,
+    "minItems": 6,
+    "maxItems": 6,
+}
+
+
+@functools.cache
+def design_schema() -> dict:
+    """The JSON Schema (draft 2020-12) of design files, as a dict (shipped as schema.json)."""
+    text = resources.files("kinegami.design").joinpath("schema.json").read_text("utf-8")
+    return json.loads(text)
+
+
+@functools.cache
+def _validator() -> jsonschema.Draft202012Validator:
+    return jsonschema.Draft202012Validator(design_schema())
+
+
+def _position(document, path) -> tuple:
+    """Document-order sort key of a JSON path (positions of keys in their objects)."""
+    key = []
+    node = document
+    for part in path:
+        if isinstance(node, dict):
+            keys = list(node)
+            key.append(keys.index(part) if part in keys else len(keys))
+            node = node.get(part)
+        elif isinstance(node, list) and isinstance(part, int) and 0 <= part < len(node):
+            key.append(part)
+            node = node[part]
+        else:
+            key.append(0)
+            node = None
+    return tuple(key)
+
+
+def check_schema(document, file=None) -> None:
+    """Raise a DesignError for the first schema violation of ``document`` (if any)."""
+    errors = list(_validator().iter_errors(document))
+    if not errors:
+        return
+    error = min(
+        errors,
+        key=lambda e: (
+            _position(document, e.absolute_path),
+            _PRIORITY.get(e.validator, 9),
+            len(e.absolute_schema_path),
+        ),
+    )
+    raise translate(error, document, file)
+
+
+def _angle_units(document) -> str:
+    units = document.get("angleUnits") if isinstance(document, dict) else None
+    return units if units in ("rad", "deg") else "rad"
+
+
+def _range_text(name, document) -> str | None:
+    if name in _ANGLE_RANGES:
+        return _ANGLE_RANGES[name][_angle_units(document)]
+    return _RANGES.get(name)
+
+
+def _quoted(values) -> str:
+    return ", ".join(json.dumps(v) if not isinstance(v, str) else f"'{v}'" for v in values)
+
+
+def translate(error: jsonschema.ValidationError, document, file=None) -> DesignError:
+    """One jsonschema error as a DesignError with path, value and what is allowed."""
+    path = list(error.absolute_path)
+    field = json_path(path)
+    name = path[-1] if path and isinstance(path[-1], str) else None
+    keyword = error.validator
+    expected = error.validator_value
+    value = error.instance
+
+    def fail(reason, where=field, **kw):
+        return DesignError(reason, field=where, file=file, **kw)
+
+    if keyword == "required":
+        missing = [k for k in expected if k not in value]
+        key = missing[0] if missing else expected[0]
+        where = json_path([*path, key])
+        if key == "type":
+            return fail(f"missing required field 'type' (one of: {', '.join(JOINT_TYPES)})", where)
+        if key == "op":
+            return fail(f"missing required field 'op' (one of: {', '.join(EDIT_OPS)})", where)
+        return fail(f"missing required field '{key}'", where)
+    if keyword == "type":
+        if name in ("pose", "transform"):
+            return fail(f"must be {_POSE_TEXT}", value=value)
+        kinds = expected if isinstance(expected, list) else [expected]
+        what = " or ".join(_TYPE_NAMES.get(k, k) for k in kinds)
+        text = _range_text(name, document) if set(kinds) & {"number", "integer"} else None
+        if text is not None and name != "pathIndex":
+            what = text if text.startswith(("a ", "an ")) else f"{what} {text}"
+        return fail(f"must be {what}", value=value)
+    if keyword == "enum":
+        if name == "type" and len(path) >= 2 and path[0] == "joints":
+            return fail(
+                f"unknown joint type {value!r}; known: {', '.join(JOINT_TYPES)}", value=value
+            )
+        if name == "op":
+            return fail(f"unknown edit op {value!r}; known: {', '.join(EDIT_OPS)}", value=value)
+        return fail(f"must be one of {_quoted(expected)}", value=value)
+    if keyword == "const":
+        if path == ["format"]:
+            return fail("not a kinegami design: format must be 'kinegami-design'", value=value)
+        if path == ["version"]:
+            return fail("unsupported version; supported versions: 1", value=value)
+        return fail(f"must be {format_value(expected)}", value=value)
+    if keyword in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum", "multipleOf"):
+        text = _range_text(name, document)
+        if text is None:
+            text = {
+                "minimum": ">=",
+                "maximum": "<=",
+                "exclusiveMinimum": ">",
+                "exclusiveMaximum": "<",
+                "multipleOf": "a multiple of",
+            }[keyword] + f" {format_value(expected)}"
+        return fail(f"out of range: must be {text}", value=value)
+    if keyword in ("minItems", "maxItems"):
+        low = error.schema.get("minItems")
+        high = error.schema.get("maxItems")
+        if low == high == 3:
+            what = "must be 3 numbers [x, y, z]"
+        elif low == high == 4 and "rows" in path:
+            what = "a DH row must have 4 numbers [theta, alpha, a, d]"
+        elif low == high == 4:
+            what = "a 4x4 matrix must have 4 rows of 4 numbers"
+        elif keyword == "minItems":
+            what = f"must have at least {low} item{'s' if low != 1 else ''}"
+        else:
+            what = f"must have at most {high} items"
+        return fail(f"{what}; it has {len(value)}", value=value)
+    if keyword == "additionalProperties":
+        allowed = list(error.schema.get("properties", {}))
+        if path and path[0] == "joints" and len(path) == 2 and path[1] == 0:
+            allowed = [k for k in allowed if k not in PLACEMENT_KEYS]
+        unknown = [k for k in value if k not in allowed and k not in PLACEMENT_KEYS]
+        unknown = unknown or [k for k in value if k not in error.schema.get("properties", {})]
+        listed = ", ".join(allowed)
+        if len(unknown) == 1:
+            close = difflib.get_close_matches(unknown[0], allowed, n=1)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
+            return fail(
+                f"unknown key '{unknown[0]}'{hint}; allowed keys: {listed}",
+                json_path([*path, unknown[0]]),
+            )
+        names = ", ".join(f"'{k}'" for k in unknown)
+        return fail(f"unknown keys {names}; allowed keys: {listed}")
+    if keyword == "propertyNames" or "propertyNames" in error.absolute_schema_path:
+        return fail(
+            f"the root joint cannot have '{value}': its pose is global and "
+            f"{', '.join(PLACEMENT_KEYS)} apply only to the joints appended after it",
+            json_path([*path, value]),
+        )
+    if keyword in ("minProperties", "maxProperties"):
+        keys = ", ".join(error.schema.get("properties", {}))
+        return fail(f"a pose step must have exactly one key, one of: {keys}", value=value)
+    if keyword == "oneOf" and not path:
+        if "joints" in value and "dh" in value:
+            return fail("give exactly one of 'joints' and 'dh', not both")
+        return fail("missing required field: one of 'joints' (a list) or 'dh' (a DH table)")
+    if keyword == "pattern" and name == "jointTypes":
+        return fail('must be a string of the letters R and P (e.g. "RRP")', value=value)
+    return fail(error.message, value=value)

@@ -1,0 +1,208 @@
+"""Writing chains as design files: exact 4x4 poses of the state-0 chain, plus the states.
+
+Every joint is written with its own parameters and its Pose at state 0 (full precision; float
+``repr`` round-trips exactly), and every non-root joint with ``relative: false, safe: false,
+fixedPosition: true, fixedOrientation: true``, so loading re-creates each joint where it was.
+Non-zero states go to ``"states"``; loading builds the chain at state 0 and then sets them.
+A chain whose root is an EndTip (possible after deleting joint 0) is written as a waypoint
+root, the tip, and an edit deleting the waypoint.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+from pathlib import Path
+
+from kinegami.chain import KinematicChain
+from kinegami.design.errors import DesignError
+from kinegami.design.reader import FORMAT, UNITS, check_document
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.export import write_atomic
+from kinegami.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    Joint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+from kinegami.validation import check_twist_portion
+
+__all__ = ["design_to_dict", "dumps_design", "save_design"]
+
+#: The placement options that re-create a joint exactly where it is.
+_FIXED = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
+
+
+def _joint_parameters(joint: Joint) -> dict:
+    """The joint's type and constructor parameters (radians, chain length units)."""
+    if type(joint) is ExtendedRevoluteJoint:
+        return {
+            "type": "ExtendedRevoluteJoint",
+            "totalBendingAngle": float(joint.totalBendingAngle),
+            "tubeLength": float(joint.tubeLength),
+            "numSinkLayers": int(joint.numSinkLayers),
+        }
+    if type(joint) is RevoluteJoint:
+        return {
+            "type": "RevoluteJoint",
+            "totalBendingAngle": float(joint.totalBendingAngle),
+            "numSinkLayers": int(joint.numSinkLayers),
+        }
+    if type(joint) is PrismaticJoint:
+        return {
+            "type": "PrismaticJoint",
+            "neutralLength": float(joint.neutralLength),
+            "numLayers": int(joint.numLayers),
+            "coneAngle": float(joint.coneAngle),
+        }
+    if type(joint) is Waypoint:
+        return {"type": "Waypoint", "pathIndex": int(joint.pathIndex())}
+    if type(joint) in (StartTip, EndTip):
+        return {"type": type(joint).__name__, "length": float(joint.length)}
+    raise InvalidTypeError(
+        f"cannot save a joint of type {type(joint).__name__}: design files know StartTip, "
+        f"EndTip, RevoluteJoint, ExtendedRevoluteJoint, PrismaticJoint and Waypoint"
+    )
+
+
+def _matrix(T) -> list[list[float]]:
+    return [[float(v) for v in row] for row in T]
+
+
+def design_to_dict(
+    chain: KinematicChain,
+    *,
+    name: str | None = None,
+    description: str | None = None,
+    units: str = "mm",
+    twistPortion: float | None = None,
+) -> dict:
+    """The design document (a JSON-ready dict) that re-creates ``chain`` exactly.
+
+    Parameters
+    ----------
+    chain : the chain (any edits and states).
+    name, description : optional texts stored in the file.
+    units : the length unit of the chain ("mm", "cm", "m" or "in"); metadata for exporters.
+    twistPortion : stored for the crease pattern when given (in [0, 1)).
+
+    Poses are those of the state-0 configuration (computed on a copy of the chain); non-zero
+    states are listed in ``"states"`` (radians for revolute joints, lengths for prismatic).
+    Angles are in radians (``"angleUnits": "rad"``).
+    """
+    if not isinstance(chain, KinematicChain):
+        raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
+    for key, text in (("name", name), ("description", description)):
+        if text is not None and not isinstance(text, str):
+            raise InvalidTypeError(f"{key} must be a string or None, got {text!r}")
+    if units not in UNITS:
+        raise InvalidParameterError(
+            f"units must be one of {', '.join(map(repr, UNITS))}, got {units!r}"
+        )
+    states = [float(joint.state) for joint in chain.Joints]
+    rest = chain
+    if any(states):
+        rest = copy.deepcopy(chain)
+        if not rest.setJointStates([0.0] * len(states)):  # pragma: no cover - 0 is in range
+            raise InvalidParameterError("cannot return the chain to state 0")
+    document = {"format": FORMAT, "version": 1}
+    if name is not None:
+        document["name"] = name
+    if description is not None:
+        document["description"] = description
+    document.update(
+        units=units,
+        angleUnits="rad",
+        numSides=int(chain.numSides),
+        r=float(chain.r),
+        maxAnglePerElbow=float(chain.maxAnglePerElbow),
+    )
+    if twistPortion is not None:
+        document["twistPortion"] = check_twist_portion(twistPortion)
+    joints = []
+    for i, joint in enumerate(rest.Joints):
+        entry = _joint_parameters(joint)
+        if i > 0:
+            entry.update(_FIXED)
+        entry["pose"] = _matrix(joint.pose_matrix)
+        joints.append(entry)
+    if isinstance(rest.Joints[0], EndTip):
+        # Deleting joint 0 can leave an EndTip as root, which no chain can start with: write
+        # a waypoint at the tip's proximal frame as root and delete it again.
+        tip = joints[0]
+        pose = tip.pop("pose")
+        tip.update(_FIXED, pose=pose)
+        T = rest.Joints[0].proximal_frame()
+        joints.insert(0, {"type": "Waypoint", "pathIndex": 2, "pose": _matrix(T)})
+        document["joints"] = joints
+        document["edits"] = [{"op": "delete", "joint": 0}]
+    else:
+        document["joints"] = joints
+    if any(states):
+        document["states"] = states
+    return document
+
+
+def _dumps(value, indent: str) -> str:
+    """JSON with lists of plain values (matrix rows, vectors) on one line."""
+    inner = indent + "  "
+    if isinstance(value, dict):
+        if not value:
+            return "{}"
+        items = [f"{inner}{json.dumps(k)}: {_dumps(v, inner)}" for k, v in value.items()]
+        return "{\n" + ",\n".join(items) + "\n" + indent + "}"
+    if isinstance(value, list):
+        if all(not isinstance(v, dict | list) for v in value):
+            return "[" + ", ".join(json.dumps(v, allow_nan=False) for v in value) + "]"
+        items = [f"{inner}{_dumps(v, inner)}" for v in value]
+        return "[\n" + ",\n".join(items) + "\n" + indent + "]"
+    return json.dumps(value, allow_nan=False, ensure_ascii=False)
+
+
+def dumps_design(document: dict) -> str:
+    """A design document as JSON text (indent 2, one matrix row or vector per line)."""
+    return _dumps(document, "") + "\n"
+
+
+def save_design(
+    chain: KinematicChain,
+    path: str | os.PathLike,
+    *,
+    name: str | None = None,
+    description: str | None = None,
+    units: str = "mm",
+    twistPortion: float | None = None,
+) -> Path:
+    """Write ``chain`` to the design file ``path`` (suffix .json) atomically; return the path.
+
+    See :func:`design_to_dict` for the content. The document is checked against the format
+    before it is written, and a failed write leaves no file (kinegami.export.write_atomic).
+
+    Examples
+    --------
+    >>> save_design(chain, "designs/arm.json", name="arm", units="mm")  # doctest: +SKIP
+    PosixPath('designs/arm.json')
+    """
+    if not isinstance(path, str | os.PathLike) or isinstance(os.fspath(path), bytes):
+        raise InvalidTypeError(f"path must be a str or a path, got {path!r}")
+    target = Path(os.fspath(path)).expanduser()
+    if target.suffix.lower() != ".json":
+        raise InvalidParameterError(
+            f"a design file name must end in .json, got {os.fspath(path)!r}"
+        )
+    if target.is_dir():
+        raise InvalidParameterError(f"{os.fspath(path)!r} is a directory, not a file name")
+    document = design_to_dict(
+        chain, name=name, description=description, units=units, twistPortion=twistPortion
+    )
+    text = dumps_design(document)
+    try:
+        check_document(json.loads(text))
+    except DesignError as error:  # e.g. a pose drifted from rigid by > 1e-9 after many edits
+        raise InvalidParameterError(f"the chain cannot be saved as a design: {error}") from None
+    write_atomic(target, text)
+    return target

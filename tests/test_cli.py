@@ -1,0 +1,242 @@
+"""The ``kinegami`` command, run as a subprocess: exit codes, outputs, clean errors."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE1 = ROOT / "examples" / "designs" / "example1.json"
+
+DESIGN = {
+    "format": "kinegami-design",
+    "version": 1,
+    "name": "Example 1A",
+    "units": "mm",
+    "numSides": 4,
+    "r": 1,
+    "joints": [
+        {"type": "StartTip", "length": 1.5, "pose": [{"Trans": [3, 3, 0]}]},
+        {"type": "PrismaticJoint", "neutralLength": 3, "numLayers": 3,
+         "coneAngle": 0.7853981633974483, "pose": [{"Trans": [5, 5, 0]}]},
+        {"type": "RevoluteJoint", "totalBendingAngle": 3.141592653589793,
+         "pose": [{"Ry": 0.7853981633974483}]},
+        {"type": "EndTip", "length": 1.5, "pose": [{"Ry": 1.5707963267948966}]},
+    ],
+    "edits": [
+        {"op": "rotateJointAboutAxisOfMotion", "joint": 4, "angle": 0.5},
+    ],
+}  # fmt: skip
+
+
+def command() -> list[str]:
+    script = Path(sys.executable).parent / "kinegami"
+    if script.exists():
+        return [str(script)]
+    return [sys.executable, "-m", "kinegami.cli"]  # pragma: no cover
+
+
+def run(*args, cwd=None) -> subprocess.CompletedProcess:
+    env = dict(os.environ, MPLBACKEND="Agg")
+    env.pop("DISPLAY", None)
+    return subprocess.run(
+        [*command(), *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env,
+        timeout=300,
+    )  # fmt: skip
+
+
+def write(path: Path, data) -> Path:
+    path.write_text(data if isinstance(data, str) else json.dumps(data, indent=2))
+    return path
+
+
+@pytest.fixture
+def design(tmp_path) -> Path:
+    return write(tmp_path / "arm.json", DESIGN)
+
+
+def assert_clean_failure(result, *words):
+    assert result.returncode == 1, result
+    assert "Traceback" not in result.stderr + result.stdout
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    for word in words:
+        assert word in lines[0], (word, lines[0])
+
+
+# --- help and version ----------------------------------------------------------------------
+@pytest.mark.parametrize("args", [[], ["--help"], ["build", "--help"], ["show", "--help"],
+                                  ["validate", "--help"]])  # fmt: skip
+def test_help_everywhere(args):
+    result = run(*args)
+    assert result.returncode == 0
+    assert "usage: kinegami" in result.stdout
+    if args[:1] == ["build"]:
+        for word in ("--output", "--formats", "dxf", "svg", "png"):
+            assert word in result.stdout
+
+
+def test_version():
+    result = run("--version")
+    assert result.returncode == 0
+    assert result.stdout.startswith("kinegami ")
+
+
+def test_unknown_command_is_a_usage_error():
+    result = run("frobnicate")
+    assert result.returncode == 2
+    assert "invalid choice" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+# --- build ---------------------------------------------------------------------------------
+def test_build_writes_files_and_prints_a_summary(design, tmp_path):
+    out = tmp_path / "out" / "nested"
+    result = run("build", design, "-o", out)
+    assert result.returncode == 0, result.stderr
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["arm.dxf", "arm.svg", "arm_3d.png", "arm_pattern.png"]
+    for path in out.iterdir():
+        assert path.stat().st_size > 0
+        assert str(path) in result.stdout
+    assert (out / "arm_3d.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (out / "arm.dxf").read_text().lstrip().startswith("0")
+    text = result.stdout
+    assert "Example 1A" in text
+    # safe placement adds waypoints (one before each joint here); counted in order of appearance
+    kinds = "1 StartTip, 3 Waypoint, 1 PrismaticJoint, 1 RevoluteJoint, 1 EndTip"
+    assert f"joints: 7 ({kinds})" in text
+    assert "links: 6" in text
+    assert "sheet:" in text and " mm x " in text
+    assert "total tube length:" in text
+    # no staging folders left behind
+    assert not [p for p in tmp_path.rglob(".kinegami-build-*")]
+
+
+def test_summary_numbers_match_the_library(design, tmp_path):
+    from kinegami.design import load_design
+    from kinegami.pattern.sheet import flatten
+
+    chain = load_design(design)
+    sheet = flatten(chain.creasePattern())
+    xmin, ymin, xmax, ymax = sheet.bounds
+    tube = chain.totalPathLength() + sum(j.neutralLength for j in chain.Joints)
+    result = run("build", design, "-o", tmp_path / "o", "--formats", "dxf")
+    assert f"sheet: {xmax - xmin:.1f} mm x {ymax - ymin:.1f} mm" in result.stdout
+    assert f"total tube length: {tube:.1f} mm" in result.stdout
+
+
+def test_units_scale_the_summary(tmp_path):
+    data = dict(DESIGN, units="cm")
+    path = write(tmp_path / "cm.json", data)
+    mm = run("build", write(tmp_path / "mm.json", DESIGN), "-o", tmp_path / "a", "--formats",
+             "dxf")  # fmt: skip
+    cm = run("build", path, "-o", tmp_path / "b", "--formats", "dxf")
+    assert "r = 1 mm" in mm.stdout and "r = 10 mm" in cm.stdout
+
+
+def test_formats_and_name(design, tmp_path):
+    result = run("build", design, "-o", tmp_path / "o", "--formats", "svg", "--name", "x")
+    assert result.returncode == 0, result.stderr
+    assert [p.name for p in (tmp_path / "o").iterdir()] == ["x.svg"]
+
+
+def test_unknown_format(design, tmp_path):
+    result = run("build", design, "-o", tmp_path / "o", "--formats", "dxf,gif")
+    assert_clean_failure(result, "'gif'", "dxf", "svg")
+    assert not (tmp_path / "o").exists()
+
+
+def test_output_is_a_file(design, tmp_path):
+    blocker = write(tmp_path / "file.txt", "x")
+    result = run("build", design, "-o", blocker)
+    assert_clean_failure(result, "not a folder")
+    result = run("build", design, "-o", blocker / "sub")
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert blocker.read_text() == "x"
+
+
+BROKEN = {
+    "invalid JSON": ('{"format": "kinegami-design", "version": 1,,}', ["line 1"]),
+    "missing field": ({k: v for k, v in DESIGN.items() if k != "numSides"}, ["numSides"]),
+    "wrong type": (dict(DESIGN, r="one"), ["r:", '"one"', "number"]),
+    "out of range": (dict(DESIGN, numSides=2), ["numSides", "2"]),
+    "unknown joint type": (
+        dict(DESIGN, joints=[*DESIGN["joints"][:2], {"type": "BallJoint"}]),
+        ["joints[2]", "BallJoint", "RevoluteJoint"],
+    ),
+    "wrong version": (dict(DESIGN, version=2), ["version", "2"]),
+    "infeasible edit": (
+        dict(DESIGN, edits=[{"op": "setJointState", "joint": 2, "state": 9}]),
+        ["edits[0]"],
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BROKEN))
+def test_bad_design_gives_one_clean_line_and_no_files(case, tmp_path):
+    data, words = BROKEN[case]
+    path = write(tmp_path / "bad.json", data)
+    out = tmp_path / "out"
+    result = run("build", path, "-o", out)
+    assert_clean_failure(result, "bad.json", *words)
+    assert not out.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.json"]
+
+
+def test_missing_design_file(tmp_path):
+    result = run("build", tmp_path / "nope.json", "-o", tmp_path / "out")
+    assert_clean_failure(result, "nope.json")
+    assert not (tmp_path / "out").exists()
+
+
+# --- validate ------------------------------------------------------------------------------
+def test_validate(design, tmp_path):
+    result = run("validate", design)
+    assert result.returncode == 0, result.stderr
+    assert "valid" in result.stdout and "4 joints" in result.stdout  # as written
+    result = run("validate", design, "--build")
+    assert result.returncode == 0, result.stderr
+    assert "builds 7 joints" in result.stdout  # waypoints added
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["arm.json"]
+
+
+@pytest.mark.parametrize("case", ["missing field", "unknown joint type", "wrong version"])
+def test_validate_rejects(case, tmp_path):
+    data, words = BROKEN[case]
+    result = run("validate", write(tmp_path / "bad.json", data))
+    assert_clean_failure(result, "bad.json", *words)
+
+
+def test_validate_does_not_build_unless_asked(tmp_path):
+    data, _ = BROKEN["infeasible edit"]
+    path = write(tmp_path / "bad.json", data)
+    assert run("validate", path).returncode == 0
+    assert_clean_failure(run("validate", path, "--build"), "edits[0]")
+
+
+# --- show ----------------------------------------------------------------------------------
+def test_show_without_a_display_says_so(design):
+    result = run("show", design)
+    assert_clean_failure(result, "no interactive backend")
+
+
+def test_show_bad_design(tmp_path):
+    data, words = BROKEN["wrong type"]
+    assert_clean_failure(run("show", write(tmp_path / "bad.json", data)), *words)
+
+
+# --- the gallery's main job (README Quick start) -------------------------------------------
+def test_quick_start_command(tmp_path):
+    shutil.copy(EXAMPLE1, tmp_path / "example1.json")
+    result = run("build", "example1.json", "-o", "out/", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+        "example1.dxf", "example1.svg", "example1_3d.png", "example1_pattern.png"
+    ]  # fmt: skip
