@@ -420,3 +420,13 @@ def test_solution_is_equivariant_under_rigid_motions(r, p1, offset, d1, d2, quat
     )
     np.testing.assert_allclose(b.tUnit, R @ a.tUnit, rtol=0, atol=1e-9)
     np.testing.assert_allclose(b.q1, R @ a.q1 + t, rtol=0, atol=1e-9 * r)
+
+
+def test_nearly_straight_turn_keeps_centre_directions_perpendicular():
+    """Regression (hypothesis): d2 tilted by 7e-11 from d1 at the same point."""
+    d1 = np.array([1.0, 1.0, 0.0]) / math.sqrt(2)
+    d2 = np.array([0.70710678118654757, 0.70710678118654757, 7.0710678118654752e-11])
+    path = solve_csc(np.zeros(3), d1, np.zeros(3), d2 / np.linalg.norm(d2), 1.0)
+    assert path is not None
+    for w, d in ((path.w1, d1), (path.w2, d2)):
+        assert abs(np.linalg.norm(w) - 1) < 1e-12 and abs(w @ d) < 1e-12

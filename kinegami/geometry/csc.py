@@ -268,6 +268,18 @@ def solve_csc(p1, d1, p2, d2, r: float) -> CSCPath | None:
     return _build(r, p1, d1, p2, d2, a, b, u)
 
 
+def _centre_direction(u: np.ndarray, d: np.ndarray, c: float) -> np.ndarray:
+    """Unit part of ``u`` perpendicular to ``d`` (c = d.u); any perpendicular for a null turn.
+
+    The subtraction loses relative accuracy as the turn vanishes, so the result is projected
+    once more (w.d ~ 1e-16) and a turn below 1e-9 rad counts as none.
+    """
+    perp = u - c * d
+    perp = perp - float(perp @ d) * d
+    n = float(np.linalg.norm(perp))
+    return perp / n if n > 1e-9 else any_perpendicular(d)
+
+
 def _build(r, p1, d1, p2, d2, a, b, u) -> CSCPath | None:
     c1 = float(d1 @ u)
     c2 = float(d2 @ u)
@@ -282,12 +294,8 @@ def _build(r, p1, d1, p2, d2, a, b, u) -> CSCPath | None:
     s = float((q2 - q1) @ u)
     if s < 0.0:
         s = 0.0
-    perp1 = u - c1 * d1
-    n1 = float(np.linalg.norm(perp1))
-    w1 = perp1 / n1 if n1 > 1e-12 else any_perpendicular(d1)
-    perp2 = u - c2 * d2
-    n2 = float(np.linalg.norm(perp2))
-    w2 = -perp2 / n2 if n2 > 1e-12 else any_perpendicular(d2)
+    w1 = _centre_direction(u, d1, c1)
+    w2 = -_centre_direction(u, d2, c2)
     k1 = np.cross(d1, w1)
     k2 = np.cross(d2, w2)
     return CSCPath(r, p1, d1, p2, d2, theta1, theta2, s, u, q1, q2, w1, w2, k1, k2)
