@@ -1,12 +1,15 @@
 """kinegami: tubular origami kinematic chains and their crease patterns.
 
 ``from kinegami import *`` gives the names the paper's listings use: ``KinematicChain``,
-the joints, ``LinkCSC``, ``TubularPattern``, ``SE3`` (spatialmath) and ``np`` (numpy).
+the joints, ``LinkCSC``, ``TubularPattern``, ``SE3`` (spatialmath) and ``np`` (numpy), plus
+``export(obj, path, **options)``, which writes a chain or a pattern in the format named by the
+file suffix (DXF, SVG, FOLD, PDF, STL, OBJ, URDF).
 """
 
 import numpy as np
 from spatialmath import SE3
 
+from kinegami import export
 from kinegami.chain import KinematicChain, PlacementWarning
 from kinegami.errors import (
     IncompatibleJointError,
@@ -52,4 +55,5 @@ __all__ = [
     "NoPathError",
     "IncompatibleJointError",
     "PlacementWarning",
+    "export",
 ]

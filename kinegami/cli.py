@@ -83,10 +83,16 @@ def _write_pngs(job: BuildJob, paths: list[Path]) -> None:
 
 
 def _registry_writer(suffix: str) -> Callable[..., None]:
-    def write(job: BuildJob, paths: list[Path]) -> None:
-        from kinegami.export.registry import export
+    """A writer through :func:`kinegami.export.export`: pattern formats get the design's
+    pattern, chain formats the chain (with the design's twistPortion and units)."""
 
-        export(job.chain, paths[0], units=job.info.units)
+    def write(job: BuildJob, paths: list[Path]) -> None:
+        from kinegami.export.registry import FORMATS, export
+
+        if FORMATS[suffix].accepts == "pattern":
+            export(job.pattern, paths[0], units=job.info.units)
+        else:
+            export(job.chain, paths[0], units=job.info.units, twistPortion=job.info.twistPortion)
 
     return write
 
@@ -188,26 +194,30 @@ def cmd_build(args: argparse.Namespace) -> int:
         staging = Path(tempfile.mkdtemp(prefix=".kinegami-build-", dir=_existing_ancestor(out)))
     except OSError as error:
         raise CommandError(f"-o: cannot write in {str(out)!r}: {error.strerror}") from None
-    written = []
+    written: list[Path] = []
     try:
-        staged = []
         for fmt in formats:
-            paths = [staging / f"{stem}{suffix}" for suffix in fmt.suffixes]
-            fmt.write(job, paths)
-            staged.extend(paths)
+            fmt.write(job, [staging / f"{stem}{suffix}" for suffix in fmt.suffixes])
+        # exporters may write more than their file (a URDF's mesh folder): move everything
+        staged = sorted(staging.iterdir())
         out.mkdir(parents=True, exist_ok=True)
         for path in staged:
             target = out / path.name
+            if path.is_dir() and target.is_dir():
+                shutil.rmtree(target)  # a folder this build owns, e.g. <stem>_meshes/
             os.replace(path, target)
             written.append(target)
     except OSError as error:
         for path in written:
-            path.unlink(missing_ok=True)
+            if path.is_dir():
+                shutil.rmtree(path, ignore_errors=True)
+            else:
+                path.unlink(missing_ok=True)
         raise CommandError(f"cannot write to {str(out)!r}: {error.strerror or error}") from None
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     lines.append("  files written:")
-    lines.extend(f"    {path}" for path in written)
+    lines.extend(f"    {path}{os.sep if path.is_dir() else ''}" for path in written)
     print("\n".join(lines))
     return 0
 

@@ -240,3 +240,21 @@ def test_quick_start_command(tmp_path):
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
         "example1.dxf", "example1.svg", "example1_3d.png", "example1_pattern.png"
     ]  # fmt: skip
+
+
+def test_chain_formats_through_the_export_registry(design, tmp_path):
+    """--formats reaches kinegami.export: a URDF comes with its mesh folder, moved in whole."""
+    import trimesh
+    import yourdfpy
+
+    out = tmp_path / "o"
+    for _ in range(2):  # a second build replaces the mesh folder
+        result = run("build", design, "-o", out, "--formats", "stl,urdf,pdf")
+        assert result.returncode == 0, result.stderr
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["arm.pdf", "arm.stl", "arm.urdf", "arm_meshes"]
+    assert f"{out / 'arm_meshes'}{os.sep}" in result.stdout
+    robot = yourdfpy.URDF.load(str(out / "arm.urdf"))
+    assert robot.validate()
+    assert len(trimesh.load(out / "arm.stl").faces) > 0
+    assert not [p for p in tmp_path.rglob(".kinegami-build-*")]

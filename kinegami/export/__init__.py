@@ -8,6 +8,10 @@ leaves a partial or temporary file behind. Missing parent folders are created.
 An exporter is a function ``exporter(pattern, stream, **options)`` writing text to ``stream``;
 :func:`register_exporter` adds one. Built in: ``.dxf`` (:func:`kinegami.export.dxf.write_dxf`)
 and ``.svg`` (:func:`kinegami.export.svg.write_svg`). See docs/fabrication.md.
+
+:func:`export` (in :mod:`kinegami.export.registry`) is the entry point for every format, patterns
+and chains alike (DXF, SVG, FOLD, PDF, STL, OBJ, URDF). This module is itself callable, so
+``kinegami.export(chain, "arm.urdf")`` works as well as ``from kinegami.export import export``.
 """
 
 from __future__ import annotations
@@ -16,6 +20,8 @@ import errno
 import io
 import os
 import secrets
+import sys
+import types
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -25,7 +31,15 @@ from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiErr
 if TYPE_CHECKING:  # pragma: no cover
     from kinegami.pattern.tubular import TubularPattern
 
-__all__ = ["ExportError", "EXPORTERS", "register_exporter", "save_pattern", "write_atomic"]
+__all__ = [
+    "ExportError",
+    "EXPORTERS",
+    "export",
+    "known_formats",
+    "register_exporter",
+    "save_pattern",
+    "write_atomic",
+]
 
 
 class ExportError(KinegamiError, OSError):
@@ -210,3 +224,16 @@ def _register_builtin() -> None:
 
 
 _register_builtin()
+
+
+from kinegami.export.registry import export, known_formats  # noqa: E402
+
+
+class _CallableModule(types.ModuleType):
+    """``kinegami.export(obj, path, **options)`` calls :func:`export`."""
+
+    def __call__(self, obj: Any, path: str | os.PathLike, **options: Any) -> Path:
+        return export(obj, path, **options)
+
+
+sys.modules[__name__].__class__ = _CallableModule

@@ -1,0 +1,550 @@
+"""STL and OBJ of a chain's 3D model in its current configuration (docs/mesh.md).
+
+The model is made of closed triangle meshes, one per *part*, built from the shapes that
+``KinematicChain.show()`` draws (:mod:`kinegami.viz.chain_geometry`), but with the tube as the
+n-gon prism it really is (``numSides`` sides, circumradius r) instead of a round cylinder:
+
+==========================  ========================================================  ==========
+part name                   shape                                                     convex
+==========================  ========================================================  ==========
+``joint_i``                 tip: hull of the n-gon at the open end and a segment of   yes
+                            one side's length at the closed end; prismatic joint:
+                            the n-gon prism from the proximal frame, length L + state
+``joint_i_proximal``,       revolute joint: hull of the proximal (distal) n-gon and   yes
+``joint_i_distal``          the hinge segment (extended revolute: with its tube)
+``link_i_arc1``,            the elbows of arc 1 (arc 2) of link i: the n-gon swept    no
+``link_i_arc2``             along each elbow's two straight halves, mitred at the
+                            plane that bisects the turn
+``link_i_twist``            the twist fitting: a twisted n-gon prism of length        no
+                            ``twistPortion`` tMag turning by the twist's residual
+                            angle in [0, 2 pi / n) (the rest is a relabelling)
+``link_i_tube``             the rest of the straight part: an n-gon prism             yes
+==========================  ========================================================  ==========
+
+Waypoints have no part; arcs without elbow and straight parts shorter than 1e-6 r are left
+out. Every part is a closed, consistently oriented surface (outward normals), so
+``trimesh.Trimesh.is_watertight`` and ``is_volume`` hold for each; parts touch (a link's arc
+ends on the joint's polygon) but are not merged, so the model as a whole is a set of closed
+shells, not one.
+
+Files are in millimetres: one chain unit (the unit of r) is ``units`` (default ``'mm'``) times
+``scale``. STL is binary (one solid, all parts); OBJ has one object (``o`` line) per part, named
+as above. Both are written from numpy; trimesh reads them back (``trimesh.load(path,
+split_objects=True)`` gives one geometry per OBJ part).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, BinaryIO, TextIO
+
+import numpy as np
+
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.export._options import UNITS_IN_MM
+from kinegami.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    Joint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+from kinegami.validation import check_positive, check_twist_portion
+from kinegami.viz.chain_geometry import (
+    regular_polygon,
+    revolute_hull_points,
+    tip_hull_points,
+)
+
+if TYPE_CHECKING:  # pragma: no cover
+    import trimesh
+
+    from kinegami.chain import KinematicChain
+    from kinegami.links import LinkCSC
+
+__all__ = [
+    "MeshPart",
+    "MIN_SEGMENT_LENGTH",
+    "chain_parts",
+    "joint_parts",
+    "link_parts",
+    "chain_mesh",
+    "mesh_factor",
+    "write_stl",
+    "write_obj",
+    "stl_bytes",
+    "shell_mass_properties",
+]
+
+#: Straight segments shorter than this many r get no part.
+MIN_SEGMENT_LENGTH = 1e-6
+
+_STL_HEADER = b"kinegami chain mesh, millimetres"
+
+
+@dataclass(frozen=True, eq=False)
+class MeshPart:
+    """One closed triangle mesh of the chain model.
+
+    Attributes
+    ----------
+    name : str
+        ``joint_i``, ``joint_i_proximal``, ``joint_i_distal``, ``link_i_arc1``,
+        ``link_i_twist``, ``link_i_tube`` or ``link_i_arc2`` (i = index in the chain).
+    vertices : numpy.ndarray, shape (k, 3)
+        World coordinates in chain units, at the chain's current configuration.
+    faces : numpy.ndarray of int, shape (m, 3)
+        Triangles, counter-clockwise seen from outside (outward normals).
+    index : int
+        The joint index (``joint_*`` parts) or link index (``link_*`` parts).
+    side : str
+        ``'proximal'``/``'distal'`` for joint halves, ``''`` for a whole joint, or the piece of
+        the link: ``'arc1'``, ``'twist'``, ``'tube'``, ``'arc2'``.
+    rings : numpy.ndarray or None, shape (m, n, 3)
+        For link parts, the n-gons the surface is swept through, in order (world, chain
+        units); None for joints (convex hulls).
+    """
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    index: int
+    side: str
+    rings: np.ndarray | None = None
+
+    @property
+    def is_joint(self) -> bool:
+        """True for joint parts, False for link parts."""
+        return self.name.startswith("joint_")
+
+    def transformed(self, T: np.ndarray, factor: float = 1.0) -> MeshPart:
+        """The part moved by the 4x4 rigid transform ``T`` and then scaled by ``factor``."""
+
+        def move(points):
+            return (points @ T[:3, :3].T + T[:3, 3]) * factor
+
+        rings = None if self.rings is None else move(self.rings)
+        return MeshPart(self.name, move(self.vertices), self.faces, self.index, self.side, rings)
+
+    def to_trimesh(self, factor: float = 1.0) -> trimesh.Trimesh:
+        """The part as a ``trimesh.Trimesh`` (vertices times ``factor``, not processed)."""
+        import trimesh
+
+        return trimesh.Trimesh(self.vertices * factor, self.faces, process=False)
+
+
+# --- building blocks -----------------------------------------------------------------------
+
+
+def _signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    tri = vertices[faces]
+    return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)
+
+
+def _outward(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """``faces`` reversed if they enclose a negative volume (consistent winding assumed)."""
+    if _signed_volume(vertices, faces) < 0.0:
+        return np.ascontiguousarray(faces[:, ::-1])
+    return faces
+
+
+def _weld(vertices: np.ndarray, faces: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Merge vertices closer than ``tol`` and drop the faces that collapse.
+
+    An elbow of a square tube turning about a polygon vertex has a side edge of zero length
+    (the inner vertex lies on the mitre plane); collapsing it keeps the surface closed.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(vertices).query_pairs(tol, output_type="ndarray")
+    if pairs.shape[0] == 0:
+        return vertices, faces
+    k = vertices.shape[0]
+    graph = coo_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(k, k))
+    _, labels = connected_components(graph, directed=False)
+    _, first = np.unique(labels, return_index=True)  # the first vertex of every group
+    keep = np.sort(first)
+    new_index = np.empty(labels.max() + 1, dtype=np.int64)
+    new_index[labels[keep]] = np.arange(keep.shape[0])
+    mapped = new_index[labels][faces]
+    distinct = (
+        (mapped[:, 0] != mapped[:, 1])
+        & (mapped[:, 1] != mapped[:, 2])
+        & (mapped[:, 0] != mapped[:, 2])
+    )
+    return vertices[keep], mapped[distinct]
+
+
+def _sweep(rings: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Closed surface through polygons ``rings`` (m, n, 3): sides and both end caps.
+
+    Vertex i of every ring is joined to vertex i of the next; the caps are fans. Vertices
+    closer than 1e-9 of the rings' extent are merged (:func:`_weld`).
+    """
+    m, n = rings.shape[0], rings.shape[1]
+    idx = np.arange(m * n).reshape(m, n)
+    nxt = np.roll(idx, -1, axis=1)
+    a, b = idx[:-1], nxt[:-1]
+    c, d = nxt[1:], idx[1:]
+    sides = np.concatenate(
+        [np.stack([a, b, c], axis=-1).reshape(-1, 3), np.stack([a, c, d], axis=-1).reshape(-1, 3)]
+    )
+    k = np.arange(1, n - 1)
+    first = np.stack([np.zeros_like(k), k + 1, k], axis=1)
+    base = (m - 1) * n
+    last = np.stack([np.full_like(k, base), base + k, base + k + 1], axis=1)
+    faces = np.concatenate([sides, first, last]).astype(np.int64)
+    vertices = rings.reshape(-1, 3).astype(float)
+    extent = float(np.ptp(vertices, axis=0).max())
+    vertices, faces = _weld(vertices, faces, 1e-9 * extent)
+    return vertices, _outward(vertices, faces)
+
+
+def _hull(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Convex hull of ``points`` as (vertices, outward faces)."""
+    from trimesh.convex import convex_hull
+
+    hull = convex_hull(np.asarray(points, dtype=float))
+    vertices = np.array(hull.vertices, dtype=float)
+    faces = np.array(hull.faces, dtype=np.int64)
+    return vertices, _outward(vertices, faces)
+
+
+def _polygon(frame: np.ndarray, r: float, n: int) -> np.ndarray:
+    return regular_polygon(frame, r, n)
+
+
+def _shifted(frame: np.ndarray, distance: float) -> np.ndarray:
+    out = np.array(frame)
+    out[:3, 3] += distance * frame[:3, 0]
+    return out
+
+
+# --- joints --------------------------------------------------------------------------------
+
+
+def joint_parts(joint: Joint, index: int, split: bool = False) -> list[MeshPart]:
+    """The parts of one joint at its current state (world coordinates, chain units).
+
+    Parameters
+    ----------
+    joint : Joint
+    index : int
+        Its index in the chain (used in the part names).
+    split : bool
+        Also split a prismatic joint into two halves that move with the bodies on either
+        side (``joint_i_proximal``: proximal frame to the centre, length L/2;
+        ``joint_i_distal``: centre + state to the distal frame, length L/2), as the URDF needs.
+        Revolute joints are always two halves.
+    """
+    n, r = joint.numSides, joint.r
+    name = f"joint_{index}"
+    if isinstance(joint, Waypoint):
+        return []
+    if isinstance(joint, PrismaticJoint):
+        z = joint.pose_matrix[:3, 2]
+        bottom = _polygon(joint.proximal_dubins_frame(), r, n)
+        L, s = joint.neutralLength, joint.state
+        if not split:
+            return [MeshPart(name, *_hull(np.vstack([bottom, bottom + (L + s) * z])), index, "")]
+        top = _polygon(joint.distal_dubins_frame(), r, n)
+        return [
+            MeshPart(
+                f"{name}_proximal",
+                *_hull(np.vstack([bottom, bottom + 0.5 * L * z])),
+                index,
+                "proximal",
+            ),
+            MeshPart(
+                f"{name}_distal", *_hull(np.vstack([top - 0.5 * L * z, top])), index, "distal"
+            ),
+        ]
+    if isinstance(joint, RevoluteJoint):
+        first, second = revolute_hull_points(joint)
+        if isinstance(joint, ExtendedRevoluteJoint):
+            first = np.vstack([first, _polygon(joint.proximal_dubins_frame(), r, n)])
+            second = np.vstack([second, _polygon(joint.distal_dubins_frame(), r, n)])
+        return [
+            MeshPart(f"{name}_proximal", *_hull(first), index, "proximal"),
+            MeshPart(f"{name}_distal", *_hull(second), index, "distal"),
+        ]
+    if isinstance(joint, StartTip | EndTip):
+        return [MeshPart(name, *_hull(tip_hull_points(joint)), index, "")]
+    points = np.vstack(
+        [
+            _polygon(joint.proximal_dubins_frame(), r, n),
+            _polygon(joint.distal_dubins_frame(), r, n),
+        ]
+    )
+    return [MeshPart(name, *_hull(points), index, "")]
+
+
+# --- links ---------------------------------------------------------------------------------
+
+
+def _arc_rings(arc, n: int) -> np.ndarray | None:
+    """Rings of an elbow arc: the n-gon at each elbow frame and the mitre between (2c+1, n, 3)."""
+    if arc.count == 0:
+        return None
+    r = arc.r
+    F = np.asarray(arc.frames)
+    delta = r * math.tan(arc.elbowAngle / 2.0)
+    rings = [_polygon(F[0], r, n)]
+    for j in range(arc.count):
+        a_in, a_out = F[j, :3, 0], F[j + 1, :3, 0]
+        start = _polygon(F[j], r, n) if j else rings[0]
+        vertex = F[j, :3, 3] + delta * a_in
+        normal = a_in + a_out
+        normal /= np.linalg.norm(normal)
+        lam = ((vertex - start) @ normal) / float(a_in @ normal)
+        rings.append(start + lam[:, None] * a_in)
+        rings.append(_polygon(F[j + 1], r, n))
+    return np.stack(rings)
+
+
+def _roll_count(twist: float, n: int, nearest: bool) -> int:
+    """Whole 2 pi / n steps of ``twist``: floor (twist fitting, residual in [0, 2 pi / n)) or
+    nearest (a straight tube whose end polygon is the start polygon up to round-off)."""
+    step = 2.0 * math.pi / n
+    if nearest:
+        return int(round(twist / step)) % n
+    alpha = twist % (2.0 * math.pi)
+    return min(int(math.floor(alpha / step)), n - 1)
+
+
+def link_parts(
+    link: LinkCSC, index: int, numSides: int, twistPortion: float = 0.2
+) -> list[MeshPart]:
+    """The parts of one link (world coordinates, chain units): arc 1, twist, tube, arc 2.
+
+    The straight part from q1 to q2 gets a twist of length ``twistPortion * tMag`` first when
+    the link has a twist fitting (|twistAngle| > 0.01), as in the crease pattern; the twisted
+    prism joins vertex k of the start polygon to the end polygon's vertex that is vertex k
+    turned by the residual angle in [0, 2 pi / n).
+    """
+    n, r = numSides, link.r
+    parts = []
+    for arc, side in ((link.elbows1, "arc1"), (link.elbows2, "arc2")):
+        rings = _arc_rings(arc, n)
+        if rings is not None:
+            parts.append(MeshPart(f"link_{index}_{side}", *_sweep(rings), index, side, rings))
+    path = link.path
+    u = np.asarray(path.tUnit, dtype=float)
+    F1, F2 = link.arc1_end_frame, link.arc2_start_frame
+    start = _polygon(F1, r, n)
+    end = _polygon(F2, r, n)
+    length = float(path.tMag)
+    minimum = MIN_SEGMENT_LENGTH * r
+    twist_length = twistPortion * length if link.hasTwist else 0.0
+    straight = []
+    if twist_length > minimum:
+        mid = end - (length - twist_length) * u
+        K = _roll_count(link.twistAngle, n, nearest=False)
+        rings = np.stack([start, np.roll(mid, K, axis=0)])
+        straight.append(MeshPart(f"link_{index}_twist", *_sweep(rings), index, "twist", rings))
+        start = mid
+        length -= twist_length
+    else:
+        K = _roll_count(link.twistAngle, n, nearest=not link.hasTwist)
+        end = np.roll(end, K, axis=0)
+    if length > minimum:
+        rings = np.stack([start, end])
+        straight.append(MeshPart(f"link_{index}_tube", *_sweep(rings), index, "tube", rings))
+    # order along the tube: arc 1, twist, tube, arc 2
+    arcs = {p.side: p for p in parts}
+    ordered = [arcs["arc1"]] if "arc1" in arcs else []
+    ordered += straight
+    if "arc2" in arcs:
+        ordered.append(arcs["arc2"])
+    return ordered
+
+
+# --- whole chain ---------------------------------------------------------------------------
+
+
+def _check_chain(chain: Any, fmt: str) -> KinematicChain:
+    from kinegami.chain import KinematicChain
+
+    if not isinstance(chain, KinematicChain):
+        raise InvalidTypeError(
+            f"the {fmt} exporter needs a KinematicChain, got {type(chain).__name__}"
+        )
+    return chain
+
+
+def chain_parts(
+    chain: KinematicChain, *, twistPortion: float = 0.2, split_joints: bool = False
+) -> list[MeshPart]:
+    """All parts of the chain in its current configuration, in order along the tube.
+
+    Parameters
+    ----------
+    chain : KinematicChain
+    twistPortion : float, optional
+        Fraction of each straight part taken by its twist fitting, in [0, 1] (as for
+        ``creasePattern``); default 0.2.
+    split_joints : bool, optional
+        Split prismatic joints into two halves (see :func:`joint_parts`).
+
+    Returns
+    -------
+    list of MeshPart
+        World coordinates, chain units: joint 0, link 1, joint 1, link 2, ...
+    """
+    chain = _check_chain(chain, "mesh")
+    twistPortion = check_twist_portion(twistPortion)
+    parts = joint_parts(chain.Joints[0], 0, split_joints)
+    for i in range(1, len(chain.Joints)):
+        parts += link_parts(chain.Links[i], i, chain.numSides, twistPortion)
+        parts += joint_parts(chain.Joints[i], i, split_joints)
+    return parts
+
+
+def mesh_factor(units: Any = "mm", scale: Any = 1.0) -> float:
+    """Millimetres per chain unit for the ``units`` and ``scale`` options (checked)."""
+    if not isinstance(units, str) or units not in UNITS_IN_MM:
+        raise InvalidParameterError(
+            f"units must be one of {', '.join(map(repr, UNITS_IN_MM))} (the length of one "
+            f"chain unit), got {units!r}"
+        )
+    return UNITS_IN_MM[units] * check_positive("scale", scale)
+
+
+def check_options(options: dict[str, Any], defaults: dict[str, Any], fmt: str) -> dict[str, Any]:
+    """``defaults`` updated by ``options``; unknown option names raise InvalidTypeError."""
+    unknown = sorted(set(options) - set(defaults))
+    if unknown:
+        raise InvalidTypeError(
+            f"{fmt} export got unknown option{'s' if len(unknown) > 1 else ''} "
+            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(defaults)}"
+        )
+    values = dict(defaults)
+    values.update(options)
+    return values
+
+
+_MESH_DEFAULTS = {"units": "mm", "scale": 1.0, "twistPortion": 0.2}
+
+
+def _scaled_parts(chain: Any, options: dict[str, Any], fmt: str) -> list[MeshPart]:
+    chain = _check_chain(chain, fmt)
+    opts = check_options(options, _MESH_DEFAULTS, fmt)
+    factor = mesh_factor(opts["units"], opts["scale"])
+    parts = chain_parts(chain, twistPortion=opts["twistPortion"])
+    return [p.transformed(np.eye(4), factor) for p in parts]
+
+
+def chain_mesh(chain: KinematicChain, **options: Any) -> trimesh.Trimesh:
+    """All parts in one ``trimesh.Trimesh`` (millimetres; options as for :func:`write_stl`).
+
+    The parts are concatenated, not merged: the result is a set of closed shells.
+    """
+    import trimesh
+
+    parts = _scaled_parts(chain, options, "mesh")
+    vertices, faces = _concatenate(parts)
+    return trimesh.Trimesh(vertices, faces, process=False)
+
+
+def _concatenate(parts: list[MeshPart]) -> tuple[np.ndarray, np.ndarray]:
+    if not parts:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    offsets = np.cumsum([0] + [p.vertices.shape[0] for p in parts[:-1]])
+    vertices = np.vstack([p.vertices for p in parts])
+    faces = np.vstack([p.faces + o for p, o in zip(parts, offsets, strict=True)])
+    return vertices, faces
+
+
+def stl_bytes(vertices: np.ndarray, faces: np.ndarray, header: bytes = _STL_HEADER) -> bytes:
+    """Binary STL of a triangle mesh (float32, unit face normals, zero attribute bytes)."""
+    tri = np.asarray(vertices, dtype=float)[np.asarray(faces, dtype=np.int64)]
+    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    norm = np.linalg.norm(normals, axis=1, keepdims=True)
+    normals = np.divide(normals, norm, out=np.zeros_like(normals), where=norm > 0)
+    record = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attributes", "<u2")])
+    data = np.zeros(tri.shape[0], dtype=record)
+    data["normal"] = normals
+    data["vertices"] = tri
+    head = header[:80].ljust(80, b" ")
+    return head + np.uint32(tri.shape[0]).astype("<u4").tobytes() + data.tobytes()
+
+
+def write_stl(chain: KinematicChain, stream: BinaryIO, **options: Any) -> None:
+    """Write the chain's model as one binary STL (millimetres, current configuration).
+
+    Parameters
+    ----------
+    chain : KinematicChain
+    stream : binary stream
+    units : {'mm', 'cm', 'm', 'in'}, optional
+        Length of one chain unit (the unit of r); default ``'mm'``.
+    scale : float, optional
+        Extra multiplier (> 0); default 1.
+    twistPortion : float, optional
+        Fraction of a straight part taken by its twist, in [0, 1]; default 0.2.
+
+    Raises
+    ------
+    InvalidTypeError
+        For an object that is not a KinematicChain or an unknown option.
+    InvalidParameterError
+        For a bad option value.
+    """
+    parts = _scaled_parts(chain, options, "STL")
+    stream.write(stl_bytes(*_concatenate(parts)))
+
+
+def write_obj(chain: KinematicChain, stream: TextIO, **options: Any) -> None:
+    """Write the chain's model as Wavefront OBJ, one object per part (millimetres).
+
+    Options as for :func:`write_stl`. Vertices are written with 12 significant digits.
+    """
+    parts = _scaled_parts(chain, options, "OBJ")
+    out = [
+        "# kinegami chain mesh: one object per part, millimetres, current configuration\n",
+        f"# {len(parts)} parts\n",
+    ]
+    offset = 1
+    for part in parts:
+        out.append(f"o {part.name}\n")
+        out.extend(f"v {x:.12g} {y:.12g} {z:.12g}\n" for x, y, z in part.vertices.tolist())
+        out.extend(f"f {a} {b} {c}\n" for a, b, c in (part.faces + offset).tolist())
+        offset += part.vertices.shape[0]
+    stream.write("".join(out))
+
+
+def shell_mass_properties(
+    vertices: np.ndarray, faces: np.ndarray, mass_per_area: float
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """Mass, centre of mass and inertia tensor of a thin shell of uniform areal density.
+
+    Every triangle is a sheet of density ``mass_per_area``; exact for the triangles (second
+    moment of a triangle with vertices a, b, c and area A: A/12 (a a' + b b' + c c' + s s'),
+    s = a + b + c).
+
+    Returns
+    -------
+    mass : float
+    com : numpy.ndarray, shape (3,)
+    inertia : numpy.ndarray, shape (3, 3)
+        About the centre of mass, axes of the input coordinates.
+    """
+    tri = np.asarray(vertices, dtype=float)[np.asarray(faces, dtype=np.int64)]
+    if tri.shape[0] == 0:
+        return 0.0, np.zeros(3), np.zeros((3, 3))
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    mass = float(mass_per_area * area.sum())
+    if mass <= 0.0:
+        return 0.0, np.zeros(3), np.zeros((3, 3))
+    s = tri.sum(axis=1)
+    com = mass_per_area * (area[:, None] * s).sum(axis=0) / 3.0 / mass
+    second = np.einsum("fki,fkj->fij", tri, tri) + np.einsum("fi,fj->fij", s, s)
+    C = mass_per_area * np.einsum("f,fij->ij", area / 12.0, second)
+    C -= mass * np.outer(com, com)
+    inertia = np.trace(C) * np.eye(3) - C
+    return mass, com, 0.5 * (inertia + inertia.T)

@@ -1,0 +1,548 @@
+"""PDF of the flat sheet at 1:1, tiled over A4 or Letter pages (docs/pdf.md).
+
+The lines are those of the DXF (:func:`kinegami.export._options.sheet_lines`: same flattening,
+``units``, ``scale``, ``perforate``, ``dash``, ``gap`` and ``skip_creases_on_cut`` options), in
+millimetres on the paper. Each page is a matplotlib figure of exactly the paper's size whose
+axes span the whole page with 1 mm of drawing = 1 mm of paper, saved with ``PdfPages``.
+
+Page layout (all lengths in mm)::
+
+    +------------------------------------------------+  paper
+    |   B1  page 2 of 3 ...    A1 ^                  |  top margin: label, neighbour above
+    |  -+----------------------------------------+-  |
+    |   |                                        |   |
+    |  <|  the part of the sheet on this page    |>  |  neighbours left and right
+    |   |  (window = paper - 2 margin - footer)  |   |
+    |  -+----------------------------------------+-  |  crop marks at the window corners
+    |                          C1 v                  |  footer: neighbour below,
+    |   legend: mountain valley cut       |--50 mm--|  |  legend, scale bar,
+    |   title, units; print at 100 %                 |  title and units
+    +------------------------------------------------+
+
+Pages are named by row letter (A = top) and column number (1 = left) and numbered row by row.
+Trim each page along its crop marks and butt the pages edge to edge; with ``overlap`` > 0 the
+windows of neighbouring pages overlap by that much and a dashed grey line marks where the
+neighbour's window begins (glue the overlap). The sheet is centred in the tiled area.
+
+Line styles (the DXF layer colours where they print well): mountain blue dash-dot, valley red
+dashed, cut black solid, boundary grey dotted; with ``perforate=True`` the fold lines are
+already dashes and are drawn solid.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, BinaryIO
+
+import numpy as np
+
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.export._options import resolve_sheet_options, sheet_lines
+from kinegami.validation import check_int, check_nonnegative, check_positive
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+    from kinegami.pattern.tubular import TubularPattern
+
+__all__ = [
+    "PAPER_SIZES",
+    "POINTS_PER_MM",
+    "PDF_DEFAULTS",
+    "Tile",
+    "PdfLayout",
+    "pdf_layout",
+    "draw_page",
+    "write_pdf",
+]
+
+#: Paper sizes (width, height) in mm, portrait.
+PAPER_SIZES = {"A4": (210.0, 297.0), "Letter": (215.9, 279.4)}
+
+#: PostScript points per millimetre.
+POINTS_PER_MM = 72.0 / 25.4
+
+#: Options specific to the PDF exporter and their defaults (lengths in mm).
+PDF_DEFAULTS = {
+    "paper": "A4",
+    "orientation": "auto",
+    "margin": 10.0,
+    "overlap": 0.0,
+    "scale_bar": 50.0,
+    "max_pages": 200,
+    "title": "kinegami crease pattern",
+}
+
+MIN_MARGIN = 6.0  # mm: the crop marks and the page label go in the margin
+FOOTER = 14.0  # mm of the window's bottom reserved for label, legend and scale bar
+MARK_GAP = 1.5  # crop mark: gap to the window corner (mm)
+MARK_LENGTH = 4.0  # crop mark length (mm)
+_FONT = 7.0  # points
+
+# kind -> (colour, line width mm, dash pattern mm or None, legend name)
+_STYLES = {
+    "M": ("#0000ff", 0.2, (3.0, 1.0, 0.5, 1.0), "mountain"),
+    "V": ("#ff0000", 0.2, (2.0, 1.0), "valley"),
+    "C": ("#000000", 0.3, None, "cut"),
+    "B": ("#808080", 0.15, (0.4, 0.8), "boundary"),
+}
+
+
+@dataclass(frozen=True)
+class Tile:
+    """One page: which part of the sheet it shows.
+
+    Attributes
+    ----------
+    row, col : int
+        0-based; row 0 is the top row.
+    label : str
+        Row letter(s) and column number, e.g. ``"A1"``, ``"B3"``.
+    page : int
+        1-based page number (row by row).
+    window : tuple of float
+        (xmin, ymin, xmax, ymax) of the sheet shown, sheet millimetres.
+    """
+
+    row: int
+    col: int
+    label: str
+    page: int
+    window: tuple[float, float, float, float]
+
+
+@dataclass(frozen=True, eq=False)
+class PdfLayout:
+    """Pages and lines of a PDF export (see :func:`pdf_layout`).
+
+    Attributes
+    ----------
+    paper : str
+    orientation : str
+        ``'portrait'`` or ``'landscape'``.
+    page_size : tuple of float
+        (width, height) of a page, mm.
+    content : tuple of float
+        (x, y, width, height) of the window on the page, mm from the lower-left corner.
+    rows, cols : int
+    tiles : tuple of Tile
+    segments : numpy.ndarray, shape (K, 2, 2)
+        The sheet's lines, sheet mm.
+    kinds : numpy.ndarray of str, shape (K,)
+    sheet_bounds : tuple of float
+        The cut rectangle (xmin, ymin, xmax, ymax), sheet mm.
+    margin, overlap, scale_bar : float
+        mm.
+    perforated : bool
+    units_text : str
+        What one pattern unit is, for the footer (e.g. ``"1 unit = 1 mm"``).
+    title : str
+    """
+
+    paper: str
+    orientation: str
+    page_size: tuple[float, float]
+    content: tuple[float, float, float, float]
+    rows: int
+    cols: int
+    tiles: tuple[Tile, ...]
+    segments: np.ndarray
+    kinds: np.ndarray
+    sheet_bounds: tuple[float, float, float, float]
+    margin: float
+    overlap: float
+    scale_bar: float
+    perforated: bool
+    units_text: str
+    title: str
+
+    @property
+    def page_count(self) -> int:
+        """Number of pages (rows x cols)."""
+        return len(self.tiles)
+
+    def page_offset(self, tile: Tile) -> tuple[float, float]:
+        """(dx, dy) with page = sheet + (dx, dy) on ``tile``'s page, mm."""
+        x, y = self.content[0], self.content[1]
+        return x - tile.window[0], y - tile.window[1]
+
+    def page_lines(self, tile: Tile) -> tuple[np.ndarray, np.ndarray]:
+        """The lines on ``tile``'s page, clipped to its window, in page mm (and their kinds)."""
+        keep, clipped = clip_to_rectangle(self.segments, tile.window)
+        dx, dy = self.page_offset(tile)
+        return clipped[keep] + np.array([dx, dy]), self.kinds[keep]
+
+
+def _row_label(row: int) -> str:
+    label = ""
+    row += 1
+    while row:
+        row, rest = divmod(row - 1, 26)
+        label = chr(ord("A") + rest) + label
+    return label
+
+
+def _count(length: float, window: float, overlap: float) -> int:
+    """Pages needed along one direction: windows of ``window`` overlapping by ``overlap``."""
+    if length <= window + 1e-9:
+        return 1
+    return int(math.ceil((length - overlap) / (window - overlap) - 1e-9))
+
+
+def clip_to_rectangle(
+    segments: np.ndarray, rect: tuple[float, float, float, float]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Clip segments to a closed rectangle (Liang-Barsky).
+
+    Parameters
+    ----------
+    segments : numpy.ndarray, shape (K, 2, 2)
+    rect : (xmin, ymin, xmax, ymax)
+
+    Returns
+    -------
+    keep : numpy.ndarray of bool, shape (K,)
+        True where a piece of positive length lies in the rectangle (boundary included).
+    clipped : numpy.ndarray, shape (K, 2, 2)
+        The pieces (meaningful where ``keep``).
+    """
+    seg = np.asarray(segments, dtype=float).reshape(-1, 2, 2)
+    p0 = seg[:, 0]
+    d = seg[:, 1] - p0
+    t0 = np.zeros(seg.shape[0])
+    t1 = np.ones(seg.shape[0])
+    inside = np.ones(seg.shape[0], dtype=bool)
+    xmin, ymin, xmax, ymax = rect
+    for axis, low, high in ((0, xmin, xmax), (1, ymin, ymax)):
+        delta = d[:, axis]
+        start = p0[:, axis]
+        still = np.abs(delta) <= 1e-12
+        inside &= ~still | ((start >= low) & (start <= high))
+        safe = np.where(still, 1.0, delta)
+        ta = (low - start) / safe
+        tb = (high - start) / safe
+        lo = np.where(still, -np.inf, np.minimum(ta, tb))
+        hi = np.where(still, np.inf, np.maximum(ta, tb))
+        t0 = np.maximum(t0, lo)
+        t1 = np.minimum(t1, hi)
+    clipped = np.stack([p0 + t0[:, None] * d, p0 + t1[:, None] * d], axis=1)
+    length = np.linalg.norm(clipped[:, 1] - clipped[:, 0], axis=1)
+    keep = inside & (t1 > t0) & (length > 1e-9)
+    return keep, clipped
+
+
+def _choice(name: str, value: Any, choices) -> Any:
+    if not isinstance(value, str) or value not in choices:
+        raise InvalidParameterError(
+            f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}"
+        )
+    return value
+
+
+def pdf_layout(pattern: TubularPattern, **options: Any) -> PdfLayout:
+    """Lay the sheet of ``pattern`` out on pages (no drawing); options as for :func:`write_pdf`.
+
+    Raises
+    ------
+    InvalidTypeError, InvalidParameterError
+        For an unknown option or a bad value, a page too small for its margins, or more
+        pages than ``max_pages``.
+    """
+    from kinegami.pattern.tubular import TubularPattern
+
+    if not isinstance(pattern, TubularPattern):
+        raise InvalidTypeError(f"pattern must be a TubularPattern, got {type(pattern).__name__}")
+    opts = resolve_sheet_options(options, PDF_DEFAULTS, "PDF")
+    extra = opts.extra
+    paper = _choice("paper", extra["paper"], tuple(PAPER_SIZES))
+    orientation = _choice("orientation", extra["orientation"], ("auto", "portrait", "landscape"))
+    margin = check_nonnegative("margin", extra["margin"])
+    if margin < MIN_MARGIN:
+        raise InvalidParameterError(
+            f"margin must be >= {MIN_MARGIN:g} mm (room for crop marks and labels), got {margin!r}"
+        )
+    overlap = check_nonnegative("overlap", extra["overlap"])
+    scale_bar = check_positive("scale_bar", extra["scale_bar"])
+    max_pages = check_int("max_pages", extra["max_pages"], minimum=1)
+    title = extra["title"]
+    if not isinstance(title, str):
+        raise InvalidTypeError(f"title must be a string, got {title!r}")
+
+    segments, kinds, bounds = sheet_lines(pattern, opts)
+    sheet_w, sheet_h = bounds[2] - bounds[0], bounds[3] - bounds[1]
+    candidates = []
+    for name in ("portrait", "landscape") if orientation == "auto" else (orientation,):
+        w, h = PAPER_SIZES[paper]
+        if name == "landscape":
+            w, h = h, w
+        win_w, win_h = w - 2.0 * margin, h - 2.0 * margin - FOOTER
+        if win_w < 20.0 or win_h < 20.0:
+            raise InvalidParameterError(
+                f"margin={margin!r} mm leaves no room on {paper} {name} paper: the window "
+                f"({win_w:.1f} x {win_h:.1f} mm) must be at least 20 x 20 mm"
+            )
+        if overlap > 0.5 * min(win_w, win_h):
+            raise InvalidParameterError(
+                f"overlap must be at most half the window ({0.5 * min(win_w, win_h):.1f} mm on "
+                f"{paper} {name} paper), got {overlap!r}"
+            )
+        if scale_bar > 0.5 * win_w - 10.0:
+            raise InvalidParameterError(
+                f"scale_bar must be at most {0.5 * win_w - 10.0:.1f} mm (half the window width "
+                f"less 10 mm) on {paper} {name} paper with margin={margin:g} mm, got "
+                f"{scale_bar!r}"
+            )
+        cols = _count(sheet_w, win_w, overlap)
+        rows = _count(sheet_h, win_h, overlap)
+        candidates.append((rows * cols, name, (w, h), (win_w, win_h), rows, cols))
+    count, name, (w, h), (win_w, win_h), rows, cols = min(candidates, key=lambda c: c[0])
+    if count > max_pages:
+        raise InvalidParameterError(
+            f"the sheet ({sheet_w:.1f} x {sheet_h:.1f} mm) needs {count} {paper} pages, more "
+            f"than max_pages={max_pages}; use a smaller scale or raise max_pages"
+        )
+    total_w = cols * win_w - (cols - 1) * overlap
+    total_h = rows * win_h - (rows - 1) * overlap
+    left = bounds[0] - 0.5 * (total_w - sheet_w)
+    top = bounds[3] + 0.5 * (total_h - sheet_h)
+    tiles = []
+    for row in range(rows):
+        for col in range(cols):
+            x0 = left + col * (win_w - overlap)
+            y1 = top - row * (win_h - overlap)
+            tiles.append(
+                Tile(
+                    row,
+                    col,
+                    f"{_row_label(row)}{col + 1}",
+                    len(tiles) + 1,
+                    (x0, y1 - win_h, x0 + win_w, y1),
+                )
+            )
+    units = options.get("units", "mm")
+    scale = float(options.get("scale", 1.0))
+    units_text = f"1 unit = {scale:g} {units}" if scale != 1.0 else f"1 unit = 1 {units}"
+    return PdfLayout(
+        paper=paper,
+        orientation=name,
+        page_size=(w, h),
+        content=(margin, margin + FOOTER, win_w, win_h),
+        rows=rows,
+        cols=cols,
+        tiles=tuple(tiles),
+        segments=segments,
+        kinds=kinds,
+        sheet_bounds=bounds,
+        margin=margin,
+        overlap=overlap,
+        scale_bar=scale_bar,
+        perforated=opts.perforate,
+        units_text=units_text,
+        title=title,
+    )
+
+
+def _dashes(pattern: tuple[float, ...] | None):
+    if pattern is None:
+        return "solid"
+    return (0.0, tuple(v * POINTS_PER_MM for v in pattern))
+
+
+def scale_bar_segment(layout: PdfLayout) -> np.ndarray:
+    """(2, 2): the scale bar's line on every page, page mm (its length is ``scale_bar``)."""
+    x, y, w, _ = layout.content
+    right = x + w
+    base = layout.margin + 6.5
+    return np.array([[right - layout.scale_bar, base], [right, base]])
+
+
+def draw_page(layout: PdfLayout, index: int, figure: Figure | None = None) -> Figure:
+    """Draw page ``index`` (0-based) of ``layout`` on a figure of exactly the paper's size.
+
+    The axes fill the figure with limits (0, width) x (0, height) in mm, so one drawing unit
+    is one millimetre of paper.
+    """
+    import matplotlib as mpl
+    from matplotlib.collections import LineCollection
+    from matplotlib.figure import Figure
+
+    tile = layout.tiles[index]
+    w, h = layout.page_size
+    if figure is None:
+        figure = Figure(figsize=(w / 25.4, h / 25.4))
+    else:
+        figure.set_size_inches(w / 25.4, h / 25.4)
+    ax = figure.add_axes((0.0, 0.0, 1.0, 1.0))
+    ax.set_xlim(0.0, w)
+    ax.set_ylim(0.0, h)
+    ax.set_axis_off()
+    lines, kinds = layout.page_lines(tile)
+    text = {"fontsize": _FONT, "color": "black"}
+    with mpl.rc_context({"lines.scale_dashes": False}):
+        for kind in ("B", "C", "V", "M"):
+            color, width, dashes, _ = _STYLES[kind]
+            if layout.perforated and kind in "MV":
+                dashes = None
+            selected = lines[kinds == kind]
+            if selected.shape[0]:
+                ax.add_collection(
+                    LineCollection(
+                        selected,
+                        colors=color,
+                        linewidths=width * POINTS_PER_MM,
+                        linestyles=[_dashes(dashes)],
+                        capstyle="butt",
+                    )
+                )
+        _marks(ax, layout, tile)
+        _footer(ax, layout, tile, text)
+    return figure
+
+
+def _marks(ax, layout: PdfLayout, tile: Tile) -> None:
+    """Crop marks at the window corners, neighbour labels and overlap lines."""
+    from matplotlib.collections import LineCollection
+
+    x, y, w, h = layout.content
+    gap = MARK_GAP
+    length = min(MARK_LENGTH, max(layout.margin - gap - 1.0, 1.0))
+    marks = []
+    for cx, sx in ((x, -1.0), (x + w, 1.0)):
+        for cy, sy in ((y, -1.0), (y + h, 1.0)):
+            marks.append([(cx + sx * gap, cy), (cx + sx * (gap + length), cy)])
+            marks.append([(cx, cy + sy * gap), (cx, cy + sy * (gap + length))])
+    ax.add_collection(LineCollection(marks, colors="black", linewidths=0.1 * POINTS_PER_MM))
+    by_position = {(t.row, t.col): t for t in layout.tiles}
+    neighbours = {
+        "up": by_position.get((tile.row - 1, tile.col)),
+        "down": by_position.get((tile.row + 1, tile.col)),
+        "left": by_position.get((tile.row, tile.col - 1)),
+        "right": by_position.get((tile.row, tile.col + 1)),
+    }
+    style = {"fontsize": _FONT, "color": "dimgray"}
+    o = layout.overlap
+    overlap_lines = []
+    if neighbours["up"] is not None:
+        ax.text(x + 0.5 * w, y + h + gap, f"{neighbours['up'].label} \u2191", ha="center",
+                va="bottom", **style)  # fmt: skip
+        overlap_lines.append([(x, y + h - o), (x + w, y + h - o)])
+    if neighbours["down"] is not None:
+        ax.text(x + 0.5 * w, y - gap, f"{neighbours['down'].label} \u2193", ha="center",
+                va="top", **style)  # fmt: skip
+        overlap_lines.append([(x, y + o), (x + w, y + o)])
+    if neighbours["left"] is not None:
+        ax.text(x - gap, y + 0.5 * h, f"\u2190 {neighbours['left'].label}", ha="right",
+                va="center", rotation=90, **style)  # fmt: skip
+        overlap_lines.append([(x + o, y), (x + o, y + h)])
+    if neighbours["right"] is not None:
+        ax.text(x + w + gap, y + 0.5 * h, f"{neighbours['right'].label} \u2192", ha="left",
+                va="center", rotation=90, **style)  # fmt: skip
+        overlap_lines.append([(x + w - o, y), (x + w - o, y + h)])
+    if o > 0.0 and overlap_lines:
+        ax.add_collection(
+            LineCollection(
+                overlap_lines,
+                colors="gray",
+                linewidths=0.1 * POINTS_PER_MM,
+                linestyles=[_dashes((1.0, 1.0))],
+            )
+        )
+
+
+def _footer(ax, layout: PdfLayout, tile: Tile, text: dict) -> None:
+    """Page label and title above the window; legend and scale bar below it."""
+    from matplotlib.collections import LineCollection
+
+    x, y, w, h = layout.content
+    left = x + MARK_GAP + MARK_LENGTH + 2.0
+    top = y + h + MARK_GAP + 1.0
+    ax.text(
+        left,
+        top,
+        f"{tile.label}   page {tile.page} of {layout.page_count} (row {_row_label(tile.row)} "
+        f"of {layout.rows}, column {tile.col + 1} of {layout.cols})",
+        ha="left",
+        va="bottom",
+        fontweight="bold",
+        **text,
+    )
+    ax.text(
+        x,
+        layout.margin + 1.5,
+        f"{layout.title}, {layout.units_text}; print at 100 % (actual size); trim along the "
+        f"crop marks",
+        ha="left",
+        va="center",
+        **text,
+    )
+    base = layout.margin + 6.5
+    cursor = x
+    for kind in ("M", "V", "C", "B"):
+        color, width, dashes, name = _STYLES[kind]
+        if layout.perforated and kind in "MV":
+            name += " (perforated)"
+            dashes = None
+        ax.add_collection(
+            LineCollection(
+                [[(cursor, base), (cursor + 8.0, base)]],
+                colors=color,
+                linewidths=width * POINTS_PER_MM,
+                linestyles=[_dashes(dashes)],
+            )
+        )
+        ax.text(cursor + 9.5, base, name, ha="left", va="center", **text)
+        cursor += 9.5 + 1.6 * len(name) + 4.0
+    bar = scale_bar_segment(layout)
+    (x0, y0), (x1, _) = bar
+    ticks = [[(x0, y0), (x1, y0)]]
+    step = 10.0 if layout.scale_bar >= 20.0 else layout.scale_bar
+    count = int(math.floor(layout.scale_bar / step + 1e-9))
+    for k in range(count + 1):
+        tick = 2.0 if k in (0, count) else 1.0
+        ticks.append([(x0 + k * step, y0), (x0 + k * step, y0 + tick)])
+    if count * step < layout.scale_bar - 1e-9:
+        ticks.append([(x1, y0), (x1, y0 + 2.0)])
+    ax.add_collection(LineCollection(ticks, colors="black", linewidths=0.2 * POINTS_PER_MM))
+    ax.text(0.5 * (x0 + x1), y0 + 2.5, f"{layout.scale_bar:g} mm", ha="center",
+            va="bottom", **text)  # fmt: skip
+
+
+def write_pdf(pattern: TubularPattern, stream: BinaryIO, **options: Any) -> None:
+    """Write the sheet of ``pattern`` at 1:1 as a PDF tiled over pages.
+
+    Parameters
+    ----------
+    pattern : TubularPattern
+    stream : binary stream
+    units, scale, perforate, dash, gap, skip_creases_on_cut
+        As for :func:`kinegami.export.dxf.write_dxf` (units of the pattern; lengths in mm).
+    paper : {'A4', 'Letter'}, optional
+        Default ``'A4'`` (210 x 297 mm; Letter 215.9 x 279.4 mm).
+    orientation : {'auto', 'portrait', 'landscape'}, optional
+        ``'auto'`` (default) takes the one needing fewer pages (portrait on a tie).
+    margin : float, optional
+        Border of every page, mm (>= 6, default 10): the crop marks, the page label and the
+        title are drawn in it, nothing of the sheet.
+    overlap : float, optional
+        Overlap of neighbouring pages' windows, mm (default 0: trim and butt).
+    scale_bar : float, optional
+        Length of the scale bar on every page, mm (default 50).
+    max_pages : int, optional
+        Refuse layouts needing more pages (default 200).
+    title : str, optional
+        Text in the footer and the PDF's Title (default ``'kinegami crease pattern'``).
+
+    Raises
+    ------
+    InvalidTypeError, InvalidParameterError
+        For an unknown option or a bad value (before anything is written).
+    """
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    layout = pdf_layout(pattern, **options)
+    metadata = {"Title": layout.title, "Creator": "kinegami", "CreationDate": None}
+    with PdfPages(stream, metadata=metadata) as pdf:
+        for index in range(layout.page_count):
+            figure = draw_page(layout, index)
+            pdf.savefig(figure)
