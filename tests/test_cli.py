@@ -258,3 +258,26 @@ def test_chain_formats_through_the_export_registry(design, tmp_path):
     assert robot.validate()
     assert len(trimesh.load(out / "arm.stl").faces) > 0
     assert not [p for p in tmp_path.rglob(".kinegami-build-*")]
+
+
+GALLERY = sorted((ROOT / "examples" / "designs").glob("*.json"))
+
+
+@pytest.mark.parametrize("path", GALLERY, ids=[p.stem for p in GALLERY])
+def test_every_gallery_design_builds_from_the_command_line(path, tmp_path, capsys):
+    """In-process (the subprocess path is covered above): exit 0 and the four files."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from kinegami.cli import main
+
+    assert main(["build", str(path), "-o", str(tmp_path)]) == 0
+    stem = path.stem
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [f"{stem}.dxf", f"{stem}.svg", f"{stem}_3d.png", f"{stem}_pattern.png"]
+    )
+    assert "total tube length" in capsys.readouterr().out
+
+
+def test_gallery_is_not_empty():
+    assert len(GALLERY) >= 10
