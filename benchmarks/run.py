@@ -8,6 +8,8 @@ not assertions: tests never time anything.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import statistics
 import tempfile
 import time
@@ -144,6 +146,49 @@ def main(argv: list[str] | None = None) -> None:
         target = Path(folder) / "chain.svg"
         t = _median_seconds(lambda: pattern.save(dxfName=str(target)), 5)
         rows.append(("SVG save, same pattern", f"{t * 1e3:.1f} ms", "-"))
+
+    # design files, DH tables, the command line and the exporters of the registry
+    from kinegami import export
+    from kinegami.design import load_design, save_design
+    from kinegami.optimize import shorten_by_axis_translations
+
+    designs = Path(__file__).resolve().parents[1] / "examples" / "designs"
+    t = _median_seconds(lambda: load_design(designs / "example1.json"), 5)
+    rows.append(("load examples/designs/example1.json", f"{t * 1e3:.1f} ms", "-"))
+    with tempfile.TemporaryDirectory() as folder:
+        target = Path(folder) / "chain.json"
+        t = _median_seconds(lambda: save_design(fresh[0], target), 5)
+        rows.append(("save_design, 32-joint chain", f"{t * 1e3:.1f} ms", "-"))
+        t = _median_seconds(lambda: load_design(target), 5)
+        rows.append(("load_design, 32-joint chain (fixed poses)", f"{t * 1e3:.1f} ms", "-"))
+    puma_rows = [(np.pi / 2, -np.pi / 2, 0, 0), (0, 0, 431.8, 149.09),
+                 (np.pi / 2, np.pi / 2, -20.32, 0), (0, -np.pi / 2, 0, 433.07),
+                 (0, np.pi / 2, 0, 0), (0, 0, 0, 56.25)]  # fmt: skip
+    t = _median_seconds(lambda: KinematicChain.from_dh(puma_rows, 6, 100), 5)
+    rows.append(("PUMA 560 from its DH table (compact)", f"{t * 1e3:.1f} ms", "-"))
+    puma = KinematicChain.from_dh(puma_rows, 6, 100)
+    before = puma.totalPathLength()
+    t0 = time.perf_counter()
+    shorten_by_axis_translations(puma)
+    rows.append((f"  shortened {before:.0f} -> {puma.totalPathLength():.0f} mm",
+                 f"{(time.perf_counter() - t0) * 1e3:.0f} ms", "-"))  # fmt: skip
+    with tempfile.TemporaryDirectory() as folder:
+        for suffix in (".fold", ".pdf", ".stl", ".obj", ".urdf"):
+            target = Path(folder) / f"chain{suffix}"
+            try:
+                export(fresh[0], target)  # first call imports the exporter
+            except ImportError:
+                rows.append((f"export {suffix}, 32-joint chain", "unavailable", "-"))
+                continue
+            t = _median_seconds(lambda target=target: export(fresh[0], target), 3)
+            rows.append((f"export {suffix}, 32-joint chain", f"{t * 1e3:.1f} ms", "-"))
+        from kinegami.cli import main as cli_main
+
+        with contextlib.redirect_stdout(io.StringIO()):
+            t0 = time.perf_counter()
+            cli_main(["build", str(designs / "example1.json"), "-o", folder])
+        rows.append(("kinegami build example1.json (DXF, SVG, 2 PNGs)",
+                     f"{(time.perf_counter() - t0) * 1e3:.0f} ms", "-"))  # fmt: skip
 
     balls, paths, fails, times = [], [], 0, []
     for seed in range(args.seeds):
