@@ -6,8 +6,9 @@ target folder and moved onto the target name with :func:`os.replace`, so a faile
 leaves a partial or temporary file behind. Missing parent folders are created.
 
 An exporter is a function ``exporter(pattern, stream, **options)`` writing text to ``stream``;
-:func:`register_exporter` adds one. Built in: ``.dxf`` (:func:`kinegami.export.dxf.write_dxf`)
-and ``.svg`` (:func:`kinegami.export.svg.write_svg`). See docs/fabrication.md.
+:func:`register_exporter` adds one. Built in: ``.dxf`` (:func:`kinegami.export.dxf.write_dxf`),
+``.svg`` (:func:`kinegami.export.svg.write_svg`) and ``.fold`` (:mod:`kinegami.export.fold`).
+See docs/fabrication.md.
 
 :func:`export` (in :mod:`kinegami.export.registry`) is the entry point for every format, patterns
 and chains alike (DXF, SVG, FOLD, PDF, STL, OBJ, URDF). This module is itself callable, so
@@ -221,6 +222,14 @@ def _register_builtin() -> None:
 
     register_exporter(".dxf", write_dxf)
     register_exporter(".svg", write_svg)
+    register_exporter(".fold", _write_fold)
+
+
+def _write_fold(pattern: TubularPattern, stream, **options: Any) -> None:
+    """FOLD 1.2 (imported on first use; see kinegami.export.fold.write_fold)."""
+    from kinegami.export.fold import write_fold
+
+    write_fold(pattern, stream, **options)
 
 
 _register_builtin()

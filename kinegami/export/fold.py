@@ -1,0 +1,562 @@
+"""FOLD 1.2 export: the flat sheet as a crease pattern, plus its folded form at joint state 0.
+
+FOLD (https://github.com/edemaine/fold) is the JSON origami format read by Origami Simulator and
+Rabbit Ear. The file written here has
+
+* frame 0, class ``creasePattern``: the flattened sheet of spec/patterns.md section 5 (the same
+  sheet as the DXF and SVG files: x in [-b/2, W + b/2], y in [y0, y0 + H], the glue tab being the
+  second copy of the starting panel) as a planar graph. Every crease is cut where it meets the
+  sheet's vertical edges, the outline is split at every vertex on it, and the faces are the
+  faces of that planar graph, counter-clockwise, printed side up (+z);
+* ``edges_assignment``: ``M`` and ``V`` for the creases, ``B`` for the sheet outline (including
+  creases lying on the top or bottom edge, spec B10, and the glue tab's outer edge). The sheet
+  has no slits, so ``C`` never occurs;
+* ``edges_foldAngle`` in degrees, FOLD's sign convention (valley > 0, mountain < 0, 0 for
+  ``B``): the magnitude is the dihedral angle of the crease in the folded form;
+* ``file_frames[0]``, class ``foldedForm``, inheriting from frame 0: the 3D position of every
+  vertex (:mod:`kinegami.pattern.folded`). Both copies of the glue tab land on the same place.
+
+Lengths are written in millimetres: one pattern unit is one ``units`` (default ``"mm"``) times
+``scale``, as in the DXF export. See docs/fold.md.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from typing import Any, TextIO
+
+import numpy as np
+
+from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
+from kinegami.export._options import UNITS_IN_MM, _positive
+from kinegami.pattern._prism import periodic_dx
+from kinegami.pattern.sheet import TOLERANCE_FACTOR
+
+__all__ = [
+    "FOLD_SPEC",
+    "SheetGraph",
+    "FoldExportError",
+    "sheet_graph",
+    "fold_dict",
+    "write_fold",
+    "fold_angles",
+]
+
+#: FOLD specification version written.
+FOLD_SPEC = 1.2
+
+_OPTIONS = ("units", "scale", "folded", "frame", "twistPortion", "title")
+
+
+class FoldExportError(KinegamiError, ValueError):
+    """The pattern's sheet is not a valid planar crease pattern (crossing or overlapping creases,
+    or a sheet of zero area)."""
+
+
+@dataclass(frozen=True, eq=False)
+class SheetGraph:
+    """The flattened sheet as a planar graph with faces and its folded 3D positions.
+
+    Attributes
+    ----------
+    vertices : numpy.ndarray, shape (K, 2)
+        Sheet coordinates (pattern units), x in [-b/2, W + b/2].
+    vertices_3d : numpy.ndarray, shape (K, 3) or None
+        Folded position of every sheet vertex (pattern units), or None when not folded.
+    source : numpy.ndarray of int, shape (K,)
+        Pattern vertex each sheet vertex is a copy of, or -1 for points where a crease meets a
+        vertical edge of the sheet (and sheet corners that are no pattern vertex).
+    between : numpy.ndarray, shape (K, 3)
+        For the vertices with ``source == -1``: (u, w, t), the point lies at fraction t of the
+        way from pattern vertex u to pattern vertex w (zeros for copies).
+    edges : numpy.ndarray of int, shape (E, 2)
+        Vertex pairs.
+    assignment : numpy.ndarray of str, shape (E,)
+        ``"M"``, ``"V"`` or ``"B"``.
+    crease : numpy.ndarray of int, shape (E,)
+        Pattern crease each edge is (a piece of), or -1 for the outline.
+    faces : list of numpy.ndarray
+        Vertex indices of every face, counter-clockwise in the sheet.
+    edge_faces : numpy.ndarray of int, shape (E, 2)
+        Face on the left and on the right of each edge (from its first to its second vertex),
+        -1 outside the sheet.
+    width, sideLength, y0, height : float
+        W, b, the bottom edge and the height H of the sheet.
+    """
+
+    vertices: np.ndarray
+    vertices_3d: np.ndarray | None
+    source: np.ndarray
+    between: np.ndarray
+    edges: np.ndarray
+    assignment: np.ndarray
+    crease: np.ndarray
+    faces: list
+    edge_faces: np.ndarray
+    width: float
+    sideLength: float
+    y0: float
+    height: float
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """The sheet rectangle (xmin, ymin, xmax, ymax) = (-b/2, y0, W + b/2, y0 + H)."""
+        half = 0.5 * self.sideLength
+        return (-half, self.y0, self.width + half, self.y0 + self.height)
+
+    def face_areas(self) -> np.ndarray:
+        """Signed area of every face in the sheet (all positive: counter-clockwise)."""
+        return np.array([_signed_area(self.vertices[f]) for f in self.faces])
+
+
+# ------------------------------------------------------------------------------------------------
+# The planar graph of the sheet
+
+
+def sheet_graph(pattern_or_chain, *, folded: bool = True, frame=None, twistPortion=0.2):
+    """The sheet of a pattern (or of a chain's crease pattern) as a planar graph with faces.
+
+    Parameters
+    ----------
+    pattern_or_chain : TubularPattern or KinematicChain
+    folded : bool, optional
+        Also compute the folded 3D position of every sheet vertex (default True).
+    frame, twistPortion
+        As for :func:`kinegami.pattern.folded.folded_form`.
+
+    Returns
+    -------
+    SheetGraph
+
+    Raises
+    ------
+    FoldExportError
+        If the sheet has zero area, or its creases cross or overlap so that the faces do not
+        tile the sheet.
+    """
+    from kinegami.pattern.folded import _resolve_input, folded_form
+
+    pattern, base = _resolve_input(pattern_or_chain, twistPortion)
+    X = None
+    if folded:
+        X = folded_form(pattern, frame=base if frame is None else frame).vertices
+    return _build_graph(pattern, X)
+
+
+def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
+    W, b, r = pattern.width, pattern.sideLength, pattern.r
+    tol = TOLERANCE_FACTOR * r
+    y0 = float(pattern.proximalMarker[1])
+    H = float(pattern.height)
+    if H <= tol:
+        raise FoldExportError(
+            f"cannot export a pattern of height {H!r}: its sheet has no area (a lone waypoint or "
+            "an empty tube has no faces)"
+        )
+    xmin, xmax = -0.5 * b, W + 0.5 * b
+    v = pattern.vertices_coords
+    nv = v.shape[0]
+    # vertex copies at shifts 0, +W, -W that lie on the sheet (ends within tol snap onto it)
+    shifts = np.array([0.0, W, -W])
+    cx = v[None, :, 0] + shifts[:, None]
+    inside = (cx >= xmin - tol) & (cx <= xmax + tol)
+    cx = np.where(np.abs(cx - xmin) <= tol, xmin, np.where(np.abs(cx - xmax) <= tol, xmax, cx))
+    copy_index = np.full((3, nv), -1)
+    s_idx, v_idx = np.nonzero(inside)
+    copy_index[s_idx, v_idx] = np.arange(s_idx.size)
+    points = [np.stack([cx[s_idx, v_idx], v[v_idx, 1]], axis=1)]
+    source = [v_idx]
+    interp = [np.zeros((s_idx.size, 3))]  # (vertex u, vertex w, t) for clip points
+    count = s_idx.size
+    clip_points: dict[tuple[int, int], int] = {}
+
+    def clip_vertex(x: float, y: float, u: int, w: int, t: float) -> int:
+        nonlocal count
+        key = (0 if x < 0.5 * W else 1, round(y / tol))
+        for dk in (0, -1, 1):
+            found = clip_points.get((key[0], key[1] + dk))
+            if found is not None:
+                return found
+        clip_points[key] = count
+        points.append(np.array([[x, y]]))
+        source.append(np.array([-1]))
+        interp.append(np.array([[u, w, t]]))
+        count += 1
+        return count - 1
+
+    e = pattern.edges_vertices
+    labels = pattern.edges_assignment
+    edges: list[tuple[int, int]] = []
+    assignment: list[str] = []
+    crease: list[int] = []
+    start = v[e[:, 0]]
+    dx = periodic_dx(v[e[:, 1], 0] - start[:, 0], W)
+    for i in range(e.shape[0]):
+        u, w = int(e[i, 0]), int(e[i, 1])
+        x0, y_0 = float(start[i, 0]), float(start[i, 1])
+        x1, y_1 = x0 + float(dx[i]), float(v[w, 1])
+        for s in (0.0, W, -W):
+            a, c = x0 + s, x1 + s
+            lo, hi = min(a, c), max(a, c)
+            if hi < xmin + tol or lo > xmax - tol:
+                continue  # outside, or touching the sheet only on a vertical edge
+            if abs(c - a) <= tol and (abs(a - xmin) <= tol or abs(a - xmax) <= tol):
+                continue  # lies on a vertical edge of the sheet: that is the outline
+            ends = []
+            xs = []
+            for x_end, vert in ((a, u), (c, w)):
+                if xmin - tol <= x_end <= xmax + tol:
+                    shift = x_end - v[vert, 0]
+                    k = int(np.argmin(np.abs(shifts - shift)))
+                    ends.append(int(copy_index[k, vert]))
+                    xs.append(float(cx[k, vert]))
+                else:
+                    edge_x = xmin if x_end < xmin else xmax
+                    t = (edge_x - a) / (c - a)
+                    ends.append(clip_vertex(edge_x, y_0 + t * (y_1 - y_0), u, w, t))
+                    xs.append(edge_x)
+            if min(ends) < 0:  # pragma: no cover - copies and clipping use the same tolerance
+                raise FoldExportError(f"crease {i} ends at a vertex missing from the sheet")
+            if max(xs) <= xmin + tol or min(xs) >= xmax - tol:
+                continue  # the piece inside lies on a vertical edge: that is the outline
+            if ends[0] == ends[1]:
+                continue
+            edges.append((ends[0], ends[1]))
+            assignment.append(str(labels[i]))
+            crease.append(i)
+    # sheet corners that are no vertex (the distal base is shifted after a twist): a point of
+    # the straight edge between the two nearest vertices on that end of the pattern
+    for cy in (y0, y0 + H):
+        on_edge = np.flatnonzero(np.abs(v[:, 1] - cy) <= tol)
+        for corner_x in (xmin, xmax):
+            current = np.concatenate(points)
+            here = (np.abs(current[:, 0] - corner_x) <= tol) & (np.abs(current[:, 1] - cy) <= tol)
+            if here.any():
+                continue
+            if on_edge.size < 2:  # pragma: no cover - every module end has its n base vertices
+                raise FoldExportError(f"no vertices on the sheet edge y = {cy:.6g}")
+            offset = periodic_dx(v[on_edge, 0] - corner_x, W)
+            left = on_edge[np.argmax(np.where(offset < 0, offset, -np.inf))]
+            right = on_edge[np.argmin(np.where(offset > 0, offset, np.inf))]
+            dl = -periodic_dx(np.array([v[left, 0] - corner_x]), W)[0]
+            dr = periodic_dx(np.array([v[right, 0] - corner_x]), W)[0]
+            clip_vertex(corner_x, cy, int(left), int(right), dl / (dl + dr))
+    P = np.concatenate(points)
+    src = np.concatenate(source)
+    itp = np.concatenate(interp)
+    edges, assignment, crease = _add_outline(P, edges, assignment, crease, xmin, xmax, y0, H, tol)
+    faces, edge_faces = _faces(P, edges, (xmax - xmin) * H)
+    V3 = None
+    if X3 is not None:
+        V3 = np.empty((P.shape[0], 3))
+        own = src >= 0
+        V3[own] = X3[src[own]]
+        clip = ~own
+        uu, ww, tt = itp[clip, 0].astype(int), itp[clip, 1].astype(int), itp[clip, 2]
+        V3[clip] = X3[uu] + tt[:, None] * (X3[ww] - X3[uu])
+    return SheetGraph(P, V3, src, itp, edges, assignment, crease, faces, edge_faces, W, b, y0, H)
+
+
+def _add_outline(P, edges, assignment, crease, xmin, xmax, y0, H, tol):
+    """Add the sheet outline split at every vertex on it; creases on it become boundary."""
+    corners = [(xmin, y0), (xmax, y0), (xmax, y0 + H), (xmin, y0 + H)]
+    for cx_, cy_ in corners:
+        if not ((np.abs(P[:, 0] - cx_) <= tol) & (np.abs(P[:, 1] - cy_) <= tol)).any():
+            raise FoldExportError(f"no vertex at the sheet corner ({cx_:.6g}, {cy_:.6g})")
+    outline = []
+    for axis, value, other in ((1, y0, 0), (0, xmax, 1), (1, y0 + H, 0), (0, xmin, 1)):
+        on = np.flatnonzero(np.abs(P[:, axis] - value) <= tol)
+        lo = xmin if other == 0 else y0
+        hi = xmax if other == 0 else y0 + H
+        on = on[(P[on, other] >= lo - tol) & (P[on, other] <= hi + tol)]
+        on = on[np.argsort(P[on, other], kind="stable")]
+        outline += list(zip(on[:-1].tolist(), on[1:].tolist(), strict=True))
+    key = {}
+    for i, (a, c) in enumerate(edges):
+        key.setdefault((min(a, c), max(a, c)), i)
+    keep = np.ones(len(edges), dtype=bool)
+    out_edges = []
+    for a, c in outline:
+        i = key.get((min(a, c), max(a, c)))
+        if i is not None:
+            keep[i] = False  # a crease on the paper's edge is the paper's edge (B10)
+        out_edges.append((a, c))
+    E = np.array([ed for ed, k in zip(edges, keep, strict=True) if k] + out_edges, dtype=np.intp)
+    A = np.array(
+        [a for a, k in zip(assignment, keep, strict=True) if k] + ["B"] * len(out_edges),
+        dtype="<U1",
+    )
+    C = np.array([c for c, k in zip(crease, keep, strict=True) if k] + [-1] * len(out_edges))
+    # the same piece twice (only possible for duplicate creases): keep the first
+    lo, hi = np.minimum(E[:, 0], E[:, 1]), np.maximum(E[:, 0], E[:, 1])
+    _, first = np.unique(lo.astype(np.int64) * (P.shape[0] + 1) + hi, return_index=True)
+    first.sort()
+    return E[first], A[first], C[first]
+
+
+def _signed_area(poly: np.ndarray) -> float:
+    """Shoelace area, relative to the first corner (exact enough for slivers far from 0)."""
+    rel = poly - poly[0]
+    x, y = rel[:, 0], rel[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float):
+    """Faces of the planar straight-line graph (P, E): counter-clockwise vertex cycles.
+
+    Half-edge h = 2i goes E[i, 0] -> E[i, 1], h = 2i + 1 the other way. Around each vertex the
+    outgoing half-edges are sorted by angle; the face to the left of u -> v continues with the
+    outgoing half-edge of v just clockwise of v -> u.
+    """
+    m = E.shape[0]
+    tail = np.empty(2 * m, dtype=np.intp)
+    head = np.empty(2 * m, dtype=np.intp)
+    tail[0::2], head[0::2] = E[:, 0], E[:, 1]
+    tail[1::2], head[1::2] = E[:, 1], E[:, 0]
+    d = P[head] - P[tail]
+    angle = np.arctan2(d[:, 1], d[:, 0])
+    order = np.lexsort((angle, tail))
+    position = np.empty(2 * m, dtype=np.intp)
+    position[order] = np.arange(2 * m)
+    first = np.searchsorted(tail[order], np.arange(P.shape[0]))
+    degree = np.bincount(tail, minlength=P.shape[0])
+    twin = np.arange(2 * m) ^ 1
+    t = twin
+    v = tail[t]  # = head of h
+    rank = position[t] - first[v]
+    prev_rank = (rank - 1) % degree[v]
+    nxt = order[first[v] + prev_rank]
+    face_of = np.full(2 * m, -1)
+    visited = np.zeros(2 * m, dtype=bool)
+    faces = []
+    outer = []
+    for h0 in range(2 * m):
+        if visited[h0]:
+            continue
+        cycle = []
+        h = h0
+        while not visited[h]:
+            visited[h] = True
+            cycle.append(h)
+            h = nxt[h]
+        cycle = np.array(cycle)
+        verts = tail[cycle]
+        if _signed_area(P[verts]) > 0:
+            face_of[cycle] = len(faces)
+            faces.append(verts)
+        else:
+            outer.append(verts)
+    total = sum(_signed_area(P[f]) for f in faces)
+    problems = []
+    if len(outer) != 1:
+        problems.append(f"{len(outer)} boundary loops (expected 1: creases not connected)")
+    if not math.isclose(total, sheet_area, rel_tol=1e-9):
+        problems.append(f"faces cover {total!r} instead of the sheet area {sheet_area!r}")
+    repeated = sum(1 for f in faces if np.unique(f).size != f.size)
+    if repeated:
+        problems.append(f"{repeated} faces are not simple polygons")
+    if problems:
+        raise FoldExportError(
+            "the sheet is not a valid planar crease pattern (crossing or overlapping creases?): "
+            + "; ".join(problems)
+        )
+    edge_faces = np.stack([face_of[0::2], face_of[1::2]], axis=1)
+    return faces, edge_faces
+
+
+# ------------------------------------------------------------------------------------------------
+# Fold angles
+
+
+def _newell(points: np.ndarray) -> np.ndarray:
+    nxt = np.roll(points, -1, axis=0)
+    n = np.array(
+        [
+            np.sum((points[:, 1] - nxt[:, 1]) * (points[:, 2] + nxt[:, 2])),
+            np.sum((points[:, 2] - nxt[:, 2]) * (points[:, 0] + nxt[:, 0])),
+            np.sum((points[:, 0] - nxt[:, 0]) * (points[:, 1] + nxt[:, 1])),
+        ]
+    )
+    norm = np.linalg.norm(n)
+    return n / norm if norm > 0 else n
+
+
+def fold_angles(graph: SheetGraph) -> np.ndarray:
+    """Signed dihedral angle of every edge in the folded form, radians, valley positive.
+
+    For an edge with faces on both sides, the angle between the two faces' printed-side normals
+    (Newell normals of their 3D polygons), positive when the crease folds towards the printed
+    side (a valley); 0 for outline edges. Folds of nearly pi come out with an arbitrary sign:
+    :func:`fold_dict` takes the sign from the assignment.
+    """
+    if graph.vertices_3d is None:
+        raise InvalidParameterError("fold_angles needs a graph built with folded=True")
+    X = graph.vertices_3d
+    normals = np.array([_newell(X[f]) for f in graph.faces])
+    out = np.zeros(graph.edges.shape[0])
+    inner = (graph.edge_faces >= 0).all(axis=1)
+    n1 = normals[graph.edge_faces[inner, 0]]
+    n2 = normals[graph.edge_faces[inner, 1]]
+    d = X[graph.edges[inner, 1]] - X[graph.edges[inner, 0]]
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    out[inner] = np.arctan2(
+        -np.einsum("ij,ij->i", np.cross(n1, n2), d), np.einsum("ij,ij->i", n1, n2)
+    )
+    return out
+
+
+# ------------------------------------------------------------------------------------------------
+# FOLD dictionary and writer
+
+
+def _resolve_options(options: dict[str, Any]) -> dict[str, Any]:
+    unknown = sorted(set(options) - set(_OPTIONS))
+    if unknown:
+        raise InvalidTypeError(
+            f"FOLD export got unknown option{'s' if len(unknown) > 1 else ''} "
+            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(_OPTIONS)}"
+        )
+    units = options.get("units", "mm")
+    if units not in UNITS_IN_MM:
+        raise InvalidParameterError(
+            f"units must be one of {', '.join(map(repr, UNITS_IN_MM))} (the length of one "
+            f"pattern unit), got {units!r}"
+        )
+    folded = options.get("folded", True)
+    if not isinstance(folded, bool | np.bool_):
+        raise InvalidTypeError(f"folded must be True or False, got {folded!r}")
+    title = options.get("title")
+    if title is not None and not isinstance(title, str):
+        raise InvalidTypeError(f"title must be a string, got {title!r}")
+    return {
+        "factor": UNITS_IN_MM[units] * _positive("scale", options.get("scale", 1.0)),
+        "folded": bool(folded),
+        "frame": options.get("frame"),
+        "twistPortion": options.get("twistPortion", 0.2),
+        "title": title,
+    }
+
+
+def _rounded(values: np.ndarray, extent: float) -> list:
+    digits = 12 - math.ceil(math.log10(extent)) if extent > 0 else 12
+    return (np.round(values, digits) + 0.0).tolist()
+
+
+def fold_dict(pattern_or_chain, **options: Any) -> dict:
+    """The FOLD 1.2 content of a pattern (or of a chain's crease pattern) as a dict.
+
+    Parameters
+    ----------
+    pattern_or_chain : TubularPattern or KinematicChain
+        A pattern made of catalog modules (e.g. ``chain.creasePattern()``) or a chain. The folded
+        form of a bare pattern is placed with its proximal end on ``frame`` (default: tube axis
+        along z); a chain's is in the chain's world frame.
+    units : {'mm', 'cm', 'm', 'in'}, optional
+        Length of one pattern unit (default ``'mm'``); coordinates are written in millimetres.
+    scale : float, optional
+        Extra multiplier of the pattern unit (default 1).
+    folded : bool, optional
+        Include the ``foldedForm`` frame (default True). Fold angles are always computed.
+    frame : SE3 or (4, 4) array, optional
+        World Dubins frame of the pattern's proximal end (see
+        :func:`kinegami.pattern.folded.folded_vertices`).
+    twistPortion : float, optional
+        For a chain: passed to ``creasePattern`` (default 0.2).
+    title : str, optional
+        ``file_title`` of the file.
+
+    Returns
+    -------
+    dict
+        Keys file_spec, file_creator, file_classes, frame_classes, frame_attributes, frame_unit,
+        vertices_coords, edges_vertices, edges_assignment, edges_foldAngle, faces_vertices and
+        (unless ``folded=False``) file_frames with the ``foldedForm`` frame.
+
+    Raises
+    ------
+    InvalidTypeError, InvalidParameterError
+        For unknown options or bad values.
+    FoldedFormError
+        For a pattern without module records.
+    FoldExportError
+        For a sheet of zero area or an invalid planar graph.
+    """
+    import kinegami
+
+    opts = _resolve_options(options)
+    graph = sheet_graph(
+        pattern_or_chain, folded=True, frame=opts["frame"], twistPortion=opts["twistPortion"]
+    )
+    angles = np.degrees(np.abs(fold_angles(graph)))
+    sign = np.where(graph.assignment == "V", 1.0, np.where(graph.assignment == "M", -1.0, 0.0))
+    fold_angle = sign * np.minimum(angles, 180.0)
+    f = opts["factor"]
+    xmin, ymin, xmax, ymax = graph.bounds
+    extent = max(abs(xmin), abs(xmax), abs(ymin), abs(ymax)) * f or 1.0
+    data: dict[str, Any] = {
+        "file_spec": FOLD_SPEC,
+        "file_creator": f"kinegami {kinegami.__version__}",
+        "file_classes": ["singleModel"],
+    }
+    if opts["title"] is not None:
+        data["file_title"] = opts["title"]
+    data.update(
+        {
+            "frame_title": "crease pattern (flattened sheet, printed side up)",
+            "frame_classes": ["creasePattern"],
+            "frame_attributes": ["2D"],
+            "frame_unit": "mm",
+            "vertices_coords": _rounded(graph.vertices * f, extent),
+            "edges_vertices": graph.edges.tolist(),
+            "edges_assignment": graph.assignment.tolist(),
+            "edges_foldAngle": (np.round(fold_angle, 9) + 0.0).tolist(),
+            "faces_vertices": [face.tolist() for face in graph.faces],
+        }
+    )
+    if opts["folded"]:
+        X = graph.vertices_3d * f
+        data["file_frames"] = [
+            {
+                "frame_title": "folded form at joint state 0",
+                "frame_classes": ["foldedForm"],
+                "frame_attributes": ["3D"],
+                "frame_inherit": True,
+                "frame_parent": 0,
+                "vertices_coords": _rounded(X, max(float(np.abs(X).max()), extent)),
+            }
+        ]
+    return data
+
+
+def write_fold(pattern_or_chain, stream: TextIO, **options: Any) -> None:
+    """Write a pattern (or a chain's crease pattern) to a text stream as FOLD 1.2 JSON.
+
+    Takes the options of :func:`fold_dict`. Everything is computed before the first character
+    is written, so a failure writes nothing; use :func:`kinegami.export.save_pattern` (or
+    ``pattern.save("name.fold")``) for an atomic file.
+    """
+    text = json.dumps(fold_dict(pattern_or_chain, **options), indent=1, allow_nan=False)
+    stream.write(text)
+    stream.write("\n")
+
+
+def save_fold(pattern_or_chain, path, **options: Any):
+    """Write a ``.fold`` file atomically (missing folders are created); returns the path.
+
+    Works for chains too (``save_pattern`` only accepts patterns).
+    """
+    import io
+    import os
+    from pathlib import Path
+
+    from kinegami.export import write_atomic
+
+    if not isinstance(path, str | os.PathLike) or not os.fspath(path).strip():
+        raise InvalidParameterError(f"path must be a non-empty file name, got {path!r}")
+    buffer = io.StringIO()
+    write_fold(pattern_or_chain, buffer, **options)
+    target = Path(os.fspath(path)).expanduser()
+    write_atomic(target, buffer.getvalue())
+    return target

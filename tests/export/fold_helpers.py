@@ -1,0 +1,181 @@
+"""Independent checks for the FOLD export and the folded form (no code shared with the package).
+
+* :func:`check_fold` is a JSON-level structural checker of a FOLD 1.2 dict (array lengths,
+  index ranges, assignments, angles, faces, frames), written from the FOLD specification.
+* :func:`polygon_errors` compares base rings with the regular polygon around a Dubins frame.
+* :func:`chain_pieces` splits a chain pattern's module records into its joints and links, and
+  :func:`prismatic_offsets` gives the translation that spec B7 adds after each prismatic joint.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+import numpy as np
+
+ASSIGNMENTS = {"M", "V", "B", "C", "F", "U", "J"}
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def check_fold(data: dict) -> list[str]:
+    """Every structural problem of a FOLD 1.2 dict (empty list when valid)."""
+    problems: list[str] = []
+    if data.get("file_spec") != 1.2:
+        problems.append(f"file_spec is {data.get('file_spec')!r}, expected 1.2")
+    creator = data.get("file_creator")
+    if not (isinstance(creator, str) and creator.startswith("kinegami ")):
+        problems.append(f"file_creator {creator!r} is not 'kinegami <version>'")
+    if data.get("file_classes") != ["singleModel"]:
+        problems.append(f"file_classes {data.get('file_classes')!r}")
+    if data.get("frame_classes") != ["creasePattern"]:
+        problems.append(f"frame_classes {data.get('frame_classes')!r}")
+    if not isinstance(data.get("frame_unit"), str):
+        problems.append("frame_unit missing")
+    V = data.get("vertices_coords")
+    if not isinstance(V, list) or not V:
+        return problems + ["vertices_coords missing or empty"]
+    nv = len(V)
+    for i, p in enumerate(V):
+        if not (isinstance(p, list) and len(p) == 2 and all(_is_number(c) for c in p)):
+            problems.append(f"vertices_coords[{i}] = {p!r} is not a 2D point")
+            break
+    E = data.get("edges_vertices")
+    A = data.get("edges_assignment")
+    F = data.get("edges_foldAngle")
+    if not (isinstance(E, list) and isinstance(A, list) and isinstance(F, list)):
+        return problems + ["edges_vertices / edges_assignment / edges_foldAngle missing"]
+    if not len(E) == len(A) == len(F):
+        problems.append(f"edge arrays differ in length: {len(E)}, {len(A)}, {len(F)}")
+    seen = set()
+    for i, e in enumerate(E):
+        ok = (
+            isinstance(e, list)
+            and len(e) == 2
+            and all(isinstance(k, int) and 0 <= k < nv for k in e)
+            and e[0] != e[1]
+        )
+        if not ok:
+            problems.append(f"edges_vertices[{i}] = {e!r} is not two distinct vertex indices")
+            continue
+        key = tuple(sorted(e))
+        if key in seen:
+            problems.append(f"edge {key} appears twice")
+        seen.add(key)
+    for i, (a, f) in enumerate(zip(A, F, strict=False)):
+        if a not in ASSIGNMENTS:
+            problems.append(f"edges_assignment[{i}] = {a!r}")
+        if not (_is_number(f) and -180.0 <= f <= 180.0):
+            problems.append(f"edges_foldAngle[{i}] = {f!r} is not in [-180, 180]")
+        elif a in ("B", "C", "F") and f != 0:
+            problems.append(f"edge {i} ({a}) has fold angle {f}")
+        elif a == "V" and f < 0 or a == "M" and f > 0:
+            problems.append(f"edge {i} ({a}) has fold angle of the wrong sign {f}")
+    faces = data.get("faces_vertices")
+    if not isinstance(faces, list) or not faces:
+        return problems + ["faces_vertices missing or empty (Origami Simulator needs faces)"]
+    edge_set = seen
+    for i, face in enumerate(faces):
+        if not (isinstance(face, list) and len(face) >= 3):
+            problems.append(f"faces_vertices[{i}] has fewer than 3 vertices")
+            continue
+        if not all(isinstance(k, int) and 0 <= k < nv for k in face):
+            problems.append(f"faces_vertices[{i}] has an invalid index")
+            continue
+        if len(set(face)) != len(face):
+            problems.append(f"faces_vertices[{i}] repeats a vertex")
+        for a, b in zip(face, face[1:] + face[:1], strict=True):
+            if tuple(sorted((a, b))) not in edge_set:
+                problems.append(f"faces_vertices[{i}] side {a}-{b} is not an edge")
+                break
+    for j, frame in enumerate(data.get("file_frames", [])):
+        if "foldedForm" not in frame.get("frame_classes", []):
+            problems.append(f"file_frames[{j}] is not a foldedForm")
+        if frame.get("frame_inherit") is not True or frame.get("frame_parent") != 0:
+            problems.append(f"file_frames[{j}] does not inherit from frame 0")
+        X = frame.get("vertices_coords")
+        if not (isinstance(X, list) and len(X) == nv):
+            problems.append(f"file_frames[{j}] has {len(X or [])} vertices, expected {nv}")
+        elif not all(isinstance(p, list) and len(p) == 3 and all(map(_is_number, p)) for p in X):
+            problems.append(f"file_frames[{j}] vertices are not 3D points")
+    return problems
+
+
+def signed_area(poly: np.ndarray) -> float:
+    """Shoelace area of a polygon (relative to its first corner, for accuracy)."""
+    rel = poly - poly[0]
+    x, y = rel[:, 0], rel[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def face_planarity(points: np.ndarray) -> float:
+    """Largest distance of a polygon's vertices from its least-squares plane."""
+    c = points - points.mean(axis=0)
+    normal = np.linalg.svd(c)[2][-1]
+    return float(np.abs(c @ normal).max())
+
+
+def polygon_corners(frame: np.ndarray, n: int, r: float) -> np.ndarray:
+    """Corners of the regular n-gon of circumradius r about a Dubins frame's origin, in its
+    y-z plane (perpendicular to the path direction x), at angles (k + 1/2) 2 pi / n from y."""
+    beta = (np.arange(n) + 0.5) * 2 * np.pi / n
+    return (
+        frame[:3, 3]
+        + r * np.cos(beta)[:, None] * frame[:3, 1]
+        + r * np.sin(beta)[:, None] * frame[:3, 2]
+    )
+
+
+def ring_error(points: np.ndarray, frame: np.ndarray, n: int, r: float) -> float:
+    """Largest distance from a ring vertex to the nearest polygon corner; also requires every
+    corner to be used once (the ring is the polygon, not a subset)."""
+    corners = polygon_corners(frame, n, r)
+    d = np.linalg.norm(points[:, None] - corners[None], axis=2)
+    nearest = d.argmin(axis=1)
+    if len(set(nearest.tolist())) != n:
+        return math.inf
+    return float(d.min(axis=1).max())
+
+
+def chain_pieces(chain, twistPortion: float = 0.2) -> list[tuple[str, int, object, int, int]]:
+    """(kind, index, joint or link, first record, end record) of the chain's crease pattern.
+
+    Mirrors how the chain composes its pattern (joint 0, then link i and joint i), with the
+    composition rule that an empty pattern after the first one leaves no record.
+    """
+    n = chain.numSides
+    pieces = []
+    count = 0
+    first = True
+
+    def add(kind, index, obj, patterns):
+        nonlocal count, first
+        start = count
+        for p in patterns:
+            if first or not p.isEmpty:
+                count += len(p.modules)
+            first = False
+        pieces.append((kind, index, obj, start, count))
+
+    add("joint", 0, chain.Joints[0], [chain.Joints[0].pattern])
+    for i in range(1, len(chain.Joints)):
+        add("link", i, chain.Links[i], chain.Links[i].pattern_modules(n, twistPortion))
+        add("joint", i, chain.Joints[i], [chain.Joints[i].pattern])
+    return pieces
+
+
+def prismatic_offsets(chain, pieces) -> list[np.ndarray]:
+    """World translation, per piece, that spec B7 adds: L = d / sin(coneAngle) along the axis
+    of every prismatic joint before the piece's end (the prismatic's own distal end included)."""
+    offsets = []
+    total = np.zeros(3)
+    for kind, _, obj, _, _ in pieces:
+        before = total.copy()
+        if kind == "joint" and type(obj).__name__ == "PrismaticJoint":
+            L = obj.neutralLength / math.sin(obj.coneAngle)
+            total = total + L * obj.pose_matrix[:3, 2]
+        offsets.append((before, total.copy()))
+    return offsets
