@@ -15,8 +15,10 @@ from __future__ import annotations
 import argparse
 import os
 import shutil
+import signal
 import sys
 import tempfile
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -150,21 +152,35 @@ def _existing_ancestor(path: Path) -> Path:
     return path
 
 
-def _summary(chain, info, design: str) -> list[str]:
+def _check_pattern(job: BuildJob, design: str) -> None:
+    """Build the crease pattern now, so that a pattern error is a design error."""
+    try:
+        job.pattern  # noqa: B018 - builds and caches it
+    except KinegamiError as error:
+        raise CommandError(f"{design}: the crease pattern cannot be built: {error}") from None
+
+
+def _printable(text: str) -> str:
+    """``text`` with control characters (newlines, escapes) shown escaped."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def _summary(job: BuildJob, design: str) -> list[str]:
     from collections import Counter
 
     from kinegami.pattern.sheet import flatten
 
+    chain, info = job.chain, job.info
     factor = UNITS_IN_MM[info.units]
     counts = Counter(type(joint).__name__ for joint in chain.Joints)
     kinds = ", ".join(f"{count} {name}" for name, count in counts.items())
-    sheet = flatten(chain.creasePattern(twistPortion=info.twistPortion))
+    sheet = flatten(job.pattern)
     xmin, ymin, xmax, ymax = sheet.bounds
     links = len(chain.Joints) - 1
     joints_length = sum(joint.neutralLength for joint in chain.Joints)
     links_length = chain.totalPathLength()
     tube = links_length + joints_length
-    title = f"{info.name} ({design})" if info.name else design
+    title = f"{_printable(info.name)} ({design})" if info.name else design
     return [
         title,
         f"  joints: {len(chain.Joints)} ({kinds})",
@@ -177,43 +193,81 @@ def _summary(chain, info, design: str) -> list[str]:
 
 
 # --- commands ----------------------------------------------------------------------------------
+def _publish(staging: Path, out: Path) -> list[Path]:
+    """Move every entry of ``staging`` into ``out``, all or nothing.
+
+    Entries already in ``out`` under the same names are first moved aside into the staging
+    folder and are put back if any move fails, so a failed build leaves ``out`` as it was.
+    """
+    staged = sorted(p for p in staging.iterdir() if p.name != ".replaced")
+    backup = staging / ".replaced"
+    backup.mkdir()
+    out.mkdir(parents=True, exist_ok=True)
+    moved: list[Path] = []
+    replaced: list[Path] = []
+    try:
+        for path in staged:
+            target = out / path.name
+            if os.path.lexists(target):
+                os.replace(target, backup / path.name)
+                replaced.append(target)
+            os.replace(path, target)
+            moved.append(target)
+    except OSError as error:
+        for target in moved:
+            if target.is_dir() and not target.is_symlink():
+                shutil.rmtree(target, ignore_errors=True)
+            else:
+                target.unlink(missing_ok=True)
+        for target in replaced:
+            try:
+                os.replace(backup / target.name, target)
+            except OSError:
+                pass
+        where = error.filename or out
+        raise CommandError(f"cannot write {str(where)!r}: {error.strerror or error}") from None
+    return moved
+
+
+def _plain_stem(stem: str) -> str:
+    if (
+        not stem
+        or stem.startswith(".")
+        or os.sep in stem
+        or (os.altsep and os.altsep in stem)
+        or any(ord(c) < 32 for c in stem)
+    ):
+        raise CommandError(f"--name: {stem!r} is not a plain file name (no folders, no dot first)")
+    return stem
+
+
 def cmd_build(args: argparse.Namespace) -> int:
     formats = _parse_formats(args.formats)
-    chain, info = _load(args.design)
-    stem = args.name or Path(args.design).stem
-    if not stem or os.sep in stem or (os.altsep and os.altsep in stem):
-        raise CommandError(f"--name: {stem!r} is not a plain file name")
+    stem = _plain_stem(args.name if args.name is not None else Path(args.design).stem)
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise CommandError(f"-o: {str(out)!r} exists and is not a folder")
+    chain, info = _load(args.design)
     job = BuildJob(chain, info)
-    lines = _summary(chain, info, args.design)
-    # write everything into a hidden staging folder, then move the files in: a failure
-    # leaves nothing behind
+    _check_pattern(job, args.design)
+    lines = _summary(job, args.design)
+    # write everything into a hidden staging folder next to the target, then move it in:
+    # a failure leaves nothing behind
     try:
         staging = Path(tempfile.mkdtemp(prefix=".kinegami-build-", dir=_existing_ancestor(out)))
     except OSError as error:
         raise CommandError(f"-o: cannot write in {str(out)!r}: {error.strerror}") from None
-    written: list[Path] = []
     try:
         for fmt in formats:
-            fmt.write(job, [staging / f"{stem}{suffix}" for suffix in fmt.suffixes])
-        # exporters may write more than their file (a URDF's mesh folder): move everything
-        staged = sorted(staging.iterdir())
-        out.mkdir(parents=True, exist_ok=True)
-        for path in staged:
-            target = out / path.name
-            if path.is_dir() and target.is_dir():
-                shutil.rmtree(target)  # a folder this build owns, e.g. <stem>_meshes/
-            os.replace(path, target)
-            written.append(target)
-    except OSError as error:
-        for path in written:
-            if path.is_dir():
-                shutil.rmtree(path, ignore_errors=True)
-            else:
-                path.unlink(missing_ok=True)
-        raise CommandError(f"cannot write to {str(out)!r}: {error.strerror or error}") from None
+            try:
+                fmt.write(job, [staging / f"{stem}{suffix}" for suffix in fmt.suffixes])
+            except KinegamiError as error:
+                raise CommandError(f"{args.design}: {fmt.name} export: {error}") from None
+            except OSError as error:
+                raise CommandError(
+                    f"{fmt.name} export: cannot write {str(out)!r}: {error.strerror or error}"
+                ) from None
+        written = _publish(staging, out)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     lines.append("  files written:")
@@ -246,8 +300,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
     validate_design(args.design)
     data = read_design(args.design)
     if args.build:
-        chain, _ = _load(args.design)
-        print(f"{args.design}: valid; builds {len(chain.Joints)} joints")
+        chain, info = _load(args.design)
+        _check_pattern(BuildJob(chain, info), args.design)
+        print(f"{args.design}: valid; builds {len(chain.Joints)} joints and the crease pattern")
         return 0
     if "joints" in data:
         what = f"{len(data['joints'])} joints"
@@ -288,7 +343,7 @@ def make_parser() -> argparse.ArgumentParser:
         + "; ".join(f"{name} = {fmt.description}" for name, fmt in known.items()),
     )
     build.add_argument(
-        "--name", metavar="STEM", help="file name stem of the outputs (default: the design's name)"
+        "--name", metavar="STEM", help="file name stem of the outputs (default: the design file's)"
     )
     build.set_defaults(run=cmd_build)
 
@@ -323,17 +378,41 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 0
+    previous = signal.getsignal(signal.SIGTERM)
+    signal.signal(signal.SIGTERM, _terminate)  # clean up staging folders on kill
     try:
-        return args.run(args)
+        with warnings.catch_warnings():
+            # numerical warnings of plotting libraries are not the user's business; the
+            # design checks reject the inputs that would make kinegami's own numbers overflow
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return args.run(args)
     except (CommandError, KinegamiError) as error:
-        print(f"kinegami {args.command}: error: {error}", file=sys.stderr)
+        _fail(args.command, str(error))
         return 1
     except OSError as error:  # e.g. the design file cannot be read
         where = f": {error.filename!r}" if error.filename else ""
-        print(f"kinegami {args.command}: error: {error.strerror or error}{where}", file=sys.stderr)
+        _fail(args.command, f"{error.strerror or error}{where}")
         return 1
     except KeyboardInterrupt:
         return 130
+    except Exception as error:  # a bug: still one line, and how to report it
+        _fail(
+            args.command,
+            f"internal error on {getattr(args, 'design', '?')}: {type(error).__name__}: "
+            f"{error} (please report this with the design file)",
+        )
+        return 1
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _fail(command: str, message: str) -> None:
+    text = _printable(" ".join(message.split()))
+    print(f"kinegami {command}: error: {text}", file=sys.stderr)
+
+
+def _terminate(signum, frame) -> None:
+    raise SystemExit(128 + signum)
 
 
 if __name__ == "__main__":

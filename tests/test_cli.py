@@ -281,3 +281,126 @@ def test_every_gallery_design_builds_from_the_command_line(path, tmp_path, capsy
 
 def test_gallery_is_not_empty():
     assert len(GALLERY) >= 10
+
+
+# --- all or nothing, in-process (failures injected) ----------------------------------------
+def _main(*args) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from kinegami.cli import main
+
+    return main([str(a) for a in args])
+
+
+def test_failed_publish_restores_the_previous_build(design, tmp_path, monkeypatch, capsys):
+    out = tmp_path / "o"
+    assert _main("build", design, "-o", out, "--formats", "dxf,svg") == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    (out / "keep.txt").write_text("user file")
+    real_replace = os.replace
+    calls = []
+
+    def failing_replace(src, dst):
+        calls.append((src, dst))
+        if len(calls) == 4:  # after arm.dxf was swapped in, while swapping arm.svg
+            raise PermissionError(13, "Permission denied", str(dst))
+        return real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", failing_replace)
+    assert _main("build", design, "-o", out, "--formats", "dxf,svg") == 1
+    monkeypatch.setattr(os, "replace", real_replace)
+    err = capsys.readouterr().err
+    assert "Permission denied" in err and "Traceback" not in err
+    after = {p.name: p.read_bytes() for p in out.iterdir() if p.name != "keep.txt"}
+    assert after == before
+    assert (out / "keep.txt").read_text() == "user file"
+    assert not list(tmp_path.rglob(".kinegami-build-*"))
+
+
+def test_build_replaces_a_folder_in_the_way(design, tmp_path):
+    out = tmp_path / "o"
+    (out / "arm.dxf").mkdir(parents=True)
+    assert _main("build", design, "-o", out, "--formats", "dxf") == 0
+    assert (out / "arm.dxf").is_file()
+
+
+def test_exporter_errors_name_the_design_and_format(design, tmp_path, monkeypatch, capsys):
+    from kinegami.errors import InvalidParameterError
+    from kinegami.export import registry
+
+    def refuse(*args, **kwargs):
+        raise InvalidParameterError("needs 761 A4 pages, more than max_pages=200")
+
+    monkeypatch.setattr(registry, "export", refuse)
+    assert _main("build", design, "-o", tmp_path / "o", "--formats", "pdf") == 1
+    err = capsys.readouterr().err.strip()
+    assert "arm.json: pdf export: needs 761 A4 pages" in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_pattern_errors_are_design_errors(design, tmp_path, monkeypatch, capsys):
+    from kinegami.chain import KinematicChain
+    from kinegami.errors import InvalidParameterError
+
+    def broken(self, twistPortion=0.2):
+        raise InvalidParameterError("bendingAngle too small to resolve")
+
+    monkeypatch.setattr(KinematicChain, "creasePattern", broken)
+    assert _main("validate", design, "--build") == 1
+    assert _main("build", design, "-o", tmp_path / "o") == 1
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 2
+    assert all("arm.json: the crease pattern cannot be built" in line for line in lines)
+    assert not (tmp_path / "o").exists()
+
+
+def test_internal_errors_are_one_line(design, tmp_path, monkeypatch, capsys):
+    from kinegami import cli
+
+    def bug(*args, **kwargs):
+        raise ZeroDivisionError("oops\nsecond line")
+
+    monkeypatch.setattr(cli, "_summary", bug)
+    assert _main("build", design, "-o", tmp_path / "o") == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "internal error" in err and "ZeroDivisionError: oops second line" in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_sigterm_during_a_build_leaves_nothing(design, tmp_path, monkeypatch):
+    import signal
+
+    from kinegami import cli
+
+    real = cli._write_pattern_file
+
+    def killed(job, paths):
+        real(job, paths)
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    monkeypatch.setitem(
+        cli.output_formats.__globals__, "_write_pattern_file", killed
+    )  # used when the format table is made
+    previous = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(SystemExit) as info:
+        _main("build", design, "-o", tmp_path / "o", "--formats", "dxf")
+    assert info.value.code == 128 + signal.SIGTERM
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["arm.json"]
+    assert signal.getsignal(signal.SIGTERM) is previous
+
+
+@pytest.mark.parametrize("name", [".", "..", ".hidden", "a/b", "tab\tname"])
+def test_bad_output_names(design, tmp_path, name, capsys):
+    assert _main("build", design, "-o", tmp_path / "o", "--name", name) == 1
+    assert "--name" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_control_characters_in_the_design_name_are_escaped(tmp_path, capsys):
+    path = write(tmp_path / "n.json", dict(DESIGN, name="a\nb\x1b[31mRED"))
+    assert _main("build", path, "-o", tmp_path / "o", "--formats", "dxf") == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out
+    assert out.splitlines()[0].startswith("a\\nb\\x1b[31mRED")
