@@ -404,3 +404,16 @@ def test_control_characters_in_the_design_name_are_escaped(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "\x1b" not in out
     assert out.splitlines()[0].startswith("a\\nb\\x1b[31mRED")
+
+
+def test_formats_all(design, tmp_path):
+    """Every registered format builds (the README's --formats all)."""
+    from kinegami.cli import output_formats
+
+    assert _main("build", design, "-o", tmp_path / "o", "--formats", "all") == 0
+    names = sorted(p.name for p in (tmp_path / "o").iterdir())
+    assert names == sorted(
+        ["arm.dxf", "arm.svg", "arm_3d.png", "arm_pattern.png", "arm.fold", "arm.pdf",
+         "arm.stl", "arm.obj", "arm.urdf", "arm_meshes"]
+    )  # fmt: skip
+    assert set(output_formats()) == {"dxf", "svg", "png", "fold", "pdf", "stl", "obj", "urdf"}
