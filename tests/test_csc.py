@@ -430,3 +430,17 @@ def test_nearly_straight_turn_keeps_centre_directions_perpendicular():
     assert path is not None
     for w, d in ((path.w1, d1), (path.w2, d2)):
         assert abs(np.linalg.norm(w) - 1) < 1e-12 and abs(w @ d) < 1e-12
+
+
+def test_near_u_turn_root_that_misses_the_end_is_rejected():
+    """Regression (hypothesis): both turns ~ pi - 1e-6; the Newton root's angle residuals are
+    tiny but the end point missed by 1.4e-8 r. Either no path, or one that ends within 1e-9 r."""
+    from scipy.spatial.transform import Rotation
+
+    R1 = Rotation.from_quat((0, 0, 1, 0)).as_matrix()
+    R2 = Rotation.from_quat((-1.192092896e-07, 0, 0.75, 1e-6)).as_matrix()
+    p2 = np.array([0.0, 1.0, 3.25])
+    path = solve_csc(np.zeros(3), R1[:, 0], p2, R2[:, 0], 1.0)
+    if path is not None:
+        end, tangent = path.reconstruct_end()
+        assert np.max(np.abs(end - p2)) <= 1e-9

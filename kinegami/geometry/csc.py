@@ -30,6 +30,8 @@ from kinegami.geometry.frames import any_perpendicular, rotation_matrix
 ANGLE_TOLERANCE = 1e-13
 #: A converged root is accepted only if its angle residuals are below this (radians).
 ACCEPT_TOLERANCE = 1e-10
+#: A path is returned only if it ends within this many r of the target (plus 1e-12 |p2 - p1|).
+END_TOLERANCE = 1e-10
 _MAX_ITERATIONS = 40
 _MAX_TAN = 1e6  # tan(theta/2) cap: theta within 2e-6 of pi
 
@@ -265,19 +267,30 @@ def solve_csc(p1, d1, p2, d2, r: float) -> CSCPath | None:
     _, a, b, nV = best
     V = D - a * d1 - b * d2
     u = V / nV
-    return _build(r, p1, d1, p2, d2, a, b, u)
+    path = _build(r, p1, d1, p2, d2, a, b, u)
+    if path is None:
+        return None
+    # Near a U-turn (a or b ~ 1e6) a root with tiny angle residuals can still miss the end
+    # point: such a path is not one (chain.md 2.3's residual check, in lengths).
+    end, tangent = path.reconstruct_end()
+    miss = float(np.max(np.abs(end - p2)))
+    if miss > END_TOLERANCE * r + 1e-12 * nD * r or float(np.max(np.abs(tangent - d2))) > 1e-10:
+        return None
+    return path
 
 
 def _centre_direction(u: np.ndarray, d: np.ndarray, c: float) -> np.ndarray:
     """Unit part of ``u`` perpendicular to ``d`` (c = d.u); any perpendicular for a null turn.
 
     The subtraction loses relative accuracy as the turn vanishes, so the result is projected
-    once more (w.d ~ 1e-16) and a turn below 1e-9 rad counts as none.
+    once more (w.d ~ 1e-16). The direction must stay the true one down to tiny turns: an
+    arbitrary w would tilt the end tangent by about the turn angle, which a long straight
+    segment turns into an end-point error.
     """
     perp = u - c * d
     perp = perp - float(perp @ d) * d
     n = float(np.linalg.norm(perp))
-    return perp / n if n > 1e-9 else any_perpendicular(d)
+    return perp / n if n > 1e-12 else any_perpendicular(d)
 
 
 def _build(r, p1, d1, p2, d2, a, b, u) -> CSCPath | None:
