@@ -152,12 +152,12 @@ def _existing_ancestor(path: Path) -> Path:
     return path
 
 
-def _check_pattern(job: BuildJob, design: str) -> None:
-    """Build the crease pattern now, so that a pattern error is a design error."""
-    try:
-        job.pattern  # noqa: B018 - builds and caches it
-    except KinegamiError as error:
-        raise CommandError(f"{design}: the crease pattern cannot be built: {error}") from None
+def _check_pattern(job: BuildJob) -> None:
+    """Build the crease pattern now, so that a pattern error is a design error naming the
+    design file and the joint or link (kinegami.design.check_pattern)."""
+    from kinegami.design import check_pattern
+
+    job._pattern = check_pattern(job.chain, job.info)
 
 
 def _printable(text: str) -> str:
@@ -249,7 +249,7 @@ def cmd_build(args: argparse.Namespace) -> int:
         raise CommandError(f"-o: {str(out)!r} exists and is not a folder")
     chain, info = _load(args.design)
     job = BuildJob(chain, info)
-    _check_pattern(job, args.design)
+    _check_pattern(job)
     lines = _summary(job, args.design)
     # write everything into a hidden staging folder next to the target, then move it in:
     # a failure leaves nothing behind
@@ -300,9 +300,15 @@ def cmd_validate(args: argparse.Namespace) -> int:
     validate_design(args.design)
     data = read_design(args.design)
     if args.build:
+        from kinegami.design import joint_table
+
         chain, info = _load(args.design)
-        _check_pattern(BuildJob(chain, info), args.design)
+        _check_pattern(BuildJob(chain, info))
         print(f"{args.design}: valid; builds {len(chain.Joints)} joints and the crease pattern")
+        print("  index  joint (the indices edits and states use)")
+        for index, kind, name in joint_table(chain, data):
+            label = f" {_printable(name)!r}" if name else ""
+            print(f"  {index:>5}  {kind}{label}")
         return 0
     if "joints" in data:
         what = f"{len(data['joints'])} joints"

@@ -7,9 +7,12 @@ Schema shipped as ``kinegami/design/schema.json`` (:func:`design_schema`).
 >>> chain = load_design("tests/design/data/example1.json")  # doctest: +SKIP
 >>> save_design(chain, "out/example1.json", name="Example 1")  # doctest: +SKIP
 
-Every problem (unreadable file, invalid JSON, schema violation, infeasible placement or edit)
-raises :class:`DesignError`, whose one-line message names the file, the JSON path of the
-problem (e.g. ``joints[2].totalBendingAngle``), what is allowed and the value found.
+Every problem (unreadable file, invalid JSON, schema violation, a value beyond the bounds of
+:mod:`kinegami.design.limits`, infeasible placement or edit) raises :class:`DesignError`, whose
+one-line message names the file, the JSON path of the problem (e.g.
+``joints[2].totalBendingAngle``), what is allowed and the value found.
+:func:`check_pattern` also checks that the chain's crease pattern can be built, and
+:func:`joint_table` lists the joints of the built chain (the indices edits and states use).
 """
 
 from __future__ import annotations
@@ -17,6 +20,8 @@ from __future__ import annotations
 import os
 
 from kinegami.chain import KinematicChain
+from kinegami.design import limits
+from kinegami.design.checks import check_pattern, joint_table
 from kinegami.design.errors import DesignError
 from kinegami.design.poses import pose_from_json
 from kinegami.design.reader import (
@@ -24,8 +29,10 @@ from kinegami.design.reader import (
     UNITS,
     VERSIONS,
     DesignInfo,
-    build_chain,
+    DesignOrigin,
+    build_plan,
     check_document,
+    origin_of,
     parse_design_text,
     read_design_file,
 )
@@ -49,12 +56,17 @@ __all__ = [
     "dumps_design",
     "design_schema",
     "pose_from_json",
+    "check_pattern",
+    "joint_table",
+    "origin_of",
+    "DesignOrigin",
+    "limits",
 ]
 
 
 def _with_info(document, file) -> tuple[KinematicChain, DesignInfo]:
     plan = check_document(document, file)
-    return build_chain(plan, file), DesignInfo.of(document, file)
+    return build_plan(plan, file)[0], DesignInfo.of(document, file)
 
 
 def load_design_with_info(path: str | os.PathLike) -> tuple[KinematicChain, DesignInfo]:
@@ -63,8 +75,10 @@ def load_design_with_info(path: str | os.PathLike) -> tuple[KinematicChain, Desi
     Raises
     ------
     DesignError
-        If the file cannot be read, is not valid JSON, violates the format, or describes a
-        chain that cannot be built (infeasible placement, edit or state).
+        If the file cannot be read (not a regular file, larger than 16 MiB), is not valid JSON,
+        violates the format or its bounds, or describes a chain that cannot be built
+        (infeasible placement, edit or state). Whether the crease pattern can be built is
+        checked by :func:`check_pattern`.
     """
     document, file = read_design_file(path)
     return _with_info(document, file)
@@ -103,7 +117,8 @@ def validate_design(path: str | os.PathLike) -> None:
     """Check the design file ``path`` without building the chain.
 
     Parses the JSON, validates it against the schema and runs the checks the schema cannot
-    express (rigid matrices, axes, joint order, placement options, joint parameters). Whether
+    express (lengths within 1e6 r, rigid matrices, axes, joint order, placement options,
+    unique joint names and the names edits use, joint parameters). Whether
     every joint can be placed and every edit and state applied is only known by building the
     chain: use :func:`load_design` for the full check. Raises DesignError; returns None.
     """

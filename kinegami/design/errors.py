@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
 import re
 
+import numpy as np
+
 from kinegami.errors import KinegamiError
 
-__all__ = ["DesignError", "json_path"]
+__all__ = ["DesignError", "json_path", "numeric_errors"]
 
 #: Marker for "no offending value" (``None`` is a valid JSON value: ``null``).
 _NO_VALUE = object()
@@ -105,3 +108,27 @@ class DesignError(KinegamiError, ValueError):
 
 def _rebuild(reason, field, has_value, value, file):
     return DesignError(reason, field=field, value=value if has_value else _NO_VALUE, file=file)
+
+
+#: Numeric problems a design's numbers could cause (overflow, NaN, division by zero).
+NUMERIC_ERRORS = (FloatingPointError, OverflowError, ZeroDivisionError)
+
+
+@contextlib.contextmanager
+def numeric_errors(field: str, file=None, what: str = "numeric error"):
+    """Run the block with numpy overflow, invalid and divide errors raised, not warned about.
+
+    A FloatingPointError (or a Python OverflowError / ZeroDivisionError) becomes a DesignError
+    at ``field``; nothing is printed. Underflow (a result rounding to 0) is ignored: it is
+    harmless and happens in ordinary geometry.
+    """
+    try:
+        with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
+            yield
+    except NUMERIC_ERRORS as error:
+        raise DesignError(
+            f"{what} ({type(error).__name__}: {error}); lengths, coordinates and angles "
+            "this large or small cannot be computed",
+            field=field,
+            file=file,
+        ) from None

@@ -19,7 +19,7 @@ import math
 import numpy as np
 from spatialmath import SE3
 
-from kinegami.design.errors import DesignError, json_path
+from kinegami.design.errors import DesignError, json_path, numeric_errors
 
 __all__ = ["RIGID_TOL", "PARALLEL_TOL", "pose_from_json", "default_xhat", "rigidity_problem"]
 
@@ -54,6 +54,12 @@ def rigidity_problem(T: np.ndarray, tol: float = RIGID_TOL) -> str | None:
     if bottom > tol:
         return "the last row must be [0, 0, 0, 1]"
     R = T[:3, :3]
+    largest = float(np.max(np.abs(R)))
+    if largest > 1.0 + tol:  # also keeps R^T R far from overflow
+        return (
+            f"the rotation part (first 3 rows and columns) must be orthonormal to {tol:g} "
+            f"(it has an entry of magnitude {largest:.3g} > 1)"
+        )
     ortho = float(np.max(np.abs(R.T @ R - np.eye(3))))
     if ortho > tol:
         return (
@@ -99,18 +105,29 @@ def _steps_pose(steps, angle_units: str) -> np.ndarray:
     return np.array(pose.A, dtype=float)
 
 
+def _scaled(vector) -> np.ndarray | None:
+    """``vector`` times a power of two bringing its largest entry into [0.5, 1) (exact, so
+    normalising it gives the same bits as normalising ``vector``); None for a zero vector."""
+    v = np.array(vector, dtype=float)
+    largest = float(np.max(np.abs(v)))
+    if largest == 0.0:
+        return None
+    return np.ldexp(v, -math.frexp(largest)[1])
+
+
 def _axis_pose(spec, path) -> np.ndarray:
     point = np.array(spec.get("point", (0.0, 0.0, 0.0)), dtype=float)
-    axis = np.array(spec["axis"], dtype=float)
-    norm = math.sqrt(float(axis @ axis))
-    if norm == 0.0 or not math.isfinite(norm):
+    axis = _scaled(spec["axis"])
+    if axis is None:
         raise DesignError(
             "the axis must be a non-zero vector", field=json_path([*path, "axis"]),
             value=spec["axis"],
         )  # fmt: skip
-    z = axis / norm
+    z = axis / math.sqrt(float(axis @ axis))
     if "xhat" in spec:
-        xhat = np.array(spec["xhat"], dtype=float)
+        xhat = _scaled(spec["xhat"])
+        if xhat is None:
+            xhat = np.zeros(3)
     else:
         xhat = default_xhat(z)
     x = xhat - float(xhat @ z) * z
@@ -146,11 +163,14 @@ def pose_from_json(spec, path=(), angle_units: str = "rad") -> np.ndarray:
     Raises
     ------
     DesignError
-        For a matrix that is not rigid, a zero axis or an ``xhat`` parallel to the axis.
+        For a matrix that is not rigid, a zero axis or an ``xhat`` parallel to the axis, or a
+        floating point overflow (only possible for translations beyond the design bounds,
+        which :func:`kinegami.design.limits.check_lengths` rejects first).
     """
     path = tuple(path)
-    if isinstance(spec, dict):
-        return _axis_pose(spec, path)
-    if spec and isinstance(spec[0], list):
-        return _matrix_pose(spec, path)
-    return _steps_pose(spec, angle_units)
+    with numeric_errors(json_path(path), what="numeric error computing the pose"):
+        if isinstance(spec, dict):
+            return _axis_pose(spec, path)
+        if spec and isinstance(spec[0], list):
+            return _matrix_pose(spec, path)
+        return _steps_pose(spec, angle_units)

@@ -4,7 +4,12 @@ Building uses exactly the Python calls a user would type: ``KinematicChain(root,
 maxAnglePerElbow=...)``, ``append(joint, relative, safe, fixedPosition, fixedOrientation)`` per
 joint (or ``KinematicChain.from_dh`` for a DH table), the edit methods in order, then
 ``setJointStates``. A PlacementWarning or a rejected edit becomes a DesignError naming
-``joints[i]`` or ``edits[i]``; nothing is printed.
+``joints[i]`` or ``edits[i]``; nothing is printed. All numeric work runs with numpy overflow,
+invalid and divide errors raised (see :func:`~kinegami.design.errors.numeric_errors`), so a
+RuntimeWarning cannot be printed either.
+
+Every chain built here is remembered (weakly) with the ``joints`` entry each of its joints
+came from (:func:`origin_of`), so that joint names can be shown and saved.
 """
 
 from __future__ import annotations
@@ -12,12 +17,14 @@ from __future__ import annotations
 import json
 import math
 import os
+import stat
 import warnings
+import weakref
 from dataclasses import dataclass
-from pathlib import Path
 
 from kinegami.chain import KinematicChain, PlacementWarning
-from kinegami.design.errors import DesignError, json_path
+from kinegami.design.errors import DesignError, json_path, numeric_errors
+from kinegami.design.limits import MAX_FILE_BYTES, check_lengths
 from kinegami.design.poses import pose_from_json, to_radians
 from kinegami.design.schema import PLACEMENT_KEYS, check_schema
 from kinegami.errors import JointIndexError, KinegamiError
@@ -39,6 +46,8 @@ __all__ = [
     "read_design_file",
     "check_document",
     "build_chain",
+    "origin_of",
+    "DesignOrigin",
 ]
 
 FORMAT = "kinegami-design"
@@ -150,6 +159,56 @@ def _check_values(node, path, file) -> None:
             ) from None
 
 
+def _file_kind(mode: int) -> str:
+    for test, kind in (
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return kind
+    return "a special file"
+
+
+def _read_regular_file(name: str) -> bytes:
+    """The bytes of the regular file ``name`` (at most MAX_FILE_BYTES); DesignError otherwise.
+
+    Opened without blocking (a FIFO with no writer must not hang) and checked with fstat
+    before reading, so devices such as /dev/zero are refused instead of read forever.
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    try:
+        fd = os.open(os.path.expanduser(name), flags)
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        raise DesignError(f"cannot read the design file: {reason}", file=name) from None
+    limit = f"design files are at most {MAX_FILE_BYTES // 2**20} MiB ({MAX_FILE_BYTES} bytes)"
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise DesignError(
+                f"cannot read the design file: it is {_file_kind(info.st_mode)}, "
+                "not a regular file",
+                file=name,
+            )
+        if info.st_size > MAX_FILE_BYTES:
+            raise DesignError(
+                f"the design file is too large ({info.st_size} bytes); {limit}", file=name
+            )
+        with open(fd, "rb", closefd=False) as stream:
+            data = stream.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        raise DesignError(f"cannot read the design file: {reason}", file=name) from None
+    finally:
+        os.close(fd)
+    if len(data) > MAX_FILE_BYTES:  # grew while being read, or a size-less special file
+        raise DesignError(f"the design file is too large (more than {limit})", file=name)
+    return data
+
+
 def read_design_file(path) -> tuple[object, str]:
     """The JSON value of the design file at ``path`` and the file name (for messages)."""
     if not isinstance(path, str | os.PathLike):
@@ -157,11 +216,7 @@ def read_design_file(path) -> tuple[object, str]:
     name = os.fspath(path)
     if isinstance(name, bytes):
         raise DesignError(f"the design file name must be a str or a path, got {path!r}")
-    try:
-        data = Path(name).expanduser().read_bytes()
-    except OSError as exc:
-        reason = exc.strerror or str(exc)
-        raise DesignError(f"cannot read the design file: {reason}", file=name) from None
+    data = _read_regular_file(name)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -220,8 +275,9 @@ class _Plan:
     chain_options: dict
     joints: list  # (Joint, append options) per entry of "joints"
     dh: dict | None  # keyword arguments of from_dh
-    edits: list  # (method name, args, kwargs); setJointState angles converted when applied
+    edits: list  # (method name, args, kwargs); a joint is an index or a name until applied
     states: list | None
+    names: tuple = ()  # the "name" of every entry of "joints" (None where it has none)
 
 
 #: Top-level fields that library messages may name.
@@ -251,27 +307,30 @@ def _make_joint(spec: dict, i: int, numSides: int, r: float, units: str, file):
         if key in spec
     }
     try:
-        if kind in ("StartTip", "EndTip"):
-            cls = StartTip if kind == "StartTip" else EndTip
-            return cls(numSides, r, Pose=pose, length=spec["length"])
-        if kind == "RevoluteJoint":
-            return RevoluteJoint(
-                numSides, r, angle["totalBendingAngle"], pose, spec.get("numSinkLayers", 1)
-            )
-        if kind == "ExtendedRevoluteJoint":
-            return ExtendedRevoluteJoint(
-                numSides,
-                r,
-                angle["totalBendingAngle"],
-                spec["tubeLength"],
-                pose,
-                spec.get("numSinkLayers", 1),
-            )
-        if kind == "PrismaticJoint":
-            return PrismaticJoint(
-                numSides, r, spec["neutralLength"], spec["numLayers"], angle["coneAngle"], pose
-            )
-        return Waypoint(numSides, r, pose, spec.get("pathIndex", 2))
+        with numeric_errors(json_path(path), file):
+            if kind in ("StartTip", "EndTip"):
+                cls = StartTip if kind == "StartTip" else EndTip
+                return cls(numSides, r, Pose=pose, length=spec["length"])
+            if kind == "RevoluteJoint":
+                return RevoluteJoint(
+                    numSides, r, angle["totalBendingAngle"], pose, spec.get("numSinkLayers", 1)
+                )
+            if kind == "ExtendedRevoluteJoint":
+                return ExtendedRevoluteJoint(
+                    numSides,
+                    r,
+                    angle["totalBendingAngle"],
+                    spec["tubeLength"],
+                    pose,
+                    spec.get("numSinkLayers", 1),
+                )
+            if kind == "PrismaticJoint":
+                return PrismaticJoint(
+                    numSides, r, spec["neutralLength"], spec["numLayers"], angle["coneAngle"], pose
+                )
+            return Waypoint(numSides, r, pose, spec.get("pathIndex", 2))
+    except DesignError:
+        raise
     except KinegamiError as error:
         raise _library_error(error, path, set(spec), file) from None
 
@@ -307,6 +366,45 @@ def _check_joint_order(joints, file) -> None:
                     value=True,
                     file=file,
                 )
+
+
+def _listed(names, limit: int = 10) -> str:
+    shown = ", ".join(f"'{name}'" for name in names[:limit])
+    return shown + (f", ... ({len(names)} names)" if len(names) > limit else "")
+
+
+def _check_names(document: dict, file) -> tuple:
+    """The joint names (unique) and the names edits refer to (existing); the names per entry."""
+    names = []
+    seen: dict[str, int] = {}
+    for i, spec in enumerate(document.get("joints", ())):
+        name = spec.get("name")
+        if name is not None:
+            if name in seen:
+                raise DesignError(
+                    f"duplicate joint name: joints[{seen[name]}] is also named '{name}' "
+                    "(names must be unique, edits refer to joints by name)",
+                    field=json_path(["joints", i, "name"]),
+                    value=name,
+                    file=file,
+                )
+            seen[name] = i
+        names.append(name)
+    for i, spec in enumerate(document.get("edits", ())):
+        ref = spec.get("joint")
+        if not isinstance(ref, str) or ref in seen:
+            continue
+        if "dh" in document:
+            reason = "a DH design has no joint names: refer to its joints by index"
+        elif seen:
+            reason = f"no joint is named '{ref}'; the joint names are {_listed(list(seen))}"
+        else:
+            reason = (
+                f"no joint is named '{ref}': no entry of 'joints' has a \"name\" "
+                "(add one, or use the index in the built chain)"
+            )
+        raise DesignError(reason, field=json_path(["edits", i, "joint"]), value=ref, file=file)
+    return tuple(names)
 
 
 def _plan_edits(edits, units: str) -> list:
@@ -356,7 +454,7 @@ def _plan_dh(dh: dict, units: str) -> dict:
 
 
 def check_document(document, file=None) -> _Plan:
-    """Check a parsed design (header, schema, semantics) without building the chain.
+    """Check a parsed design (header, schema, bounds, semantics) without building the chain.
 
     Returns the plan :func:`build_chain` executes. Joints are constructed (they check their
     own parameters) but nothing is placed, so infeasible placements, edits and states are only
@@ -374,6 +472,8 @@ def _check_document(document, file) -> _Plan:
     _check_values(document, [], file)
     _check_header(document, file)
     check_schema(document, file)
+    check_lengths(document, file)
+    names = _check_names(document, file)
     units = document.get("angleUnits", "rad")
     numSides = int(document["numSides"])
     r = float(document["r"])
@@ -393,34 +493,92 @@ def _check_document(document, file) -> _Plan:
         dh = _plan_dh(document["dh"], units)
     edits = _plan_edits(document.get("edits", []), units)
     states = document.get("states")
-    return _Plan(numSides, r, units, chain_options, joints, dh, edits, states)
+    return _Plan(numSides, r, units, chain_options, joints, dh, edits, states, names)
+
+
+# --- where the joints of a built chain come from ---------------------------------------------
+@dataclass(frozen=True)
+class DesignOrigin:
+    """Where each joint of a chain built from a design came from.
+
+    Attributes
+    ----------
+    kind : ``"joints"`` or ``"dh"``, how the design gave the chain.
+    sources : per joint of the built chain, the index of its entry in the design's ``joints``
+        list, or None for a waypoint added by safe placement (and for every joint of a DH
+        design).
+    names : per joint of the built chain, the ``name`` of its entry (None if it has none).
+    types : the joints' type names when built (a chain whose joints no longer have these
+        types, e.g. after a Python ``delete``, has no known origin).
+    file : the design file (None for a design given as text or a dict without a file name).
+    """
+
+    kind: str
+    sources: tuple
+    names: tuple
+    types: tuple
+    file: str | None = None
+
+
+_ORIGINS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _type_names(chain: KinematicChain) -> tuple:
+    return tuple(type(joint).__name__ for joint in chain.Joints)
+
+
+def origin_of(chain: KinematicChain) -> DesignOrigin | None:
+    """The :class:`DesignOrigin` of a chain built from a design, or None.
+
+    None when ``chain`` was not built by the design loader, or when its joints have changed
+    type since (joints were deleted or appended in Python). Edits that keep the joints, such
+    as ``setJointState`` or ``transformJoint``, keep the origin.
+    """
+    origin = _ORIGINS.get(chain)
+    if origin is None or origin.types != _type_names(chain):
+        return None
+    return origin
 
 
 # --- building --------------------------------------------------------------------------------
-def _recorded(call):
-    """Run ``call()`` with PlacementWarnings recorded, not shown; (result, last message)."""
+def _recorded(call, where: str, file):
+    """Run ``call()`` with PlacementWarnings recorded, not shown; (result, last message).
+
+    Numeric errors (overflow, NaN) and RuntimeWarnings become DesignErrors at ``where``.
+    """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PlacementWarning)
-        result = call()
+        warnings.simplefilter("always", RuntimeWarning)
+        with numeric_errors(where, file):
+            result = call()
     messages = []
     for w in caught:
         if issubclass(w.category, PlacementWarning):
             messages.append(str(w.message))
+        elif issubclass(w.category, RuntimeWarning):
+            raise DesignError(f"numeric problem: {w.message}", field=where, file=file)
         else:  # not ours to swallow
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     return result, (messages[-1] if messages else None)
 
 
-def _build_from_joints(plan: _Plan, file) -> KinematicChain:
+def _build_from_joints(plan: _Plan, file) -> tuple[KinematicChain, list]:
     root, _ = plan.joints[0]
     try:
-        chain = KinematicChain(root, **plan.chain_options)
+        chain, _ = _recorded(
+            lambda: KinematicChain(root, **plan.chain_options), json_path(["joints", 0]), file
+        )
+    except DesignError:
+        raise
     except KinegamiError as error:
         raise _library_error(error, ["joints", 0], set(), file) from None
+    sources = [0]
     for i, (joint, options) in enumerate(plan.joints[1:], start=1):
         where = json_path(["joints", i])
         try:
-            index, message = _recorded(lambda j=joint, o=options: chain.append(j, **o))
+            index, message = _recorded(lambda j=joint, o=options: chain.append(j, **o), where, file)
+        except DesignError:
+            raise
         except KinegamiError as error:
             raise _library_error(error, ["joints", i], set(PLACEMENT_KEYS), file) from None
         if index is None:
@@ -430,18 +588,23 @@ def _build_from_joints(plan: _Plan, file) -> KinematicChain:
                 field=where,
                 file=file,
             )
-    return chain
+        # safe placement inserts waypoints before the new joint
+        sources.extend([None] * (index - len(sources)))
+        sources.append(i)
+    return chain, sources
 
 
-def _build_from_dh(plan: _Plan, file) -> KinematicChain:
+def _build_from_dh(plan: _Plan, file) -> tuple[KinematicChain, list]:
     options = dict(plan.dh)
     table = options.pop("table")
     options.update(plan.chain_options)
     names = set(options) | {"table", "convention", "jointTypes"}
     try:
         chain, _ = _recorded(
-            lambda: KinematicChain.from_dh(table, plan.numSides, plan.r, **options)
+            lambda: KinematicChain.from_dh(table, plan.numSides, plan.r, **options), "dh", file
         )
+    except DesignError:
+        raise
     except KinegamiError as error:
         message = str(error)
         first = message.split(" ", 1)[0]
@@ -452,20 +615,41 @@ def _build_from_dh(plan: _Plan, file) -> KinematicChain:
         else:
             field = "dh"
         raise DesignError(message, field=field, file=file) from None
-    return chain
+    return chain, [None] * len(chain)
 
 
-def _apply_edits(chain: KinematicChain, plan: _Plan, file) -> None:
+def _edit_index(ref, plan: _Plan, sources: list, deleted: dict, where, file) -> int:
+    """The built-chain index an edit's ``joint`` (an index or a name) refers to now."""
+    if not isinstance(ref, str):
+        return int(ref)
+    entry = plan.names.index(ref)  # the names were checked by check_document
+    if entry in sources:
+        return sources.index(entry)
+    raise DesignError(
+        f"joint '{ref}' (joints[{entry}]) is no longer in the chain: "
+        f"edits[{deleted[entry]}] deleted it",
+        field=json_path([*where, "joint"]),
+        value=ref,
+        file=file,
+    )
+
+
+def _apply_edits(chain: KinematicChain, plan: _Plan, file, sources: list) -> None:
+    deleted: dict[int, int] = {}  # entry of "joints" -> the edit that deleted it
     for i, (op, args, kwargs) in enumerate(plan.edits):
         where = ["edits", i]
         if "joint" in _ARGUMENTS[op]:
-            args = (int(args[0]), *args[1:])
+            args = (_edit_index(args[0], plan, sources, deleted, where, file), *args[1:])
         if op == "setJointState":
             index, state = args
             if -len(chain) <= index < len(chain) and isinstance(chain.Joints[index], RevoluteJoint):
                 args = (index, to_radians(state, plan.angle_units))
         try:
-            ok, message = _recorded(lambda op=op, a=args, k=kwargs: getattr(chain, op)(*a, **k))
+            ok, message = _recorded(
+                lambda op=op, a=args, k=kwargs: getattr(chain, op)(*a, **k), json_path(where), file
+            )
+        except DesignError:
+            raise
         except JointIndexError:
             n = len(chain)
             raise DesignError(
@@ -480,6 +664,10 @@ def _apply_edits(chain: KinematicChain, plan: _Plan, file) -> None:
                 field=json_path(where),
                 file=file,
             )
+        if op == "delete":
+            entry = sources.pop(args[0] % (len(chain) + 1))
+            if entry is not None:
+                deleted[entry] = i
 
 
 _ARGUMENTS = {
@@ -520,18 +708,31 @@ def _apply_states(chain: KinematicChain, plan: _Plan, file) -> None:
                 file=file,
             )
         values.append(state)
-    ok, message = _recorded(lambda: chain.setJointStates(values))
+    ok, message = _recorded(lambda: chain.setJointStates(values), "states", file)
     if not ok:  # pragma: no cover - ranges were checked above
         raise DesignError(f"infeasible states: {message}", field="states", file=file)
 
 
-def build_chain(plan: _Plan, file=None) -> KinematicChain:
-    """Execute a plan of :func:`check_document`: place, edit, set states."""
+def build_plan(plan: _Plan, file=None) -> tuple[KinematicChain, DesignOrigin]:
+    """Execute a plan of :func:`check_document`; the chain and where its joints came from."""
     if plan.dh is not None:
-        chain = _build_from_dh(plan, file)
+        chain, sources = _build_from_dh(plan, file)
     else:
-        chain = _build_from_joints(plan, file)
-    _apply_edits(chain, plan, file)
+        chain, sources = _build_from_joints(plan, file)
+    _apply_edits(chain, plan, file, sources)
     if plan.states is not None:
         _apply_states(chain, plan, file)
-    return chain
+    origin = DesignOrigin(
+        kind="dh" if plan.dh is not None else "joints",
+        sources=tuple(sources),
+        names=tuple(None if k is None else plan.names[k] for k in sources),
+        types=_type_names(chain),
+        file=None if file is None else os.fspath(file),
+    )
+    _ORIGINS[chain] = origin
+    return chain, origin
+
+
+def build_chain(plan: _Plan, file=None) -> KinematicChain:
+    """Execute a plan of :func:`check_document`: place, edit, set states."""
+    return build_plan(plan, file)[0]

@@ -15,6 +15,7 @@ from importlib import resources
 import jsonschema
 
 from kinegami.design.errors import DesignError, format_value, json_path
+from kinegami.design.limits import NUM_LAYERS_MAX, NUM_SIDES_MAX, NUM_SINK_LAYERS_MAX
 
 __all__ = ["design_schema", "check_schema", "JOINT_TYPES", "EDIT_OPS", "PLACEMENT_KEYS"]
 
@@ -37,20 +38,22 @@ EDIT_OPS = (
 PLACEMENT_KEYS = ("relative", "safe", "fixedPosition", "fixedOrientation")
 
 #: Valid ranges of numeric fields as the messages state them (radians / degrees for angles).
+_LENGTH = "> 0 and <= 1e6 r (1e6 times the tube radius)"
+_COORDINATE = "within +-1e6 r (1e6 times the tube radius)"
 _RANGES = {
-    "numSides": "an even integer >= 4",
-    "r": "> 0",
+    "numSides": f"an even integer in [4, {NUM_SIDES_MAX}]",
+    "r": "in [1e-6, 1e6] (file length units)",
     "twistPortion": "in [0, 1)",
-    "length": "> 0",
-    "tubeLength": "> 0",
-    "neutralLength": "> 0",
-    "tipLength": "> 0",
-    "numSinkLayers": "an integer >= 1",
-    "numLayers": "an integer >= 1",
+    "length": _LENGTH,
+    "tubeLength": _LENGTH,
+    "neutralLength": _LENGTH,
+    "tipLength": _LENGTH,
+    "numSinkLayers": f"an integer in [1, {NUM_SINK_LAYERS_MAX}]",
+    "numLayers": f"an integer in [1, {NUM_LAYERS_MAX}]",
     "pathIndex": "0, 1 or 2",
 }
 _ANGLE_RANGES = {
-    "maxAnglePerElbow": {"rad": "in (0, pi] radians", "deg": "in (0, 180] degrees"},
+    "maxAnglePerElbow": {"rad": "in [pi/180, pi] radians", "deg": "in [1, 180] degrees"},
     "totalBendingAngle": {"rad": "in (0, 2pi) radians", "deg": "in (0, 360) degrees"},
     "coneAngle": {"rad": "in [pi/6, pi/2) radians", "deg": "in [30, 90) degrees"},
 }
@@ -133,7 +136,12 @@ def _angle_units(document) -> str:
     return units if units in ("rad", "deg") else "rad"
 
 
-def _range_text(name, document) -> str | None:
+def _range_text(name, document, schema=None) -> str | None:
+    defs = design_schema()["$defs"]
+    if schema is not None and schema == defs["coordinate"]:
+        return _COORDINATE
+    if schema is not None and schema == defs["length"]:
+        return _LENGTH
     if name in _ANGLE_RANGES:
         return _ANGLE_RANGES[name][_angle_units(document)]
     return _RANGES.get(name)
@@ -167,6 +175,10 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
     if keyword == "type":
         if name in ("pose", "transform"):
             return fail(f"must be {_POSE_TEXT}", value=value)
+        if name == "joint" and len(path) == 3 and path[0] == "edits":
+            return fail(
+                "must be a joint index (an integer) or a joint name (a string)", value=value
+            )
         kinds = expected if isinstance(expected, list) else [expected]
         what = " or ".join(_TYPE_NAMES.get(k, k) for k in kinds)
         text = _range_text(name, document) if set(kinds) & {"number", "integer"} else None
@@ -188,7 +200,7 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
             return fail("unsupported version; supported versions: 1", value=value)
         return fail(f"must be {format_value(expected)}", value=value)
     if keyword in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum", "multipleOf"):
-        text = _range_text(name, document)
+        text = _range_text(name, document, error.schema)
         if text is None:
             text = {
                 "minimum": ">=",
@@ -241,6 +253,8 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
         if "joints" in value and "dh" in value:
             return fail("give exactly one of 'joints' and 'dh', not both")
         return fail("missing required field: one of 'joints' (a list) or 'dh' (a DH table)")
+    if keyword == "minLength" and name == "joint":
+        return fail("a joint name must not be empty", value=value)
     if keyword == "pattern" and name == "jointTypes":
         return fail('must be a string of the letters R and P (e.g. "RRP")', value=value)
     return fail(error.message, value=value)

@@ -5,7 +5,8 @@ Every joint is written with its own parameters and its Pose at state 0 (full pre
 fixedPosition: true, fixedOrientation: true``, so loading re-creates each joint where it was.
 Non-zero states go to ``"states"``; loading builds the chain at state 0 and then sets them.
 A chain whose root is an EndTip (possible after deleting joint 0) is written as a waypoint
-root, the tip, and an edit deleting the waypoint.
+root, the tip, and an edit deleting the waypoint. Joint names are kept for a chain loaded from a
+design (see :func:`kinegami.design.reader.origin_of`).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from pathlib import Path
 
 from kinegami.chain import KinematicChain
 from kinegami.design.errors import DesignError
-from kinegami.design.reader import FORMAT, UNITS, check_document
+from kinegami.design.reader import FORMAT, UNITS, check_document, origin_of
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export import write_atomic
 from kinegami.joints import (
@@ -92,7 +93,9 @@ def design_to_dict(
 
     Poses are those of the state-0 configuration (computed on a copy of the chain); non-zero
     states are listed in ``"states"`` (radians for revolute joints, lengths for prismatic).
-    Angles are in radians (``"angleUnits": "rad"``).
+    Angles are in radians (``"angleUnits": "rad"``). If the chain was loaded from a design
+    whose joints have names, each joint keeps its ``"name"`` (as long as the chain's joints
+    still have the types they were loaded with; waypoints added by placement have none).
     """
     if not isinstance(chain, KinematicChain):
         raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
@@ -103,6 +106,8 @@ def design_to_dict(
         raise InvalidParameterError(
             f"units must be one of {', '.join(map(repr, UNITS))}, got {units!r}"
         )
+    origin = origin_of(chain)
+    names = origin.names if origin is not None else (None,) * len(chain.Joints)
     states = [float(joint.state) for joint in chain.Joints]
     rest = chain
     if any(states):
@@ -126,6 +131,8 @@ def design_to_dict(
     joints = []
     for i, joint in enumerate(rest.Joints):
         entry = _joint_parameters(joint)
+        if names[i] is not None:
+            entry = {"type": entry.pop("type"), "name": names[i], **entry}
         if i > 0:
             entry.update(_FIXED)
         entry["pose"] = _matrix(joint.pose_matrix)

@@ -71,12 +71,12 @@ def _joint(i, key, value):
 SCHEMA_CASES = {
     "missing numSides": (_drop("numSides"), "numSides", None, ["missing required field"]),
     "missing r": (_drop("r"), "r", None, ["missing required field 'r'"]),
-    "r as string": (_set("r", "1.0"), "r", '"1.0"', ["must be a number > 0"]),
-    "numSides 2": (_set("numSides", 2), "numSides", "2", ["even integer >= 4"]),
-    "numSides odd": (_set("numSides", 5), "numSides", "5", ["even integer >= 4"]),
-    "numSides float": (_set("numSides", 4.5), "numSides", "4.5", ["even integer >= 4"]),
-    "r negative": (_set("r", -1), "r", "-1", ["> 0"]),
-    "r zero": (_set("r", 0), "r", "0", ["> 0"]),
+    "r as string": (_set("r", "1.0"), "r", '"1.0"', ["must be a number in [1e-6, 1e6]"]),
+    "numSides 2": (_set("numSides", 2), "numSides", "2", ["even integer in [4, 64]"]),
+    "numSides odd": (_set("numSides", 5), "numSides", "5", ["even integer in [4, 64]"]),
+    "numSides float": (_set("numSides", 4.5), "numSides", "4.5", ["even integer in [4, 64]"]),
+    "r negative": (_set("r", -1), "r", "-1", ["in [1e-6, 1e6]"]),
+    "r zero": (_set("r", 0), "r", "0", ["in [1e-6, 1e6]"]),
     "bending 7 rad": (
         _joint(2, "totalBendingAngle", 7),
         "joints[2].totalBendingAngle",
@@ -105,7 +105,7 @@ SCHEMA_CASES = {
         "0.1",
         ["[pi/6, pi/2) radians"],
     ),
-    "numLayers 0": (_joint(1, "numLayers", 0), "joints[1].numLayers", "0", ["integer >= 1"]),
+    "numLayers 0": (_joint(1, "numLayers", 0), "joints[1].numLayers", "0", ["in [1, 200]"]),
     "length negative": (_joint(0, "length", -2), "joints[0].length", "-2", ["> 0"]),
     "pathIndex 3": (
         lambda d: d["joints"].insert(1, {"type": "Waypoint", "pathIndex": 3}),
@@ -113,7 +113,12 @@ SCHEMA_CASES = {
         "3",
         ["0, 1, 2"],
     ),
-    "maxAnglePerElbow 4": (_set("maxAnglePerElbow", 4), "maxAnglePerElbow", "4", ["(0, pi]"]),
+    "maxAnglePerElbow 4": (
+        _set("maxAnglePerElbow", 4),
+        "maxAnglePerElbow",
+        "4",
+        ["[pi/180, pi] radians"],
+    ),
     "twistPortion 1": (_set("twistPortion", 1), "twistPortion", "1", ["[0, 1)"]),
     "units": (_set("units", "km"), "units", '"km"', ["'mm', 'cm', 'm', 'in'"]),
     "angleUnits": (_set("angleUnits", "grad"), "angleUnits", '"grad"', ["'rad', 'deg'"]),
@@ -418,8 +423,10 @@ def test_error_attributes_and_classes():
     error = info.value
     assert isinstance(error, KinegamiError) and isinstance(error, ValueError)
     assert (error.file, error.field, error.value) == ("arm.json", "r", "1")
-    assert error.reason == "must be a number > 0"
-    assert str(error) == 'arm.json: r: must be a number > 0 (got "1")'
+    assert error.reason == "must be a number in [1e-6, 1e6] (file length units)"
+    assert str(error) == (
+        'arm.json: r: must be a number in [1e-6, 1e6] (file length units) (got "1")'
+    )
     again = pickle.loads(pickle.dumps(error))
     assert str(again) == str(error) and again.field == "r"
 

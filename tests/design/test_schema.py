@@ -61,6 +61,14 @@ def test_public_functions():
         "load_design_with_info": (
             "(path: 'str | os.PathLike') -> 'tuple[KinematicChain, DesignInfo]'"
         ),
+        "check_pattern": (
+            "(chain: 'KinematicChain', info: 'DesignInfo | None' = None, "
+            "file: 'str | os.PathLike | None' = None) -> 'TubularPattern'"
+        ),
+        "joint_table": (
+            "(chain: 'KinematicChain', document: 'dict') -> 'list[tuple[int, str, str | None]]'"
+        ),
+        "origin_of": "(chain: 'KinematicChain') -> 'DesignOrigin | None'",
     }
     for name, signature in signatures.items():
         assert str(inspect.signature(getattr(design, name))) == signature, name

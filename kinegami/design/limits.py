@@ -1,0 +1,122 @@
+"""Upper bounds of design files, and the check of lengths against the tube radius.
+
+The bounds keep every design cheap to build and free of numeric overflow:
+
+* ``numSides`` <= :data:`NUM_SIDES_MAX`, ``numSinkLayers`` <= :data:`NUM_SINK_LAYERS_MAX`,
+  ``numLayers`` <= :data:`NUM_LAYERS_MAX` and ``maxAnglePerElbow`` >=
+  :data:`MIN_ANGLE_PER_ELBOW`: one joint's crease pattern then has at most about 4e4 vertices
+  and one link's about 6e4 (measured, see docs/design-format.md).
+* ``r`` in [:data:`R_MIN`, :data:`R_MAX`] (file units), and every length and translation
+  coordinate finite with ``|value| <= LENGTH_FACTOR * r``: products and squares of lengths stay
+  far from the float range.
+* A design file is a regular file of at most :data:`MAX_FILE_BYTES` bytes.
+
+The schema (schema.json) states the same integer and radius bounds, and the absolute length
+bound ``LENGTH_FACTOR * R_MAX``; :func:`check_lengths` checks the bound relative to ``r``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from kinegami.design.errors import DesignError, json_path
+
+__all__ = [
+    "NUM_SIDES_MAX",
+    "NUM_SINK_LAYERS_MAX",
+    "NUM_LAYERS_MAX",
+    "MIN_ANGLE_PER_ELBOW",
+    "R_MIN",
+    "R_MAX",
+    "LENGTH_FACTOR",
+    "MAX_FILE_BYTES",
+    "check_lengths",
+]
+
+#: Largest number of polygon sides of the tube.
+NUM_SIDES_MAX = 64
+#: Largest number of sink layers of a revolute joint.
+NUM_SINK_LAYERS_MAX = 32
+#: Largest number of REBO layers of a prismatic joint.
+NUM_LAYERS_MAX = 200
+#: Smallest maxAnglePerElbow (radians): one degree.
+MIN_ANGLE_PER_ELBOW = math.pi / 180.0
+#: Smallest and largest tube radius (file length units).
+R_MIN = 1e-6
+R_MAX = 1e6
+#: Every length and translation coordinate must satisfy |value| <= LENGTH_FACTOR * r.
+LENGTH_FACTOR = 1e6
+#: Largest design file, in bytes (16 MiB).
+MAX_FILE_BYTES = 16 * 1024 * 1024
+
+#: Length fields of joints (positive) and of the dh object.
+_JOINT_LENGTHS = ("length", "tubeLength", "neutralLength")
+_DH_LENGTHS = ("neutralLength", "tipLength")
+_TRANSLATION_STEPS = ("Tx", "Ty", "Tz")
+
+
+def _checker(r: float, file):
+    limit = LENGTH_FACTOR * r
+
+    def check(value, path, positive: bool = False) -> None:
+        if abs(value) <= limit and (value > 0 or not positive):
+            return
+        what = "> 0 and <= 1e6 r" if positive else "within +-1e6 r"
+        raise DesignError(
+            f"out of range: lengths and translation coordinates must be {what} "
+            f"= {limit:g} (r = {r:g})",
+            field=json_path(path),
+            value=value,
+            file=file,
+        )
+
+    return check
+
+
+def _check_pose(spec, path, check) -> None:
+    """The translation coordinates of a schema-valid pose (matrix, steps or axis)."""
+    if isinstance(spec, dict):
+        for k, value in enumerate(spec.get("point", ())):
+            check(value, [*path, "point", k])
+    elif spec and isinstance(spec[0], list):
+        for row in range(3):
+            check(spec[row][3], [*path, row, 3])
+    else:
+        for i, step in enumerate(spec):
+            ((key, value),) = step.items()
+            if key == "Trans":
+                for k, v in enumerate(value):
+                    check(v, [*path, i, key, k])
+            elif key in _TRANSLATION_STEPS:
+                check(value, [*path, i, key])
+
+
+def check_lengths(document: dict, file=None) -> None:
+    """Every length and translation coordinate of a schema-valid ``document`` within 1e6 r.
+
+    Checked: joint lengths (``length``, ``tubeLength``, ``neutralLength``), the translations of
+    every pose and edit transform (matrix column 4, ``Trans``/``Tx``/``Ty``/``Tz`` steps, axis
+    ``point``), edit ``distance``, DH ``a`` and ``d`` and the DH lengths. Raises DesignError
+    naming the first offending field.
+    """
+    r = float(document["r"])
+    check = _checker(r, file)
+    for i, spec in enumerate(document.get("joints", ())):
+        for key in _JOINT_LENGTHS:
+            if key in spec:
+                check(spec[key], ["joints", i, key], positive=True)
+        if "pose" in spec:
+            _check_pose(spec["pose"], ["joints", i, "pose"], check)
+    dh = document.get("dh")
+    if dh is not None:
+        for k, row in enumerate(dh["rows"]):
+            check(row[2], ["dh", "rows", k, 2])
+            check(row[3], ["dh", "rows", k, 3])
+        for key in _DH_LENGTHS:
+            if key in dh:
+                check(dh[key], ["dh", key], positive=True)
+    for i, spec in enumerate(document.get("edits", ())):
+        if "distance" in spec:
+            check(spec["distance"], ["edits", i, "distance"])
+        if "transform" in spec:
+            _check_pose(spec["transform"], ["edits", i, "transform"], check)
