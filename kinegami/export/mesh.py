@@ -21,11 +21,20 @@ part name                   shape                                               
 ``link_i_tube``             the rest of the straight part: an n-gon prism             yes
 ==========================  ========================================================  ==========
 
-Waypoints have no part; arcs without elbow and straight parts shorter than 1e-6 r are left
-out. Every part is a closed, consistently oriented surface (outward normals), so
-``trimesh.Trimesh.is_watertight`` and ``is_volume`` hold for each; parts touch (a link's arc
-ends on the joint's polygon) but are not merged, so the model as a whole is a set of closed
-shells, not one.
+Waypoints have no part. Features below ``MESH_TOLERANCE`` r (1e-4 r) are not modelled:
+straight parts shorter than that are left out, and the vertices of a swept part closer than
+that along the sweep are merged (an elbow whose polygon vertex lies on, or within 1e-4 r of,
+the mitre plane has a vanishing side edge). An arc turning less than ``MIN_ARC_ANGLE``
+(1e-3 rad) has no part of its own: the neighbouring straight part is stretched to the arc's
+far polygon (the surface moves by less than r theta^2 < 1e-6 r). Without a straight part such
+an arc is swept on its own, or left out if no vertex moves more than 1e-4 r, so parts with no
+straight part between them may be up to 2e-4 r apart.
+
+Every part is a closed, consistently oriented surface (outward normals), so
+``trimesh.Trimesh.is_watertight`` and ``is_volume`` hold for each; the link parts have no edge
+shorter than 1e-4 r, so they stay closed when a reader merges close vertices. Parts touch (a
+link's arc ends on the joint's polygon) but are not merged, so the model as a whole is a set of
+closed shells, not one.
 
 Files are in millimetres: one chain unit (the unit of r) is ``units`` (default ``'mm'``) times
 ``scale``. STL is binary (one solid, all parts); OBJ has one object (``o`` line) per part, named
@@ -67,6 +76,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "MeshPart",
+    "MESH_TOLERANCE",
+    "MIN_ARC_ANGLE",
     "MIN_SEGMENT_LENGTH",
     "chain_parts",
     "joint_parts",
@@ -79,8 +90,16 @@ __all__ = [
     "shell_mass_properties",
 ]
 
+#: Smallest feature of the mesh, in units of r: swept vertices closer than this are merged.
+#: 1e-4 r keeps every edge well above float32 STL resolution and readers' merge distance
+#: (trimesh: 1e-8) for tubes down to r = 1 mm written in metres.
+MESH_TOLERANCE = 1e-4
 #: Straight segments shorter than this many r get no part.
-MIN_SEGMENT_LENGTH = 1e-6
+MIN_SEGMENT_LENGTH = MESH_TOLERANCE
+#: Arcs turning less than this (radians) are merged into the neighbouring straight part. An
+#: elbow of at least this turn moves its outermost polygon vertex by more than 5e-4 r (five
+#: times ``MESH_TOLERANCE``) on each side of its mitre.
+MIN_ARC_ANGLE = 1e-3
 
 _STL_HEADER = b"kinegami chain mesh, millimetres"
 
@@ -151,57 +170,63 @@ def _outward(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return faces
 
 
-def _weld(vertices: np.ndarray, faces: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """Merge vertices closer than ``tol`` and drop the faces that collapse.
+def _weld_along_sweep(rings: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex ids of ``rings`` (m, n, 3) after merging each vertex into the last kept one of its
+    column (vertex k of every ring) while they are at most ``tol`` apart.
 
-    An elbow of a square tube turning about a polygon vertex has a side edge of zero length
-    (the inner vertex lies on the mitre plane); collapsing it keeps the surface closed.
-    """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-    from scipy.spatial import cKDTree
-
-    pairs = cKDTree(vertices).query_pairs(tol, output_type="ndarray")
-    if pairs.shape[0] == 0:
-        return vertices, faces
-    k = vertices.shape[0]
-    graph = coo_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(k, k))
-    _, labels = connected_components(graph, directed=False)
-    _, first = np.unique(labels, return_index=True)  # the first vertex of every group
-    keep = np.sort(first)
-    new_index = np.empty(labels.max() + 1, dtype=np.int64)
-    new_index[labels[keep]] = np.arange(keep.shape[0])
-    mapped = new_index[labels][faces]
-    distinct = (
-        (mapped[:, 0] != mapped[:, 1])
-        & (mapped[:, 1] != mapped[:, 2])
-        & (mapped[:, 0] != mapped[:, 2])
-    )
-    return vertices[keep], mapped[distinct]
-
-
-def _sweep(rings: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Closed surface through polygons ``rings`` (m, n, 3): sides and both end caps.
-
-    Vertex i of every ring is joined to vertex i of the next; the caps are fans. Vertices
-    closer than 1e-9 of the rings' extent are merged (:func:`_weld`).
+    Returns ``(vertices, ids)``, ids of shape (m, n). Only vertices of the same column are
+    merged, and every kept vertex is at most ``tol`` from the ones merged into it. Merging
+    vertex k of ring i into ring i - 1 collapses a side edge of the sweep; the triangles
+    between two columns then zip two polylines, so the surface stays a closed 2-manifold.
     """
     m, n = rings.shape[0], rings.shape[1]
-    idx = np.arange(m * n).reshape(m, n)
+    ids = np.empty((m, n), dtype=np.int64)
+    ids[0] = np.arange(n)
+    kept = [rings[0]]
+    last = rings[0].copy()
+    count = n
+    for i in range(1, m):
+        new = np.linalg.norm(rings[i] - last, axis=1) > tol
+        ids[i] = ids[i - 1]
+        k = int(np.count_nonzero(new))
+        if k:
+            ids[i, new] = np.arange(count, count + k)
+            last[new] = rings[i, new]
+            kept.append(rings[i, new])
+            count += k
+    return np.vstack(kept).astype(float), ids
+
+
+def _sweep(rings: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """Closed surface through polygons ``rings`` (m, n, 3): sides and both end caps.
+
+    Vertex i of every ring is joined to vertex i of the next; vertices of one column closer
+    than ``tol`` along the sweep are merged (:func:`_weld_along_sweep`) and the triangles
+    that collapse are dropped. The caps are fans from the column that moves farthest, which
+    is never merged into a single point, so no fan diagonal is shared by both caps. Returns
+    None when every column stays within ``tol`` of its first vertex (no volume).
+    """
+    n = rings.shape[1]
+    travel = np.linalg.norm(rings - rings[0], axis=2).max(axis=0)
+    apex = int(np.argmax(travel))
+    if travel[apex] <= tol:
+        return None
+    vertices, idx = _weld_along_sweep(rings, tol)
     nxt = np.roll(idx, -1, axis=1)
     a, b = idx[:-1], nxt[:-1]
     c, d = nxt[1:], idx[1:]
     sides = np.concatenate(
         [np.stack([a, b, c], axis=-1).reshape(-1, 3), np.stack([a, c, d], axis=-1).reshape(-1, 3)]
     )
+    order = (apex + np.arange(n)) % n
     k = np.arange(1, n - 1)
-    first = np.stack([np.zeros_like(k), k + 1, k], axis=1)
-    base = (m - 1) * n
-    last = np.stack([np.full_like(k, base), base + k, base + k + 1], axis=1)
+    head, tail = idx[0, order], idx[-1, order]
+    first = np.stack([np.full_like(k, head[0]), head[k + 1], head[k]], axis=1)
+    last = np.stack([np.full_like(k, tail[0]), tail[k], tail[k + 1]], axis=1)
     faces = np.concatenate([sides, first, last]).astype(np.int64)
-    vertices = rings.reshape(-1, 3).astype(float)
-    extent = float(np.ptp(vertices, axis=0).max())
-    vertices, faces = _weld(vertices, faces, 1e-9 * extent)
+    distinct = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2])
+    distinct &= faces[:, 0] != faces[:, 2]
+    faces = faces[distinct]
     return vertices, _outward(vertices, faces)
 
 
@@ -325,43 +350,52 @@ def link_parts(
     The straight part from q1 to q2 gets a twist of length ``twistPortion * tMag`` first when
     the link has a twist fitting (|twistAngle| > 0.01), as in the crease pattern; the twisted
     prism joins vertex k of the start polygon to the end polygon's vertex that is vertex k
-    turned by the residual angle in [0, 2 pi / n).
+    turned by the residual angle in [0, 2 pi / n). A twist that leaves less than
+    ``MIN_SEGMENT_LENGTH`` r of tube takes the whole straight part.
+
+    An arc turning less than ``MIN_ARC_ANGLE`` has no part when the link has a straight part:
+    that part then starts (ends) on the link's start (end) polygon instead of the arc's other
+    end. Without a straight part such an arc is swept on its own, or left out when no vertex
+    moves more than ``MESH_TOLERANCE`` r.
     """
     n, r = numSides, link.r
-    parts = []
-    for arc, side in ((link.elbows1, "arc1"), (link.elbows2, "arc2")):
-        rings = _arc_rings(arc, n)
-        if rings is not None:
-            parts.append(MeshPart(f"link_{index}_{side}", *_sweep(rings), index, side, rings))
-    path = link.path
-    u = np.asarray(path.tUnit, dtype=float)
-    F1, F2 = link.arc1_end_frame, link.arc2_start_frame
-    start = _polygon(F1, r, n)
-    end = _polygon(F2, r, n)
-    length = float(path.tMag)
-    minimum = MIN_SEGMENT_LENGTH * r
+    tol = MESH_TOLERANCE * r
+    arc1, arc2 = link.elbows1, link.elbows2
+    u = np.asarray(link.path.tUnit, dtype=float)
+    length = float(link.path.tMag)
+    merge1 = length > tol and arc1.angle < MIN_ARC_ANGLE
+    merge2 = length > tol and arc2.angle < MIN_ARC_ANGLE
+    near = _polygon(link.start_frame if merge1 else link.arc1_end_frame, r, n)
+    end = _polygon(link.arc2_start_frame, r, n)
+    far = _polygon(link.end_frame, r, n) if merge2 else end
     twist_length = twistPortion * length if link.hasTwist else 0.0
-    straight = []
-    if twist_length > minimum:
-        mid = end - (length - twist_length) * u
+    straight = []  # (side, near polygon, far polygon, roll of the far polygon)
+    if twist_length > tol:
         K = _roll_count(link.twistAngle, n, nearest=False)
-        rings = np.stack([start, np.roll(mid, K, axis=0)])
-        straight.append(MeshPart(f"link_{index}_twist", *_sweep(rings), index, "twist", rings))
-        start = mid
-        length -= twist_length
-    else:
+        rest = length - twist_length
+        if rest > tol:
+            mid = end - rest * u
+            straight = [("twist", near, mid, K), ("tube", mid, far, 0)]
+        else:
+            straight = [("twist", near, far, K)]
+    elif length > tol:
         K = _roll_count(link.twistAngle, n, nearest=not link.hasTwist)
-        end = np.roll(end, K, axis=0)
-    if length > minimum:
-        rings = np.stack([start, end])
-        straight.append(MeshPart(f"link_{index}_tube", *_sweep(rings), index, "tube", rings))
-    # order along the tube: arc 1, twist, tube, arc 2
-    arcs = {p.side: p for p in parts}
-    ordered = [arcs["arc1"]] if "arc1" in arcs else []
-    ordered += straight
-    if "arc2" in arcs:
-        ordered.append(arcs["arc2"])
-    return ordered
+        straight = [("tube", near, far, K)]
+
+    parts = []
+
+    def add(side: str, rings: np.ndarray | None) -> None:
+        mesh = None if rings is None else _sweep(rings, tol)
+        if mesh is not None:
+            parts.append(MeshPart(f"link_{index}_{side}", *mesh, index, side, rings))
+
+    if not merge1:
+        add("arc1", _arc_rings(arc1, n))
+    for side, first, last, K in straight:
+        add(side, np.stack([first, np.roll(last, K, axis=0)]))
+    if not merge2:
+        add("arc2", _arc_rings(arc2, n))
+    return parts
 
 
 # --- whole chain ---------------------------------------------------------------------------

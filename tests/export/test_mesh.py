@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 import trimesh
-from hypothesis import given, settings
+from hypothesis import given, reject, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
@@ -22,15 +22,20 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
-from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
 from kinegami.export.mesh import (
+    MESH_TOLERANCE,
+    MIN_ARC_ANGLE,
     chain_mesh,
     chain_parts,
     joint_parts,
+    link_parts,
     shell_mass_properties,
     write_obj,
     write_stl,
 )
+from kinegami.geometry.frames import rotation_matrix
+from kinegami.links import LinkCSC
 from kinegami.viz.chain_geometry import regular_polygon
 
 EXAMPLE_1_PARTS = [
@@ -263,6 +268,296 @@ def test_random_chains_give_closed_parts(chain, data):
         # as a reader sees it: coincident vertices merged, degenerate faces dropped
         processed = trimesh.Trimesh(part.vertices, part.faces)
         assert processed.is_watertight and processed.is_volume, part.name
+
+
+# --- degenerate elbows -----------------------------------------------------------------------
+
+
+def elbow_volume(n: int, r: float, angle: float) -> float:
+    """Volume of one elbow: two prisms cut by the mitre, each of axis length r tan(angle / 2)
+    at the polygon's centroid."""
+    return 2.0 * polygon_area(n, r) * r * math.tan(angle / 2.0)
+
+
+def assert_welded_volume(part, exact: float, r: float) -> None:
+    """The part's volume is ``exact`` up to the vertex merge: every vertex moved by at most
+    MESH_TOLERANCE r, which changes the volume by at most that times the surface area."""
+    mesh = part.to_trimesh()
+    assert abs(mesh.volume - exact) <= MESH_TOLERANCE * r * mesh.area + 1e-12 * exact
+
+
+def assert_closed_volume(part, r: float) -> None:
+    """Closed and outward as written and as a reader merges it; no edge below the tolerance."""
+    mesh = part.to_trimesh()
+    assert mesh.is_watertight and mesh.is_winding_consistent, part.name
+    assert mesh.volume > 0.0, part.name
+    processed = trimesh.Trimesh(part.vertices, part.faces)
+    assert processed.is_watertight and processed.is_volume, part.name
+    assert processed.faces.shape == part.faces.shape, part.name  # the reader merged nothing
+    if not part.is_joint:
+        assert mesh.edges_unique_length.min() > MESH_TOLERANCE * r, part.name
+
+
+def assert_parts_join(link, parts, n: int, tol: float, meet: bool = True) -> None:
+    """The link's parts start on its start polygon, meet ring to ring and end on its end
+    polygon, within ``tol``. Without ``meet`` (a twist and no straight part to hold it), only
+    arc 1 must start on the start polygon and arc 2 end on the end polygon."""
+    assert parts, link
+    start = regular_polygon(link.start_frame, link.r, n)
+    end = regular_polygon(link.end_frame, link.r, n)
+    if not meet:
+        sides = {p.side: p for p in parts}
+        assert "arc1" not in sides or same_point_sets(rings(sides["arc1"], n)[0], start, tol)
+        assert "arc2" not in sides or same_point_sets(rings(sides["arc2"], n)[-1], end, tol)
+        return
+    assert same_point_sets(rings(parts[0], n)[0], start, tol)
+    for a, b in zip(parts, parts[1:], strict=False):
+        assert same_point_sets(rings(a, n)[-1], rings(b, n)[0], tol), (a.name, b.name)
+    assert same_point_sets(rings(parts[-1], n)[-1], end, tol)
+
+
+def csc_link(r, theta1, psi1, s, theta2, psi2, roll=0.0, start=None, max_angle=math.pi / 2):
+    """The link along the CSC path that leaves ``start`` (default: identity) turning theta1
+    towards the direction at angle psi1 from the frame's y axis (about its x axis), runs s
+    straight, turns theta2 towards psi2 of the carried frame and ends rolled by ``roll``."""
+    start = np.eye(4) if start is None else np.asarray(start, dtype=float)
+
+    def arc(F, theta, psi):
+        d = F[:3, 0]
+        w = math.cos(psi) * F[:3, 1] + math.sin(psi) * F[:3, 2]
+        G = np.array(F)
+        G[:3, :3] = rotation_matrix(np.cross(d, w), theta) @ F[:3, :3]
+        G[:3, 3] = F[:3, 3] + r * (math.sin(theta) * d + (1.0 - math.cos(theta)) * w)
+        return G
+
+    F = arc(start, theta1, psi1)
+    F[:3, 3] += s * F[:3, 0]
+    F = arc(F, theta2, psi2)
+    F[:3, :3] = F[:3, :3] @ rotation_matrix([1.0, 0.0, 0.0], roll)
+    return LinkCSC(r, start, F, max_angle)
+
+
+#: Chains found by hypothesis (test_random_chains_give_closed_parts), poses as first three
+#: rows. In the first two, link 4 ends with an arc of 2.3e-9 (1.3e-9) rad: one elbow whose
+#: polygons lie 2e-9 apart, which the old vertex merge collapsed into a 4-vertex non-manifold.
+#: In the third, the inner vertex of link 2's first elbow lies 4.5e-9 from its mitre plane: a
+#: side edge that a reader's vertex merge (trimesh: 1e-8) collapses into degenerate faces.
+HYPOTHESIS_FINDS = {
+    "tiny arc 2.3e-9 rad": (4, [
+        ("W", 2, [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.25]]),
+        ("R", 1.0, [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 6.26616915342202]]),
+        ("W", 0, [[1.0, 0.0, 0.0, 3.9299278016535077], [0.0, 1.0, 0.0, 0.0],
+                  [0.0, 0.0, 1.0, 6.26616915342202]]),
+        ("W", 0, [[6.123233995736766e-17, 0.0, 1.0, 4.929927816774182], [0.0, 1.0, 0.0, 0.0],
+                  [-1.0, 0.0, 6.123233995736766e-17, -1.2941682147698188]]),
+        ("R", 1.0, [[-1.0, 0.0, 2e-09, 2.5153013062947427e-08], [0.0, 1.0, 0.0, 0.0],
+                    [-2e-09, 0.0, -1.0, -6.310337378051694]]),
+    ]),
+    "tiny arc 1.3e-9 rad": (4, [
+        ("W", 2, [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.25]]),
+        ("R", 1.0, [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 6.26616915342202]]),
+        ("W", 0, [[1.0, 0.0, 0.0, 3.9299278016535077], [0.0, 1.0, 0.0, 0.0],
+                  [0.0, 0.0, 1.0, 6.26616915342202]]),
+        ("W", 0, [[6.123233995736766e-17, -1.0, -5.000000000000001e-19, 4.929927806066428],
+                  [1.0, 6.123233995736766e-17, -5e-19, 4.412920685969156],
+                  [5.000000000000001e-19, -5e-19, 1.0, 6.26616915342202]]),
+        ("R", 1.0, [[-0.9999999999999998, -9.999999999999999e-10, 9.999999999999999e-10,
+                     9.429089844321103e-09],
+                    [9.999999999999999e-10, 5e-19, 0.9999999999999998, 9.429089844321103],
+                    [-9.999999999999999e-10, 0.9999999999999998, 5e-19, 6.26616915342202]]),
+    ]),
+    "vertex 4.5e-9 from a mitre": (8, [
+        ("W", 2, [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.25]]),
+        ("R", 1.8984375, [[0.23404447533338035, 0.8909422780193955, -0.3891594028204032,
+                           -4.336552292638626],
+                          [-0.8909422780193955, 0.0363240647789308, -0.45266148450640925,
+                           -0.35025597798085784],
+                          [-0.3891594028204032, 0.45266148450640925, 0.8022795894455503,
+                           6.356937614145996]]),
+    ]),
+}  # fmt: skip
+
+
+def hypothesis_find(name: str) -> KinematicChain:
+    """The chain ``HYPOTHESIS_FINDS[name]`` (r = 1), every joint at its given global pose."""
+    n, joints = HYPOTHESIS_FINDS[name]
+    chain = KinematicChain(StartTip(n, 1.0, SE3(), 1.5))
+    for kind, value, rows in joints:
+        T = np.vstack([rows, [0.0, 0.0, 0.0, 1.0]])
+        joint = (
+            Waypoint(n, 1.0, T, pathIndex=value) if kind == "W" else RevoluteJoint(n, 1.0, value, T)
+        )
+        fixed = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
+        assert chain.append(joint, **fixed) is not None
+    return chain
+
+
+@pytest.mark.parametrize("name", sorted(HYPOTHESIS_FINDS))
+def test_hypothesis_finds_give_closed_parts(name):
+    chain = hypothesis_find(name)
+    for part in chain_parts(chain, split_joints=True):
+        assert_closed_volume(part, chain.r)
+    for i in range(1, len(chain.Joints)):
+        link = chain.Links[i]
+        assert_parts_join(link, link_parts(link, i, chain.numSides), chain.numSides, 1e-9)
+
+
+@pytest.mark.parametrize("name", ["tiny arc 1.3e-9 rad", "tiny arc 2.3e-9 rad"])
+def test_tiny_arc_of_a_hypothesis_find_is_merged(name):
+    chain = hypothesis_find(name)
+    link = chain.Links[4]
+    assert 1e-9 < link.path.theta2 < 3e-9 and link.elbows2.count == 1
+    names = [p.name for p in chain_parts(chain) if p.index == 4 and not p.is_joint]
+    assert names == ["link_4_arc1", "link_4_tube"]
+
+
+def test_weld_of_a_vertex_next_to_the_mitre():
+    """The hypothesis find's inner vertex: its three copies are one vertex, the other seven
+    columns keep theirs; the volume is that of the exact rings."""
+    chain = hypothesis_find("vertex 4.5e-9 from a mitre")
+    part = next(p for p in chain_parts(chain) if p.name == "link_2_arc1")
+    ring = rings(part, 8)
+    assert ring.shape[0] == 3
+    steps = np.linalg.norm(ring[1] - ring[0], axis=1)
+    assert np.sum(steps < MESH_TOLERANCE) == 1 and steps.min() < 1e-8
+    assert part.vertices.shape[0] == 3 * 8 - 2
+    exact = elbow_volume(8, 1.0, chain.Links[2].elbows1.elbowAngle)
+    assert_welded_volume(part, exact, 1.0)
+
+
+@pytest.mark.parametrize("theta", [0.0, 1e-12, 2e-9, 1e-6, 0.5 * MIN_ARC_ANGLE])
+def test_tiny_arcs_are_merged_into_the_straight_part(theta):
+    """Arcs turning less than MIN_ARC_ANGLE: no part; the tube (twist) starts and ends exactly
+    on the link's polygons, also with a twist."""
+    for roll, names in ((0.0, ["link_1_tube"]), (1.0, ["link_1_twist", "link_1_tube"])):
+        link = csc_link(1.5, theta, 0.3, 4.0, theta, -2.0, roll=roll)
+        parts = link_parts(link, 1, 6)
+        assert [p.name for p in parts] == names
+        for part in parts:
+            assert_closed_volume(part, 1.5)
+        assert_parts_join(link, parts, 6, 1e-12)
+
+
+@pytest.mark.parametrize("psi", [0.3, math.pi / 4, 2.0])
+def test_merged_arc_moves_the_surface_by_less_than_r_theta_squared(psi):
+    """The mitre polygon of the arc that was merged lies within r theta^2 of the tube."""
+    r, n, theta = 1.5, 4, 0.9 * MIN_ARC_ANGLE
+    link = csc_link(r, theta, psi, 2.0, 0.0, 0.0)
+    (tube,) = link_parts(link, 1, n)
+    start = link.start_frame
+    polygon = regular_polygon(start, r, n)
+    w = (link.path.c1 - start[:3, 3]) / r  # towards the turning centre
+    lam = math.tan(theta / 2) * (r - (polygon - start[:3, 3]) @ w)
+    mitre = polygon + lam[:, None] * start[:3, 0]
+    _, distance, _ = trimesh.proximity.closest_point(tube.to_trimesh(), mitre)
+    assert lam.max() > 0.5 * r * theta  # the arc was not nothing
+    assert distance.max() < r * theta**2
+
+
+def test_arc_just_above_the_merge_angle_has_its_part():
+    link = csc_link(1.0, 1.01 * MIN_ARC_ANGLE, 0.3, 4.0, 0.5, 1.0)
+    parts = link_parts(link, 1, 4)
+    assert [p.name for p in parts] == ["link_1_arc1", "link_1_tube", "link_1_arc2"]
+    for part in parts:
+        assert_closed_volume(part, 1.0)
+    assert_parts_join(link, parts, 4, 1e-12)
+
+
+@pytest.mark.parametrize("theta", [1e-6, 0.5 * MIN_ARC_ANGLE])
+def test_tiny_arc_without_straight_part(theta):
+    """No straight part to merge into: the arc is swept on its own (a sliver, still closed) or
+    left out when it moves no vertex by more than MESH_TOLERANCE r."""
+    link = csc_link(1.0, 0.8, 0.4, 0.0, theta, 1.3)
+    parts = link_parts(link, 1, 6)
+    expected = ["link_1_arc1"] + (["link_1_arc2"] if theta * 1.0 > MESH_TOLERANCE else [])
+    assert [p.name for p in parts] == expected
+    for part in parts:
+        assert_closed_volume(part, 1.0)
+    assert_parts_join(link, parts, 6, MESH_TOLERANCE)
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e-15, 1e-9, 1e-6, -1e-4, 1e-2])
+@pytest.mark.parametrize("n", [4, 6, 12])
+def test_elbow_turning_towards_a_polygon_vertex(n, offset):
+    """The inner polygon vertex on (or next to) the mitre plane: its side edges vanish (or
+    nearly) and are merged; the part stays a closed volume of the rings' volume."""
+    psi = math.pi / n + offset  # vertex 0 lies at pi/n from the frame's y axis
+    link = csc_link(2.0, 1.2, psi, 3.0, 2.5, math.pi / n + 2 * math.pi / n - offset)
+    parts = link_parts(link, 1, n)
+    assert [p.name for p in parts] == ["link_1_arc1", "link_1_tube", "link_1_arc2"]
+    for part in parts:
+        assert_closed_volume(part, 2.0)
+    assert_parts_join(link, parts, n, 1e-9)
+    assert_welded_volume(parts[0], elbow_volume(n, 2.0, 1.2), 2.0)
+
+
+def test_many_tiny_elbows():
+    """maxAnglePerElbow = 1e-4: 500 elbows whose polygons lie about MESH_TOLERANCE r apart, so
+    columns are merged in runs of different lengths; the arc stays closed and keeps its
+    volume (the swept area times the centre arc length r theta)."""
+    n, r, theta = 6, 1.0, 0.05
+    link = csc_link(r, theta, 0.2, 1.0, 0.0, 0.0, max_angle=1e-4)
+    assert link.elbows1.count == 500
+    parts = link_parts(link, 1, n)
+    assert [p.name for p in parts] == ["link_1_arc1", "link_1_tube"]
+    for part in parts:
+        assert_closed_volume(part, r)
+    arc = parts[0]
+    assert arc.vertices.shape[0] < rings(arc, n).shape[0] * n  # merged
+    assert_welded_volume(arc, 500 * elbow_volume(n, r, theta / 500), r)
+    assert_parts_join(link, parts, n, 1e-9)
+
+
+angles = st.one_of(
+    st.just(0.0),
+    st.floats(-13.0, -1.0).map(lambda e: 10.0**e),
+    st.floats(0.0, 3.0),
+)
+
+
+@settings(deadline=None, max_examples=60)
+@given(
+    n=st.sampled_from([4, 6, 8, 16]),
+    r=st.floats(0.5, 5.0),
+    theta1=angles,
+    theta2=angles,
+    vertex1=st.integers(0, 15),
+    vertex2=st.integers(0, 15),
+    near=st.tuples(st.floats(-13.0, 0.0), st.floats(-13.0, 0.0)),
+    s=st.one_of(st.just(0.0), st.floats(-8.0, 1.0).map(lambda e: 10.0**e)),
+    roll=st.floats(-math.pi, math.pi),
+    twist_portion=st.floats(0.0, 0.999),
+    max_angle=st.sampled_from([math.pi / 2, 0.4, 0.01]),
+)
+def test_random_links_give_closed_joined_parts(
+    n, r, theta1, theta2, vertex1, vertex2, near, s, roll, twist_portion, max_angle
+):
+    """Links with vanishing or small turns, turns towards (nearly) a polygon vertex, and
+    straight parts from 0 to 10 r: every part is a closed volume, and the parts join ring to
+    ring, exactly when the link has a straight part, else within 2 MESH_TOLERANCE r (a left
+    out straight part and a left out arc)."""
+    psi1 = math.pi / n + 2 * math.pi * vertex1 / n + 10.0 ** near[0]
+    psi2 = math.pi / n + 2 * math.pi * vertex2 / n - 10.0 ** near[1]
+    try:
+        link = csc_link(r, theta1, psi1, s * r, theta2, psi2, roll, max_angle=max_angle)
+    except NoPathError:
+        # solve_csc misses some paths whose straight part is much shorter than r, e.g.
+        # theta1 = 0, s = 0, theta2 = 1e-6 or theta1 = 0, s = 1.5e-5 r, theta2 = 1.75 (a solver
+        # limitation: the mesh is not reached)
+        reject()
+    parts = link_parts(link, 1, n, twist_portion)
+    for part in parts:
+        assert_closed_volume(part, r)
+    if not parts:  # nothing of volume: the link is shorter than the tolerance
+        assert link.path.length < 2 * MESH_TOLERANCE * r + r * MIN_ARC_ANGLE
+        return
+    straight = link.path.tMag > MESH_TOLERANCE * r
+    # a twist needs a straight part: without one the arcs meet turned by the roll between them
+    # (up to a relabelling by whole 2 pi / n steps)
+    step = 2 * math.pi / n
+    residual = link.twistAngle % step
+    meet = straight or min(residual, step - residual) < 1e-9
+    assert_parts_join(link, parts, n, 1e-9 * r if straight else 2 * MESH_TOLERANCE * r, meet)
 
 
 # --- files ---------------------------------------------------------------------------------
