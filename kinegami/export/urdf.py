@@ -5,7 +5,8 @@ Bodies
     or prismatic joint, ``body_b`` everything after the b-th one up to the next. Waypoints,
     tips and the links (tubes) are fixed parts of the body they lie in; a revolute or prismatic
     joint's proximal half belongs to the body before it and its distal half to the body after.
-    A chain without movable joints is a single link.
+    A chain without movable joints gives one URDF link per chain joint (with the link into
+    it), joined by fixed joints ``joint_k``; a single-joint chain is a single link.
 
 Joints
     Chain joint i, if revolute or prismatic, is the URDF ``<joint name="joint_i">`` of that type
@@ -260,10 +261,22 @@ def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
 
     bodies = chain_bodies(chain)
     parts = chain_parts(chain, twistPortion=twist_portion, split_joints=True)
-    to_body = [inverse(bodies.frame(b)) for b in range(bodies.count)]
-    body_parts: list[list] = [[] for _ in range(bodies.count)]
+    # Without movable joints, each chain joint (and the link into it) is its own URDF link,
+    # joined to the previous one by a fixed joint; otherwise one URDF link per rigid body.
+    fixed = not bodies.movable and len(chain.Joints) > 1
+    if fixed:
+        origins = [bodies.zero_poses[k][:3, 3] for k in range(len(chain.Joints))]
+        frames = [np.eye(4) for _ in origins]
+        for frame, origin in zip(frames, origins, strict=True):
+            frame[:3, 3] = origin
+    else:
+        frames = [bodies.frame(b) for b in range(bodies.count)]
+    to_body = [inverse(frame) for frame in frames]
+    body_parts: list[list] = [[] for _ in frames]
     for part in parts:
-        if part.is_joint:
+        if fixed:
+            b = part.index
+        elif part.is_joint:
             b = (bodies.distal_body if part.side == "distal" else bodies.proximal_body)[part.index]
         else:  # link i lies between joint i-1's distal side and joint i's proximal side
             b = bodies.proximal_body[part.index]
@@ -280,7 +293,7 @@ def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
     for material, rgba in (("kinegami_joint", _JOINT_RGBA), ("kinegami_link", _LINK_RGBA)):
         ET.SubElement(ET.SubElement(robot, "material", name=material), "color", rgba=rgba)
     files: dict[str, bytes] = {}
-    for b in range(bodies.count):
+    for b in range(len(frames)):
         link = ET.SubElement(robot, "link", name=f"body_{b}")
         if density > 0.0 and body_parts[b]:
             _inertial(link, body_parts[b], density)
@@ -297,6 +310,13 @@ def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
                 ET.SubElement(geometry, "mesh", filename=filename)
                 if tag == "visual":
                     ET.SubElement(element, "material", name=material)
+    if fixed:
+        for k in range(1, len(frames)):
+            element = ET.SubElement(robot, "joint", name=f"joint_{k}", type="fixed")
+            ET.SubElement(element, "parent", link=f"body_{k - 1}")
+            ET.SubElement(element, "child", link=f"body_{k}")
+            offset = (origins[k] - origins[k - 1]) * metres
+            ET.SubElement(element, "origin", xyz=_vector(offset), rpy="0 0 0")
     for b, k in enumerate(bodies.movable, start=1):
         joint = chain.Joints[k]
         parent = bodies.proximal_body[k]

@@ -215,20 +215,37 @@ def test_limits_effort_and_velocity(tmp_path, example_1a):
     assert defaults.joint_map["joint_4"].limit.velocity == 1.0
 
 
-def test_chain_without_movable_joints_is_one_link(tmp_path):
+def test_chain_without_movable_joints_has_fixed_joints(tmp_path):
+    """Issue 5: no movable joints still gives a valid file, with fixed joints."""
     chain = KinematicChain(StartTip(4, 1, SE3(), 1.5))
     fixed = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
     chain.append(Waypoint(4, 1, SE3.Trans(0, 0, 4)), **fixed)
     chain.append(EndTip(4, 1, SE3.Trans(0, 0, 8), 1.5), **fixed)
     path = export(chain, tmp_path / "rigid.urdf")
     robot = load(path)
-    assert list(robot.link_map) == ["body_0"]
-    assert robot.num_actuated_joints == 0 and robot.robot.joints == []
-    names = {v.name for v in robot.link_map["body_0"].visuals}
-    assert names == {"joint_0", "link_1_tube", "link_2_tube", "joint_2"}
+    assert robot.validate()
+    assert list(robot.link_map) == ["body_0", "body_1", "body_2"]
+    assert robot.num_actuated_joints == 0
+    assert [(j.name, j.type, j.parent, j.child) for j in robot.robot.joints] == [
+        ("joint_1", "fixed", "body_0", "body_1"), ("joint_2", "fixed", "body_1", "body_2"),
+    ]  # fmt: skip
+    for k, joint in enumerate(chain.Joints):  # each body sits at its joint's centre (metres)
+        T = robot.get_transform(f"body_{k}", "body_0")
+        assert np.allclose(T[:3, 3], joint.pose_matrix[:3, 3] * 1e-3, atol=1e-12)
+        assert np.allclose(T[:3, :3], np.eye(3), atol=1e-12)
+    visuals = {k: {v.name for v in link.visuals} for k, link in robot.link_map.items()}
+    assert visuals == {
+        "body_0": {"joint_0"}, "body_1": {"link_1_tube"}, "body_2": {"link_2_tube", "joint_2"},
+    }  # fmt: skip
     lo, hi = robot.scene.bounds
     assert lo[2] == pytest.approx(-0.75e-3, abs=1e-8)  # STL is float32
     assert hi[2] == pytest.approx(8.75e-3, abs=1e-8)
+
+
+def test_single_joint_chain_is_one_link(tmp_path):
+    robot = load(export(KinematicChain(StartTip(4, 1, SE3(), 1.5)), tmp_path / "one.urdf"))
+    assert robot.validate()
+    assert list(robot.link_map) == ["body_0"] and robot.robot.joints == []
 
 
 # --- meshes and inertia ----------------------------------------------------------------------
