@@ -14,15 +14,19 @@ first joint's proximal Dubins frame, so the folded form lies on the chain's 3D m
 every module end coincides with the chain's joint and link frames. Two exceptions follow the
 pattern rather than the kinematic model, because the pattern cannot fold otherwise:
 
-* a prismatic joint's pattern folds to length d + L (L = d / sin(coneAngle)) instead of the
-  kinematic d (spec B7), so everything after a prismatic joint is translated by L along its axis;
+* a prismatic joint's pattern folds to length d' + L instead of the kinematic d: the sleeve adds
+  L = d / sin(coneAngle) (spec B7) and the bellows, folded with rigid faces, is
+  d' = :func:`rebo_folded_length` >= d long; everything after a prismatic joint is translated by
+  d' + L - d along its axis;
 * turns and twists of at most 0.01 rad that the link builder leaves out of the pattern, and tubes
   shorter than eps = 1e-4 b, are missing from the folded form too (patterns.md 4.2).
 
 Where the spec gives no positions (the REBO bellows, the nested sink layers of the revolute
 joint, the free crimp flaps of the revolute joint and tips) docs/fold.md says which isometric
-realisation is used. Vertices the pattern moved by less than eps (elbow columns snapped by fix B6,
-seam snapping of section 2.1) are put back on an isometry by a damped least-squares solve.
+realisation is used; every face is then a rigid, planar copy of its flat polygon. Vertices the
+pattern moved by less than eps (elbow columns snapped by fix B6, seam snapping of section 2.1)
+are put back on an isometry of the creases by a damped least-squares solve; the faces next to
+them bend slightly (docs/fold.md).
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ from kinegami.pattern.prismatic import rebo_geometry
 from kinegami.pattern.revolute import revolute_geometry
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 from kinegami.pattern.twist import twist_geometry
+from kinegami.validation import check_in_range, check_num_sides, check_positive
 
 __all__ = [
     "FoldedForm",
@@ -48,6 +53,8 @@ __all__ = [
     "folded_form",
     "folded_vertices",
     "module_fold",
+    "rebo_folded_length",
+    "rebo_tilt",
     "UVA_TO_DUBINS",
 ]
 
@@ -581,7 +588,7 @@ def _module_geometry(n: int, r: float, kind: str, params: tuple):
         T = _translation(ell)
     elif kind == "rebo":
         X = _fold_rebo_vertices(prism, xy, p["neutralLength"], p["numLayers"], p["coneAngle"])
-        T = _translation(p["neutralLength"])
+        T = _translation(rebo_folded_length(n, p["neutralLength"], p["coneAngle"]))
     elif kind == "prismatic":
         X, T = _fold_prismatic(prism, pattern, p["neutralLength"], p["numLayers"], p["coneAngle"])
     else:  # pragma: no cover - _rebuild_cached rejects unknown kinds first
@@ -804,91 +811,85 @@ def _fold_sink_chains(prism, xy, X, matched, centre, H):
 # --- REBO (spec 3.7) and prismatic joint (3.8) ---------------------------------------------
 
 
-@functools.lru_cache(maxsize=256)
-def _rebo_waist(n: int, r: float, d: float, N: int, beta: float) -> tuple[np.ndarray, np.ndarray]:
-    """3D A_{0,0} and O_{0,0} of a REBO layer (docs/fold.md): the waist of the bellows.
+def rebo_tilt(numSides: int, coneAngle: float) -> float:
+    """Inclination gamma of the REBO's faces in its rigid folded state, radians.
 
-    Layer rings are the base polygon, d/N apart and not twisted; each layer is mirror symmetric
-    about its waist plane a = d/(2N), where A and O lie. A_{0,0} is at distance l1 from B_{0,0}
-    (height d/(2N), so a horizontal reach of l1 cos(beta)) in the direction rotated by ``phi``
-    from the inward radial one; O_{0,0} is at distance o from A_{0,0}, turned a right angle from
-    it (the flat angle between the column and the midline); ``phi`` solves the length of the
-    waist crease |A_{0,-1} O_{0,0}| = b - o. Of the (two) roots, the larger one is the one under
-    which every REBO crease folds the way its label says (tests/export/test_fold.py).
+    Every layer folds as a rigid bellows (docs/fold.md): each quadrilateral face turns about its
+    layer-ring edge, inwards, until it makes the angle gamma with the cross-section plane, and
+    the pleat triangles close exactly when l1 cos(gamma) = o cot(pi/n), i.e.
+
+        cos(gamma) = cot(alpha_f) cot(pi/n) = tan(pi cos(beta) / n) / tan(pi / n),
+
+    with alpha_f = (pi/2)(1 - 2 cos(beta)/n) the flat cone angle of spec 3.7. Then beta <= gamma
+    < pi/2, and gamma -> beta as n grows. (The other rigid state, gamma = pi/2, is the unfolded
+    tube.)
+
+    Parameters
+    ----------
+    numSides : int
+        n, even and >= 4.
+    coneAngle : float
+        beta in (0, pi/2), radians.
+
+    Examples
+    --------
+    >>> round(rebo_tilt(4, math.pi / 4), 6)
+    0.90141
     """
-    prism = make_prism(n, r)
-    geo = rebo_geometry(prism, d, N, beta)
-    l1, o, b = geo.l1, geo.offset, prism.b
-    z = d / (2.0 * N)
-    reach = math.sqrt(max(l1 * l1 - z * z, 0.0))
-    beta0 = prism.vertex_angles[0]
-    B0 = r * np.array([math.cos(beta0), math.sin(beta0)])
-    step = 2.0 * math.pi / n
-    c, s_ = math.cos(step), math.sin(step)
-    rot = np.array([[c, -s_], [s_, c]])
+    n = check_num_sides(numSides)
+    beta = check_in_range("coneAngle", coneAngle, 0.0, 0.5 * math.pi, range_text="(0, pi/2)")
+    ratio = math.tan(math.pi * math.cos(beta) / n) / math.tan(math.pi / n)
+    return math.acos(min(ratio, 1.0))
 
-    def points(phi: float):
-        direction = np.array([math.cos(beta0 + math.pi + phi), math.sin(beta0 + math.pi + phi)])
-        A = B0 + reach * direction
-        back = np.array([direction[1], -direction[0]])
-        return A, A + o * back
 
-    def residual(phi: float) -> float:
-        A, Ov = points(phi)
-        return float(np.linalg.norm(rot.T @ A - Ov) - (b - o))
+def rebo_folded_length(numSides: int, neutralLength: float, coneAngle: float) -> float:
+    """Axial length of a REBO in its rigid folded state: d sin(gamma) / sin(beta) (>= d).
 
-    grid = np.linspace(-math.pi, math.pi, 4097)
-    values = np.array([residual(v) for v in grid])
-    roots = []
-    for i in np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) <= 0):
-        lo, hi = grid[i], grid[i + 1]
-        flo = values[i]
-        for _ in range(80):
-            mid = 0.5 * (lo + hi)
-            fm = residual(mid)
-            if (fm <= 0) == (flo <= 0):
-                lo, flo = mid, fm
-            else:
-                hi = mid
-        roots.append(0.5 * (lo + hi))
-    if not roots:
-        raise FoldedFormError(
-            f"no folded REBO layer with neutralLength={d!r}, numLayers={N}, coneAngle={beta!r} "
-            f"for numSides={n}: the layer cannot reach its length with unbent creases"
-        )
-    phi = max(roots)
-    A, Ov = points(phi)
-    return np.array([A[0], A[1], z]), np.array([Ov[0], Ov[1], z])
+    Each of the N layers is 2 l1 sin(gamma) long, l1 = d / (2 N sin(beta)); gamma is
+    :func:`rebo_tilt`. This is the length of the prismatic joint's bellows in the folded form
+    (same unit as ``neutralLength``; independent of r and of the number of layers).
+    """
+    gamma = rebo_tilt(numSides, coneAngle)
+    d = check_positive("neutralLength", neutralLength)
+    return d * math.sin(gamma) / math.sin(coneAngle)
 
 
 def _fold_rebo_vertices(prism: Prism, xy: np.ndarray, d: float, N: int, beta: float):
-    """Positions of REBO vertices given their local flat coordinates (y from 0 to H)."""
-    n, r = prism.numSides, prism.r
+    """Positions of REBO vertices given their local flat coordinates (y from 0 to H).
+
+    The rigid folded state (docs/fold.md): layer rings are the base polygon, 2 l1 sin(gamma)
+    apart and not twisted. The lower quadrilateral (B_{i,k}, B_{i,k+1}, O_{i,k+1}, A_{i,k}) of
+    panel k is the flat quadrilateral turned about its ring edge by gamma towards the axis, so
+    A_{i,k} = B_{i,k} + l1 (cos(gamma) nu_k + sin(gamma) e_a), nu_k the inward normal of panel k,
+    and O_{i,k+1} = A_{i,k} + (b - o) t_k, t_k the direction of the ring edge; the upper
+    quadrilateral is its mirror image in the waist plane. Every face is planar and every crease
+    keeps its length.
+    """
+    n, b = prism.numSides, prism.b
     geo = rebo_geometry(prism, d, N, beta)
-    l1 = geo.l1
-    A0, O0 = _rebo_waist(n, r, d, N, beta)
-    k = np.arange(n)
-    step = 2.0 * math.pi / n
+    l1, o = geo.l1, geo.offset
+    gamma = rebo_tilt(n, beta)
+    layer = 2.0 * l1 * math.sin(gamma)
+    ring = _corners(prism)
+    normal_angle = (np.arange(n) + 1.0) * (2.0 * math.pi / n)  # outward normal of panel k
+    inward = -np.stack([np.cos(normal_angle), np.sin(normal_angle), np.zeros(n)], axis=1)
+    edge = np.roll(ring, -1, axis=0) - ring
+    edge /= np.linalg.norm(edge, axis=1)[:, None]
+    mid = ring + l1 * math.cos(gamma) * inward  # A_{0,k}
+    mid[:, 2] = 0.5 * layer
+    offset_mid = np.roll(mid + (b - o) * edge, 1, axis=0)  # O_{0,k+1} from panel k
     x = prism.columns
     names_xy = []
     names_X = []
-    ring = _corners(prism)
     for i in range(N + 1):
         names_xy.append(np.stack([x, np.full(n, 2.0 * i * l1)], axis=1))
-        names_X.append(ring + np.array([0.0, 0.0, i * d / N]))
+        names_X.append(ring + np.array([0.0, 0.0, i * layer]))
+    offset_x = wrap_x(x - o, prism.W, prism.eps)
     for i in range(N):
-        for point, flat_x in ((A0, x), (O0, wrap_x(x - geo.offset, prism.W, prism.eps))):
-            ang = k * step
-            P3 = np.stack(
-                [
-                    np.cos(ang) * point[0] - np.sin(ang) * point[1],
-                    np.sin(ang) * point[0] + np.cos(ang) * point[1],
-                    np.full(n, point[2] + i * d / N),
-                ],
-                axis=1,
-            )
-            names_xy.append(np.stack([flat_x, np.full(n, (2.0 * i + 1.0) * l1)], axis=1))
-            names_X.append(P3)
+        mid_y = np.full(n, (2.0 * i + 1.0) * l1)
+        rise = np.array([0.0, 0.0, i * layer])
+        names_xy += [np.stack([x, mid_y], axis=1), np.stack([offset_x, mid_y], axis=1)]
+        names_X += [mid + rise, offset_mid + rise]
     X, matched = _assign(
         xy, np.concatenate(names_xy), np.concatenate(names_X), prism.W, 1e-9 * prism.r
     )
@@ -897,7 +898,11 @@ def _fold_rebo_vertices(prism: Prism, xy: np.ndarray, d: float, N: int, beta: fl
 
 
 def _fold_prismatic(prism: Prism, pattern: TubularPattern, d: float, N: int, beta: float):
-    """Sleeve, lining folded back inside it, REBO, piston (spec 3.8 folded reading, B7)."""
+    """Sleeve, lining folded back inside it, REBO, piston (spec 3.8 folded reading, B7).
+
+    The bellows is in its rigid folded state, of length d' = :func:`rebo_folded_length`, so the
+    joint folds to d' + L.
+    """
     geo = rebo_geometry(prism, d, N, beta)
     L = geo.height
     xy = pattern.vertices_coords
@@ -913,5 +918,6 @@ def _fold_prismatic(prism: Prism, pattern: TubularPattern, d: float, N: int, bet
     local = xy[rebo].copy()
     local[:, 1] -= 2.0 * L
     X[rebo] = _fold_rebo_vertices(prism, local, d, N, beta)
-    X[piston, 2] = d + (y[piston] - 3.0 * L)
-    return X, _translation(d + L)
+    length = rebo_folded_length(prism.numSides, d, beta)
+    X[piston, 2] = length + (y[piston] - 3.0 * L)
+    return X, _translation(length + L)

@@ -4,7 +4,11 @@
   index ranges, assignments, angles, faces, frames), written from the FOLD specification.
 * :func:`polygon_errors` compares base rings with the regular polygon around a Dubins frame.
 * :func:`chain_pieces` splits a chain pattern's module records into its joints and links, and
-  :func:`prismatic_offsets` gives the translation that spec B7 adds after each prismatic joint.
+  :func:`prismatic_offsets` gives the translation that spec B7 (and the rigid bellows) adds
+  after each prismatic joint.
+* :func:`face_congruence` and :func:`face_planarity` measure how far a folded face is from a
+  rigid copy of its flat polygon; :func:`rebo_rigid_length` is the length of a bellows whose
+  faces stay rigid.
 """
 
 from __future__ import annotations
@@ -118,6 +122,33 @@ def face_planarity(points: np.ndarray) -> float:
     return float(np.abs(c @ normal).max())
 
 
+def face_congruence(flat: np.ndarray, folded: np.ndarray) -> float:
+    """Largest |3D distance - flat distance| over all vertex pairs of one face.
+
+    Zero exactly when the folded face is a rigid (possibly mirrored) copy of the flat polygon,
+    so every straight segment drawn across the face keeps its length.
+    """
+    d2 = np.linalg.norm(flat[:, None] - flat[None], axis=2)
+    d3 = np.linalg.norm(folded[:, None] - folded[None], axis=2)
+    return float(np.abs(d3 - d2).max())
+
+
+def rebo_rigid_length(n: int, d: float, cone_angle: float) -> float:
+    """Axial length of a REBO of neutral length d folded with rigid faces (spec 3.7 geometry).
+
+    Derivation (independent of the package): turn every lower quadrilateral of a layer about
+    its ring edge by the inclination g towards the axis. Its midline corners then sit l1 cos g
+    inside the ring edge, along the panel's inward normal, at height l1 sin g. The pleat
+    crease O_k-A_k (flat length o) joins the corners of two neighbouring panels, whose normals
+    differ by 2 pi / n: its squared 3D length is o^2 - 2 o l1 cos g sin(2 pi/n)
+    + 2 (l1 cos g)^2 (1 - cos(2 pi/n)), which equals o^2 iff l1 cos g = o cot(pi/n). With
+    l1 = d / (2 N sin(beta)) and o = l1 tan(pi cos(beta) / n) every layer is 2 l1 sin g long, so
+    the N layers are d sin g / sin(beta) long.
+    """
+    cos_g = math.tan(math.pi * math.cos(cone_angle) / n) / math.tan(math.pi / n)
+    return d * math.sqrt(1.0 - cos_g**2) / math.sin(cone_angle)
+
+
 def polygon_corners(frame: np.ndarray, n: int, r: float) -> np.ndarray:
     """Corners of the regular n-gon of circumradius r about a Dubins frame's origin, in its
     y-z plane (perpendicular to the path direction x), at angles (k + 1/2) 2 pi / n from y."""
@@ -168,14 +199,17 @@ def chain_pieces(chain, twistPortion: float = 0.2) -> list[tuple[str, int, objec
 
 
 def prismatic_offsets(chain, pieces) -> list[np.ndarray]:
-    """World translation, per piece, that spec B7 adds: L = d / sin(coneAngle) along the axis
-    of every prismatic joint before the piece's end (the prismatic's own distal end included)."""
+    """World translation, per piece, that the folded prismatic joints add: each folds to
+    d' + L instead of the kinematic d (spec B7: the sleeve adds L = d / sin(coneAngle); the
+    rigid bellows is d' = :func:`rebo_rigid_length` long), along its axis, for every prismatic
+    joint before the piece's end (the prismatic's own distal end included)."""
     offsets = []
     total = np.zeros(3)
     for kind, _, obj, _, _ in pieces:
         before = total.copy()
         if kind == "joint" and type(obj).__name__ == "PrismaticJoint":
-            L = obj.neutralLength / math.sin(obj.coneAngle)
-            total = total + L * obj.pose_matrix[:3, 2]
+            d, beta = obj.neutralLength, obj.coneAngle
+            extra = d / math.sin(beta) + rebo_rigid_length(chain.numSides, d, beta) - d
+            total = total + extra * obj.pose_matrix[:3, 2]
         offsets.append((before, total.copy()))
     return offsets
