@@ -49,7 +49,9 @@ def main(path: Path = HERE / "fold_example1.png") -> Path:
     form = folded_form(chain)
     graph = sheet_graph(chain)
     X = graph.vertices_3d
-    joint = np.zeros(form.pattern.numVertices, dtype=bool)
+    # sized by the sheet's (unsnapped) pattern: vertices that fix B6 merged in the catalog come
+    # after the catalog's and count as link vertices
+    joint = np.zeros(graph.pattern.numVertices, dtype=bool)
     for module in form.modules:
         if module.kind in JOINT_KINDS:
             joint[module.vertices] = True

@@ -3,10 +3,13 @@
 FOLD (https://github.com/edemaine/fold) is the JSON origami format read by Origami Simulator and
 Rabbit Ear. The file written here has
 
-* frame 0, class ``creasePattern``: the flattened sheet of spec/patterns.md section 5 (the same
-  sheet as the DXF and SVG files: x in [-b/2, W + b/2], y in [y0, y0 + H], the glue tab being the
-  second copy of the starting panel) as a planar graph. Every crease is cut where it meets the
-  sheet's vertical edges, the outline is split at every vertex on it, and the faces are the
+* frame 0, class ``creasePattern``: the flattened sheet of spec/patterns.md section 5 (the sheet of
+  the DXF and SVG files: x in [-b/2, W + b/2], y in [y0, y0 + H], the glue tab being the second copy
+  of the starting panel) as a planar graph, drawn from the pattern's unsnapped geometry
+  (:func:`kinegami.pattern.folded.unsnapped_form`: no vertex moved by the catalog's eps = 1e-4 b
+  rules, so the folded form keeps every edge length; it differs from the DXF sheet by less than eps,
+  or up to 2e-4 r next to an elbow column collapsed by fix B6). Every crease is cut where it meets
+  the sheet's vertical edges, the outline is split at every vertex on it, and the faces are the
   faces of that planar graph, counter-clockwise, printed side up (+z);
 * ``edges_assignment``: ``M`` and ``V`` for the creases, ``B`` for the sheet outline (including
   creases lying on the top or bottom edge, spec B10, and the glue tab's outer edge). The sheet
@@ -84,6 +87,9 @@ class SheetGraph:
         -1 outside the sheet.
     width, sideLength, y0, height : float
         W, b, the bottom edge and the height H of the sheet.
+    pattern : TubularPattern or None
+        The pattern the sheet was drawn from (for a catalog pattern its unsnapped geometry),
+        whose vertices ``source`` and ``between`` index and whose creases ``crease`` indexes.
     """
 
     vertices: np.ndarray
@@ -99,6 +105,7 @@ class SheetGraph:
     sideLength: float
     y0: float
     height: float
+    pattern: Any = None
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
@@ -118,6 +125,14 @@ class SheetGraph:
 def sheet_graph(pattern_or_chain, *, folded: bool = True, frame=None, twistPortion=0.2):
     """The sheet of a pattern (or of a chain's crease pattern) as a planar graph with faces.
 
+    The sheet is that of the pattern's unsnapped geometry
+    (:func:`kinegami.pattern.folded.unsnapped_form`): where the catalog moved vertices (fix B6, seam
+    snapping) they stay where the module formulas put them, so the folded form keeps every edge
+    length; the sheet differs from the DXF sheet by less than eps = 1e-4 b, or up to 2e-4 r next to
+    an elbow column collapsed by B6 (docs/fold.md). ``source`` indexes the vertices of that
+    unsnapped pattern (``pattern`` attribute of the result), whose vertex i is vertex i of the given
+    pattern for every i below its vertex count.
+
     Parameters
     ----------
     pattern_or_chain : TubularPattern or KinematicChain
@@ -136,13 +151,13 @@ def sheet_graph(pattern_or_chain, *, folded: bool = True, frame=None, twistPorti
         If the sheet has zero area, or its creases cross or overlap so that the faces do not
         tile the sheet.
     """
-    from kinegami.pattern.folded import _resolve_input, folded_form
+    from kinegami.pattern.folded import _resolve_input, unsnapped_form
 
     pattern, base = _resolve_input(pattern_or_chain, twistPortion)
-    X = None
-    if folded:
-        X = folded_form(pattern, frame=base if frame is None else frame).vertices
-    return _build_graph(pattern, X)
+    if not pattern.modules and not folded:  # a hand-made pattern: its own geometry
+        return _build_graph(pattern, None)
+    form = unsnapped_form(pattern, frame=base if frame is None else frame)
+    return _build_graph(form.pattern, form.vertices if folded else None)
 
 
 def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
@@ -256,7 +271,9 @@ def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
         clip = ~own
         uu, ww, tt = itp[clip, 0].astype(int), itp[clip, 1].astype(int), itp[clip, 2]
         V3[clip] = X3[uu] + tt[:, None] * (X3[ww] - X3[uu])
-    return SheetGraph(P, V3, src, itp, edges, assignment, crease, faces, edge_faces, W, b, y0, H)
+    return SheetGraph(
+        P, V3, src, itp, edges, assignment, crease, faces, edge_faces, W, b, y0, H, pattern
+    )
 
 
 def _add_outline(P, edges, assignment, crease, xmin, xmax, y0, H, tol):

@@ -23,10 +23,14 @@ pattern rather than the kinematic model, because the pattern cannot fold otherwi
 
 Where the spec gives no positions (the REBO bellows, the nested sink layers of the revolute
 joint, the free crimp flaps of the revolute joint and tips) docs/fold.md says which isometric
-realisation is used; every face is then a rigid, planar copy of its flat polygon. Vertices the
-pattern moved by less than eps (elbow columns snapped by fix B6, seam snapping of section 2.1)
-are put back on an isometry of the creases by a damped least-squares solve; the faces next to
-them bend slightly (docs/fold.md).
+realisation is used; every face is then a rigid, planar copy of its flat polygon.
+
+Snapped vertices. The catalog moves some vertices by a little (elbow columns merged or collapsed
+by fix B6, points snapped onto the seam, section 2.1); no fold of those keeps every length.
+:func:`unsnapped_form` rebuilds the modules without those rules (a few more vertices and short
+creases) and folds them exactly: the FOLD exporter writes that sheet. :func:`folded_form` keeps
+the catalog's vertices and puts the ones around snapped vertices back on an isometry of the
+creases by a damped least-squares solve; the faces next to them bend slightly (docs/fold.md).
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ from kinegami.pattern._prism import Prism, make_prism, periodic_dx, wrap_x
 from kinegami.pattern.elbow import elbow_geometry
 from kinegami.pattern.prismatic import rebo_geometry
 from kinegami.pattern.revolute import revolute_geometry
+from kinegami.pattern.sheet import TOLERANCE_FACTOR
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 from kinegami.pattern.twist import twist_geometry
 from kinegami.validation import check_in_range, check_num_sides, check_positive
@@ -50,11 +55,13 @@ __all__ = [
     "FoldedForm",
     "FoldedModule",
     "FoldedFormError",
+    "UnsnappedForm",
     "folded_form",
     "folded_vertices",
     "module_fold",
     "rebo_folded_length",
     "rebo_tilt",
+    "unsnapped_form",
     "UVA_TO_DUBINS",
 ]
 
@@ -66,6 +73,11 @@ UVA_TO_DUBINS = np.array(
 
 #: Crease length errors above this many r trigger the Gauss-Newton repair.
 REPAIR_TOLERANCE = 1e-10
+
+#: Points of an unsnapped module closer than this many r are one vertex: they coincide to the
+#: tolerance of the flat sheet (kinegami.pattern.sheet.TOLERANCE_FACTOR), below which the sheet's
+#: planar graph cannot tell points apart.
+MERGE_TOLERANCE = TOLERANCE_FACTOR
 
 
 class FoldedFormError(InvalidParameterError):
@@ -113,8 +125,8 @@ class FoldedForm:
     modules : tuple of FoldedModule
         The modules in order, with their vertices and world end frames.
     repaired : numpy.ndarray of int
-        Indices of the vertices moved by the isometry repair (near vertices the pattern had
-        snapped by less than eps = 1e-4 b); empty for exact patterns.
+        Indices of the vertices moved by the isometry repair (near vertices the catalog had
+        snapped, fix B6 and seam snapping); empty for exact patterns.
     maxLengthError : float
         Largest |3D length - flat length| over all creases after folding (pattern units).
     """
@@ -135,6 +147,60 @@ class FoldedForm:
         e = self.pattern.edges_vertices
         d3 = np.linalg.norm(self.vertices[e[:, 1]] - self.vertices[e[:, 0]], axis=1)
         return d3 - self.pattern.edge_lengths()
+
+
+@dataclass(frozen=True, eq=False)
+class UnsnappedForm:
+    """A pattern's unsnapped geometry and its exact folded form (what the FOLD file writes).
+
+    The catalog moves some vertices a little (elbow columns merged with their base or collapsed onto
+    the midline by fix B6: less than eps = 1e-4 b, or up to about 2e-4 r for a column collapsed by
+    its tuck offset; points snapped onto the seam, spec 2.1: less than eps); no folded form of those
+    vertices keeps every crease length. The unsnapped pattern puts every vertex where the module
+    formulas put it (a few more vertices and short creases where B6 merged points), so its fold is
+    piecewise isometric: every face is a planar rigid copy of its flat polygon.
+
+    Attributes
+    ----------
+    pattern : TubularPattern
+        The unsnapped pattern: vertex i < ``catalog.numVertices`` stands for vertex i of the
+        catalog pattern (at most about eps away in the plane, see :meth:`displacement`); the
+        vertices that only the unsnapped geometry has follow. Same n, r, height, markers' y and
+        module records as the catalog pattern; creases labelled by the catalog's rules.
+    catalog : TubularPattern
+        The pattern that was given (as built by the catalog).
+    vertices : numpy.ndarray, shape (N', 3)
+        World position of every vertex of ``pattern`` at joint state 0 (pattern units).
+    modules : tuple of FoldedModule
+        The modules in order (``vertices``: their vertices in ``pattern``) with world end frames.
+    maxLengthError : float
+        Largest |3D length - flat length| over the creases of ``pattern`` (pattern units).
+    """
+
+    pattern: TubularPattern
+    catalog: TubularPattern
+    vertices: np.ndarray
+    modules: tuple[FoldedModule, ...]
+    maxLengthError: float
+
+    @property
+    def extraVertices(self) -> int:
+        """Number of vertices that only the unsnapped pattern has (merged by fix B6)."""
+        return self.pattern.numVertices - self.catalog.numVertices
+
+    def length_errors(self) -> np.ndarray:
+        """3D length minus flat length of every crease of ``pattern``, shape (M,)."""
+        return _length_errors(self.pattern, self.vertices)
+
+    def displacement(self) -> np.ndarray:
+        """Flat distance from every catalog vertex to the unsnapped vertex standing for it (the
+        shortest way on the tube), shape (N,), pattern units: 0 except where a point was
+        snapped onto the seam, and below eps = 1e-4 b unless two snaps add up (a twist's
+        reference point snapped onto the seam moves every later module by less than eps). The
+        vertices that B6 merged are not included (they are ``extraVertices``)."""
+        N = self.catalog.numVertices
+        d = self.pattern.vertices_coords[:N] - self.catalog.vertices_coords
+        return np.hypot(periodic_dx(d[:, 0], self.catalog.width), d[:, 1])
 
 
 # ------------------------------------------------------------------------------------------------
@@ -187,6 +253,32 @@ def folded_form(pattern_or_chain, frame=None, twistPortion: float = 0.2) -> Fold
         base = _frame_array(frame)
     G0 = base @ UVA_TO_DUBINS
     return _fold(pattern, G0)
+
+
+def unsnapped_form(pattern_or_chain, frame=None, twistPortion: float = 0.2) -> UnsnappedForm:
+    """The unsnapped geometry of a pattern or chain and its exact folded form.
+
+    Takes the arguments of :func:`folded_vertices`. Every module is rebuilt from its record
+    without the catalog's eps rules (see :class:`UnsnappedForm`) and the modules are composed as
+    in spec 2.2 but with x reduced modulo W only. The FOLD exporter writes this sheet.
+
+    Raises
+    ------
+    InvalidTypeError, FoldedFormError
+        As :func:`folded_form`.
+
+    Examples
+    --------
+    >>> from kinegami.pattern import ElbowFittingPattern
+    >>> p = ElbowFittingPattern(6, 1.0, np.pi / 2, 0.0)  # column 4 has h_4 = 0 (worked example B)
+    >>> u = unsnapped_form(p)
+    >>> u.extraVertices, bool(u.maxLengthError < 1e-12)
+    (0, True)
+    """
+    pattern, base = _resolve_input(pattern_or_chain, twistPortion)
+    if frame is not None:
+        base = _frame_array(frame)
+    return _fold_unsnapped(pattern, base @ UVA_TO_DUBINS)
 
 
 def module_fold(pattern: TubularPattern) -> tuple[np.ndarray, np.ndarray | None]:
@@ -250,7 +342,19 @@ def _freeze(params) -> tuple:
 # Composition replay (spec section 2.2) and assembly
 
 
-def _fold(pattern: TubularPattern, G0: np.ndarray) -> FoldedForm:
+@dataclass(frozen=True, eq=False)
+class _Placement:
+    """Where one catalog module went in the composite: global index of each local vertex and
+    which of them it added (the others are its proximal base, shared with the module before)."""
+
+    record: ModuleRecord
+    mapping: np.ndarray
+    is_new: np.ndarray
+
+
+def _replay(pattern: TubularPattern) -> list[_Placement]:
+    """Replay the composition of ``pattern.modules`` (spec 2.2) and check that it rebuilds the
+    pattern's vertices; returns the placement of every module."""
     if not pattern.modules:
         raise FoldedFormError(
             "cannot fold a pattern without module records (kind 'custom'): only patterns made "
@@ -259,20 +363,14 @@ def _fold(pattern: TubularPattern, G0: np.ndarray) -> FoldedForm:
     n, r = pattern.numSides, pattern.r
     prism = make_prism(n, r)
     W, eps = prism.W, prism.eps
-    X = np.full((pattern.numVertices, 3), np.nan)
     coords = np.full((pattern.numVertices, 2), np.nan)
-    pinned = np.zeros(pattern.numVertices, dtype=bool)
-    modules = []
-    G = np.array(G0, dtype=float)
+    placements = []
     marker = np.array(pattern.proximalMarker, dtype=float)
     distal_idx = None
     distal_xy = None
     next_index = 0
-    seam_error = 0.0
-    repaired = [np.zeros(0, dtype=np.intp)]
     for m, record in enumerate(pattern.modules):
         local = _rebuild(n, r, record, m)
-        Xl, T, fixed = _module_geometry(n, r, record.kind, _freeze(record.params))
         offset = marker - local.proximalMarker
         xy = local.vertices_coords + offset
         xy[:, 0] = wrap_x(xy[:, 0], W, eps)
@@ -293,20 +391,8 @@ def _fold(pattern: TubularPattern, G0: np.ndarray) -> FoldedForm:
         next_index += count
         if next_index > pattern.numVertices:
             raise _mismatch(m, record, "more vertices than the pattern has")
-        world = (G[:3, :3] @ Xl.T).T + G[:3, 3]
-        old = mapping[~is_new]
-        if old.size:
-            seam_error = max(seam_error, float(np.abs(X[old] - world[~is_new]).max()))
-        X[mapping[is_new]] = world[is_new]
         coords[mapping[is_new]] = xy[is_new]
-        for base in (local.proximalBase, local.distalBase):
-            if base is not None:
-                pinned[mapping[base]] = True
-        proximal = G @ UVA_TO_DUBINS.T
-        G = G @ T
-        distal = G @ UVA_TO_DUBINS.T
-        modules.append(FoldedModule(record, _readonly(mapping.copy()), proximal, distal))
-        repaired.append(mapping[fixed])
+        placements.append(_Placement(record, mapping, is_new))
         marker = local.distalMarker + offset
         marker[0] = wrap_x(marker[0:1], W, eps)[0]
         if local.distalBase is None:
@@ -323,6 +409,36 @@ def _fold(pattern: TubularPattern, G0: np.ndarray) -> FoldedForm:
             "the pattern's module records do not rebuild its vertices (largest difference "
             f"{max(np.abs(dx).max(), np.abs(dy).max()):.3g}); was it reversed or edited by hand?"
         )
+    return placements
+
+
+def _fold(pattern: TubularPattern, G0: np.ndarray) -> FoldedForm:
+    placements = _replay(pattern)
+    n, r = pattern.numSides, pattern.r
+    X = np.full((pattern.numVertices, 3), np.nan)
+    pinned = np.zeros(pattern.numVertices, dtype=bool)
+    modules = []
+    G = np.array(G0, dtype=float)
+    seam_error = 0.0
+    repaired = [np.zeros(0, dtype=np.intp)]
+    for placement in placements:
+        record, mapping, is_new = placement.record, placement.mapping, placement.is_new
+        fold = _module_fold(n, r, record.kind, _freeze(record.params))
+        world = (G[:3, :3] @ fold.X.T).T + G[:3, 3]
+        old = mapping[~is_new]
+        if old.size:
+            seam_error = max(seam_error, float(np.abs(X[old] - world[~is_new]).max()))
+        X[mapping[is_new]] = world[is_new]
+        catalog = fold.catalog
+        for base in (catalog.proximalBase, catalog.distalBase):
+            if base is not None:
+                pinned[mapping[base]] = True
+        proximal = G @ UVA_TO_DUBINS.T
+        G = G @ fold.T
+        modules.append(
+            FoldedModule(record, _readonly(mapping.copy()), proximal, G @ UVA_TO_DUBINS.T)
+        )
+        repaired.append(mapping[fold.repaired])
     if seam_error > 1e-6 * r:  # pragma: no cover - would be a bug in a module's geometry
         raise FoldedFormError(f"module ends do not meet in 3D (gap {seam_error:.3g})")
     # composition may have snapped vertices near the seam (section 2.1): repair those too
@@ -331,6 +447,89 @@ def _fold(pattern: TubularPattern, G0: np.ndarray) -> FoldedForm:
     errors = _length_errors(pattern, X)
     X.flags.writeable = False
     return FoldedForm(pattern, X, tuple(modules), repaired, float(np.abs(errors).max(initial=0.0)))
+
+
+def _fold_unsnapped(pattern: TubularPattern, G0: np.ndarray) -> UnsnappedForm:
+    """Compose the unsnapped modules (:func:`unsnapped_form`) and fold them.
+
+    The composition is that of spec 2.2 without the eps rules: x is reduced modulo W only (no
+    snapping onto the seam, also for the markers), and every module is placed with the exact
+    marker. Vertex i < N of the result is vertex i of ``pattern`` (the correspondence comes
+    from the replay of the catalog composition); the vertices that only the unsnapped modules
+    have follow, numbered in module order.
+    """
+    placements = _replay(pattern)
+    n, r = pattern.numSides, pattern.r
+    prism = make_prism(n, r)
+    W = prism.W
+    N = pattern.numVertices
+    coords = [np.full((N, 2), np.nan)]
+    X = [np.full((N, 3), np.nan)]
+    edges, labels, modules = [], [], []
+    next_extra = N
+    gap = 0.0
+    G = np.array(G0, dtype=float)
+    marker = np.array(pattern.proximalMarker, dtype=float)
+    for placement in placements:
+        record, mapping, is_new = placement.record, placement.mapping, placement.is_new
+        fold = _module_fold(n, r, record.kind, _freeze(record.params))
+        exact = fold.exact
+        offset = marker - exact.proximalMarker
+        xy = exact.vertices_coords + offset
+        xy[:, 0] = _mod_w(xy[:, 0], W)
+        world = (G[:3, :3] @ fold.X_exact.T).T + G[:3, 3]
+        emap = np.full(exact.numVertices, -1, dtype=np.intp)
+        emap[fold.corr] = mapping
+        extra = emap < 0
+        count = int(np.count_nonzero(extra))
+        emap[extra] = np.arange(next_extra, next_extra + count)
+        next_extra += count
+        new = extra.copy()
+        new[fold.corr[is_new]] = True
+        shared = emap[~new]
+        if shared.size:  # the proximal base: must meet the previous distal base exactly
+            flat = coords[0][shared] - xy[~new]
+            flat[:, 0] = periodic_dx(flat[:, 0], W)
+            gap = max(
+                gap, float(np.abs(flat).max()), float(np.abs(X[0][shared] - world[~new]).max())
+            )
+        own = new & ~extra
+        coords[0][emap[own]] = xy[own]
+        X[0][emap[own]] = world[own]
+        coords.append(xy[extra])
+        X.append(world[extra])
+        edges.append(emap[exact.edges_vertices])
+        labels.append(exact.edges_assignment)
+        proximal = G @ UVA_TO_DUBINS.T
+        G = G @ fold.T
+        modules.append(FoldedModule(record, _readonly(emap), proximal, G @ UVA_TO_DUBINS.T))
+        marker = exact.distalMarker + offset
+        marker[0] = _mod_w(marker[0:1], W)[0]
+    if gap > 1e-9 * r:  # pragma: no cover - would be a bug in a module's unsnapped geometry
+        raise FoldedFormError(f"unsnapped module ends do not meet (gap {gap:.3g})")
+    coords = np.concatenate(coords)
+    X = np.concatenate(X)
+    edges = np.concatenate(edges)
+    labels = np.concatenate(labels)
+    # spec 2.2 step 5: a crease joining the same two vertices as an earlier one is dropped
+    lo = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64)
+    hi = np.maximum(edges[:, 0], edges[:, 1]).astype(np.int64)
+    first = np.unique(lo * coords.shape[0] + hi, return_index=True)[1]
+    first.sort()
+    edges, labels = edges[first], labels[first]
+    exact = TubularPattern._build(
+        n, r, coords, np.ascontiguousarray(edges), labels,
+        None if pattern.proximalBase is None else pattern.proximalBase.copy(),
+        None if pattern.distalBase is None else pattern.distalBase.copy(),
+        np.array(pattern.proximalMarker, dtype=float), marker, pattern.height, pattern.modules,
+    )  # fmt: skip
+    short = exact.edge_lengths() < MERGE_TOLERANCE * r
+    if short.any():  # pragma: no cover - the unsnapped modules merge coincident vertices
+        raise FoldedFormError(f"{int(short.sum())} unsnapped creases have zero length")
+    errors = _length_errors(exact, X)
+    for a in (coords, X):
+        a.flags.writeable = False
+    return UnsnappedForm(exact, pattern, X, tuple(modules), float(np.abs(errors).max(initial=0.0)))
 
 
 def _mismatch(m: int, record: ModuleRecord, what: str) -> FoldedFormError:
@@ -414,9 +613,9 @@ def _repair_isometry(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Move vertices so every crease has its flat length (weighted min-norm Gauss-Newton).
 
-    Only needed where the pattern moved vertices by less than eps (B6 snapping of elbow
-    columns, snapping onto the seam, section 2.1): the exact module geometry then misses some
-    flat lengths by O(eps). The ends of those creases move. Pinned vertices (base rings) stay
+    Only needed where the pattern moved vertices a little (B6 snapping of elbow columns,
+    snapping onto the seam, section 2.1): the exact module geometry then misses some flat
+    lengths by O(eps). The ends of those creases move. Pinned vertices (base rings) stay
     on their frames unless ``release`` and a crease between two pinned vertices is wrong (a base
     vertex snapped onto the seam), or creases stay wrong with the base vertices fixed (a vertex
     next to a base snapped onto the seam): their base vertices then move too, 400 times more
@@ -555,52 +754,188 @@ def _corners(prism: Prism, angle_offset: float = 0.0) -> np.ndarray:
     return prism.r * np.stack([np.cos(beta), np.sin(beta), np.zeros_like(beta)], axis=1)
 
 
+def _mod_w(x: np.ndarray, W: float) -> np.ndarray:
+    """x reduced into [0, W) without snapping (spec 2.1 less its eps rule)."""
+    x = np.mod(x, W)
+    return np.where(x >= W, 0.0, x)
+
+
+@dataclass(frozen=True, eq=False)
+class _ModuleFold:
+    """A catalog module folded at state 0, in its proximal frame (e_u, e_v, e_a).
+
+    ``exact`` is the module without the eps rules (:func:`_exact_module`) and ``X_exact`` its
+    exact, piecewise isometric fold; ``corr[j]`` is the vertex of ``exact`` that vertex j of the
+    catalog module stands for. ``X`` is the catalog module's fold: ``X_exact[corr]``, put back on
+    an isometry of its creases where the catalog moved vertices (``repaired``, local indices).
+    """
+
+    catalog: TubularPattern
+    exact: TubularPattern
+    X_exact: np.ndarray
+    T: np.ndarray
+    corr: np.ndarray
+    X: np.ndarray
+    repaired: np.ndarray
+
+
 @functools.lru_cache(maxsize=512)
-def _module_geometry(n: int, r: float, kind: str, params: tuple):
-    """(X, T, repaired): local vertex positions of a catalog module, its proximal-to-distal
-    transform and the local indices of the vertices moved by the isometry repair (elbow columns
-    the catalog snapped by less than eps, fix B6)."""
+def _module_fold(n: int, r: float, kind: str, params: tuple) -> _ModuleFold:
+    """The folded module of a record (cached): see :class:`_ModuleFold`."""
     prism = make_prism(n, r)
-    pattern = _rebuild_cached(n, r, kind, params)
+    catalog = _rebuild_cached(n, r, kind, params)
     p = dict(params)
-    xy = pattern.vertices_coords
+    exact, corr = _exact_module(prism, catalog, kind, p)
+    xy = exact.vertices_coords
     if kind in ("tube", "waypoint"):
         X = _polygon_point(prism, xy[:, 0])
         X[:, 2] = xy[:, 1]
-        T = _translation(pattern.height)
+        T = _translation(exact.height)
     elif kind == "twist":
-        X, T = _fold_twist(prism, pattern, p["twistAngle"], p["moduleHeight"])
+        X, T = _fold_twist(prism, exact, p["twistAngle"], p["moduleHeight"])
     elif kind == "elbow":
-        X, T = _fold_elbow(prism, pattern, p["bendingAngle"], p["rotationalAxisAngle"])
+        X, T = _fold_elbow(prism, exact, p["bendingAngle"], p["rotationalAxisAngle"])
     elif kind == "revolute":
         h_r = prism.a * math.tan(p["totalBendingAngle"] / 4.0)
-        X = _fold_revolute(prism, pattern, h_r, with_distal=True)
+        X = _fold_revolute(prism, exact, h_r, with_distal=True)
         T = _translation(2.0 * h_r)
     elif kind == "end_tip":
-        X = _fold_revolute(prism, pattern, p["length"], with_distal=False)
+        X = _fold_revolute(prism, exact, p["length"], with_distal=False)
         T = _translation(p["length"])
     elif kind == "start_tip":
         ell = p["length"]
         mirrored = xy.copy()
-        mirrored[:, 1] = pattern.height - xy[:, 1]
-        X = _fold_revolute(prism, pattern, ell, with_distal=False, xy=mirrored)
+        mirrored[:, 1] = exact.height - xy[:, 1]
+        X = _fold_revolute(prism, exact, ell, with_distal=False, xy=mirrored)
         X[:, 2] = ell - X[:, 2]
         T = _translation(ell)
     elif kind == "rebo":
         X = _fold_rebo_vertices(prism, xy, p["neutralLength"], p["numLayers"], p["coneAngle"])
         T = _translation(rebo_folded_length(n, p["neutralLength"], p["coneAngle"]))
     elif kind == "prismatic":
-        X, T = _fold_prismatic(prism, pattern, p["neutralLength"], p["numLayers"], p["coneAngle"])
+        X, T = _fold_prismatic(prism, exact, p["neutralLength"], p["numLayers"], p["coneAngle"])
     else:  # pragma: no cover - _rebuild_cached rejects unknown kinds first
         raise KeyError(kind)
-    pinned = np.zeros(pattern.numVertices, dtype=bool)
-    for base in (pattern.proximalBase, pattern.distalBase):
+    pinned = np.zeros(catalog.numVertices, dtype=bool)
+    for base in (catalog.proximalBase, catalog.distalBase):
         if base is not None:
             pinned[base] = True
-    X, repaired = _repair_isometry(pattern, X, pinned, release=False)
-    for a in (X, T, repaired):
+    X_catalog, repaired = _repair_isometry(catalog, X[corr], pinned, release=False)
+    for a in (X, T, corr, X_catalog, repaired):
         a.flags.writeable = False
-    return X, T, repaired
+    return _ModuleFold(catalog, exact, X, T, corr, X_catalog, repaired)
+
+
+def _module_geometry(n: int, r: float, kind: str, params: tuple):
+    """(X, T, repaired): the catalog module's local vertex positions, its proximal-to-distal
+    transform and the local indices of the vertices moved by the isometry repair."""
+    fold = _module_fold(n, r, kind, params)
+    return fold.X, fold.T, fold.repaired
+
+
+def _exact_module(prism: Prism, catalog: TubularPattern, kind: str, p: dict):
+    """The module without the eps rules, and the vertex of it each catalog vertex stands for.
+
+    The catalog moves some points a little: it snaps points within eps = 1e-4 b of the seam
+    onto it (section 2.1; inside a module: a twist's distal base and marker, a REBO's pleat
+    offset points, an elbow's offset points) and, in an elbow, merges the tuck vertices of
+    columns with h_k < eps with P_k and D_k and collapses columns close to the midline into one
+    vertex (fix B6). The unsnapped module keeps those points where the module's formulas put
+    them, so that its exact fold is an isometry; only vertices closer than
+    ``MERGE_TOLERANCE`` r are one vertex. Every other module is its catalog module.
+    """
+    identity = np.arange(catalog.numVertices)
+    W, b = prism.W, prism.b
+    xy = catalog.vertices_coords.copy()
+    distal_marker = catalog.distalMarker.copy()
+    if kind == "elbow":
+        exact = _exact_elbow(prism, p["bendingAngle"], p["rotationalAxisAngle"], catalog.modules)
+        return exact, _match_vertices(catalog.vertices_coords, exact.vertices_coords, prism)
+    if kind == "twist":
+        geo = twist_geometry(prism, p["twistAngle"], p["moduleHeight"])
+        if geo.degenerate:
+            return catalog, identity
+        xy[catalog.distalBase, 0] = _mod_w(prism.columns + geo.shift, W)
+        distal_marker[0] = _mod_w(np.array([geo.K * b + geo.shift]), W)[0]
+    elif kind in ("rebo", "prismatic"):
+        geo = rebo_geometry(prism, p["neutralLength"], p["numLayers"], p["coneAngle"])
+        # the only points of these modules that can be snapped: the pleat offsets of column 0
+        snapped = xy[:, 0] == 0.0
+        if not snapped.any():
+            return catalog, identity
+        xy[snapped, 0] = _mod_w(prism.columns[:1] - geo.offset, W)[0]
+    else:
+        return catalog, identity
+    exact = TubularPattern._build(
+        prism.numSides, prism.r, xy, catalog.edges_vertices.copy(),
+        catalog.edges_assignment.copy(), catalog.proximalBase.copy(), catalog.distalBase.copy(),
+        catalog.proximalMarker.copy(), distal_marker, catalog.height, catalog.modules,
+    )  # fmt: skip
+    return exact, identity
+
+
+def _exact_elbow(prism: Prism, theta: float, phi: float, records) -> TubularPattern:
+    """The elbow of spec 3.3 with four tuck vertices L, M, O, U on every column (no eps rules).
+
+    Vertices closer than ``MERGE_TOLERANCE`` r are merged (exactly collapsed columns, h_k = 0),
+    the creases between merged vertices dropped and repeated creases kept once, the first in
+    the spec's order (so two adjacent collapsed columns share one M crease, as in step 5).
+    """
+    geo = elbow_geometry(prism, theta, phi)
+    n, W = prism.numSides, prism.W
+    x = prism.columns
+    h, H_m = geo.h, geo.H_m
+    H = 2.0 * H_m
+    k = np.arange(n)
+    P, D = k, n + k
+    L, M, Of, U = 2 * n + 4 * k, 2 * n + 4 * k + 1, 2 * n + 4 * k + 2, 2 * n + 4 * k + 3
+    xy = np.empty((6 * n, 2))
+    xy[P] = np.stack([x, np.zeros(n)], axis=1)
+    xy[D] = np.stack([x, np.full(n, H)], axis=1)
+    xy[L] = np.stack([x, h], axis=1)
+    xy[M] = np.stack([x, np.full(n, H_m)], axis=1)
+    xy[Of] = np.stack([_mod_w(x + (H_m - h) * np.tan(geo.tuck), W), np.full(n, H_m)], axis=1)
+    xy[U] = np.stack([x, H - h], axis=1)
+    prev, nxt = (k - 1) % n, (k + 1) % n
+    table = [  # spec 3.3 step 3, in the catalog's order
+        (L[prev], L, "M"), (P, L, "M"), (U[prev], U, "M"), (U, D, "M"), (M, Of, "V"),
+        (Of, M[nxt], "V"), (L, M, "V"), (M, U, "M"), (L, Of, "M"), (U, Of, "V"),
+    ]  # fmt: skip
+    edges = np.concatenate([np.stack([a, c], axis=1) for a, c, _ in table])
+    labels = np.concatenate([np.full(n, lab, dtype="<U1") for _, _, lab in table])
+    # merge coincident vertices into the lowest index (P and D come first)
+    dx = periodic_dx(xy[:, None, 0] - xy[None, :, 0], W)
+    close = np.hypot(dx, xy[:, None, 1] - xy[None, :, 1]) < MERGE_TOLERANCE * prism.r
+    rep = np.argmax(close, axis=1)
+    while not np.array_equal(rep[rep], rep):
+        rep = rep[rep]
+    keep = np.flatnonzero(rep == np.arange(6 * n))
+    index = np.full(6 * n, -1)
+    index[keep] = np.arange(keep.size)
+    edges = index[rep[edges]]
+    lo, hi = edges.min(axis=1), edges.max(axis=1)
+    first = np.zeros(edges.shape[0], dtype=bool)
+    first[np.unique(lo * keep.size + hi, return_index=True)[1]] = True
+    first &= lo != hi
+    return TubularPattern._build(
+        n, prism.r, xy[keep], np.ascontiguousarray(edges[first]), labels[first], index[P],
+        index[D], np.zeros(2), np.array([0.0, H]), H, tuple(records),
+    )  # fmt: skip
+
+
+def _match_vertices(catalog_xy: np.ndarray, exact_xy: np.ndarray, prism: Prism) -> np.ndarray:
+    """For every catalog vertex, the nearest unsnapped vertex (periodic in x): the same point
+    (a collapsed column's Q_k is M_k), or less than eps away for a point snapped onto the
+    seam."""
+    dx = periodic_dx(catalog_xy[:, None, 0] - exact_xy[None, :, 0], prism.W)
+    dist = np.hypot(dx, catalog_xy[:, None, 1] - exact_xy[None, :, 1])
+    nearest = np.argmin(dist, axis=1)
+    worst = dist[np.arange(catalog_xy.shape[0]), nearest].max(initial=0.0)
+    if worst > 3.0 * prism.eps or np.unique(nearest).size != nearest.size:
+        raise FoldedFormError(  # pragma: no cover - a catalog module changed its vertices
+            f"the catalog module's vertices do not match its unsnapped geometry ({worst:.3g})"
+        )
+    return nearest
 
 
 def _assign(
@@ -699,8 +1034,8 @@ def _fold_elbow(prism: Prism, pattern: TubularPattern, theta: float, phi: float)
             add(wrapped, image)
     named_xy = np.concatenate(names_xy)
     named_X = np.concatenate(names_X)
-    # exact modules match to round-off; columns snapped by the B6 rules are within ~eps
-    X, matched = _assign(pattern.vertices_coords, named_xy, named_X, prism.W, 2.0 * prism.eps)
+    # the unsnapped elbow's vertices are named points (merged ones within MERGE_TOLERANCE r)
+    X, matched = _assign(pattern.vertices_coords, named_xy, named_X, prism.W, MERGE_TOLERANCE * r)
     _require_all(matched, "elbow")
     T = np.eye(4)
     T[:3, :3] = R
@@ -884,7 +1219,7 @@ def _fold_rebo_vertices(prism: Prism, xy: np.ndarray, d: float, N: int, beta: fl
     for i in range(N + 1):
         names_xy.append(np.stack([x, np.full(n, 2.0 * i * l1)], axis=1))
         names_X.append(ring + np.array([0.0, 0.0, i * layer]))
-    offset_x = wrap_x(x - o, prism.W, prism.eps)
+    offset_x = _mod_w(x - o, prism.W)
     for i in range(N):
         mid_y = np.full(n, (2.0 * i + 1.0) * l1)
         rise = np.array([0.0, 0.0, i * layer])

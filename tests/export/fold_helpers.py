@@ -213,3 +213,44 @@ def prismatic_offsets(chain, pieces) -> list[np.ndarray]:
             total = total + extra * obj.pose_matrix[:3, 2]
         offsets.append((before, total.copy()))
     return offsets
+
+
+def segments_distance(A: np.ndarray, B: np.ndarray, samples: int = 9) -> float:
+    """Largest distance from a point of the segments ``A`` (k, 2, 2) to the union of the
+    segments ``B`` (m, 2, 2), sampling ``samples`` points along every segment of ``A``."""
+    if A.shape[0] == 0:
+        return 0.0
+    if B.shape[0] == 0:
+        return math.inf
+    t = np.linspace(0.0, 1.0, samples)
+    points = (A[:, None, 0] + t[None, :, None] * (A[:, None, 1] - A[:, None, 0])).reshape(-1, 2)
+    a = B[:, 0]
+    ab = B[:, 1] - B[:, 0]
+    length2 = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
+    worst = 0.0
+    for start in range(0, points.shape[0], 256):
+        p = points[start : start + 256]
+        ap = p[:, None, :] - a[None, :, :]
+        s = np.clip(np.einsum("pij,ij->pi", ap, ab) / length2, 0.0, 1.0)
+        d = np.linalg.norm(ap - s[..., None] * ab[None], axis=2)
+        worst = max(worst, float(d.min(axis=1).max()))
+    return worst
+
+
+def sheet_distance(graph, sheet) -> float:
+    """Hausdorff distance (sampled) between the FOLD sheet's creases and the DXF sheet's.
+
+    Every FOLD crease (M or V) must lie near a DXF crease or the cut outline (the DXF drops
+    crease pieces within eps of a vertical cut edge), and every DXF crease near a FOLD crease
+    or the FOLD outline (creases on the top and bottom edges are the outline, B, in FOLD).
+    Labels are not compared: where fix B6 put an elbow's tuck boundary on a module ring, the
+    DXF has one crease there and FOLD two, h_k apart, each with its own label.
+    """
+    P, E, A = graph.vertices, graph.edges, graph.assignment
+    segments = P[E]
+    ours = segments[A != "B"]
+    theirs = np.concatenate([sheet.select("M"), sheet.select("V")])
+    return max(
+        segments_distance(ours, np.concatenate([theirs, sheet.select("C")])),
+        segments_distance(theirs, np.concatenate([ours, segments[A == "B"]])),
+    )
