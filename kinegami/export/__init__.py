@@ -40,6 +40,7 @@ __all__ = [
     "register_exporter",
     "save_pattern",
     "write_atomic",
+    "write_atomic_bytes",
 ]
 
 
@@ -106,7 +107,7 @@ def _target_path(dxfName: str | os.PathLike | None) -> Path:
 def _export_error(exc: OSError, path: Path, what: str) -> ExportError:
     """ExportError carrying ``exc``'s errno, printed as ``[Errno n] message: 'path'``."""
     reason = exc.strerror or str(exc)
-    message = f"cannot write the pattern ({what}): {reason}"
+    message = f"cannot write the file ({what}): {reason}"
     if exc.errno is None:
         return ExportError(f"{message}: {str(path)!r}")
     return ExportError(exc.errno, message, str(path))
@@ -124,40 +125,56 @@ def _create_temp(folder: Path, name: str) -> tuple[int, str]:
     raise FileExistsError(errno.EEXIST, "no free temporary file name", str(folder))
 
 
-def write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path`` atomically, creating missing parent folders.
-
-    Raises
-    ------
-    ExportError
-        If a folder cannot be created or the file cannot be written; no file is left behind.
-    """
+def prepare_folder(path: Path) -> None:
+    """Create ``path``'s parent folder (ExportError if impossible, e.g. it is a file)."""
     parent = path.parent
     if parent.exists() and not parent.is_dir():
         raise ExportError(
-            errno.ENOTDIR, f"cannot write the pattern: {str(parent)!r} is a file, not a folder",
+            errno.ENOTDIR, f"cannot write the file: {str(parent)!r} is a file, not a folder",
             str(path),
         )  # fmt: skip
     try:
         parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise _export_error(exc, path, f"cannot create the folder {str(parent)!r}") from exc
+
+
+def discard(tmp: str | os.PathLike) -> None:
+    """Remove a temporary file, ignoring errors (it may not exist)."""
     try:
-        fd, tmp = _create_temp(parent, path.name)
+        os.unlink(tmp)
+    except OSError:
+        pass
+
+
+def write_atomic_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically, creating missing parent folders.
+
+    Raises
+    ------
+    ExportError
+        If a folder cannot be created or the file cannot be written; no file is left behind.
+    """
+    path = Path(path)
+    prepare_folder(path)
+    try:
+        fd, tmp = _create_temp(path.parent, path.name)
     except OSError as exc:
         raise _export_error(exc, path, "cannot create a file in its folder") from exc
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as stream:
-            stream.write(text)
+        with os.fdopen(fd, "wb") as stream:
+            stream.write(data)
         os.replace(tmp, path)
     except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+        discard(tmp)
         if isinstance(exc, OSError) and not isinstance(exc, KinegamiError):
             raise _export_error(exc, path, "write failed") from exc
         raise
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` as UTF-8 (newlines as ``\\n``) atomically; see :func:`write_atomic_bytes`."""
+    write_atomic_bytes(path, text.encode("utf-8"))
 
 
 def save_pattern(

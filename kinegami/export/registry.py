@@ -40,6 +40,7 @@ from typing import Any
 
 import kinegami.export as _base
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
+from kinegami.export import write_atomic_bytes  # re-exported: part of this module's API
 
 __all__ = [
     "ExportFormat",
@@ -309,53 +310,6 @@ def export(obj: Any, path: str | os.PathLike, **options: Any) -> Path:
 # --- atomic writing ------------------------------------------------------------------------
 
 
-def _prepare_folder(path: Path) -> None:
-    """Create ``path``'s parent folder (ExportError if impossible)."""
-    parent = path.parent
-    if parent.exists() and not parent.is_dir():
-        raise _base.ExportError(
-            errno.ENOTDIR,
-            f"cannot write the file: {str(parent)!r} is a file, not a folder",
-            str(path),
-        )
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise _base._export_error(exc, path, f"cannot create the folder {str(parent)!r}") from exc
-
-
-def _discard(tmp: str) -> None:
-    try:
-        os.unlink(tmp)
-    except OSError:
-        pass
-
-
-def write_atomic_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically, creating missing parent folders.
-
-    Raises
-    ------
-    ExportError
-        If a folder cannot be created or the file cannot be written; no file is left behind.
-    """
-    path = Path(path)
-    _prepare_folder(path)
-    try:
-        fd, tmp = _base._create_temp(path.parent, path.name)
-    except OSError as exc:
-        raise _base._export_error(exc, path, "cannot create a file in its folder") from exc
-    try:
-        with os.fdopen(fd, "wb") as stream:
-            stream.write(data)
-        os.replace(tmp, path)
-    except BaseException as exc:
-        _discard(tmp)
-        if isinstance(exc, OSError) and not isinstance(exc, KinegamiError):
-            raise _base._export_error(exc, path, "write failed") from exc
-        raise
-
-
 def _temp_folder(parent: Path, name: str, tag: str) -> Path:
     for _ in range(100):
         candidate = parent / f".{name}.{secrets.token_hex(4)}.{tag}"
@@ -427,7 +381,7 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
             raise _base.ExportError(
                 errno.EISDIR, f"cannot write {head!r}: a folder of that name exists", str(existing)
             )
-    _prepare_folder(path)
+    _base.prepare_folder(path)
     temps: list[tuple[str, Path]] = []  # (name, temporary path), not yet moved
     moved: list[tuple[Path, Path | None]] = []  # folders moved into place, with their backup
     try:
@@ -475,7 +429,7 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
                 if tmp.is_dir():
                     shutil.rmtree(tmp, ignore_errors=True)
                 else:
-                    _discard(str(tmp))
+                    _base.discard(str(tmp))
     except OSError as exc:
         if isinstance(exc, KinegamiError):
             raise
