@@ -33,7 +33,13 @@ from kinegami.placement import (
     published_safe_placement,
     radial_safe_placement,
 )
-from kinegami.validation import check_max_angle_per_elbow, check_real, check_twist_portion
+from kinegami.validation import (
+    check_max_angle_per_elbow,
+    check_real,
+    check_translation,
+    check_twist_portion,
+    shown,
+)
 
 __all__ = ["KinematicChain", "PlacementWarning"]
 
@@ -57,7 +63,7 @@ class PlacementWarning(UserWarning):
 
 def _check_bool(name: str, value) -> bool:
     if not isinstance(value, bool | np.bool_):
-        raise InvalidTypeError(f"{name} must be True or False, got {value!r}")
+        raise InvalidTypeError(f"{name} must be True or False, got {shown(value)}")
     return bool(value)
 
 
@@ -143,7 +149,8 @@ class KinematicChain:
 
         Parameters
         ----------
-        table : rows (theta, alpha, a, d), one per joint; radians and the chain's length unit.
+        table : rows (theta, alpha, a, d), one per joint; radians and the chain's length unit;
+            |a| and |d| <= 1e6 r.
         numSides, r : the tube (an even number of sides >= 4, radius > 0).
         convention : ``"standard"`` (joint i moves about z of frame i-1; frame 0 = world) or
             ``"modified"`` (Craig: joint i moves about z of frame i). See :mod:`kinegami.dh`.
@@ -218,24 +225,24 @@ class KinematicChain:
     # --- helpers -----------------------------------------------------------------------------
     def _root_link(self, root: Joint) -> LinkCSC:
         frame = root.proximal_dubins_frame()
-        return LinkCSC(self.r, frame, frame, self.maxAnglePerElbow)
+        return LinkCSC._between(self.r, self.maxAnglePerElbow, frame, frame)
 
     def _link(self, parent: Joint, child: Joint) -> LinkCSC:
-        return LinkCSC(
+        return LinkCSC._between(
             self.r,
+            self.maxAnglePerElbow,
             parent.distal_dubins_frame(),
             child.proximal_dubins_frame(),
-            self.maxAnglePerElbow,
         )
 
     def _index(self, jointIndex) -> int:
         if isinstance(jointIndex, bool) or not isinstance(jointIndex, int | np.integer):
-            raise InvalidTypeError(f"jointIndex must be an integer, got {jointIndex!r}")
+            raise InvalidTypeError(f"jointIndex must be an integer, got {shown(jointIndex)}")
         n = len(self._joints)
         j = int(jointIndex)
         if not -n <= j < n:
             raise JointIndexError(
-                f"jointIndex must be in [{-n}, {n - 1}] for a chain of {n} joints, got {j}"
+                f"jointIndex must be in [{-n}, {n - 1}] for a chain of {n} joints, got {shown(j)}"
             )
         return j % n
 
@@ -454,16 +461,17 @@ class KinematicChain:
 
         With propagation every later joint moves with it (only the link into the joint is
         re-solved); without, only this joint moves (its two links are re-solved). Returns True,
-        or False with a PlacementWarning (chain unchanged) when a link cannot be built.
+        or False with a PlacementWarning (chain unchanged) when a link cannot be built. The
+        translation of ``Transformation`` lies within +-1e6 r (InvalidParameterError otherwise).
         """
         j = self._index(jointIndex)
-        T = pose_array(Transformation, "Transformation")
+        T = pose_array(Transformation, "Transformation", r=self.r)
         prop = _propagate_flag(propogate, propagate)
         return self._try_edit("transformJoint", lambda: self._moved(j, T, prop))
 
     def transformAll(self, Transformation) -> bool:
         """Move the whole chain rigidly by ``Transformation`` (no link is re-solved)."""
-        T = pose_array(Transformation, "Transformation")
+        T = pose_array(Transformation, "Transformation", r=self.r)
         joints = [joint.transformed(T) for joint in self._joints]
         links = [link.transformed(T) for link in self._links]
         self._commit(joints, links, self._ball.transformed(T))
@@ -509,8 +517,10 @@ class KinematicChain:
 
         The axis line is kept, so the chain's kinematics are unchanged. With
         ``applyToPreviousWaypoint`` a waypoint just before the joint moves with it.
+        ``distance`` lies within +-1e6 r (an InvalidParameterError names it otherwise, and the
+        chain is unchanged).
         """
-        d = check_real("distance", distance)
+        d = check_translation("distance", distance, self.r)
         return self._axis_edit(
             "translateJointAlongAxisOfMotion",
             jointIndex,
@@ -633,6 +643,13 @@ class KinematicChain:
             modules += link.pattern_modules(self.numSides, twistPortion)
             modules.append(joint.pattern)
         return TubularPattern.concatenate(modules)
+
+    def clearance(self, states=None):
+        """Self-intersection at the current states or at ``states`` (one per joint): a
+        ClearanceReport (``.ok``, ``.min_clearance``, ``.pairs``). See kinegami.clearance."""
+        from kinegami.clearance import chain_clearance
+
+        return chain_clearance(self, states)
 
     def show(self, **options):
         """Draw the chain in 3D with matplotlib; returns (figure, axes). See kinegami.viz."""

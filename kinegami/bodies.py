@@ -1,0 +1,438 @@
+"""The solid parts of a folded chain, shared by the clearance engine, meshes and views.
+
+See docs/clearance.md. Two descriptions of the same parts, both in world coordinates (units of
+r) at the chain's current configuration:
+
+* **Shapes** (what meshes and pictures are made of): the n-gon of circumradius r in a Dubins
+  frame (:func:`regular_polygon`), the point sets whose convex hulls are the joints
+  (:func:`revolute_hull_points`, :func:`tip_hull_points`, :func:`prismatic_prism_vertices`) and
+  the polygons an elbow fitting is swept through (:func:`elbow_rings`).
+* **Capsules** (what the clearance engine tests): the tube's centreline as a polyline of
+  segments, each the axis of a capsule of radius r that encloses every part along it
+  (:class:`CapsuleModel`, built by :func:`capsule_model`).
+
+The centreline of a folded chain is a polyline: an elbow fitting is two straight legs that meet
+at its vertex (the intersection of the tangents of its arc), so a link is
+``p1 -> vertices of arc 1 -> vertices of arc 2 -> p2`` (the straight part lies on the segment
+from the last vertex of arc 1 to the first vertex of arc 2), a revolute joint is
+``proximal origin -> centre -> distal origin`` (a kink by its state at the hinge), and
+a prismatic joint or a tip is the segment from its proximal to its distal origin. Waypoints add
+nothing. Every part lies within r of its segment, except the mitred corners of an elbow, which
+reach up to ``r tan(alpha / 2)`` past the vertex on the outside of the turn. They lie in one
+more capsule per elbow, the *mitre capsule*: radius r, from the vertex V outwards along
+``e = unit(a_in - a_out)`` (in the plane of the turn, away from its centre) for
+``r (1 - cos(alpha/2)) / cos(alpha/2)``. Why that suffices: beyond the plane through V normal
+to the incoming leg, the leg's solid is the convex hull of the outer half of the disc of radius
+r in that plane (within r of V) and the outer half of the mitre ellipse (semi-axes
+r / cos(alpha/2) along e and r across); a point x e + y f of that ellipse, 0 <= x, is within r
+of the segment [0, x1] e whenever x (1 - cos(alpha/2)) <= x1, so both halves, and therefore
+their hull, lie in the capsule (docs/clearance.md has the figure).
+
+Each segment carries the total turning of the centreline up to it (arc angles, plus |state| at
+every revolute hinge): the clearance engine tests two segments only when the centreline between
+them turns by at least pi.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinegami.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    Joint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+
+__all__ = [
+    "polygon_side",
+    "regular_polygon",
+    "circle_points",
+    "prismatic_prism_vertices",
+    "revolute_hull_points",
+    "tip_hull_points",
+    "elbow_rings",
+    "CapsuleModel",
+    "capsule_model",
+    "joint_label",
+    "JOINT_FIXED",
+    "JOINT_REVOLUTE",
+    "JOINT_PRISMATIC",
+]
+
+
+# --- shapes ----------------------------------------------------------------------------------
+def polygon_side(r: float, n: int) -> float:
+    """Side length 2 r sin(pi/n) of the regular n-gon of circumradius r."""
+    return 2.0 * r * math.sin(math.pi / n)
+
+
+def circle_points(centre, e1, e2, r: float, angles) -> np.ndarray:
+    """Points ``centre + r (cos t e1 + sin t e2)`` for each t in ``angles``, shape (m, 3)."""
+    t = np.asarray(angles, dtype=float)[:, None]
+    return (
+        np.asarray(centre, dtype=float)
+        + r * np.cos(t) * np.asarray(e1, dtype=float)
+        + r * np.sin(t) * np.asarray(e2, dtype=float)
+    )
+
+
+def regular_polygon(frame: np.ndarray, r: float, n: int) -> np.ndarray:
+    """(n, 3) vertices of the n-gon of circumradius ``r`` in the (b, c) plane of ``frame``.
+
+    ``frame`` is a 4x4 Dubins frame (first axis = path direction); the polygon is centred at
+    its origin and its vertex k lies at angle pi/n + 2 pi k/n from the frame's b axis, so two
+    sides are parallel to c (the revolute hinge line, the fold of a tip).
+    """
+    psi = math.pi / n + 2.0 * math.pi * np.arange(n) / n
+    return circle_points(frame[:3, 3], frame[:3, 1], frame[:3, 2], r, psi)
+
+
+def _hinge(centre, direction, length: float) -> np.ndarray:
+    d = 0.5 * length * np.asarray(direction, dtype=float)
+    return np.stack([centre - d, centre + d])
+
+
+def _shifted(frame: np.ndarray, distance: float) -> np.ndarray:
+    """``frame`` translated along its own first axis."""
+    out = np.array(frame)
+    out[:3, 3] += distance * frame[:3, 0]
+    return out
+
+
+def prismatic_prism_vertices(joint: PrismaticJoint) -> np.ndarray:
+    """(2, n, 3): the prism of a prismatic joint, from its proximal origin along z, L + state.
+
+    The polygon lies in the joint's x-y plane (about the joint's own axis of motion).
+    """
+    frame = joint.proximal_dubins_frame()
+    bottom = regular_polygon(frame, joint.r, joint.numSides)
+    top = bottom + (joint.neutralLength + joint.state) * joint.pose_matrix[:3, 2]
+    return np.stack([bottom, top])
+
+
+def revolute_hull_points(joint: RevoluteJoint) -> tuple[np.ndarray, np.ndarray]:
+    """Point sets whose hulls are the two halves of a revolute joint's body, each (n + 2, 3).
+
+    Each half is the n-gon of the proximal (distal) frame plus the hinge segment
+    p +- (side/2) z at the joint centre. For an extended revolute joint the polygons sit at the
+    ends of its straight tubes, ``tubeLength`` inside the proximal and distal frames.
+    """
+    n, r = joint.numSides, joint.r
+    T = joint.pose_matrix
+    hinge = _hinge(T[:3, 3], T[:3, 2], polygon_side(r, n))
+    h = joint.tubeLength if isinstance(joint, ExtendedRevoluteJoint) else 0.0
+    proximal = _shifted(joint.proximal_dubins_frame(), h)
+    distal = _shifted(joint.distal_dubins_frame(), -h)
+    return (
+        np.vstack([regular_polygon(proximal, r, n), hinge]),
+        np.vstack([regular_polygon(distal, r, n), hinge]),
+    )
+
+
+def tip_hull_points(joint: StartTip | EndTip) -> np.ndarray:
+    """(n + 2, 3): the n-gon at a tip's open end plus a segment of one side's length at the
+    closed end (along the frame's c axis, parallel to two sides of the polygon)."""
+    n, r = joint.numSides, joint.r
+    if isinstance(joint, StartTip):
+        open_end, closed_end = joint.distal_dubins_frame(), joint.proximal_dubins_frame()
+    else:
+        open_end, closed_end = joint.proximal_dubins_frame(), joint.distal_dubins_frame()
+    segment = _hinge(closed_end[:3, 3], closed_end[:3, 2], polygon_side(r, n))
+    return np.vstack([regular_polygon(open_end, r, n), segment])
+
+
+def elbow_rings(arc, n: int) -> np.ndarray | None:
+    """Polygons an arc's elbows are swept through: the n-gon at each elbow frame and the mitre
+    polygon between (2 count + 1, n, 3); None for an arc without elbows.
+
+    ``arc`` is a :class:`~kinegami.links.ElbowArc`. The mitre polygon is the start polygon
+    carried along the incoming axis to the plane through the vertex that bisects the turn.
+    """
+    if arc.count == 0:
+        return None
+    r = arc.r
+    F = np.asarray(arc.frames)
+    delta = r * math.tan(arc.elbowAngle / 2.0)
+    rings = [regular_polygon(F[0], r, n)]
+    for j in range(arc.count):
+        a_in, a_out = F[j, :3, 0], F[j + 1, :3, 0]
+        start = regular_polygon(F[j], r, n) if j else rings[0]
+        vertex = F[j, :3, 3] + delta * a_in
+        normal = a_in + a_out
+        normal /= np.linalg.norm(normal)
+        lam = ((vertex - start) @ normal) / float(a_in @ normal)
+        rings.append(start + lam[:, None] * a_in)
+        rings.append(regular_polygon(F[j + 1], r, n))
+    return np.stack(rings)
+
+
+# --- capsules --------------------------------------------------------------------------------
+#: Joint motion codes of :class:`CapsuleModel`.
+JOINT_FIXED, JOINT_REVOLUTE, JOINT_PRISMATIC = 0, 1, 2
+
+_ORDINALS = (
+    "first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth", "tenth",
+)  # fmt: skip
+
+
+def _ordinal(k: int) -> str:
+    """'first', 'second', ... for k = 1..10, then '11th', '12th', ..."""
+    if 1 <= k <= len(_ORDINALS):
+        return _ORDINALS[k - 1]
+    suffix = "th" if 10 <= k % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(k % 10, "th")
+    return f"{k}{suffix}"
+
+
+def joint_label(chain, index: int, names=None) -> str:
+    """``"joint 5, RevoluteJoint 'wrist'"``: a joint in words (``names[index]`` if given)."""
+    joint = chain.Joints[index]
+    text = f"joint {index}, {type(joint).__name__}"
+    if names is not None and index < len(names) and names[index] is not None:
+        text += f" '{names[index]}'"
+    return text
+
+
+@dataclass(frozen=True, eq=False)
+class CapsuleModel:
+    """The chain's centreline as capsules of radius ``r``, and how they move with the joints.
+
+    Everything is at the chain's current configuration, world coordinates, units of r.
+
+    Attributes
+    ----------
+    r : float
+        Capsule radius: the tube's circumradius.
+    starts, ends : numpy.ndarray, shape (S, 3)
+        End points of every capsule's segment, already extended past elbow vertices.
+    start_body, end_body : numpy.ndarray of int, shape (S,)
+        Index j of the joint whose distal side each end point moves with (j = -1: the base).
+        A link into joint i moves with joint i - 1; the distal half of a revolute joint and
+        the distal end of a prismatic joint move with the joint itself.
+    turning : numpy.ndarray, shape (S,)
+        Total turning of the centreline from the root to the segment (radians), without the
+        revolute hinges; at a configuration q, every revolute joint j <= ``start_body`` adds
+        |q_j| (its hinge lies before the segment).
+    joint_kind : numpy.ndarray of int, shape (J,)
+        ``JOINT_FIXED``, ``JOINT_REVOLUTE`` or ``JOINT_PRISMATIC`` of every joint.
+    joint_point, joint_axis : numpy.ndarray, shape (J, 3)
+        A point of every joint's axis of motion and its unit direction (current configuration).
+    states : numpy.ndarray, shape (J,)
+        The current states.
+    pieces : tuple
+        Per segment, ``(breaks, labels)``: the distances along the segment (from its start, in
+        units of r, extension included) at which the part changes, and the ``len(breaks) + 1``
+        part labels ("link 3, second elbow", "joint 4, RevoluteJoint, distal half", ...).
+    element : numpy.ndarray of int, shape (S,)
+        Per segment, 2 i for joint i and 2 i - 1 for link i (the order along the tube).
+    """
+
+    r: float
+    starts: np.ndarray
+    ends: np.ndarray
+    start_body: np.ndarray
+    end_body: np.ndarray
+    turning: np.ndarray
+    joint_kind: np.ndarray
+    joint_point: np.ndarray
+    joint_axis: np.ndarray
+    states: np.ndarray
+    pieces: tuple
+    element: np.ndarray
+
+    @property
+    def count(self) -> int:
+        """Number of capsules."""
+        return int(self.starts.shape[0])
+
+    def label(self, segment: int, s: float) -> str:
+        """The part at parameter ``s`` in [0, 1] of capsule ``segment``, in words."""
+        breaks, labels = self.pieces[segment]
+        length = float(np.linalg.norm(self.ends[segment] - self.starts[segment]))
+        at = s * length
+        for k, b in enumerate(breaks):
+            if at < b:
+                return labels[k]
+        return labels[-1]
+
+
+class _Builder:
+    """Collects the capsules of a chain, segment by segment along the tube."""
+
+    def __init__(self, r: float):
+        self.r = r
+        self.rows: list[tuple] = []
+
+    def add(self, a, b, body_a, body_b, turning, element, breaks, labels, ext_a=0.0, ext_b=0.0):
+        """A segment a -> b extended by ``ext_a`` before a and ``ext_b`` past b; ``breaks`` are
+        distances from a at which the label changes (``len(labels) == len(breaks) + 1``)."""
+        a = np.asarray(a, dtype=float)
+        b = np.asarray(b, dtype=float)
+        d = b - a
+        length = float(np.linalg.norm(d))
+        if length > 0.0:
+            u = d / length
+        else:
+            u = np.zeros(3)
+            ext_a = ext_b = 0.0
+        start = a - ext_a * u
+        end = b + ext_b * u
+        shifted = tuple(ext_a + x for x in breaks)
+        self.rows.append((start, end, body_a, body_b, turning, element, shifted, tuple(labels)))
+
+
+def _link_events(link, i: int, twistPortion: float) -> list[tuple]:
+    """The link's centreline as events in order: ("label", point, text) where a part starts,
+    ("vertex", point, (angle, incoming direction, outgoing direction)) at every elbow vertex."""
+    r = link.r
+    p = link.path
+    events: list[tuple] = []
+    elbow = 0
+
+    def arc_events(arc):
+        nonlocal elbow
+        if arc.count == 0:
+            return
+        delta = r * math.tan(arc.elbowAngle / 2.0)
+        F = np.asarray(arc.frames)
+        for j in range(arc.count):
+            elbow += 1
+            events.append(("label", F[j, :3, 3], f"link {i}, {_ordinal(elbow)} elbow"))
+            turn = (arc.elbowAngle, F[j, :3, 0], F[j + 1, :3, 0])
+            events.append(("vertex", F[j, :3, 3] + delta * F[j, :3, 0], turn))
+
+    arc_events(link.elbows1)
+    if p.tMag > 0.0:
+        q1 = np.asarray(p.q1, dtype=float)
+        if link.hasTwist:
+            events.append(("label", q1, f"link {i}, twist"))
+            q1 = q1 + twistPortion * p.tMag * np.asarray(p.tUnit, dtype=float)
+        events.append(("label", q1, f"link {i}, straight tube"))
+    arc_events(link.elbows2)
+    return events
+
+
+def _mitre_extent(r: float, alpha: float) -> float:
+    """Length of an elbow's mitre capsule: r (1 - cos(alpha/2)) / cos(alpha/2)."""
+    c = math.cos(alpha / 2.0)
+    return r * (1.0 - c) / c
+
+
+def _link_capsules(out: _Builder, link, i: int, turning: float, twistPortion: float) -> float:
+    """Add link i (from joint i - 1 to joint i); returns the turning after it.
+
+    The polyline's edges are capsules of radius r; each elbow vertex adds its mitre capsule
+    (see :func:`capsule_model`) with the turning half-way through the elbow.
+    """
+    if link.path.length <= 0.0:
+        return turning
+    r = out.r
+    start = np.asarray(link.start_frame[:3, 3], dtype=float)
+    end = np.asarray(link.end_frame[:3, 3], dtype=float)
+    events = _link_events(link, i, twistPortion)
+    edge_start = start
+    breaks: list[float] = []
+    labels: list[str] = []
+    for kind, point, value in events + [("end", end, None)]:
+        if kind == "label":
+            along = float(np.linalg.norm(point - edge_start))
+            if not labels or along <= 1e-12 * r and not breaks:
+                labels[:] = [value]
+            else:
+                breaks.append(along)
+                labels.append(value)
+            continue
+        if not labels:
+            labels = [f"link {i}, straight tube"]
+        out.add(edge_start, point, i - 1, i - 1, turning, 2 * i - 1, breaks, labels)
+        if kind == "vertex":
+            alpha, a_in, a_out = value
+            outward = a_in - a_out  # in the plane of the turn, away from its centre
+            norm = float(np.linalg.norm(outward))
+            if norm > 0.0:
+                tip = point + _mitre_extent(r, alpha) * outward / norm
+                out.add(point, tip, i - 1, i - 1, turning + alpha / 2.0, 2 * i - 1, [],
+                        [labels[-1]])  # fmt: skip
+            turning += alpha
+        edge_start = point
+        breaks, labels = [], [labels[-1]]
+    return turning
+
+
+def _joint_capsules(out: _Builder, joint: Joint, j: int, turning: float, text: str) -> None:
+    """Add joint j (nothing for a waypoint)."""
+    if isinstance(joint, Waypoint):
+        return
+    proximal = joint.proximal_frame()[:3, 3]
+    distal = joint.distal_frame()[:3, 3]
+    if isinstance(joint, RevoluteJoint):
+        centre = joint.pose_matrix[:3, 3]
+        out.add(proximal, centre, j - 1, j - 1, turning, 2 * j, [], [f"{text}, proximal half"])
+        # the distal half moves with the joint; its hinge adds |state| to the turning
+        out.add(centre, distal, j, j, turning, 2 * j, [], [f"{text}, distal half"])
+        return
+    body_b = j if isinstance(joint, PrismaticJoint) else j - 1
+    out.add(proximal, distal, j - 1, body_b, turning, 2 * j, [], [text])
+
+
+def capsule_model(chain, names=None, twistPortion: float = 0.2) -> CapsuleModel:
+    """The :class:`CapsuleModel` of ``chain`` at its current configuration.
+
+    Parameters
+    ----------
+    chain : KinematicChain
+    names : sequence of str or None, optional
+        A name for every joint (None where it has none), used in the part labels.
+    twistPortion : float, optional
+        Fraction of a straight part taken by its twist fitting (labels only); default 0.2.
+    """
+    joints = chain.Joints
+    links = chain.Links
+    out = _Builder(float(chain.r))
+    turning = 0.0
+    count = len(joints)
+    kinds = np.zeros(count, dtype=np.int64)
+    points = np.zeros((count, 3))
+    axes = np.zeros((count, 3))
+    states = np.zeros(count)
+    for j, joint in enumerate(joints):
+        T = joint.pose_matrix
+        points[j] = T[:3, 3]
+        axes[j] = T[:3, 2]
+        states[j] = joint.state
+        if isinstance(joint, RevoluteJoint):
+            kinds[j] = JOINT_REVOLUTE
+        elif isinstance(joint, PrismaticJoint):
+            kinds[j] = JOINT_PRISMATIC
+        if j > 0:
+            turning = _link_capsules(out, links[j], j, turning, twistPortion)
+        _joint_capsules(out, joint, j, turning, joint_label(chain, j, names))
+    rows = out.rows
+
+    def column(k: int, dtype, shape: tuple = ()) -> np.ndarray:
+        return np.array([row[k] for row in rows], dtype=dtype).reshape((len(rows), *shape))
+
+    model = CapsuleModel(
+        r=out.r,
+        starts=column(0, float, (3,)),
+        ends=column(1, float, (3,)),
+        start_body=column(2, np.int64),
+        end_body=column(3, np.int64),
+        turning=column(4, float),
+        element=column(5, np.int64),
+        pieces=tuple((row[6], row[7]) for row in rows),
+        joint_kind=kinds,
+        joint_point=points,
+        joint_axis=axes,
+        states=states,
+    )
+    for array in vars(model).values():
+        if isinstance(array, np.ndarray):
+            array.setflags(write=False)
+    return model
