@@ -14,10 +14,8 @@ from __future__ import annotations
 
 import argparse
 import os
-import shutil
 import signal
 import sys
-import tempfile
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -193,42 +191,6 @@ def _summary(job: BuildJob, design: str) -> list[str]:
 
 
 # --- commands ----------------------------------------------------------------------------------
-def _publish(staging: Path, out: Path) -> list[Path]:
-    """Move every entry of ``staging`` into ``out``, all or nothing.
-
-    Entries already in ``out`` under the same names are first moved aside into the staging
-    folder and are put back if any move fails, so a failed build leaves ``out`` as it was.
-    """
-    staged = sorted(p for p in staging.iterdir() if p.name != ".replaced")
-    backup = staging / ".replaced"
-    backup.mkdir()
-    out.mkdir(parents=True, exist_ok=True)
-    moved: list[Path] = []
-    replaced: list[Path] = []
-    try:
-        for path in staged:
-            target = out / path.name
-            if os.path.lexists(target):
-                os.replace(target, backup / path.name)
-                replaced.append(target)
-            os.replace(path, target)
-            moved.append(target)
-    except OSError as error:
-        for target in moved:
-            if target.is_dir() and not target.is_symlink():
-                shutil.rmtree(target, ignore_errors=True)
-            else:
-                target.unlink(missing_ok=True)
-        for target in replaced:
-            try:
-                os.replace(backup / target.name, target)
-            except OSError:
-                pass
-        where = error.filename or out
-        raise CommandError(f"cannot write {str(where)!r}: {error.strerror or error}") from None
-    return moved
-
-
 def _plain_stem(stem: str) -> str:
     if (
         not stem
@@ -251,25 +213,32 @@ def cmd_build(args: argparse.Namespace) -> int:
     job = BuildJob(chain, info)
     _check_pattern(job)
     lines = _summary(job, args.design)
-    # write everything into a hidden staging folder next to the target, then move it in:
-    # a failure leaves nothing behind
+    # write everything into a hidden staging folder in the target, then publish it as one
+    # transaction (kinegami.export.publish): a failure or an interrupt leaves the folder as
+    # it was, and a build killed earlier is recovered first
+    from kinegami.export.publish import open_staging
+
     try:
-        staging = Path(tempfile.mkdtemp(prefix=".kinegami-build-", dir=_existing_ancestor(out)))
+        staging = open_staging(out)
     except OSError as error:
+        if isinstance(error, KinegamiError):
+            raise
         raise CommandError(f"-o: cannot write in {str(out)!r}: {error.strerror}") from None
     try:
+        if staging.note:
+            _note(args.command, staging.note)
         for fmt in formats:
             try:
-                fmt.write(job, [staging / f"{stem}{suffix}" for suffix in fmt.suffixes])
+                fmt.write(job, [staging.new / f"{stem}{suffix}" for suffix in fmt.suffixes])
             except KinegamiError as error:
                 raise CommandError(f"{args.design}: {fmt.name} export: {error}") from None
             except OSError as error:
                 raise CommandError(
                     f"{fmt.name} export: cannot write {str(out)!r}: {error.strerror or error}"
                 ) from None
-        written = _publish(staging, out)
+        written = staging.publish()  # all or nothing, whatever interrupts it
     finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        staging.close()
     lines.append("  files written:")
     lines.extend(f"    {path}{os.sep if path.is_dir() else ''}" for path in written)
     print("\n".join(lines))
@@ -384,8 +353,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 0
-    previous = signal.getsignal(signal.SIGTERM)
-    signal.signal(signal.SIGTERM, _terminate)  # clean up staging folders on kill
+    handled = [s for s in (signal.SIGTERM, getattr(signal, "SIGHUP", None)) if s is not None]
+    previous = {s: signal.getsignal(s) for s in handled}
+    for signum in handled:  # clean up staging folders on kill (SIGKILL: the next build does)
+        if previous[signum] != signal.SIG_IGN:  # nohup: stay ignored
+            signal.signal(signum, _terminate)
     try:
         with warnings.catch_warnings():
             # numerical warnings of plotting libraries are not the user's business; the
@@ -409,7 +381,9 @@ def main(argv: list[str] | None = None) -> int:
         )
         return 1
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            if handler is not None:
+                signal.signal(signum, handler)
 
 
 def _fail(command: str, message: str) -> None:
@@ -417,7 +391,13 @@ def _fail(command: str, message: str) -> None:
     print(f"kinegami {command}: error: {text}", file=sys.stderr)
 
 
+def _note(command: str, message: str) -> None:
+    print(f"kinegami {command}: note: {_printable(' '.join(message.split()))}", file=sys.stderr)
+
+
 def _terminate(signum, frame) -> None:
+    """SIGTERM and SIGHUP end the command like Ctrl-C does: ``finally`` blocks run (staging
+    folders go away) and publishing, which defers them, first finishes its rollback."""
     raise SystemExit(128 + signum)
 
 

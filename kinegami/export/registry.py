@@ -33,6 +33,7 @@ import io
 import os
 import secrets
 import shutil
+import signal
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
@@ -41,6 +42,7 @@ from typing import Any
 import kinegami.export as _base
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
 from kinegami.export import write_atomic_bytes  # re-exported: part of this module's API
+from kinegami.export.publish import deferred_signals
 
 __all__ = [
     "ExportFormat",
@@ -359,7 +361,12 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
 
     Everything is written to temporary names first; then existing folders are moved aside,
     the new ones moved in and the files replaced, main file last. If any step fails the
-    moves are undone and the temporaries removed, so the folder is as before.
+    moves are undone and the temporaries removed, so the folder is as before. Ctrl-C, SIGTERM
+    and SIGHUP are held back while the moves run (:func:`kinegami.export.publish.deferred_signals`):
+    the moves stop and are undone, then the signal takes effect. (A SIGKILL in the middle can
+    leave the old folder as a hidden ``.<name>.<random>.old`` beside it. ``kinegami build``
+    writes into a fresh staging folder, so nothing old is at stake there, and publishes with
+    :mod:`kinegami.export.publish`, which recovers after a SIGKILL.)
 
     Raises
     ------
@@ -400,30 +407,40 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
                     with os.fdopen(fd, "wb") as stream:
                         stream.write(content)
             order = sorted(temps, key=lambda item: item[0] == path.name)  # main file last
-            for head, tmp in order:
-                target = parent / head
-                if tmp.is_dir():
-                    backup = None
-                    if target.exists():
-                        backup = _temp_folder(parent, head, "old")
-                        backup.rmdir()
-                        os.replace(target, backup)
-                    try:
-                        os.replace(tmp, target)
-                    except BaseException:
+            # Ctrl-C, SIGTERM and SIGHUP wait until the moves are done or undone
+            with deferred_signals() as received:
+                try:
+                    for head, tmp in order:
+                        if received:
+                            raise _base.ExportError(
+                                errno.EINTR,
+                                f"cannot write the files: interrupted by "
+                                f"{signal.Signals(received[0]).name}; nothing was written",
+                                str(path),
+                            )
+                        target = parent / head
+                        if tmp.is_dir():
+                            backup = None
+                            if target.exists():
+                                backup = _temp_folder(parent, head, "old")
+                                backup.rmdir()
+                                os.replace(target, backup)
+                            try:
+                                os.replace(tmp, target)
+                            except BaseException:
+                                if backup is not None:
+                                    os.replace(backup, target)
+                                raise
+                            moved.append((target, backup))
+                        else:  # a replaced file cannot come back: the main file is last
+                            os.replace(tmp, target)
+                        temps.remove((head, tmp))
+                except BaseException:
+                    for target, backup in reversed(moved):
+                        shutil.rmtree(target, ignore_errors=True)
                         if backup is not None:
                             os.replace(backup, target)
-                        raise
-                    moved.append((target, backup))
-                else:  # a replaced file cannot come back: the main file is replaced last
-                    os.replace(tmp, target)
-                temps.remove((head, tmp))
-        except BaseException:
-            for target, backup in reversed(moved):
-                shutil.rmtree(target, ignore_errors=True)
-                if backup is not None:
-                    os.replace(backup, target)
-            raise
+                    raise
         finally:
             for _, tmp in temps:
                 if tmp.is_dir():
