@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kinegami.bodies import JOINT_PRISMATIC, JOINT_REVOLUTE, CapsuleModel, capsule_model
+from kinegami.bodies import JOINT_REVOLUTE, CapsuleModel, capsule_model
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.segments import segment_distances
 from kinegami.validation import check_real
@@ -155,32 +155,107 @@ def _rotations(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * K + c * (K @ K)
 
 
+def _ball(points: np.ndarray, r: float) -> tuple[np.ndarray, float]:
+    """A ball (centre, radius) containing every point of ``points`` (k, 3) grown by r."""
+    centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
+    return centre, float(np.sqrt(((points - centre) ** 2).sum(axis=1)).max()) + r
+
+
 class ClearanceEngine:
     """Fast clearance queries on one chain (its joints and links as they were when built).
 
     Configurations are absolute states, one per joint, as ``setJointStates`` takes them.
+
+    The capsules are grouped into rigid bodies (the parts between two movable joints). Pairs
+    inside one body never move relative to each other, so they are measured once. For pairs
+    of bodies, a ball around each body (fixed in the body) is the broad phase; the capsules of
+    two bodies whose balls are close are then tested capsule ball against capsule ball, and
+    exactly (segment distance) when those are close too.
     """
 
     def __init__(self, chain, names=None):
         self.model: CapsuleModel = capsule_model(chain, names)
         m = self.model
-        self.r = m.r
+        self.r = r = m.r
         self.ranges = np.array([joint.stateRange() for joint in chain.Joints], dtype=float)
+        movable = np.nonzero(m.joint_kind != 0)[0]
+        self.movable = movable
+        # rigid body of every joint's distal side: number of movable joints up to it
+        body_of_joint = np.cumsum(m.joint_kind != 0)
+        body = np.concatenate([[0], body_of_joint])  # index j + 1; joint -1 (base) -> 0
+        self.body_a = body[m.start_body + 1]
+        self.body_b = body[m.end_body + 1]
+        kinds = m.joint_kind[movable]
+        self._revolute_m = kinds == JOINT_REVOLUTE
         S = m.count
-        revolute = m.joint_kind == JOINT_REVOLUTE
-        self._revolute = revolute
-        max_kink = np.where(revolute, np.max(np.abs(self.ranges), axis=1), 0.0)
-        # most turning the hinges up to body b can add: prefix sums, index b + 1 (b = -1: 0)
+        NB = movable.size + 1
+        self.bodies = NB
+        # most turning the hinges before body b can add (prefix over movable joints)
+        max_kink = np.where(
+            self._revolute_m, np.max(np.abs(self.ranges[movable]), axis=1), 0.0
+        ) if movable.size else np.zeros(0)  # fmt: skip
         kink_prefix = np.concatenate([[0.0], np.cumsum(max_kink)])
+        # body balls (in the current configuration; they move with their body); a prismatic
+        # segment belongs to its proximal body, with its ball over the whole stroke
+        ext_lo = np.zeros(S)
+        ext_hi = np.zeros(S)
+        seg_body = self.body_a
+        axis = np.zeros((S, 3))
+        for s in np.nonzero(self.body_a != self.body_b)[0]:
+            j = int(movable[self.body_b[s] - 1])
+            lo, hi = self.ranges[j]
+            ext_lo[s] = lo - m.states[j]
+            ext_hi[s] = hi - m.states[j]
+            axis[s] = m.joint_axis[j]
+        points_by_body: list[list[np.ndarray]] = [[] for _ in range(NB)]
+        for s in range(S):
+            pts = points_by_body[seg_body[s]]
+            pts += [m.starts[s], m.ends[s]]
+            if ext_hi[s] != ext_lo[s]:
+                pts += [m.ends[s] + ext_lo[s] * axis[s], m.ends[s] + ext_hi[s] * axis[s]]
+        centres = np.zeros((NB, 3))
+        radii = np.zeros(NB)
+        for b, pts in enumerate(points_by_body):
+            if pts:
+                centres[b], radii[b] = _ball(np.array(pts), r)
+            else:
+                radii[b] = -np.inf  # an empty body never collides
+        self.body_centres = centres
+        self.body_radii = radii
+        # candidate pairs i < j whose turning gap can reach pi
         i, j = np.triu_indices(S, 1)
         gap_max = (
             m.turning[j] - m.turning[i]
-            + kink_prefix[m.start_body[j] + 1] - kink_prefix[m.start_body[i] + 1]
+            + kink_prefix[self.body_a[j]] - kink_prefix[self.body_a[i]]
         )  # fmt: skip
         keep = gap_max >= math.pi - TURN_TOLERANCE
-        self.first = i[keep]
-        self.second = j[keep]
-        self._movable = np.nonzero(m.joint_kind != 0)[0]
+        i, j = i[keep], j[keep]
+        bi, bj = seg_body[i], seg_body[j]
+        same = (bi == bj) & (self.body_a[i] == self.body_b[i]) & (self.body_a[j] == self.body_b[j])
+        # pairs inside one rigid body: measured once
+        self.static = None  # (clearance, pair index in static arrays) of the worst static pair
+        si, sj = i[same], j[same]
+        self._static_pairs = (si, sj)
+        if si.size:
+            d, s_, t_ = segment_distances(m.starts[si], m.ends[si], m.starts[sj], m.ends[sj])
+            self._static_clearance = d - 2.0 * r
+            self._static_st = (s_, t_)
+        else:
+            self._static_clearance = np.zeros(0)
+            self._static_st = (np.zeros(0), np.zeros(0))
+        # pairs across bodies, grouped by body pair (CSR)
+        di, dj = i[~same], j[~same]
+        lo_b = np.minimum(seg_body[di], seg_body[dj])
+        hi_b = np.maximum(seg_body[di], seg_body[dj])
+        code = lo_b * NB + hi_b
+        order = np.argsort(code, kind="stable")
+        di, dj, code = di[order], dj[order], code[order]
+        self.first, self.second = di, dj
+        pair_codes, starts, counts = np.unique(code, return_index=True, return_counts=True)
+        self.body_pair_lo = pair_codes // NB
+        self.body_pair_hi = pair_codes % NB
+        self.body_pair_start = starts
+        self.body_pair_count = counts
 
     # --- kinematics ------------------------------------------------------------------------
     def check_states(self, states, name: str = "states") -> np.ndarray:
@@ -198,57 +273,100 @@ class ClearanceEngine:
         for k, (s, (lo, hi)) in enumerate(zip(values, self.ranges, strict=True)):
             if not lo - 1e-12 <= s <= hi + 1e-12:
                 raise InvalidParameterError(
-                    f"{name}[{k}] = {s!r} is outside joint {k}'s state range "
+                    f"{name}[{k}] = {float(s)!r} is outside joint {k}'s state range "
                     f"[{lo:.6g}, {hi:.6g}]"
                 )
         return values
 
     def body_transforms(self, Q: np.ndarray) -> np.ndarray:
-        """(K, J + 1, 4, 4): world motion of every body (index b + 1; 0 = base) at each of the
+        """(K, bodies, 4, 4): world motion of every rigid body (0 = base) at each of the
         configurations ``Q`` (K, J), relative to the chain's current configuration."""
         m = self.model
-        K, J = Q.shape
-        B = np.empty((K, J + 1, 4, 4))
+        K = Q.shape[0]
+        B = np.empty((K, self.bodies, 4, 4))
         B[:, 0] = np.eye(4)
-        delta = Q - m.states[None, :]
-        for j in range(J):
-            kind = m.joint_kind[j]
-            if kind == 0 or not np.any(delta[:, j]):
-                B[:, j + 1] = B[:, j]
+        for b, j in enumerate(self.movable, start=1):
+            delta = Q[:, j] - m.states[j]
+            if not np.any(delta):
+                B[:, b] = B[:, b - 1]
                 continue
             M = np.zeros((K, 4, 4))
             M[:, 3, 3] = 1.0
-            if kind == JOINT_REVOLUTE:
-                R = _rotations(m.joint_axis[j], delta[:, j])
+            if m.joint_kind[j] == JOINT_REVOLUTE:
+                R = _rotations(m.joint_axis[j], delta)
                 p = m.joint_point[j]
                 M[:, :3, :3] = R
                 M[:, :3, 3] = p - R @ p
             else:  # prismatic
                 M[:, :3, :3] = np.eye(3)
-                M[:, :3, 3] = delta[:, j, None] * m.joint_axis[j]
-            B[:, j + 1] = B[:, j] @ M
+                M[:, :3, 3] = delta[:, None] * m.joint_axis[j]
+            B[:, b] = B[:, b - 1] @ M
         return B
 
-    def segments(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """World segment end points (K, S, 3) twice, at configurations ``Q`` (K, J)."""
+    def _segments(self, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         m = self.model
-        B = self.body_transforms(Q)
-        Ba = B[:, m.start_body + 1]
-        Bb = B[:, m.end_body + 1]
+        Ba = B[:, self.body_a]
+        Bb = B[:, self.body_b]
         a = np.einsum("ksij,sj->ksi", Ba[..., :3, :3], m.starts) + Ba[..., :3, 3]
         b = np.einsum("ksij,sj->ksi", Bb[..., :3, :3], m.ends) + Bb[..., :3, 3]
         return a, b
 
+    def segments(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World segment end points (K, S, 3) twice, at configurations ``Q`` (K, J)."""
+        return self._segments(self.body_transforms(np.asarray(Q, dtype=float)))
+
     def turning(self, Q: np.ndarray) -> np.ndarray:
         """(K, S) turning of the centreline up to every segment at configurations ``Q``."""
         m = self.model
-        kinks = np.where(self._revolute[None, :], np.abs(Q), 0.0)
-        prefix = np.concatenate([np.zeros((Q.shape[0], 1)), np.cumsum(kinks, axis=1)], axis=1)
-        return m.turning[None, :] + prefix[:, m.start_body + 1]
+        Qm = np.asarray(Q, dtype=float)[:, self.movable]
+        kinks = np.where(self._revolute_m[None, :], np.abs(Qm), 0.0)
+        prefix = np.concatenate([np.zeros((Qm.shape[0], 1)), np.cumsum(kinks, axis=1)], axis=1)
+        return m.turning[None, :] + prefix[:, self.body_a]
 
-    # --- queries ---------------------------------------------------------------------------
-    def _pair(self, k: int, s: float, t: float, a, b, clearance: float) -> CollidingPair:
-        i, j = int(self.first[k]), int(self.second[k])
+    # --- the core query --------------------------------------------------------------------
+    def _candidates(self, Q: np.ndarray, threshold: float):
+        """Exact clearances of every tested pair across bodies whose capsule balls are within
+        ``threshold`` of each other, at configurations ``Q`` (K, J).
+
+        Returns (k, pair, clearance, s, t, a, b): config index, index into first/second, the
+        clearance and closest-point parameters of each such pair, and the world segments.
+        """
+        B = self.body_transforms(Q)
+        a, b = self._segments(B)
+        empty = (np.zeros(0, dtype=np.int64),) * 2 + (np.zeros(0),) * 3
+        if self.body_pair_lo.size == 0:
+            return (*empty, a, b)
+        centres = np.einsum("kbij,bj->kbi", B[..., :3, :3], self.body_centres) + B[..., :3, 3]
+        lo, hi = self.body_pair_lo, self.body_pair_hi
+        gap = np.sqrt(((centres[:, lo] - centres[:, hi]) ** 2).sum(axis=2))
+        near = gap - self.body_radii[lo] - self.body_radii[hi] <= threshold
+        kk, bp = np.nonzero(near)
+        if kk.size == 0:
+            return (*empty, a, b)
+        counts = self.body_pair_count[bp]
+        total = int(counts.sum())
+        k_rep = np.repeat(kk, counts)
+        offsets = np.repeat(self.body_pair_start[bp] - np.cumsum(counts) + counts, counts)
+        pair = offsets + np.arange(total)
+        S = self.model.count
+        flat_i = k_rep * S + self.first[pair]
+        flat_j = k_rep * S + self.second[pair]
+        # capsule balls first (centre and half-length per capsule and configuration)
+        centre = (0.5 * (a + b)).reshape(-1, 3)
+        half = (0.5 * np.sqrt(((b - a) ** 2).sum(axis=2))).reshape(-1)
+        d = np.take(centre, flat_i, axis=0) - np.take(centre, flat_j, axis=0)
+        lower = np.sqrt(np.einsum("ij,ij->i", d, d)) - half[flat_i] - half[flat_j]
+        keep = lower <= threshold + 2.0 * self.r
+        if self._revolute_m.any():
+            tau = self.turning(Q).reshape(-1)
+            keep &= tau[flat_j] - tau[flat_i] >= math.pi - TURN_TOLERANCE
+        idx = np.nonzero(keep)[0]
+        fi, fj = flat_i[idx], flat_j[idx]
+        af, bf = a.reshape(-1, 3), b.reshape(-1, 3)
+        dist, s, t = segment_distances(af[fi], bf[fi], af[fj], bf[fj])
+        return k_rep[idx], pair[idx], dist - 2.0 * self.r, s, t, a, b
+
+    def _pair(self, i: int, j: int, s: float, t: float, a, b, clearance: float):
         p = a[i] + s * (b[i] - a[i])
         q = a[j] + t * (b[j] - a[j])
         return CollidingPair(
@@ -258,43 +376,64 @@ class ClearanceEngine:
             (tuple(map(float, p)), tuple(map(float, q))),
         )
 
+    def _static_at(self, k_static: int, a, b) -> CollidingPair:
+        si, sj = self._static_pairs
+        s_, t_ = self._static_st
+        return self._pair(int(si[k_static]), int(sj[k_static]), s_[k_static], t_[k_static],
+                          a, b, self._static_clearance[k_static])  # fmt: skip
+
+    # --- queries ---------------------------------------------------------------------------
     def report(self, states) -> ClearanceReport:
         """The :class:`ClearanceReport` at one configuration (absolute states, checked)."""
         q = self.check_states(states)
         values = tuple(float(x) for x in q)
-        if self.first.size == 0:
-            return ClearanceReport(True, math.inf, (), None, values)
         Q = q[None, :]
-        a, b = (x[0] for x in self.segments(Q))
-        tau = self.turning(Q)[0]
-        tested = tau[self.second] - tau[self.first] >= math.pi - TURN_TOLERANCE
-        idx = np.nonzero(tested)[0]
-        if idx.size == 0:
-            return ClearanceReport(True, math.inf, (), None, values)
-        i, j = self.first[idx], self.second[idx]
-        centre = 0.5 * (a + b)
-        half = 0.5 * np.linalg.norm(b - a, axis=1)
-        gap = np.linalg.norm(centre[i] - centre[j], axis=1)
-        lower = gap - half[i] - half[j]
-        bound = max(float(gap.min()), 2.0 * self.r)
-        near = idx[lower <= bound]
-        i, j = self.first[near], self.second[near]
-        dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
-        clearance = dist - 2.0 * self.r
-        order = np.argsort(clearance, kind="stable")
-        best = int(order[0])
-        closest = self._pair(int(near[best]), s[best], t[best], a, b, clearance[best])
         limit = -CONTACT_TOLERANCE * self.r
-        pairs: dict[tuple[str, str], CollidingPair] = {}
-        for k in order:
-            if clearance[k] >= limit:
+        threshold = 4.0 * self.r
+        while True:
+            k, pair, clearance, s, t, a, b = self._candidates(Q, threshold)
+            a0, b0 = a[0], b[0]
+            best = float(clearance.min()) if clearance.size else math.inf
+            if self._static_clearance.size:
+                best = min(best, float(self._static_clearance.min()))
+            if best <= threshold or threshold > 1e3 * self._extent():
                 break
-            pair = self._pair(int(near[k]), s[k], t[k], a, b, clearance[k])
+            threshold = max(2.0 * threshold, best)
+        entries = [
+            (float(c), ("d", int(p), float(si), float(ti)))
+            for c, p, si, ti in zip(clearance, pair, s, t, strict=True)
+        ]
+        entries += [(float(c), ("s", n)) for n, c in enumerate(self._static_clearance)]
+        if not entries:
+            return ClearanceReport(True, math.inf, (), None, values)
+        entries.sort(key=lambda e: e[0])
+
+        def make(entry):
+            c, ref = entry
+            if ref[0] == "s":
+                return self._static_at(ref[1], a0, b0)
+            _, p, si, ti = ref
+            return self._pair(int(self.first[p]), int(self.second[p]), si, ti, a0, b0, c)
+
+        closest = make(entries[0])
+        pairs: dict[tuple[str, str], CollidingPair] = {}
+        for entry in entries:
+            if entry[0] >= limit:
+                break
+            pair = make(entry)
             pairs.setdefault((pair.first, pair.second), pair)
-        min_clearance = float(clearance[best])
+        min_clearance = entries[0][0]
         return ClearanceReport(
             min_clearance >= limit, min_clearance, tuple(pairs.values()), closest, values
         )
+
+    def _extent(self) -> float:
+        """Size of the chain (for the search radius of :meth:`report`)."""
+        m = self.model
+        if m.count == 0:
+            return self.r
+        pts = np.vstack([m.starts, m.ends])
+        return float(np.ptp(pts, axis=0).max()) + self.r
 
     def worst(self, Q: np.ndarray) -> tuple[np.ndarray, list]:
         """Deepest overlap at each configuration of ``Q`` (K, J), unchecked.
@@ -307,38 +446,41 @@ class ClearanceEngine:
         K = Q.shape[0]
         out = np.full(K, np.inf)
         found: list = [None] * K
-        P = self.first.size
-        if P == 0 or K == 0:
-            return out, found
-        chunk = max(1, _BATCH_PAIRS // P)
         limit = -CONTACT_TOLERANCE * self.r
+        static_worst = None
+        if self._static_clearance.size:
+            n = int(np.argmin(self._static_clearance))
+            if self._static_clearance[n] < limit:
+                static_worst = n
+        chunk = 256
         for start in range(0, K, chunk):
             Qc = Q[start : start + chunk]
-            a, b = self.segments(Qc)
-            tau = self.turning(Qc)
-            centre = 0.5 * (a + b)
-            half = 0.5 * np.linalg.norm(b - a, axis=2)
-            i, j = self.first, self.second
-            gap = np.linalg.norm(centre[:, i] - centre[:, j], axis=2)
-            candidate = gap - half[:, i] - half[:, j] < 2.0 * self.r + limit
-            candidate &= tau[:, j] - tau[:, i] >= math.pi - TURN_TOLERANCE
-            ks, ps = np.nonzero(candidate)
-            if ks.size == 0:
-                continue
-            ii, jj = i[ps], j[ps]
-            dist, s, t = segment_distances(a[ks, ii], b[ks, ii], a[ks, jj], b[ks, jj])
-            clearance = dist - 2.0 * self.r
-            colliding = clearance < limit
-            for n in np.nonzero(colliding)[0]:
-                k = int(ks[n]) + start
-                if clearance[n] < out[k]:
-                    out[k] = clearance[n]
-                    found[k] = (int(ps[n]), float(s[n]), float(t[n]), int(ks[n]), a, b)
-            # turn the winners of this chunk into pairs while a, b are at hand
-            for k in range(start, min(K, start + chunk)):
-                if found[k] is not None and not isinstance(found[k], CollidingPair):
-                    p, s_k, t_k, local, a_c, b_c = found[k]
-                    found[k] = self._pair(p, s_k, t_k, a_c[local], b_c[local], out[k])
+            k, pair, clearance, s, t, a, b = self._candidates(Qc, 0.0)
+            if static_worst is not None:
+                value = float(self._static_clearance[static_worst])
+                for local in range(Qc.shape[0]):
+                    out[start + local] = value
+                    found[start + local] = ("s", static_worst, local)
+            colliding = np.nonzero(clearance < limit)[0]
+            # the deepest overlap per configuration
+            order = colliding[np.argsort(clearance[colliding], kind="stable")]
+            for n in order:
+                kk = start + int(k[n])
+                if clearance[n] < out[kk]:
+                    out[kk] = clearance[n]
+                    found[kk] = ("d", int(pair[n]), float(s[n]), float(t[n]), int(k[n]))
+            for local in range(Qc.shape[0]):
+                ref = found[start + local]
+                if ref is None or isinstance(ref, CollidingPair):
+                    continue
+                if ref[0] == "s":
+                    found[start + local] = self._static_at(ref[1], a[local], b[local])
+                else:
+                    _, p, si, ti, kl = ref
+                    found[start + local] = self._pair(
+                        int(self.first[p]), int(self.second[p]), si, ti, a[kl], b[kl],
+                        out[start + local],
+                    )  # fmt: skip
         return out, found
 
     def colliding(self, Q: np.ndarray) -> np.ndarray:
@@ -349,42 +491,57 @@ class ClearanceEngine:
     def free_intervals(self, states: np.ndarray, resolution: int = 64) -> tuple:
         """Per joint, the clear interval of its own state around ``states`` (see SweepReport).
 
-        The range is scanned on a grid of ``resolution`` steps and each end found by 30
-        bisection steps between the last clear and the first colliding grid state, so an
+        The range is scanned on a grid of ``resolution`` steps per side and each end found by
+        30 bisection steps between the last clear and the first colliding grid state, so an
         interval is exact to about range / 2^30 unless a collision hides between two grid
         states.
         """
         J = len(states)
         if self.colliding(states[None, :])[0]:
             return (None,) * J
-        out: list = []
-        for j in range(J):
+        out: list = [(float(s), float(s)) for s in states]
+        jobs = []  # (joint, side target)
+        for j in self.movable:
             lo, hi = self.ranges[j]
-            s0 = float(states[j])
-            if self.model.joint_kind[j] == 0 or hi <= lo:
-                out.append((s0, s0))
-                continue
-            ends = []
-            for target in (lo, hi):
-                grid = np.linspace(s0, target, resolution + 1)[1:]
-                Q = np.repeat(states[None, :], grid.size, axis=0)
-                Q[:, j] = grid
-                hits = np.nonzero(self.colliding(Q))[0]
-                if hits.size == 0:
-                    ends.append(float(target))
-                    continue
-                bad = float(grid[hits[0]])
-                good = s0 if hits[0] == 0 else float(grid[hits[0] - 1])
-                for _ in range(30):
-                    mid = 0.5 * (good + bad)
-                    q = states.copy()
-                    q[j] = mid
-                    if self.colliding(q[None, :])[0]:
-                        bad = mid
-                    else:
-                        good = mid
-                ends.append(good)
-            out.append((ends[0], ends[1]))
+            if hi > lo:
+                jobs += [(int(j), float(lo)), (int(j), float(hi))]
+        if not jobs:
+            return tuple(out)
+        # grid scan of every joint and side in one batch
+        rows = []
+        for j, target in jobs:
+            grid = np.linspace(states[j], target, resolution + 1)[1:]
+            Q = np.repeat(states[None, :], grid.size, axis=0)
+            Q[:, j] = grid
+            rows.append(Q)
+        hits = self.colliding(np.vstack(rows)).reshape(len(jobs), resolution)
+        good = np.empty(len(jobs))
+        bad = np.full(len(jobs), np.nan)
+        for n, (j, target) in enumerate(jobs):
+            grid = np.linspace(states[j], target, resolution + 1)
+            first = np.nonzero(hits[n])[0]
+            if first.size == 0:
+                good[n] = target
+            else:
+                good[n] = grid[first[0]]
+                bad[n] = grid[first[0] + 1]
+        open_ = np.nonzero(~np.isnan(bad))[0]
+        for _ in range(30):  # bisection, all open ends at once
+            if open_.size == 0:
+                break
+            mid = 0.5 * (good[open_] + bad[open_])
+            Q = np.repeat(states[None, :], open_.size, axis=0)
+            for row, n in enumerate(open_):
+                Q[row, jobs[n][0]] = mid[row]
+            hit = self.colliding(Q)
+            bad[open_[hit]] = mid[hit]
+            good[open_[~hit]] = mid[~hit]
+        for n, (j, _) in enumerate(jobs):
+            lo, hi = out[j]
+            if good[n] <= states[j]:
+                out[j] = (float(good[n]), hi)
+            else:
+                out[j] = (lo, float(good[n]))
         return tuple(out)
 
 
