@@ -302,13 +302,17 @@ def _recover_locked(out: Path) -> str | None:
         return None
     parts = []
     if restored:
-        parts.append(f"put back {len(restored)} earlier file(s) ({_names(sorted(restored))})")
-    if withdrawn:
-        parts.append(
-            f"took out {len(withdrawn)} half-published one(s) ({_names(sorted(withdrawn))})"
-        )
-    parts.append(f"removed {removed} hidden staging folder(s)")
-    return f"an earlier build into {str(out)!r} was interrupted; recovered: " + ", ".join(parts)
+        parts.append(f"put back the earlier {_names(sorted(restored))}")
+    new_only = sorted(set(withdrawn) - set(restored))
+    if new_only:
+        parts.append(f"took out the half-published {_names(new_only)}")
+    if removed == 1:
+        what = f"an earlier build into {str(out)!r} was interrupted"
+        parts.append("removed its hidden staging folder")
+    else:
+        what = f"{removed} earlier builds into {str(out)!r} were interrupted"
+        parts.append("removed their hidden staging folders")
+    return "; ".join([what, *parts])
 
 
 def recover(out: str | os.PathLike) -> str | None:
