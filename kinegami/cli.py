@@ -143,13 +143,6 @@ def _load(design: str):
     return load_design_with_info(design)
 
 
-def _existing_ancestor(path: Path) -> Path:
-    path = path.absolute()
-    while not path.exists():
-        path = path.parent
-    return path
-
-
 def _check_pattern(job: BuildJob) -> None:
     """Build the crease pattern now, so that a pattern error is a design error naming the
     design file and the joint or link (kinegami.design.check_pattern)."""
