@@ -30,6 +30,8 @@ VIEW = {"elev": 30.0, "azim": -60.0}
 #: Magnification of the 3D box (show() uses 1.15; the chains rarely fill the box's corners).
 ZOOM = 1.5
 PATTERN_DPI = 80
+#: PNG text chunks: none, so that a new matplotlib version alone does not change the files.
+PNG_METADATA = {"Software": None}
 
 
 def axis_pose(point, axis, xhat) -> SE3:
@@ -74,7 +76,13 @@ def save_figure(fig, path: Path, dpi: int, tight: bool = False) -> Path:
 
     buffer = io.BytesIO()
     try:
-        fig.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight" if tight else None)
+        fig.savefig(
+            buffer,
+            format="png",
+            dpi=dpi,
+            bbox_inches="tight" if tight else None,
+            metadata=PNG_METADATA,
+        )
     finally:
         plt.close(fig)
     return write_bytes_atomic(path, buffer.getvalue())

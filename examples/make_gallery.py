@@ -8,6 +8,11 @@ chain with the design loader and writes, into ``docs/images/gallery/`` (or FOLDE
 * ``<name>.png``: the 3D view of the chain, 640 x 560 pixels, the same camera for every entry;
 * ``<name>_pattern.png``: its crease pattern (valley folds red, mountain folds blue).
 
+The pictures are reproducible byte for byte: a second run, or a run on another machine with the
+same versions of matplotlib and numpy, writes the same files (no version stamp in the PNGs, faces
+in a fixed order and shaded from exact normals), so git shows a picture as changed only when its
+chain changed (tests/test_gallery.py checks it under another OpenBLAS kernel).
+
 Drawing uses matplotlib's Agg backend (no screen needed). A design whose placement or edits fail
 stops the command with the loader's one-line error; nothing is half-written (each picture is
 written to a temporary file and then renamed).

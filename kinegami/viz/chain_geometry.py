@@ -33,6 +33,7 @@ __all__ = [
     "circle_points",
     "arc_points",
     "convex_hull_faces",
+    "face_normals",
     "prism_faces",
     "prismatic_prism_vertices",
     "revolute_hull_points",
@@ -94,7 +95,9 @@ def convex_hull_faces(points) -> list[np.ndarray]:
     """Faces of the convex hull of ``points`` (k, 3): one ordered polygon per planar facet.
 
     Coplanar hull triangles are merged, so a box gives 6 quadrilaterals. A flat or degenerate
-    point set gives an empty list.
+    point set gives an empty list. The output does not depend on the order in which qhull lists
+    its triangles (which changes with the last bits of the points): faces come in the order of
+    their point indices, each counter-clockwise about its outward normal from its lowest index.
     """
     from scipy.spatial import ConvexHull, QhullError
 
@@ -111,8 +114,9 @@ def convex_hull_faces(points) -> list[np.ndarray]:
         groups.setdefault(key, set()).update(int(i) for i in simplex)
         normals[key] = eq[:3]
     faces = []
-    for key, idx in groups.items():
-        face = pts[sorted(idx)]
+    for key in sorted(groups, key=lambda k: sorted(groups[k])):
+        idx = np.array(sorted(groups[key]))
+        face = pts[idx]
         normal = normals[key]
         centre = face.mean(axis=0)
         e1 = face[0] - centre
@@ -120,8 +124,28 @@ def convex_hull_faces(points) -> list[np.ndarray]:
         e2 = np.cross(normal, e1)
         d = face - centre
         order = np.argsort(np.arctan2(d @ e2, d @ e1))
+        order = np.roll(order, -int(np.argmin(order)))  # start at the lowest index
         faces.append(face[order])
     return faces
+
+
+def face_normals(polygons) -> np.ndarray:
+    """(q, 3) normals of q planar polygons (each (k, 3), or a (q, k, 3) array), by Newell's
+    method: twice the area times the unit normal, right-handed about the vertex order.
+
+    Unlike a normal from three of the vertices, it stays exact when two vertices coincide (a
+    quadrilateral that is really a triangle, where an elbow's mitre meets its end circle).
+    A polygon without area gives a zero vector.
+    """
+    if isinstance(polygons, np.ndarray) and polygons.ndim == 3:
+        d = polygons - polygons.mean(axis=1, keepdims=True)
+        return np.cross(d, np.roll(d, -1, axis=1)).sum(axis=1)
+    out = np.zeros((len(polygons), 3))
+    for i, poly in enumerate(polygons):
+        d = np.asarray(poly, dtype=float)
+        d = d - d.mean(axis=0)
+        out[i] = np.cross(d, np.roll(d, -1, axis=0)).sum(axis=0)
+    return out
 
 
 def prism_faces(bottom: np.ndarray, top: np.ndarray) -> list[np.ndarray]:

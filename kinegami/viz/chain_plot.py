@@ -132,6 +132,31 @@ def resolve_chain_options(options: dict[str, Any]) -> dict[str, Any]:
     return opts
 
 
+#: Direction towards the light of shaded faces: mplot3d's own (azimuth 225, altitude 19.4712 deg).
+_LIGHT_AZIMUTH, _LIGHT_ALTITUDE = 225.0, 19.4712
+
+
+def _shading(normals: np.ndarray) -> np.ndarray:
+    """(q,) brightness of faces with these normals, as mplot3d shades them: 0.3 facing away from
+    the light, 1 facing it; 0.65 for a face without a normal."""
+    from matplotlib.colors import LightSource
+
+    light = LightSource(azdeg=_LIGHT_AZIMUTH, altdeg=_LIGHT_ALTITUDE).direction
+    length = np.linalg.norm(normals, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cosine = np.where(length > 0.0, (normals @ light) / length, 0.0)
+    return 0.3 + 0.7 * (cosine + 1.0) / 2.0
+
+
+def _shaded(rgba, shading):
+    """``rgba`` with its colour (not its alpha) scaled by each face's ``shading``."""
+    if np.isscalar(shading):
+        return rgba
+    colours = np.tile(np.asarray(rgba, dtype=float), (len(shading), 1))
+    colours[:, :3] *= shading[:, None]
+    return colours
+
+
 class _Scene:
     """Adds artists to a 3D axes and remembers the extent of everything added."""
 
@@ -156,12 +181,18 @@ class _Scene:
             return None
         for poly in polys if isinstance(polys, list) else [polys]:
             self._extent(poly)
-        kwargs = {"facecolors": to_rgba(facecolor, alpha), "linewidths": linewidth}
+        shading = _shading(geo.face_normals(polys)) if shade else 1.0
+        kwargs = {
+            "facecolors": _shaded(to_rgba(facecolor, alpha), shading),
+            "linewidths": linewidth,
+        }
         if edgecolor != "none":
-            kwargs["edgecolors"] = to_rgba(edgecolor, min(1.0, 2.0 * alpha))
+            kwargs["edgecolors"] = _shaded(to_rgba(edgecolor, min(1.0, 2.0 * alpha)), shading)
         elif not shade:
             kwargs["edgecolors"] = "none"
-        collection = self.art3d.Poly3DCollection(list(polys), shade=shade, **kwargs)
+        # shaded here, not by matplotlib: its normal from three vertices is noise on a face with
+        # two coincident vertices (so the colour changed with the CPU's rounding)
+        collection = self.art3d.Poly3DCollection(list(polys), shade=False, **kwargs)
         collection.set_gid(gid)
         self.ax.add_collection3d(collection)
         return collection

@@ -85,6 +85,41 @@ def test_convex_hull_faces_merges_coplanar_triangles():
     assert all(len(f) == 4 for f in faces)
 
 
+def test_convex_hull_faces_come_in_index_order_from_their_lowest_index():
+    """The output is canonical, whatever order qhull lists its triangles in: faces sorted by
+    their point indices, each starting at its lowest index, counter-clockwise seen from
+    outside."""
+    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
+    faces = geo.convex_hull_faces(cube)
+    index = {tuple(p): i for i, p in enumerate(cube)}
+    ids = [[index[tuple(p)] for p in face] for face in faces]
+    assert [sorted(f) for f in ids] == sorted(sorted(f) for f in ids)
+    assert all(f[0] == min(f) for f in ids)
+    centre = cube.mean(axis=0)
+    for face in faces:
+        outward = face.mean(axis=0) - centre
+        assert geo.face_normals([face])[0] @ outward > 0
+
+
+def test_face_normals_newell():
+    square = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0]], dtype=float)
+    assert_allclose(geo.face_normals(square[None]), [[0, 0, 8]])  # twice the area, along +z
+    assert_allclose(geo.face_normals([square[::-1]]), [[0, 0, -8]])
+
+
+def test_face_normals_of_a_quadrilateral_with_two_coincident_vertices():
+    """Where an elbow's mitre meets its end circle a quad is a triangle: its normal is the
+    triangle's, to rounding, although the first three vertices span nothing."""
+    a, b, c = np.array([5.0, 1.0, 2.0]), np.array([6.0, 1.0, 2.0]), np.array([5.0, 1.0, 3.0])
+    quad = np.array([a, b, b + 1e-15, c])
+    triangle = np.cross(b - a, c - a)
+    normal = geo.face_normals(quad[None])[0]
+    assert_allclose(
+        normal / np.linalg.norm(normal), triangle / np.linalg.norm(triangle), atol=1e-12
+    )
+    assert_allclose(geo.face_normals([quad]), [normal])  # list and array agree
+
+
 def test_convex_hull_of_flat_points_is_empty():
     assert geo.convex_hull_faces(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]])) == []
 

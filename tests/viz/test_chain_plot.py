@@ -295,3 +295,49 @@ def test_fifty_joint_chain_draws_quickly():
     fig, _ = chain.show()
     fig.canvas.draw()
     assert time.perf_counter() - start < 5.0
+
+
+def test_shading_matches_mplot3d_on_ordinary_faces():
+    """Faces are shaded here (Newell normals) the way mplot3d shades them itself."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    from kinegami.viz.chain_geometry import face_normals
+    from kinegami.viz.chain_plot import _shaded, _shading
+
+    rng = np.random.default_rng(3)
+    triangles = rng.normal(size=(40, 3, 3))
+    colour = to_rgba("tab:blue", 0.4)
+    ax = plt.figure().add_subplot(projection="3d")
+    collection = Poly3DCollection(list(triangles), shade=True, facecolors=colour)
+    ax.add_collection3d(collection)
+    ax.figure.canvas.draw()
+    theirs = collection.get_facecolor()  # in drawing order: compare sorted by brightness
+    ours = _shaded(colour, _shading(face_normals(triangles)))
+    plt.close(ax.figure)
+    assert_allclose(ours[np.argsort(ours[:, 0])], theirs[np.argsort(theirs[:, 0])], atol=1e-12)
+
+
+def test_elbow_triangles_are_shaded_by_their_plane(example_1a):
+    """An elbow quad whose two vertices coincide is drawn in the shade of its triangle, not of
+    the noise in the null vector that three of its vertices give (which changed with the CPU)."""
+    from kinegami.viz.chain_geometry import grid_quads, link_elbow_grids
+    from kinegami.viz.chain_plot import _shaded, _shading
+
+    fig, ax = example_1a.show()
+    fig.canvas.draw()
+    drawn = _artist(ax, "link-elbows").get_facecolor()
+    plt.close(fig)
+    grids = [
+        g for link in example_1a.Links if len(g := link_elbow_grids(link, style.linkSurfaceSides))
+    ]
+    q = grid_quads(np.concatenate(grids))
+    gaps = np.stack([np.linalg.norm(q[:, i] - q[:, (i + 1) % 4], axis=1) for i in range(4)], 1)
+    pinched = gaps.min(axis=1) < 1e-9 * gaps.max(axis=1)
+    assert pinched.sum() > 10  # the case exists in Example 1A
+    # each quad's plane from its two diagonals, which a repeated vertex does not spoil
+    normals = np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1])
+    expected = _shaded(to_rgba(style.CHAIN_PLOT_DEFAULTS["linkColor"], 1.0), _shading(normals))
+    expected[:, 3] = drawn[:, 3]
+    assert_allclose(
+        drawn[np.lexsort(drawn.T[::-1])], expected[np.lexsort(expected.T[::-1])], atol=1e-9
+    )
