@@ -290,6 +290,9 @@ def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
             f"at zero configuration "
         )
     )
+    # MuJoCo's URDF importer (in older releases) keeps only the file name of a mesh path
+    # unless told not to
+    ET.SubElement(ET.SubElement(robot, "mujoco"), "compiler", strippath="false")
     for material, rgba in (("kinegami_joint", _JOINT_RGBA), ("kinegami_link", _LINK_RGBA)):
         ET.SubElement(ET.SubElement(robot, "material", name=material), "color", rgba=rgba)
     files: dict[str, bytes] = {}

@@ -287,6 +287,20 @@ def test_mesh_paths_are_relative(tmp_path, example_1a):
     assert len(robot.scene.geometry) == len(set(filenames))
 
 
+def test_mujoco_keeps_the_mesh_paths(tmp_path, example_1a):
+    """MuJoCo's importer strips mesh paths to their file names unless the robot says
+    <mujoco><compiler strippath="false"/></mujoco>; yourdfpy still validates the file."""
+    path = export(example_1a, tmp_path / "robot.urdf")
+    root = ET.parse(path).getroot()
+    assert root.tag == "robot"
+    mujoco = root.findall("mujoco")
+    assert len(mujoco) == 1
+    compilers = mujoco[0].findall("compiler")
+    assert [c.attrib for c in compilers] == [{"strippath": "false"}]
+    robot = load(path)
+    assert len(robot.robot.links) == len(root.findall("link"))
+
+
 def test_inertia_is_a_paper_shell(tmp_path, example_1a):
     robot = load(export(example_1a, tmp_path / "e.urdf", mass_per_area=0.1))
     total_area = 0.0
