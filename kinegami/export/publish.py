@@ -289,19 +289,19 @@ def _recover_locked(out: Path) -> str | None:
             if not _flock(fd, block=False):
                 continue  # a build that is still running, or no locks here: leave it
             entries = _read_journal(staging)
-            if entries is not None:
-                try:
+            try:
+                if entries is not None:
                     undone = _rollback(out, staging, entries)
-                except OSError as exc:
-                    raise PublishError(
-                        exc.errno,
-                        f"cannot put back the files of an interrupted build into {str(out)!r} "
-                        f"({exc.strerror or exc}); they are in {str(staging / 'old')!r}",
-                        exc.filename,
-                    ) from None
-                withdrawn += undone[0]
-                restored += undone[1]
-            _retire(staging)
+                    withdrawn += undone[0]
+                    restored += undone[1]
+                _retire(staging)
+            except OSError as exc:
+                raise PublishError(
+                    exc.errno,
+                    f"cannot put back the files of an interrupted build into {str(out)!r} "
+                    f"({exc.strerror or exc}); they are in {str(staging / 'old')!r}",
+                    exc.filename,
+                ) from None
             removed += 1
         finally:
             os.close(fd)

@@ -333,6 +333,19 @@ def test_sigkill_at_any_step_is_recovered_by_the_next_build(out, step):
     assert snapshot(out) == new_state()
 
 
+def test_a_recovery_that_fails_keeps_the_leftover(out, monkeypatch):
+    run_paused(out, 4, signal.SIGKILL)  # a.txt replaced, m moved aside
+    kept = leftovers(out)
+    monkeypatch.setattr(publish, "_move", Moves({}, from_on=1))  # the first move back works
+    with pytest.raises(PublishError, match="cannot put back the files") as info:
+        build(out)
+    assert f"{kept[0]}/old" in str(info.value)
+    monkeypatch.undo()
+    assert leftovers(out) == kept
+    assert "put back the earlier a.txt;" in recover(out)  # m went back on the first try
+    assert snapshot(out) == old_state()
+
+
 def test_sigkill_of_a_first_build_is_recovered(tmp_path):
     target = tmp_path / "fresh"
     status = run_paused(target, 3, signal.SIGKILL)  # journal, n... : two entries are in
