@@ -26,7 +26,13 @@ import numpy as np
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.frames import rot_x, rot_z, translation
 from kinegami.joints import EndTip, PrismaticJoint, RevoluteJoint
-from kinegami.validation import check_num_sides, check_radius
+from kinegami.validation import (
+    check_num_sides,
+    check_radius,
+    check_real,
+    check_translation,
+    shown,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from kinegami.chain import KinematicChain
@@ -51,6 +57,8 @@ def _check_convention(convention) -> str:
 def dh_transform(theta: float, alpha: float, a: float, d: float, convention: str = "standard"):
     """4x4 transform of one DH row (angles in radians) from frame i-1 to frame i."""
     convention = _check_convention(convention)
+    theta, alpha = check_real("theta", theta), check_real("alpha", alpha)
+    a, d = check_real("a", a), check_real("d", d)
     if convention == "standard":
         return rot_z(theta) @ translation([0.0, 0.0, d]) @ translation([a, 0.0, 0.0]) @ rot_x(alpha)
     return rot_x(alpha) @ translation([a, 0.0, 0.0]) @ rot_z(theta) @ translation([0.0, 0.0, d])
@@ -65,17 +73,21 @@ def _check_table(table) -> np.ndarray:
     for i, row in enumerate(table):
         try:
             values = [float(v) for v in row]
+        except OverflowError:  # a Python int beyond the float range
+            raise InvalidParameterError(
+                f"table row {i} must be finite numbers (within +-1.8e308), got {shown(row)}"
+            ) from None
         except (TypeError, ValueError):
             raise InvalidTypeError(
-                f"table row {i} must be 4 numbers (theta, alpha, a, d), got {row!r}"
+                f"table row {i} must be 4 numbers (theta, alpha, a, d), got {shown(row)}"
             ) from None
         if len(values) != 4:
             raise InvalidParameterError(
                 f"table row {i} must have 4 entries (theta, alpha, a, d), got {len(values)}: "
-                f"{row!r}"
+                f"{shown(row)}"
             )
         if not all(math.isfinite(v) for v in values):
-            raise InvalidParameterError(f"table row {i} must be finite numbers, got {row!r}")
+            raise InvalidParameterError(f"table row {i} must be finite numbers, got {shown(row)}")
         rows.append(values)
     if not rows:
         raise InvalidParameterError("table must have at least one row (theta, alpha, a, d)")
@@ -182,21 +194,30 @@ def chain_from_dh(
     if not isinstance(endTip, bool | np.bool_):
         raise InvalidTypeError(f"endTip must be True or False, got {endTip!r}")
     rows = _check_table(table)
+    for i, (_, _, a, d) in enumerate(rows):
+        check_translation(f"table row {i} a", a, r)
+        check_translation(f"table row {i} d", d, r)
     types = parse_joint_types(jointTypes, len(rows))
     if neutralLength is None:
         neutralLength = 3.0 * r
     if tipLength is None:
         tipLength = 1.5 * r
 
+    # the joints are made at the identity and then moved to their frames: composed DH frames
+    # are computed positions, not user poses, so they are not held to the +-1e6 r bound
     def make(kind: str, T: np.ndarray):
         if kind == "R":
-            return RevoluteJoint(numSides, r, totalBendingAngle, T, numSinkLayers=numSinkLayers)
-        return PrismaticJoint(numSides, r, neutralLength, numLayers, coneAngle, T)
+            joint = RevoluteJoint(numSides, r, totalBendingAngle, I4, numSinkLayers=numSinkLayers)
+        else:
+            joint = PrismaticJoint(numSides, r, neutralLength, numLayers, coneAngle, I4)
+        return joint.with_pose(T)
 
+    I4 = np.eye(4)
     frames = dh_joint_frames(rows, convention)
     joints = [make(kind, T) for kind, T in zip(types, frames, strict=True)]
     if endTip:
-        joints.append(EndTip(numSides, r, dh_tool_frame(rows, convention), tipLength))
+        tool = dh_tool_frame(rows, convention)
+        joints.append(EndTip(numSides, r, I4, tipLength).with_pose(tool))
 
     chain = cls(joints[0], maxAnglePerElbow=maxAnglePerElbow)
     options = {"relative": False}

@@ -6,6 +6,10 @@ z axis = axis of motion), a tube radius ``r``, a polygon side count ``numSides``
 length for prismatic joints, 0 at construction) and a path direction: column ``pathIndex()`` of
 the Pose, the tangent of the tube centreline through the joint.
 
+Lengths lie in (0, 1e6 r] and Pose translations within +-1e6 r (see
+:mod:`kinegami.validation`); an InvalidParameterError names the parameter, the value and the
+bound otherwise.
+
 Joints are values: a chain never changes a joint in place, it swaps in modified copies
 (``with_pose``, ``with_state``), which is what makes its edits transactions.
 """
@@ -32,9 +36,10 @@ from kinegami.geometry.frames import (
 from kinegami.validation import (
     check_in_range,
     check_int,
+    check_length,
     check_num_sides,
-    check_positive,
     check_radius,
+    check_translation_part,
 )
 
 __all__ = [
@@ -50,8 +55,12 @@ __all__ = [
 ]
 
 
-def pose_array(Pose, name: str = "Pose") -> np.ndarray:
-    """A validated 4x4 float array from an SE3 or a 4x4 array-like (proper rigid, finite)."""
+def pose_array(Pose, name: str = "Pose", r: float | None = None) -> np.ndarray:
+    """A validated 4x4 float array from an SE3 or a 4x4 array-like (proper rigid, finite).
+
+    With the tube radius ``r``, the translation must also lie within +-1e6 r in each
+    coordinate (:data:`kinegami.validation.LENGTH_FACTOR`).
+    """
     if isinstance(Pose, SE3):
         if len(Pose) != 1:
             raise InvalidParameterError(f"{name} must be a single SE3, got {len(Pose)} poses")
@@ -59,6 +68,10 @@ def pose_array(Pose, name: str = "Pose") -> np.ndarray:
     else:
         try:
             T = np.array(Pose, dtype=float)
+        except OverflowError:  # a Python int beyond the float range
+            raise InvalidParameterError(
+                f"{name} must be finite, got an entry beyond the float range (+-1.8e308)"
+            ) from None
         except (TypeError, ValueError):
             raise InvalidTypeError(
                 f"{name} must be an SE3 or a 4x4 array, got {type(Pose).__name__}"
@@ -72,6 +85,8 @@ def pose_array(Pose, name: str = "Pose") -> np.ndarray:
             f"{name} must be a proper rigid transform (orthonormal rotation with determinant +1 "
             f"and last row 0 0 0 1), got\n{T}"
         )
+    if r is not None:
+        check_translation_part(name, T, r)
     T.setflags(write=False)
     return T
 
@@ -92,7 +107,7 @@ class Joint:
         self._numSides = check_num_sides(numSides)
         self._r = check_radius(r)
         self._neutralLength = float(neutralLength)
-        self._T = pose_array(Pose)
+        self._T = pose_array(Pose, r=self._r)
         self._state = 0.0
 
     # --- published attributes -------------------------------------------------------------
@@ -281,10 +296,11 @@ class RevoluteJoint(Joint):
     Parameters
     ----------
     numSides : even number of polygon sides, >= 4.
-    r : tube radius, > 0.
+    r : tube radius, in [1e-6, 1e6].
     totalBendingAngle : total range of rotation in (0, 2pi) radians; states lie in
         [-totalBendingAngle/2, +totalBendingAngle/2].
-    Pose : SE3 (or 4x4 array) of the joint centre; z is the rotation axis.
+    Pose : SE3 (or 4x4 array) of the joint centre; z is the rotation axis. Its translation
+        lies within +-1e6 r (as every length and translation, see :mod:`kinegami.validation`).
     numSinkLayers : number of recursive sink gadget layers in the pattern (>= 1; stiffness).
     """
 
@@ -323,7 +339,7 @@ class ExtendedRevoluteJoint(RevoluteJoint):
     """A revolute joint with a straight tube of length ``tubeLength`` on each side."""
 
     def __init__(self, numSides, r, totalBendingAngle, tubeLength, Pose, numSinkLayers=1):
-        self.tubeLength = check_positive("tubeLength", tubeLength)
+        self.tubeLength = check_length("tubeLength", tubeLength, check_radius(r))
         super().__init__(numSides, r, totalBendingAngle, Pose, numSinkLayers)
         self._neutralLength += 2.0 * self.tubeLength
 
@@ -343,7 +359,7 @@ class PrismaticJoint(Joint):
     Parameters
     ----------
     numSides, r : as for every joint.
-    neutralLength : length d > 0 of the joint at state 0.
+    neutralLength : length d of the joint at state 0, in (0, 1e6 r].
     numLayers : number of REBO layers (integer >= 1).
     coneAngle : REBO cone angle in [pi/6, pi/2) radians; the state range is
         [d/(2 sin coneAngle) - d, d/sin coneAngle - d].
@@ -353,7 +369,7 @@ class PrismaticJoint(Joint):
     def __init__(self, numSides, r, neutralLength, numLayers, coneAngle, Pose):
         n = check_num_sides(numSides)
         r = check_radius(r)
-        d = check_positive("neutralLength", neutralLength)
+        d = check_length("neutralLength", neutralLength, r)
         self.numLayers = check_int("numLayers", numLayers, minimum=1)
         self.coneAngle = check_in_range(
             "coneAngle",
@@ -431,12 +447,12 @@ class Waypoint(Joint):
 
 
 class Tip(Joint):
-    """Base of the closed tube ends; ``length`` is the axial length (> 0)."""
+    """Base of the closed tube ends; ``length`` is the axial length, in (0, 1e6 r]."""
 
     def __init__(self, numSides, r, Pose, length):
         n = check_num_sides(numSides)
         r = check_radius(r)
-        self.length = check_positive("length", length)
+        self.length = check_length("length", length, r)
         super().__init__(n, r, self.length, Pose)
 
     def _describe(self) -> str:

@@ -106,13 +106,26 @@ def _elbow_arc(
     return ElbowArc(theta, count, phi, frames, r)
 
 
+def _solved_path(r: float, start: np.ndarray, end: np.ndarray) -> CSCPath:
+    path = solve_csc(start[:3, 3], start[:3, 0], end[:3, 3], end[:3, 0], r)
+    if path is None:
+        raise NoPathError(
+            "no CSC path with both turns < pi joins the start frame at "
+            f"{np.round(start[:3, 3], 6).tolist()} (direction "
+            f"{np.round(start[:3, 0], 6).tolist()}) to the end frame at "
+            f"{np.round(end[:3, 3], 6).tolist()} (direction {np.round(end[:3, 0], 6).tolist()})"
+        )
+    return path
+
+
 class LinkCSC:
     """A link: the CSC Dubins path from ``StartDubinsPose`` to ``EndDubinsPose``.
 
     Parameters
     ----------
-    r : tube radius = turning radius (> 0).
-    StartDubinsPose, EndDubinsPose : SE3 (or 4x4 arrays), x axis = path tangent.
+    r : tube radius = turning radius, in [1e-6, 1e6].
+    StartDubinsPose, EndDubinsPose : SE3 (or 4x4 arrays), x axis = path tangent; their
+        translations lie within +-1e6 r.
     maxAnglePerElbow : largest turn of one elbow, in (0, pi] (default pi/2).
 
     Raises NoPathError (a ValueError) when no path with both turns < pi exists.
@@ -127,17 +140,19 @@ class LinkCSC:
     def __init__(self, r, StartDubinsPose, EndDubinsPose, maxAnglePerElbow=np.pi / 2):
         r = check_radius(r)
         max_angle = check_max_angle_per_elbow(maxAnglePerElbow)
-        start = pose_array(StartDubinsPose, "StartDubinsPose")
-        end = pose_array(EndDubinsPose, "EndDubinsPose")
-        path = solve_csc(start[:3, 3], start[:3, 0], end[:3, 3], end[:3, 0], r)
-        if path is None:
-            raise NoPathError(
-                "no CSC path with both turns < pi joins the start frame at "
-                f"{np.round(start[:3, 3], 6).tolist()} (direction "
-                f"{np.round(start[:3, 0], 6).tolist()}) to the end frame at "
-                f"{np.round(end[:3, 3], 6).tolist()} (direction {np.round(end[:3, 0], 6).tolist()})"
-            )
-        self._init(r, max_angle, start, end, path)
+        start = pose_array(StartDubinsPose, "StartDubinsPose", r=r)
+        end = pose_array(EndDubinsPose, "EndDubinsPose", r=r)
+        self._init(r, max_angle, start, end, _solved_path(r, start, end))
+
+    @classmethod
+    def _between(cls, r, max_angle, start: np.ndarray, end: np.ndarray) -> LinkCSC:
+        """The link between two frames the chain computed (already checked: rigid, finite;
+        not held to the +-1e6 r bound of user poses). Raises NoPathError."""
+        start = np.array(start, dtype=float)
+        end = np.array(end, dtype=float)
+        start.setflags(write=False)
+        end.setflags(write=False)
+        return cls._from_parts(r, max_angle, start, end, _solved_path(r, start, end))
 
     def _init(self, r, max_angle, start, end, path):
         self.r = r

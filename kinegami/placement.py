@@ -94,7 +94,8 @@ def _waypoint(template: Joint, R: np.ndarray, origin: np.ndarray, path_index: in
     T = np.eye(4)
     T[:3, :3] = R
     T[:3, 3] = origin
-    return Waypoint(template.numSides, template.r, T, pathIndex=path_index)
+    # a computed position, not a user parameter: not held to the +-1e6 r bound of Poses
+    return Waypoint(template.numSides, template.r, np.eye(4), pathIndex=path_index).with_pose(T)
 
 
 def published_safe_placement(

@@ -2,6 +2,19 @@
 
 Every check names the parameter, the value received and the valid range, so a user sees
 ``numSides must be an even integer >= 4, got 5`` rather than a traceback from numpy.
+
+Bounds of the API (the same as those of design files, docs/design-format.md):
+
+* the tube radius r lies in [:data:`R_MIN`, :data:`R_MAX`] = [1e-6, 1e6];
+* every length (tip ``length``, ``tubeLength``, ``neutralLength``) lies in (0, 1e6 r] and every
+  distance or translation given to the API (``translateJointAlongAxisOfMotion``'s distance,
+  the translation of a joint's ``Pose``, of a ``Transformation``, of a link's Dubins poses, DH
+  ``a`` and ``d``) within +-1e6 r (:data:`LENGTH_FACTOR`);
+* numbers are finite; a Python int beyond the float range is an InvalidParameterError.
+
+Positions the library computes itself (placement, composed DH frames, the result of several
+edits) are not re-checked against these bounds: each step stays within them, so nothing
+overflows.
 """
 
 from __future__ import annotations
@@ -13,15 +26,95 @@ import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 
+#: Smallest and largest tube radius r (in the chain's length unit), as in design files.
+R_MIN = 1e-6
+R_MAX = 1e6
+#: Every length, distance and translation coordinate given to the API (and written in a design
+#: file) satisfies ``|value| <= LENGTH_FACTOR * r``. With r <= R_MAX, squares and products of
+#: such values stay far from the float range, and r stays well above their rounding error.
+LENGTH_FACTOR = 1e6
+#: Longest rendering of a value in a message, in characters (longer ones end in "...").
+SHOWN_LIMIT = 80
+
+
+def _digits(value: int) -> str:
+    """How many decimal digits the int ``value`` has ("about N" when too long to print)."""
+    try:
+        return str(len(str(abs(value))))
+    except ValueError:  # more digits than sys.get_int_max_str_digits()
+        return f"about {int(abs(value).bit_length() * math.log10(2)) + 1}"
+
+
+def shorten(text: str, limit: int = SHOWN_LIMIT) -> str:
+    """``text`` on one line, cut to ``limit`` characters (ending in "...") if longer."""
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def shown(value, limit: int = SHOWN_LIMIT) -> str:
+    """A one-line ``repr`` of a user value for messages, at most ``limit`` characters.
+
+    Integers too long to be useful (more than 30 digits) are described by their number of
+    digits, so that even ints beyond ``sys.get_int_max_str_digits()`` can be named.
+    """
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 100:
+        sign = "a negative" if value < 0 else "an"
+        return f"<{sign} integer of {_digits(value)} digits>"
+    if isinstance(value, str | list | tuple) and len(value) > limit:
+        value = value[: limit + 1]  # the repr of the rest would be cut anyway
+    try:
+        text = repr(value)
+    except Exception:  # a repr that fails (recursion, huge ints inside a container)
+        text = f"<{type(value).__name__}>"
+    return shorten(text, limit)
+
 
 def check_real(name: str, value) -> float:
     """Return ``value`` as a float, or raise if it is not a finite real number."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real | np.floating | np.integer):
-        raise InvalidTypeError(f"{name} must be a real number, got {value!r}")
-    value = float(value)
+        raise InvalidTypeError(f"{name} must be a real number, got {shown(value)}")
+    try:
+        value = float(value)
+    except OverflowError:  # a Python int (or Fraction) beyond the float range
+        raise InvalidParameterError(
+            f"{name} must be a finite number (within +-1.8e308), got {shown(value)}"
+        ) from None
     if not math.isfinite(value):
         raise InvalidParameterError(f"{name} must be a finite number, got {value!r}")
     return value
+
+
+def _limit_text(r: float) -> str:
+    return f"1e6 r = {LENGTH_FACTOR * r:g} (r = {r:g})"
+
+
+def check_length(name: str, value, r: float) -> float:
+    """A length: a finite real number in (0, LENGTH_FACTOR * r]."""
+    value = check_real(name, value)
+    if not 0.0 < value <= LENGTH_FACTOR * r:
+        raise InvalidParameterError(
+            f"{name} must be > 0 and <= {_limit_text(r)}, got {value!r}"
+        )
+    return value
+
+
+def check_translation(name: str, value, r: float) -> float:
+    """A distance or translation coordinate: a finite real number within +-LENGTH_FACTOR * r."""
+    value = check_real(name, value)
+    if not abs(value) <= LENGTH_FACTOR * r:
+        raise InvalidParameterError(f"{name} must be within +-{_limit_text(r)}, got {value!r}")
+    return value
+
+
+def check_translation_part(name: str, T: np.ndarray, r: float) -> None:
+    """The translation column of the 4x4 array ``T`` within +-LENGTH_FACTOR * r."""
+    t = T[:3, 3]
+    k = int(np.argmax(np.abs(t)))
+    if not abs(t[k]) <= LENGTH_FACTOR * r:
+        raise InvalidParameterError(
+            f"{name} translation must be within +-{_limit_text(r)} in each coordinate, "
+            f"got {float(t[k])!r} in {'xyz'[k]}"
+        )
 
 
 def check_positive(name: str, value) -> float:
@@ -69,10 +162,10 @@ def check_int(name: str, value, minimum: int | None = None) -> int:
         if isinstance(value, float) and value.is_integer():
             value = int(value)
         else:
-            raise InvalidTypeError(f"{name} must be an integer, got {value!r}")
+            raise InvalidTypeError(f"{name} must be an integer, got {shown(value)}")
     value = int(value)
     if minimum is not None and value < minimum:
-        raise InvalidParameterError(f"{name} must be an integer >= {minimum}, got {value}")
+        raise InvalidParameterError(f"{name} must be an integer >= {minimum}, got {shown(value)}")
     return value
 
 
@@ -81,15 +174,23 @@ def check_num_sides(value) -> int:
     try:
         n = check_int("numSides", value)
     except InvalidTypeError:
-        raise InvalidTypeError(f"numSides must be an even integer >= 4, got {value!r}") from None
+        raise InvalidTypeError(
+            f"numSides must be an even integer >= 4, got {shown(value)}"
+        ) from None
     if n < 4 or n % 2:
-        raise InvalidParameterError(f"numSides must be an even integer >= 4, got {n}")
+        raise InvalidParameterError(f"numSides must be an even integer >= 4, got {shown(n)}")
     return n
 
 
 def check_radius(value, name: str = "r") -> float:
-    """The tube radius: finite and > 0."""
-    return check_positive(name, value)
+    """The tube radius: a finite number in [R_MIN, R_MAX] = [1e-6, 1e6]."""
+    value = check_positive(name, value)
+    if not R_MIN <= value <= R_MAX:
+        raise InvalidParameterError(
+            f"{name} must lie in [{R_MIN:g}, {R_MAX:g}] (the tube radius, in the chain's "
+            f"length unit), got {value!r}"
+        )
+    return value
 
 
 def check_max_angle_per_elbow(value) -> float:

@@ -23,6 +23,7 @@ from kinegami.design.reader import (
 )
 from kinegami.errors import InvalidTypeError, KinegamiError
 from kinegami.pattern import TubularPattern
+from kinegami.validation import shorten
 
 __all__ = ["check_pattern", "joint_table"]
 
@@ -46,7 +47,7 @@ def _joint_text(chain: KinematicChain, origin: DesignOrigin | None, index: int) 
     joint = chain.Joints[index]
     text = f"chain joint {index} ({type(joint).__name__}"
     if origin is not None and origin.names[index] is not None:
-        text += f" '{origin.names[index]}'"
+        text += f" '{shorten(origin.names[index])}'"
     elif origin is not None and origin.kind == "joints" and origin.sources[index] is None:
         text += ", added by safe placement"
     return text + ")"

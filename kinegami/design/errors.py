@@ -11,6 +11,7 @@ import re
 import numpy as np
 
 from kinegami.errors import KinegamiError
+from kinegami.validation import shown
 
 __all__ = ["DesignError", "json_path", "numeric_errors"]
 
@@ -20,16 +21,27 @@ _NO_VALUE = object()
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
 
+#: Longest key shown in a JSON path (longer ones end in "...").
+_KEY_LIMIT = 80
+
+
 def json_path(parts) -> str:
-    """``("joints", 2, "pose")`` -> ``"joints[2].pose"``; the empty path is ``"$"``."""
+    """``("joints", 2, "pose")`` -> ``"joints[2].pose"``; the empty path is ``"$"``.
+
+    Keys longer than 80 characters are shortened (ending in "...").
+    """
     text = ""
     for part in parts:
         if isinstance(part, int):
             text += f"[{part}]"
-        elif _IDENTIFIER.match(str(part)):
-            text += f".{part}" if text else str(part)
+            continue
+        part = str(part)
+        if len(part) > _KEY_LIMIT:
+            part = part[: _KEY_LIMIT - 3] + "..."
+        if _IDENTIFIER.match(part):
+            text += f".{part}" if text else part
         else:
-            text += f"[{json.dumps(str(part))}]"
+            text += f"[{json.dumps(part)}]"
     return text or "$"
 
 
@@ -38,23 +50,90 @@ def _one_line(text: str) -> str:
 
 
 def format_value(value, limit: int = 100) -> str:
-    """A short one-line JSON-like rendering of ``value`` for messages."""
-    try:
-        text = json.dumps(value, ensure_ascii=False, allow_nan=True, default=_default)
-    except (TypeError, ValueError):
-        text = repr(value)
-    text = _one_line(text)
+    """A short one-line JSON-like rendering of ``value`` for messages (at most ``limit``
+    characters, ending in "..." when cut).
+
+    Only the first ``limit`` characters are ever produced: a list of a million joints, a value
+    nested a thousand levels deep or an integer of 5000 digits costs no more than a number.
+    """
+    pieces = []
+    size = 0
+    for piece in _pieces(value, limit):
+        pieces.append(piece)
+        size += len(piece)
+        if size > limit:
+            break
+    text = _one_line("".join(pieces))
     if len(text) > limit:
         text = text[: limit - 3] + "..."
     return text
 
 
-def _default(value):
-    if hasattr(value, "tolist"):
-        return value.tolist()
-    if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
-    raise TypeError(type(value).__name__)
+class _Text(str):
+    """A piece of punctuation in :func:`_pieces` (not a value to render)."""
+
+
+def _pieces(value, limit: int):
+    """The rendering of ``value`` piece by piece, without recursion (lazily)."""
+    stack = [iter((value,))]
+    while stack:
+        item = next(stack[-1], _END)
+        if item is _END:
+            stack.pop()
+        elif type(item) is _Text:
+            yield item
+        elif isinstance(item, dict):
+            stack.append(_object_pieces(item))
+        elif isinstance(item, list | tuple) or (
+            isinstance(item, np.ndarray) and item.ndim > 0
+        ):
+            stack.append(_array_pieces(item))
+        else:
+            yield _scalar(item, limit)
+
+
+_END = object()
+
+
+def _object_pieces(obj: dict):
+    yield _Text("{")
+    for k, (key, value) in enumerate(obj.items()):
+        key = key if isinstance(key, str) else str(key)
+        yield _Text((", " if k else "") + _string(key, 100) + ": ")
+        yield value
+    yield _Text("}")
+
+
+def _array_pieces(items):
+    yield _Text("[")
+    for k, value in enumerate(items):
+        if k:
+            yield _Text(", ")
+        yield value
+    yield _Text("]")
+
+
+def _string(text: str, limit: int) -> str:
+    return json.dumps(text[: limit + 1], ensure_ascii=False)
+
+
+def _scalar(value, limit: int) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool | np.bool_):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return _string(value, limit)
+    if isinstance(value, int | np.integer):
+        return shown(int(value))  # digits counted, not printed, for huge ints
+    if isinstance(value, float | np.floating):
+        value = float(value)
+        if math.isnan(value):
+            return "NaN"
+        if math.isinf(value):
+            return "Infinity" if value > 0 else "-Infinity"
+        return repr(value)
+    return shown(value, limit)
 
 
 class DesignError(KinegamiError, ValueError):

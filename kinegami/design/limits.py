@@ -9,10 +9,16 @@ The bounds keep every design cheap to build and free of numeric overflow:
 * ``r`` in [:data:`R_MIN`, :data:`R_MAX`] (file units), and every length and translation
   coordinate finite with ``|value| <= LENGTH_FACTOR * r``: products and squares of lengths stay
   far from the float range.
-* A design file is a regular file of at most :data:`MAX_FILE_BYTES` bytes.
+* A design file is a regular file of at most :data:`MAX_FILE_BYTES` bytes, with at most
+  :data:`MAX_JOINTS` joints, :data:`MAX_DH_ROWS` DH rows, :data:`MAX_EDITS` edits,
+  :data:`MAX_STATES` states and :data:`MAX_POSE_STEPS` steps per pose, lists and objects nested
+  at most :data:`MAX_DEPTH` deep (a design needs 6), and numbers within the float range. These
+  caps are checked while the file is parsed or before anything else is validated, so even a
+  file of 16 MiB is rejected in a fraction of a second.
 
-The schema (schema.json) states the same integer and radius bounds, and the absolute length
-bound ``LENGTH_FACTOR * R_MAX``; :func:`check_lengths` checks the bound relative to ``r``.
+The schema (schema.json) states the same integer, radius and count bounds, and the absolute
+length bound ``LENGTH_FACTOR * R_MAX``; :func:`check_lengths` checks the bound relative to
+``r``. The radius and length bounds are those of the Python API (:mod:`kinegami.validation`).
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ from __future__ import annotations
 import math
 
 from kinegami.design.errors import DesignError, json_path
+from kinegami.validation import LENGTH_FACTOR, R_MAX, R_MIN
 
 __all__ = [
     "NUM_SIDES_MAX",
@@ -30,7 +37,15 @@ __all__ = [
     "R_MAX",
     "LENGTH_FACTOR",
     "MAX_FILE_BYTES",
+    "MAX_JOINTS",
+    "MAX_DH_ROWS",
+    "MAX_EDITS",
+    "MAX_STATES",
+    "MAX_POSE_STEPS",
+    "MAX_DEPTH",
     "check_lengths",
+    "too_many",
+    "too_deep",
 ]
 
 #: Largest number of polygon sides of the tube.
@@ -41,13 +56,23 @@ NUM_SINK_LAYERS_MAX = 32
 NUM_LAYERS_MAX = 200
 #: Smallest maxAnglePerElbow (radians): one degree.
 MIN_ANGLE_PER_ELBOW = math.pi / 180.0
-#: Smallest and largest tube radius (file length units).
-R_MIN = 1e-6
-R_MAX = 1e6
-#: Every length and translation coordinate must satisfy |value| <= LENGTH_FACTOR * r.
-LENGTH_FACTOR = 1e6
+# R_MIN, R_MAX (imported): smallest and largest tube radius (file length units), 1e-6 and 1e6.
+# LENGTH_FACTOR (imported): every length and translation coordinate has |value| <= 1e6 r.
 #: Largest design file, in bytes (16 MiB).
 MAX_FILE_BYTES = 16 * 1024 * 1024
+#: Most entries of "joints" (loading takes about 15 ms per joint with safe placement).
+MAX_JOINTS = 1000
+#: Most rows of a DH table.
+MAX_DH_ROWS = 1000
+#: Most edits.
+MAX_EDITS = 1000
+#: Most states: one per joint of the built chain, and safe placement adds up to two
+#: waypoints per joint.
+MAX_STATES = 3 * MAX_JOINTS
+#: Most steps of a pose written as a list of steps.
+MAX_POSE_STEPS = 100
+#: Deepest nesting of lists and objects (the document itself is level 1; designs need 6).
+MAX_DEPTH = 32
 
 #: Length fields of joints (positive) and of the dh object.
 _JOINT_LENGTHS = ("length", "tubeLength", "neutralLength")
@@ -120,3 +145,20 @@ def check_lengths(document: dict, file=None) -> None:
             check(spec["distance"], ["edits", i, "distance"])
         if "transform" in spec:
             _check_pose(spec["transform"], ["edits", i, "transform"], check)
+
+
+def too_many(what: str, cap: int, name: str, count: int | None = None) -> str:
+    """The reason of a DesignError for a list of ``what`` beyond its cap ``name``."""
+    has = "more" if count is None else str(count)
+    return (
+        f"too many {what}: a design has at most {cap} "
+        f"(kinegami.design.limits.{name}); this one has {has}"
+    )
+
+
+def too_deep() -> str:
+    """The reason of a DesignError for nesting beyond :data:`MAX_DEPTH`."""
+    return (
+        f"nested too deeply: lists and objects nest at most {MAX_DEPTH} levels deep in a "
+        "design (kinegami.design.limits.MAX_DEPTH; a design needs 6)"
+    )

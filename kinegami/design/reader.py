@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import stat
 import warnings
 import weakref
@@ -24,9 +25,19 @@ from dataclasses import dataclass
 
 from kinegami.chain import KinematicChain, PlacementWarning
 from kinegami.design.errors import DesignError, json_path, numeric_errors
-from kinegami.design.limits import MAX_FILE_BYTES, check_lengths
+from kinegami.design.limits import (
+    MAX_DEPTH,
+    MAX_DH_ROWS,
+    MAX_EDITS,
+    MAX_FILE_BYTES,
+    MAX_JOINTS,
+    MAX_STATES,
+    check_lengths,
+    too_deep,
+    too_many,
+)
 from kinegami.design.poses import pose_from_json, to_radians
-from kinegami.design.schema import PLACEMENT_KEYS, check_schema
+from kinegami.design.schema import PLACEMENT_KEYS, check_schema, check_top_level
 from kinegami.errors import JointIndexError, KinegamiError
 from kinegami.joints import (
     EndTip,
@@ -36,6 +47,7 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
+from kinegami.validation import shorten, shown
 
 __all__ = [
     "DesignInfo",
@@ -104,59 +116,243 @@ def _object_pairs(pairs):
     return obj
 
 
+class LongInteger:
+    """An integer literal of a design with too many digits for ``int()`` (more than
+    ``sys.get_int_max_str_digits()``, 4300 by default); the checks report it by its field."""
+
+    __slots__ = ("digits", "negative")
+
+    def __init__(self, literal: str):
+        self.negative = literal.startswith("-")
+        self.digits = len(literal) - self.negative
+
+    def __repr__(self) -> str:
+        sign = "a negative" if self.negative else "an"
+        return f"<{sign} integer of {self.digits} digits>"
+
+
+def _parse_int(literal: str):
+    try:
+        return int(literal)
+    except ValueError:  # more digits than int() converts
+        return LongInteger(literal)
+
+
+_WHITESPACE = re.compile(r"[ \t\n\r]*")
+#: Lists parsed one item at a time, so that an over-long one fails at its cap (JSON path ->
+#: cap, what the items are).
+_CAPPED = {
+    ("joints",): (MAX_JOINTS, "joints", "MAX_JOINTS"),
+    ("edits",): (MAX_EDITS, "edits", "MAX_EDITS"),
+    ("states",): (MAX_STATES, "states", "MAX_STATES"),
+    ("dh", "rows"): (MAX_DH_ROWS, "DH rows", "MAX_DH_ROWS"),
+}
+#: Objects parsed one member at a time (to reach the capped lists inside them).
+_OPENED = {(), ("dh",)}
+
+
+class _Parser:
+    """JSON parsing of a design (the standard library's scanner does the work).
+
+    The top-level object, ``dh`` and the capped lists are walked member by member, so that a
+    list beyond its cap is rejected after reading at most cap + 1 items, however long the
+    file. Integer literals too long for ``int()`` become :class:`LongInteger` (reported with
+    their field by the checks); nesting deep enough to exhaust the parser's recursion is an
+    error too.
+    """
+
+    def __init__(self, text: str, file):
+        self.text = text
+        self.file = file
+        options = dict(object_pairs_hook=_object_pairs, parse_constant=float)
+        self.scan_fast = json.JSONDecoder(**options).scan_once
+        self.scan_long = json.JSONDecoder(**options, parse_int=_parse_int).scan_once
+
+    def fail(self, message: str, pos: int):
+        error = json.JSONDecodeError(message, self.text, pos)
+        raise DesignError(
+            f"invalid JSON at line {error.lineno}, column {error.colno}: {message}",
+            file=self.file,
+        )
+
+    def skip(self, i: int) -> int:
+        return _WHITESPACE.match(self.text, i).end()
+
+    def document(self):
+        if self.text.startswith("\ufeff"):
+            self.fail("Unexpected UTF-8 BOM (decode using utf-8-sig)", 0)
+        i = self.skip(0)
+        value, i = self.value(i, ())
+        i = self.skip(i)
+        if i != len(self.text):
+            self.fail("Extra data", i)
+        return value
+
+    def value(self, i: int, path: tuple):
+        char = self.text[i : i + 1]
+        if char == "{" and path in _OPENED:
+            return self.object(i, path)
+        if char == "[" and path in _CAPPED:
+            return self.array(i, path)
+        return self.scan(i, path)
+
+    def scan(self, i: int, path: tuple):
+        try:
+            try:
+                return self.scan_fast(self.text, i)
+            except json.JSONDecodeError:
+                raise
+            except ValueError:  # an integer literal too long for int(): parse again
+                return self.scan_long(self.text, i)
+        except StopIteration as stop:
+            self.fail("Expecting value", stop.value)
+        except json.JSONDecodeError as error:
+            self.fail(error.msg, error.pos)
+        except RecursionError:
+            raise DesignError(too_deep(), field=json_path(path), file=self.file) from None
+
+    def object(self, i: int, path: tuple):
+        text = self.text
+        pairs = []
+        i = self.skip(i + 1)
+        if text[i : i + 1] == "}":
+            return _object_pairs(pairs), i + 1
+        while True:
+            if text[i : i + 1] != '"':
+                self.fail("Expecting property name enclosed in double quotes", i)
+            try:
+                key, i = json.decoder.scanstring(text, i + 1)
+            except json.JSONDecodeError as error:
+                self.fail(error.msg, error.pos)
+            i = self.skip(i)
+            if text[i : i + 1] != ":":
+                self.fail("Expecting ':' delimiter", i)
+            value, i = self.value(self.skip(i + 1), (*path, key))
+            pairs.append((key, value))
+            i = self.skip(i)
+            char = text[i : i + 1]
+            if char == "}":
+                return _object_pairs(pairs), i + 1
+            if char != ",":
+                self.fail("Expecting ',' delimiter", i)
+            i = self.skip(i + 1)
+
+    def array(self, i: int, path: tuple):
+        cap, what, name = _CAPPED[path]
+        text = self.text
+        items = []
+        i = self.skip(i + 1)
+        if text[i : i + 1] == "]":
+            return items, i + 1
+        while True:
+            if len(items) == cap:
+                raise DesignError(too_many(what, cap, name), field=json_path(path), file=self.file)
+            value, i = self.scan(self.skip(i), (*path, len(items)))
+            items.append(value)
+            i = self.skip(i)
+            char = text[i : i + 1]
+            if char == "]":
+                return items, i + 1
+            if char != ",":
+                self.fail("Expecting ',' delimiter", i)
+            i += 1
+
+
 def parse_design_text(text: str, file=None):
-    """The JSON value of ``text``; DesignError on invalid JSON (with line and column)."""
+    """The JSON value of ``text``; DesignError on invalid JSON (with line and column).
+
+    Also a DesignError: a list of joints, edits, states or DH rows beyond its cap
+    (:mod:`kinegami.design.limits`; found while parsing, so a huge file fails fast), nesting
+    deeper than the parser can follow, duplicate keys, non-finite numbers and integers beyond
+    the float range (these are checked again by :func:`check_document`).
+    """
     if not isinstance(text, str):
         raise DesignError(
             f"the design must be JSON text (str), got {type(text).__name__}", file=file
         )
-    try:
-        document = json.loads(
-            text, object_pairs_hook=_object_pairs, parse_constant=lambda name: float(name)
-        )
-    except json.JSONDecodeError as exc:
-        raise DesignError(
-            f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", file=file
-        ) from None
-    except RecursionError:
-        raise DesignError("invalid JSON: nested too deeply", file=file) from None
-    _check_values(document, [], file)
-    return document
+    return _Parser(text, file).document()
 
 
-def _check_values(node, path, file) -> None:
-    """Duplicate keys and non-finite numbers (NaN, Infinity, 1e999) are errors."""
-    if isinstance(node, dict):
-        for key in getattr(node, "duplicates", ()):
-            raise DesignError(
-                f"duplicate key '{key}' (each key may appear once per object)",
-                field=json_path([*path, key]),
-                file=file,
-            )
-        for key, value in node.items():
-            if not isinstance(key, str):
+def _check_values(document, file, root: tuple = ()) -> None:
+    """Nesting, keys and numbers of a parsed document, walked without recursion.
+
+    Errors: nesting deeper than MAX_DEPTH (also catches a dict or list containing itself),
+    duplicate and non-string keys, non-finite numbers (NaN, Infinity, 1e999), integers beyond
+    the float range. Reported in document order, at the JSON path of the problem.
+    """
+    # entries: (node, depth, trail); a trail is (key, parent trail), built only on error
+    stack = [(document, len(root) + 1, (root, None) if root else None)]
+    while stack:
+        node, depth, trail = stack.pop()
+        if isinstance(node, dict | list | tuple):
+            if depth > MAX_DEPTH:
+                raise DesignError(too_deep(), field=_trail_path(trail), file=file)
+            if isinstance(node, dict):
+                for key in getattr(node, "duplicates", ()):
+                    raise DesignError(
+                        f"duplicate key '{shorten(key)}' (each key may appear once per "
+                        "object)",
+                        field=json_path([*_trail_parts(trail), key]),
+                        file=file,
+                    )
+                for key in node:
+                    if not isinstance(key, str):
+                        raise DesignError(
+                            f"object keys must be strings, got {shown(key)}",
+                            field=_trail_path(trail),
+                            file=file,
+                        )
+                items = node.items()
+            else:
+                items = enumerate(node)
+            children = [
+                (value, depth + 1, (key, trail))
+                for key, value in items
+                if isinstance(value, dict | list | tuple | float | int | LongInteger)
+            ]
+            stack.extend(reversed(children))
+        elif isinstance(node, float):
+            if not math.isfinite(node):
                 raise DesignError(
-                    f"object keys must be strings, got {key!r}", field=json_path(path), file=file
+                    "numbers must be finite: NaN, Infinity and numbers beyond +-1.8e308 "
+                    "(such as 1e999) are not allowed",
+                    field=_trail_path(trail),
+                    value=node,
+                    file=file,
                 )
-            _check_values(value, [*path, key], file)
-    elif isinstance(node, list | tuple):
-        for i, value in enumerate(node):
-            _check_values(value, [*path, i], file)
-    elif isinstance(node, float):
-        if not math.isfinite(node):
+        elif isinstance(node, LongInteger) or (
+            isinstance(node, int) and not isinstance(node, bool) and node.bit_length() > 1000
+            and not _fits_float(node)
+        ):
             raise DesignError(
-                "numbers must be finite (NaN and Infinity are not valid JSON)",
-                field=json_path(path),
+                "number too large: numbers must be within +-1.8e308",
+                field=_trail_path(trail),
                 value=node,
                 file=file,
             )
-    elif isinstance(node, int) and not isinstance(node, bool):
-        try:
-            float(node)
-        except OverflowError:
-            raise DesignError(
-                "number too large", field=json_path(path), value=node, file=file
-            ) from None
+
+
+def _fits_float(value: int) -> bool:
+    try:
+        float(value)
+    except OverflowError:
+        return False
+    return True
+
+
+def _trail_parts(trail) -> list:
+    parts = []
+    while trail is not None:
+        key, trail = trail
+        if isinstance(key, tuple):  # the root path of a sub-walk
+            parts.extend(reversed(key))
+        else:
+            parts.append(key)
+    return parts[::-1]
+
+
+def _trail_path(trail) -> str:
+    return json_path(_trail_parts(trail))
 
 
 def _file_kind(mode: int) -> str:
@@ -232,6 +428,12 @@ def _check_header(document, file) -> None:
         raise DesignError(
             'a design must be a JSON object {...} with "format": "kinegami-design"',
             value=document,
+            file=file,
+        )
+    for key in document.duplicates if isinstance(document, _Object) else ():
+        raise DesignError(
+            f"duplicate key '{shorten(key)}' (each key may appear once per object)",
+            field=json_path([key]),
             file=file,
         )
     if "format" not in document:
@@ -369,8 +571,8 @@ def _check_joint_order(joints, file) -> None:
 
 
 def _listed(names, limit: int = 10) -> str:
-    shown = ", ".join(f"'{name}'" for name in names[:limit])
-    return shown + (f", ... ({len(names)} names)" if len(names) > limit else "")
+    listed = ", ".join(f"'{shorten(name)}'" for name in names[:limit])
+    return listed + (f", ... ({len(names)} names)" if len(names) > limit else "")
 
 
 def _check_names(document: dict, file) -> tuple:
@@ -382,7 +584,7 @@ def _check_names(document: dict, file) -> tuple:
         if name is not None:
             if name in seen:
                 raise DesignError(
-                    f"duplicate joint name: joints[{seen[name]}] is also named '{name}' "
+                    f"duplicate joint name: joints[{seen[name]}] is also named '{shorten(name)}' "
                     "(names must be unique, edits refer to joints by name)",
                     field=json_path(["joints", i, "name"]),
                     value=name,
@@ -397,10 +599,12 @@ def _check_names(document: dict, file) -> tuple:
         if "dh" in document:
             reason = "a DH design has no joint names: refer to its joints by index"
         elif seen:
-            reason = f"no joint is named '{ref}'; the joint names are {_listed(list(seen))}"
+            reason = (
+                f"no joint is named '{shorten(ref)}'; the joint names are {_listed(list(seen))}"
+            )
         else:
             reason = (
-                f"no joint is named '{ref}': no entry of 'joints' has a \"name\" "
+                f"no joint is named '{shorten(ref)}': no entry of 'joints' has a \"name\" "
                 "(add one, or use the index in the built chain)"
             )
         raise DesignError(reason, field=json_path(["edits", i, "joint"]), value=ref, file=file)
@@ -468,9 +672,24 @@ def check_document(document, file=None) -> _Plan:
         raise
 
 
+#: Top-level fields checked only after the cheap ones (their size is capped first).
+_BULKY = ("joints", "dh", "edits", "states")
+
+
 def _check_document(document, file) -> _Plan:
-    _check_values(document, [], file)
+    # cheap checks first: the header, then the small top-level fields and the sizes of the
+    # bulky ones, so that a huge design with a wrong "units" fails in no time
     _check_header(document, file)
+    for key, value in document.items():
+        if key not in _BULKY:
+            _check_values(value, file, root=(key,))
+    dh = document.get("dh")
+    if isinstance(dh, dict):
+        for key, value in dh.items():
+            if key != "rows":
+                _check_values(value, file, root=("dh", key))
+    check_top_level(document, file)
+    _check_values(document, file)
     check_schema(document, file)
     check_lengths(document, file)
     names = _check_names(document, file)
@@ -626,7 +845,7 @@ def _edit_index(ref, plan: _Plan, sources: list, deleted: dict, where, file) -> 
     if entry in sources:
         return sources.index(entry)
     raise DesignError(
-        f"joint '{ref}' (joints[{entry}]) is no longer in the chain: "
+        f"joint '{shorten(ref)}' (joints[{entry}]) is no longer in the chain: "
         f"edits[{deleted[entry]}] deleted it",
         field=json_path([*where, "joint"]),
         value=ref,

@@ -15,7 +15,18 @@ from importlib import resources
 import jsonschema
 
 from kinegami.design.errors import DesignError, format_value, json_path
-from kinegami.design.limits import NUM_LAYERS_MAX, NUM_SIDES_MAX, NUM_SINK_LAYERS_MAX
+from kinegami.design.limits import (
+    MAX_DH_ROWS,
+    MAX_EDITS,
+    MAX_JOINTS,
+    MAX_POSE_STEPS,
+    MAX_STATES,
+    NUM_LAYERS_MAX,
+    NUM_SIDES_MAX,
+    NUM_SINK_LAYERS_MAX,
+    too_many,
+)
+from kinegami.validation import shorten, shown
 
 __all__ = ["design_schema", "check_schema", "JOINT_TYPES", "EDIT_OPS", "PLACEMENT_KEYS"]
 
@@ -70,6 +81,19 @@ _POSE_TEXT = (
     "a pose: a 4x4 matrix (list of 4 rows), a list of steps such as "
     '[{"Trans": [x, y, z]}, {"Ry": angle}], or an axis object {"point", "axis", "xhat"}'
 )
+#: Capped lists: JSON path -> (what the items are, the name of the cap in limits).
+_CAPS = {
+    ("joints",): ("joints", "MAX_JOINTS"),
+    ("edits",): ("edits", "MAX_EDITS"),
+    ("states",): ("states", "MAX_STATES"),
+    ("dh", "rows"): ("DH rows", "MAX_DH_ROWS"),
+}
+_CAP_VALUES = {
+    "MAX_JOINTS": MAX_JOINTS,
+    "MAX_EDITS": MAX_EDITS,
+    "MAX_STATES": MAX_STATES,
+    "MAX_DH_ROWS": MAX_DH_ROWS,
+}
 #: Keyword order among several errors at the same place (most basic first).
 _PRIORITY = {
     "type": 0,
@@ -97,6 +121,69 @@ def _validator() -> jsonschema.Draft202012Validator:
     return jsonschema.Draft202012Validator(design_schema())
 
 
+#: Parts of the schema that describe bulky content: the top-level check keeps only these (the
+#: full check validates their items; their caps are checked without jsonschema, whose
+#: messages contain the whole list).
+_SIZE_KEYWORDS = ("type", "minItems")
+
+
+@functools.cache
+def _top_level_validator() -> jsonschema.Draft202012Validator:
+    """A validator of the top-level fields only: every small field as in the full schema, the
+    type of ``joints``, ``edits``, ``states`` and ``dh.rows``, nothing inside them."""
+    full = design_schema()
+    defs = full["$defs"]
+    properties = {}
+    for key, schema in full["properties"].items():
+        if key in ("joints", "edits", "states"):
+            schema = {k: v for k, v in schema.items() if k in _SIZE_KEYWORDS}
+        elif key == "dh":
+            rows = defs["dh"]["properties"]["rows"]
+            schema = {
+                "type": "object",
+                "properties": {"rows": {k: v for k, v in rows.items() if k in _SIZE_KEYWORDS}},
+            }
+        properties[key] = schema
+    angle = {
+        units: {"properties": {"maxAnglePerElbow": defs[name]["properties"]["maxAnglePerElbow"]}}
+        for units, name in (("deg", "angleRangesDeg"), ("rad", "angleRangesRad"))
+    }
+    top = {
+        **{k: v for k, v in full.items() if k not in ("properties", "then", "else", "$defs")},
+        "properties": properties,
+        "then": angle["deg"],
+        "else": angle["rad"],
+    }
+    return jsonschema.Draft202012Validator(top)
+
+
+def check_top_level(document, file=None) -> None:
+    """Raise a DesignError for the first problem of the top-level fields of ``document``.
+
+    Cheap whatever the size of the design: it checks the small fields (format, version,
+    units, numSides, r, ...) and only the type and length of the joints, edits, states and
+    DH rows (at most :data:`~kinegami.design.limits.MAX_JOINTS` joints, and so on), not what
+    they contain (:func:`check_schema` does). ``document`` must not nest deeper than
+    MAX_DEPTH outside those lists (jsonschema's messages recurse).
+    """
+    _first_error(_top_level_validator(), document, file)
+    for path, (what, name) in _CAPS.items():
+        node = document
+        for key in path:
+            node = node.get(key) if isinstance(node, dict) else None
+        cap = _CAP_VALUES[name]
+        if isinstance(node, list) and len(node) > cap:
+            reason = too_many(what, cap, name, len(node))
+            raise DesignError(reason, field=json_path(path), file=file)
+    for key, field in (("joints", "pose"), ("edits", "transform")):
+        entries = document.get(key)
+        for i, entry in enumerate(entries if isinstance(entries, list) else ()):
+            steps = entry.get(field) if isinstance(entry, dict) else None
+            if isinstance(steps, list) and len(steps) > MAX_POSE_STEPS:
+                reason = too_many("pose steps", MAX_POSE_STEPS, "MAX_POSE_STEPS", len(steps))
+                raise DesignError(reason, field=json_path([key, i, field]), file=file)
+
+
 def _position(document, path) -> tuple:
     """Document-order sort key of a JSON path (positions of keys in their objects)."""
     key = []
@@ -117,7 +204,11 @@ def _position(document, path) -> tuple:
 
 def check_schema(document, file=None) -> None:
     """Raise a DesignError for the first schema violation of ``document`` (if any)."""
-    errors = list(_validator().iter_errors(document))
+    _first_error(_validator(), document, file)
+
+
+def _first_error(validator, document, file) -> None:
+    errors = list(validator.iter_errors(document))
     if not errors:
         return
     error = min(
@@ -188,10 +279,11 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
     if keyword == "enum":
         if name == "type" and len(path) >= 2 and path[0] == "joints":
             return fail(
-                f"unknown joint type {value!r}; known: {', '.join(JOINT_TYPES)}", value=value
+                f"unknown joint type {shown(value)}; known: {', '.join(JOINT_TYPES)}", value=value
             )
         if name == "op":
-            return fail(f"unknown edit op {value!r}; known: {', '.join(EDIT_OPS)}", value=value)
+            known = ", ".join(EDIT_OPS)
+            return fail(f"unknown edit op {shown(value)}; known: {known}", value=value)
         return fail(f"must be one of {_quoted(expected)}", value=value)
     if keyword == "const":
         if path == ["format"]:
@@ -210,6 +302,11 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
                 "multipleOf": "a multiple of",
             }[keyword] + f" {format_value(expected)}"
         return fail(f"out of range: must be {text}", value=value)
+    if keyword == "maxItems" and tuple(path) in _CAPS:
+        what, name = _CAPS[tuple(path)]
+        return fail(too_many(what, expected, name, len(value)))
+    if keyword == "maxItems" and len(path) >= 2 and path[-1] in ("pose", "transform"):
+        return fail(too_many("pose steps", expected, "MAX_POSE_STEPS", len(value)))
     if keyword in ("minItems", "maxItems"):
         low = error.schema.get("minItems")
         high = error.schema.get("maxItems")
@@ -235,10 +332,11 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
             close = difflib.get_close_matches(unknown[0], allowed, n=1)
             hint = f" (did you mean '{close[0]}'?)" if close else ""
             return fail(
-                f"unknown key '{unknown[0]}'{hint}; allowed keys: {listed}",
+                f"unknown key '{shorten(unknown[0])}'{hint}; allowed keys: {listed}",
                 json_path([*path, unknown[0]]),
             )
-        names = ", ".join(f"'{k}'" for k in unknown)
+        names = ", ".join(f"'{shorten(k)}'" for k in unknown[:5])
+        names += f", ... ({len(unknown)} keys)" if len(unknown) > 5 else ""
         return fail(f"unknown keys {names}; allowed keys: {listed}")
     if keyword == "propertyNames" or "propertyNames" in error.absolute_schema_path:
         return fail(
@@ -257,4 +355,4 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
         return fail("a joint name must not be empty", value=value)
     if keyword == "pattern" and name == "jointTypes":
         return fail('must be a string of the letters R and P (e.g. "RRP")', value=value)
-    return fail(error.message, value=value)
+    return fail(shorten(error.message, 200), value=value)
