@@ -36,18 +36,29 @@ DESIGN = {
 
 
 def command() -> list[str]:
-    script = Path(sys.executable).parent / "kinegami"
-    if script.exists():
-        return [str(script)]
-    return [sys.executable, "-m", "kinegami.cli"]  # pragma: no cover
+    """The command as the tests run it: ``python -m kinegami`` from this source tree (see
+    :func:`source_env`), never an installed copy that may predate the last edit."""
+    return [sys.executable, "-m", "kinegami"]
 
 
-def run(*args, cwd=None) -> subprocess.CompletedProcess:
+def source_env(**changes) -> dict[str, str]:
+    """The environment of a subprocess that imports kinegami from this checkout: the repository
+    first on PYTHONPATH, no display, the Agg backend; ``changes`` on top (None removes)."""
     env = dict(os.environ, MPLBACKEND="Agg")
     env.pop("DISPLAY", None)
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
+    for name, value in changes.items():
+        if value is None:
+            env.pop(name, None)
+        else:
+            env[name] = value
+    return env
+
+
+def run(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [*command(), *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env,
-        timeout=300,
+        [*command(), *map(str, args)], capture_output=True, text=True, cwd=cwd,
+        env=env or source_env(), timeout=300,
     )  # fmt: skip
 
 
@@ -86,6 +97,13 @@ def test_version():
     result = run("--version")
     assert result.returncode == 0
     assert result.stdout.startswith("kinegami ")
+
+
+def test_the_command_runs_this_source_tree(tmp_path):
+    """From any folder, the command the tests run imports the package of this checkout."""
+    probe = [sys.executable, "-c", "import kinegami; print(kinegami.__file__)"]
+    done = subprocess.run(probe, capture_output=True, text=True, cwd=tmp_path, env=source_env())
+    assert Path(done.stdout.strip()) == ROOT / "kinegami" / "__init__.py"
 
 
 def test_unknown_command_is_a_usage_error():
@@ -224,6 +242,67 @@ def test_validate_does_not_build_unless_asked(tmp_path):
     path = write(tmp_path / "bad.json", data)
     assert run("validate", path).returncode == 0
     assert_clean_failure(run("validate", path, "--build"), "edits[0]")
+
+
+# --- start-up without a writable home folder -------------------------------------------------
+def homeless_env(tmp_path) -> dict[str, str]:
+    """HOME where matplotlib cannot make its folders (``.config`` and ``.cache`` are files, which
+    even root cannot write into), no XDG or MPLCONFIGDIR variables, and a TMPDIR of its own."""
+    home = tmp_path / "home"
+    home.mkdir()
+    for name in (".config", ".cache"):
+        (home / name).write_text("")
+    home.chmod(0o500)
+    (tmp_path / "tmp").mkdir()
+    return source_env(
+        HOME=str(home), XDG_CONFIG_HOME=None, XDG_CACHE_HOME=None, MPLCONFIGDIR=None,
+        TMPDIR=str(tmp_path / "tmp"),
+    )  # fmt: skip
+
+
+def private_folder(tmp_path) -> Path:
+    return tmp_path / "tmp" / f"kinegami-matplotlib-{os.getuid()}"
+
+
+@pytest.mark.skipif(not hasattr(os, "getuid"), reason="POSIX user ids")
+def test_without_a_writable_home_only_kinegamis_error_is_printed(tmp_path):
+    result = run("validate", tmp_path / "nope.json", env=homeless_env(tmp_path))
+    assert_clean_failure(result, "nope.json")  # no matplotlib cache warning before it
+    folder = private_folder(tmp_path)
+    assert folder.is_dir() and folder.stat().st_mode & 0o777 == 0o700
+
+
+@pytest.mark.skipif(not hasattr(os, "getuid"), reason="POSIX user ids")
+def test_without_a_writable_home_the_font_cache_is_kept(design, tmp_path):
+    env = homeless_env(tmp_path)
+    result = run("build", design, "-o", tmp_path / "o", "--formats", "png", env=env)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+    assert list(private_folder(tmp_path).glob("fontlist-*.json"))  # for the next run
+
+
+@pytest.mark.skipif(not hasattr(os, "getuid"), reason="POSIX user ids")
+def test_a_private_folder_that_others_can_use_is_not_used(design, tmp_path):
+    env = homeless_env(tmp_path)
+    folder = private_folder(tmp_path)
+    folder.mkdir()
+    folder.chmod(0o777)
+    result = run("build", design, "-o", tmp_path / "o", "--formats", "png", env=env)
+    assert result.returncode == 0 and result.stderr == ""
+    assert list(folder.iterdir()) == []  # a fresh folder was used instead, and removed
+    assert sorted(p.name for p in (tmp_path / "tmp").iterdir()) == [folder.name]
+
+
+def test_a_library_import_does_not_change_matplotlibs_folder(tmp_path):
+    """Only the command picks a folder: ``import kinegami`` leaves the environment alone."""
+    probe = "import os, kinegami; print(os.environ.get('MPLCONFIGDIR', ''))"
+    done = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True,
+        env=homeless_env(tmp_path), cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "kinegami-matplotlib" not in done.stdout
+    assert not private_folder(tmp_path).exists()
 
 
 # --- show ----------------------------------------------------------------------------------
