@@ -33,6 +33,15 @@ from kinegami.dh import dh_joint_frames, dh_tool_frame
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
+
+
+def source_env(**changes) -> dict[str, str]:
+    """A script's environment: kinegami imported from this checkout, the Agg backend."""
+    env = dict(os.environ, MPLBACKEND="Agg", **changes)
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])
+    return env
+
+
 DESIGNS = EXAMPLES / "designs"
 
 #: gallery entry -> its script (None: Example 1, whose script is the paper's listing).
@@ -330,7 +339,7 @@ def test_puma_joints_on_the_dh_axes_and_shorter(designs):
 def script_runs(tmp_path_factory):
     """Every script started at once (``python examples/<name>.py <tmp>/<name>``); waited on in
     the tests. Returns name -> (process, output folder)."""
-    env = dict(os.environ, MPLBACKEND="Agg")
+    env = source_env()
     runs = {}
     for name in SCRIPTS:
         folder = tmp_path_factory.mktemp("gallery") / name
@@ -376,7 +385,7 @@ def test_script_rejects_extra_arguments(tmp_path):
         capture_output=True,
         text=True,
         cwd=tmp_path,
-        env=dict(os.environ, MPLBACKEND="Agg"),
+        env=source_env(),
     )
     assert result.returncode != 0
     assert "usage: python planar_joint.py [output-folder]" in result.stderr
@@ -395,6 +404,7 @@ def test_make_gallery_writes_both_pictures(tmp_path):
         capture_output=True,
         text=True,
         cwd=tmp_path,
+        env=source_env(),
     )
     assert result.returncode == 0, result.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == [
@@ -410,6 +420,7 @@ def test_make_gallery_unknown_name(tmp_path):
         capture_output=True,
         text=True,
         cwd=tmp_path,
+        env=source_env(),
     )
     assert result.returncode == 2
     assert "no design file for nosuch" in result.stderr
@@ -429,7 +440,7 @@ def test_gallery_pictures_do_not_depend_on_the_process_or_the_cpu(tmp_path):
             [sys.executable, str(EXAMPLES / "make_gallery.py"), "spherical_joint", "--output",
              str(tmp_path / key)],
             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-            env=dict(os.environ, MPLBACKEND="Agg", **extra),
+            env=source_env(**extra),
         )
         for key, extra in runs.items()
     }  # fmt: skip
