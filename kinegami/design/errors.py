@@ -22,13 +22,13 @@ _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
 
 #: Longest key shown in a JSON path (longer ones end in "...").
-_KEY_LIMIT = 80
+_KEY_LIMIT = 40
 
 
 def json_path(parts) -> str:
     """``("joints", 2, "pose")`` -> ``"joints[2].pose"``; the empty path is ``"$"``.
 
-    Keys longer than 80 characters are shortened (ending in "...").
+    Keys longer than 40 characters are shortened (ending in "...").
     """
     text = ""
     for part in parts:
@@ -41,7 +41,7 @@ def json_path(parts) -> str:
         if _IDENTIFIER.match(part):
             text += f".{part}" if text else part
         else:
-            text += f"[{json.dumps(part)}]"
+            text += f"[{json.dumps(part, ensure_ascii=False)}]"
     return text or "$"
 
 

@@ -66,9 +66,9 @@ MAX_JOINTS = 1000
 MAX_DH_ROWS = 1000
 #: Most edits.
 MAX_EDITS = 1000
-#: Most states: one per joint of the built chain, and safe placement adds up to two
-#: waypoints per joint.
-MAX_STATES = 3 * MAX_JOINTS
+#: Most states: one per joint of the built chain (safe placement adds a few waypoints per
+#: joint, at most four).
+MAX_STATES = 5 * MAX_JOINTS
 #: Most steps of a pose written as a list of steps.
 MAX_POSE_STEPS = 100
 #: Deepest nesting of lists and objects (the document itself is level 1; designs need 6).

@@ -262,9 +262,10 @@ def parse_design_text(text: str, file=None):
     """The JSON value of ``text``; DesignError on invalid JSON (with line and column).
 
     Also a DesignError: a list of joints, edits, states or DH rows beyond its cap
-    (:mod:`kinegami.design.limits`; found while parsing, so a huge file fails fast), nesting
-    deeper than the parser can follow, duplicate keys, non-finite numbers and integers beyond
-    the float range (these are checked again by :func:`check_document`).
+    (:mod:`kinegami.design.limits`; found while parsing, so a huge file fails fast) and nesting
+    deeper than the parser can follow. Duplicate keys (remembered by the objects), nesting
+    beyond MAX_DEPTH, non-finite numbers and integers beyond the float range (kept as
+    :class:`LongInteger` when too long for ``int()``) are reported by :func:`check_document`.
     """
     if not isinstance(text, str):
         raise DesignError(
