@@ -10,12 +10,18 @@ Rabbit Ear. The file written here has
   rules, so the folded form keeps every edge length; it differs from the DXF sheet by less than eps,
   or up to 2e-4 r next to an elbow column collapsed by fix B6). Every crease is cut where it meets
   the sheet's vertical edges, the outline is split at every vertex on it, and the faces are the
-  faces of that planar graph, counter-clockwise, printed side up (+z);
+  faces of that planar graph, counter-clockwise, printed side up (+z). No vertex only splits a
+  straight line: where two collinear edges with the same assignment and fold angle meet at a
+  vertex with no other edge (a module boundary that is no crease, a point of the outline), they
+  are one edge; and no face has a straight corner: a face with one (a crease ending on a
+  straight crease) is split by flat ``F`` diagonals. Origami Simulator turns such corners into
+  zero-area triangles, and its solver blows up on them;
 * ``edges_assignment``: ``M`` and ``V`` for the creases, ``B`` for the sheet outline (including
-  creases lying on the top or bottom edge, spec B10, and the glue tab's outer edge). The sheet
-  has no slits, so ``C`` never occurs;
+  creases lying on the top or bottom edge, spec B10, and the glue tab's outer edge), ``F`` for
+  those diagonals (the catalog's patterns need none). The sheet has no slits, so ``C`` never
+  occurs;
 * ``edges_foldAngle`` in degrees, FOLD's sign convention (valley > 0, mountain < 0, 0 for
-  ``B``): the magnitude is the dihedral angle of the crease in the folded form;
+  ``B`` and ``F``): the magnitude is the dihedral angle of the crease in the folded form;
 * ``file_frames[0]``, class ``foldedForm``, inheriting from frame 0: the 3D position of every
   vertex (:mod:`kinegami.pattern.folded`). Both copies of the glue tab land on the same place.
 
@@ -45,6 +51,8 @@ __all__ = [
     "fold_dict",
     "write_fold",
     "fold_angles",
+    "file_fold_angles",
+    "straight_corners",
 ]
 
 #: FOLD specification version written.
@@ -77,11 +85,13 @@ class SheetGraph:
     edges : numpy.ndarray of int, shape (E, 2)
         Vertex pairs.
     assignment : numpy.ndarray of str, shape (E,)
-        ``"M"``, ``"V"`` or ``"B"``.
+        ``"M"``, ``"V"``, ``"B"`` or ``"F"`` (a flat diagonal splitting a straight corner).
     crease : numpy.ndarray of int, shape (E,)
-        Pattern crease each edge is (a piece of), or -1 for the outline.
+        Pattern crease each edge is (a piece of; for collinear creases merged into one edge, the
+        first of them), or -1 for the outline and the flat diagonals.
     faces : list of numpy.ndarray
-        Vertex indices of every face, counter-clockwise in the sheet.
+        Vertex indices of every face, counter-clockwise in the sheet, none with a straight
+        corner (:func:`straight_corners`).
     edge_faces : numpy.ndarray of int, shape (E, 2)
         Face on the left and on the right of each edge (from its first to its second vertex),
         -1 outside the sheet.
@@ -131,7 +141,9 @@ def sheet_graph(pattern_or_chain, *, folded: bool = True, frame=None, twistPorti
     length; the sheet differs from the DXF sheet by less than eps = 1e-4 b, or up to 2e-4 r next to
     an elbow column collapsed by B6 (docs/fold.md). ``source`` indexes the vertices of that
     unsnapped pattern (``pattern`` attribute of the result), whose vertex i is vertex i of the given
-    pattern for every i below its vertex count.
+    pattern for every i below its vertex count. Vertices that only split a straight line are
+    merged away and straight face corners split by flat diagonals (module docstring); without
+    ``folded`` (a pattern made by hand) the fold angles are not compared when merging.
 
     Parameters
     ----------
@@ -262,7 +274,8 @@ def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
     src = np.concatenate(source)
     itp = np.concatenate(interp)
     edges, assignment, crease = _add_outline(P, edges, assignment, crease, xmin, xmax, y0, H, tol)
-    faces, edge_faces = _faces(P, edges, (xmax - xmin) * H)
+    sheet_area = (xmax - xmin) * H
+    faces, edge_faces = _faces(P, edges, sheet_area)
     V3 = None
     if X3 is not None:
         V3 = np.empty((P.shape[0], 3))
@@ -271,6 +284,19 @@ def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
         clip = ~own
         uu, ww, tt = itp[clip, 0].astype(int), itp[clip, 1].astype(int), itp[clip, 2]
         V3[clip] = X3[uu] + tt[:, None] * (X3[ww] - X3[uu])
+    keep, alive, edges = _merge_straight_vertices(P, V3, edges, assignment, faces, edge_faces, tol)
+    if not keep.all():  # the faces lose the merged vertices, the edges keep their faces
+        new_index = np.cumsum(keep) - 1
+        faces = [new_index[f[keep[f]]] for f in faces]
+        assignment, crease, edge_faces = assignment[alive], crease[alive], edge_faces[alive]
+        P, src, itp = P[keep], src[keep], itp[keep]
+        V3 = None if V3 is None else V3[keep]
+    extra = _straight_corner_diagonals(P, faces, tol)
+    if extra.size:
+        edges = np.concatenate([edges, extra])
+        assignment = np.concatenate([assignment, np.full(extra.shape[0], "F", dtype="<U1")])
+        crease = np.concatenate([crease, np.full(extra.shape[0], -1)])
+        faces, edge_faces = _faces(P, edges, sheet_area)
     return SheetGraph(
         P, V3, src, itp, edges, assignment, crease, faces, edge_faces, W, b, y0, H, pattern
     )
@@ -313,11 +339,160 @@ def _add_outline(P, edges, assignment, crease, xmin, xmax, y0, H, tol):
     return E[first], A[first], C[first]
 
 
+def _merge_straight_vertices(P, X, E, A, faces, edge_faces, tol):
+    """Remove the vertices that only split a straight line: degree 2, on the segment between
+    their two neighbours (within ``tol`` in the sheet and, when folded, in 3D), both edges with
+    the same assignment and fold angle. The two edges become one, which keeps the index (and
+    so the crease and faces) of the first.
+
+    Returns the vertices to keep and the edges to keep (boolean masks), and the kept edges'
+    vertex pairs, renumbered.
+    """
+    m = E.shape[0]
+    angle = None
+    if X is not None:
+        angle = _dihedral_angles(X, faces, E, edge_faces)
+    ends = E.copy()
+    alive = np.ones(m, dtype=bool)
+    incident: list[list[int]] = [[] for _ in range(P.shape[0])]
+    for i, (a, c) in enumerate(E.tolist()):
+        incident[a].append(i)
+        incident[c].append(i)
+    keep = np.ones(P.shape[0], dtype=bool)
+    for v in range(P.shape[0]):
+        if len(incident[v]) != 2:
+            continue
+        i, j = incident[v]
+        a = int(ends[i, 0] if ends[i, 1] == v else ends[i, 1])
+        c = int(ends[j, 0] if ends[j, 1] == v else ends[j, 1])
+        if a == c or A[i] != A[j]:
+            continue
+        if _off_segment(P[v], P[a], P[c]) > tol:
+            continue
+        if X is not None and (
+            _off_segment(X[v], X[a], X[c]) > tol or abs(angle[i] - angle[j]) > 1e-9
+        ):
+            continue
+        ends[i, ends[i] == v] = c  # edge i now runs to c; edge j goes
+        alive[j] = False
+        incident[c][incident[c].index(j)] = i
+        incident[v] = []
+        keep[v] = False
+    new_index = np.cumsum(keep) - 1
+    return keep, alive, new_index[ends[alive]]
+
+
+def _off_segment(p: np.ndarray, a: np.ndarray, c: np.ndarray) -> float:
+    """Distance from p to the segment a-c (any dimension)."""
+    d = c - a
+    t = float(np.clip(np.dot(p - a, d) / max(float(np.dot(d, d)), 1e-300), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * d)))
+
+
+#: A face corner counts as straight when the sine of its angle is at most this (and it is not a
+#: zero angle): within 1e-6 rad of 180 degrees.
+STRAIGHT_CORNER_SINE = 1e-6
+
+
+def _corner_sines(poly: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sine and cosine of the angle at every corner of a polygon (2D)."""
+    before = np.roll(poly, 1, axis=0) - poly
+    after = np.roll(poly, -1, axis=0) - poly
+    norm = np.linalg.norm(before, axis=1) * np.linalg.norm(after, axis=1)
+    cross = before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0]
+    dot = np.einsum("ij,ij->i", before, after)
+    return cross / norm, dot / norm
+
+
+def straight_corners(P: np.ndarray, face: np.ndarray) -> np.ndarray:
+    """Positions in ``face`` of its straight corners (angle within 1e-6 rad of 180 degrees)."""
+    sine, cosine = _corner_sines(P[face])
+    return np.flatnonzero((np.abs(sine) <= STRAIGHT_CORNER_SINE) & (cosine < 0))
+
+
+def _straight_corner_diagonals(P: np.ndarray, faces: list, tol: float) -> np.ndarray:
+    """Flat diagonals that split every face with a straight corner into faces without one.
+
+    A straight corner (a crease ending on a straight line: a T junction) makes a face whose
+    triangulation, in Origami Simulator, has zero-area triangles. Each such corner gets a
+    diagonal to the vertex of its face that maximises the smallest of the four angles the
+    diagonal makes; the pieces are split again until no straight corner is left.
+    """
+    out: list[tuple[int, int]] = []
+    corners, nxt, prev, first = _face_cycles(faces)
+    before, after = P[prev] - P[corners], P[nxt] - P[corners]
+    norm = np.linalg.norm(before, axis=1) * np.linalg.norm(after, axis=1)
+    sine = (before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0]) / norm
+    straight = (np.abs(sine) <= STRAIGHT_CORNER_SINE) & (np.einsum("ij,ij->i", before, after) < 0)
+    face_of = np.repeat(np.arange(len(faces)), np.diff(np.append(first, corners.size)))
+    stack = [faces[i] for i in np.unique(face_of[straight]).tolist()]
+    while stack:
+        face = stack.pop()
+        corners = straight_corners(P, face)
+        if not corners.size:
+            continue
+        best = None
+        k = face.size
+        for i in corners.tolist():
+            for j in range(k):
+                if (j - i) % k in (0, 1, k - 1):
+                    continue
+                first = np.roll(face, -i)[: (j - i) % k + 1]
+                second = np.roll(face, -j)[: (i - j) % k + 1]
+                if not _is_inner_diagonal(P, face, first, second, tol):
+                    continue
+                score = min(_smallest_angle(P[first]), _smallest_angle(P[second]))
+                if best is None or score > best[0]:
+                    best = (score, first, second)
+        if best is None:  # pragma: no cover - a face with a straight corner has a diagonal
+            raise FoldExportError(f"no diagonal splits the face {face.tolist()} at its corner")
+        _, first, second = best
+        out.append((int(first[0]), int(first[-1])))
+        stack += [first, second]
+    return np.array(out, dtype=np.intp).reshape(-1, 2)
+
+
+def _smallest_angle(poly: np.ndarray) -> float:
+    sine, cosine = _corner_sines(poly)
+    return float(np.arctan2(sine, cosine).min())
+
+
+def _is_inner_diagonal(P, face, first, second, tol) -> bool:
+    """The chord first[0]-first[-1] lies inside the face: both pieces are counter-clockwise
+    with areas adding up to the face's, and it crosses no side of the face."""
+    a, c = P[first[0]], P[first[-1]]
+    area1, area2 = _signed_area(P[first]), _signed_area(P[second])
+    if area1 <= tol * tol or area2 <= tol * tol:
+        return False
+    if not math.isclose(area1 + area2, _signed_area(P[face]), rel_tol=1e-9):
+        return False
+    ends = {int(first[0]), int(first[-1])}
+    for u, w in zip(face.tolist(), np.roll(face, -1).tolist(), strict=True):
+        if u in ends or w in ends:
+            continue
+        if _segments_cross(a, c, P[u], P[w], tol):
+            return False
+    return True
+
+
+def _segments_cross(a, c, p, q, tol) -> bool:
+    """Segments a-c and p-q meet (touching within tol counts)."""
+
+    def side(o, u, w):
+        return (u[0] - o[0]) * (w[1] - o[1]) - (u[1] - o[1]) * (w[0] - o[0])
+
+    d1, d2 = side(a, c, p), side(a, c, q)
+    d3, d4 = side(p, q, a), side(p, q, c)
+    if d1 * d2 < 0 and d3 * d4 < 0:
+        return True
+    return min(_off_segment(p, a, c), _off_segment(q, a, c)) <= tol
+
+
 def _signed_area(poly: np.ndarray) -> float:
     """Shoelace area, relative to the first corner (exact enough for slivers far from 0)."""
     rel = poly - poly[0]
-    x, y = rel[:, 0], rel[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    x, y = rel[:, 0], rel[:, 1]  # the closing term vanishes: the first corner is the origin
+    return 0.5 * float(np.dot(x[:-1], y[1:]) - np.dot(y[:-1], x[1:]))
 
 
 def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float):
@@ -387,17 +562,35 @@ def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float):
 # Fold angles
 
 
-def _newell(points: np.ndarray) -> np.ndarray:
-    nxt = np.roll(points, -1, axis=0)
-    n = np.array(
+def _face_cycles(faces: list) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """All faces' corners in one array: (corner vertex, next corner's vertex, previous
+    corner's vertex), face after face, and the index of every face's first corner."""
+    sizes = np.array([f.size for f in faces], dtype=np.intp)
+    first = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.intp)
+    corners = np.concatenate(faces).astype(np.intp)
+    position = np.arange(corners.size) - np.repeat(first, sizes)
+    size = np.repeat(sizes, sizes)
+    start = np.repeat(first, sizes)
+    nxt = corners[start + (position + 1) % size]
+    prev = corners[start + (position - 1) % size]
+    return corners, nxt, prev, first
+
+
+def _newell_normals(X: np.ndarray, faces: list) -> np.ndarray:
+    """Unit Newell normal of every 3D face polygon (zero for a degenerate one)."""
+    corners, nxt, _, first = _face_cycles(faces)
+    p, q = X[corners], X[nxt]
+    terms = np.stack(
         [
-            np.sum((points[:, 1] - nxt[:, 1]) * (points[:, 2] + nxt[:, 2])),
-            np.sum((points[:, 2] - nxt[:, 2]) * (points[:, 0] + nxt[:, 0])),
-            np.sum((points[:, 0] - nxt[:, 0]) * (points[:, 1] + nxt[:, 1])),
-        ]
+            (p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2]),
+            (p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0]),
+            (p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1]),
+        ],
+        axis=1,
     )
-    norm = np.linalg.norm(n)
-    return n / norm if norm > 0 else n
+    n = np.add.reduceat(terms, first, axis=0)
+    norm = np.linalg.norm(n, axis=1)
+    return n / np.where(norm > 0, norm, 1.0)[:, None]
 
 
 def fold_angles(graph: SheetGraph) -> np.ndarray:
@@ -410,18 +603,33 @@ def fold_angles(graph: SheetGraph) -> np.ndarray:
     """
     if graph.vertices_3d is None:
         raise InvalidParameterError("fold_angles needs a graph built with folded=True")
-    X = graph.vertices_3d
-    normals = np.array([_newell(X[f]) for f in graph.faces])
-    out = np.zeros(graph.edges.shape[0])
-    inner = (graph.edge_faces >= 0).all(axis=1)
-    n1 = normals[graph.edge_faces[inner, 0]]
-    n2 = normals[graph.edge_faces[inner, 1]]
-    d = X[graph.edges[inner, 1]] - X[graph.edges[inner, 0]]
+    return _dihedral_angles(graph.vertices_3d, graph.faces, graph.edges, graph.edge_faces)
+
+
+def _dihedral_angles(X, faces, edges, edge_faces) -> np.ndarray:
+    """Signed dihedral angle of every edge (radians, valley positive; 0 on the outline)."""
+    normals = _newell_normals(X, faces)
+    out = np.zeros(edges.shape[0])
+    inner = (edge_faces >= 0).all(axis=1)
+    n1 = normals[edge_faces[inner, 0]]
+    n2 = normals[edge_faces[inner, 1]]
+    d = X[edges[inner, 1]] - X[edges[inner, 0]]
     d /= np.linalg.norm(d, axis=1)[:, None]
     out[inner] = np.arctan2(
         -np.einsum("ij,ij->i", np.cross(n1, n2), d), np.einsum("ij,ij->i", n1, n2)
     )
     return out
+
+
+def file_fold_angles(graph: SheetGraph) -> np.ndarray:
+    """The ``edges_foldAngle`` of the file: degrees, rounded to 1e-9 degree, FOLD's signs.
+
+    The magnitude is that of :func:`fold_angles` (at most 180); the sign is the assignment's:
+    positive for ``V``, negative for ``M``, and 0 for ``B`` and ``F``.
+    """
+    angles = np.degrees(np.abs(fold_angles(graph)))
+    sign = np.where(graph.assignment == "V", 1.0, np.where(graph.assignment == "M", -1.0, 0.0))
+    return np.round(sign * np.minimum(angles, 180.0), 9) + 0.0
 
 
 # ------------------------------------------------------------------------------------------------
@@ -506,9 +714,7 @@ def fold_dict(pattern_or_chain, **options: Any) -> dict:
     graph = sheet_graph(
         pattern_or_chain, folded=True, frame=opts["frame"], twistPortion=opts["twistPortion"]
     )
-    angles = np.degrees(np.abs(fold_angles(graph)))
-    sign = np.where(graph.assignment == "V", 1.0, np.where(graph.assignment == "M", -1.0, 0.0))
-    fold_angle = sign * np.minimum(angles, 180.0)
+    fold_angle = file_fold_angles(graph)
     f = opts["factor"]
     xmin, ymin, xmax, ymax = graph.bounds
     extent = max(abs(xmin), abs(xmax), abs(ymin), abs(ymax)) * f or 1.0
@@ -528,7 +734,7 @@ def fold_dict(pattern_or_chain, **options: Any) -> dict:
             "vertices_coords": _rounded(graph.vertices * f, extent),
             "edges_vertices": graph.edges.tolist(),
             "edges_assignment": graph.assignment.tolist(),
-            "edges_foldAngle": (np.round(fold_angle, 9) + 0.0).tolist(),
+            "edges_foldAngle": fold_angle.tolist(),
             "faces_vertices": [face.tolist() for face in graph.faces],
         }
     )

@@ -254,3 +254,39 @@ def sheet_distance(graph, sheet) -> float:
         segments_distance(ours, np.concatenate([theirs, sheet.select("C")])),
         segments_distance(theirs, np.concatenate([ours, segments[A == "B"]])),
     )
+
+
+def vertex_degrees(data: dict) -> np.ndarray:
+    """Number of edges at every vertex of a FOLD dict."""
+    E = np.array(data["edges_vertices"])
+    return np.bincount(E.ravel(), minlength=len(data["vertices_coords"]))
+
+
+def degree_two_vertices(data: dict) -> list[tuple[int, float]]:
+    """(vertex, angle between its two edges in radians) for every vertex with two edges."""
+    V = np.array(data["vertices_coords"], dtype=float)
+    E = np.array(data["edges_vertices"])
+    out = []
+    for v in np.flatnonzero(vertex_degrees(data) == 2):
+        ends = E[(E == v).any(axis=1)]
+        a, c = (int(e[0] if e[1] == v else e[1]) for e in ends)
+        u, w = V[a] - V[v], V[c] - V[v]
+        cosine = float(u @ w) / float(np.linalg.norm(u) * np.linalg.norm(w))
+        out.append((int(v), math.acos(max(-1.0, min(1.0, cosine)))))
+    return out
+
+
+def face_corner_angles(data: dict) -> list[np.ndarray]:
+    """Interior angle (radians, in (0, 2 pi)) at every corner of every face, counter-clockwise
+    faces assumed."""
+    V = np.array(data["vertices_coords"], dtype=float)
+    out = []
+    for face in data["faces_vertices"]:
+        P = V[face]
+        before = np.roll(P, 1, axis=0) - P
+        after = np.roll(P, -1, axis=0) - P
+        # angle from the side to the next corner round to the side to the previous one
+        cross = after[:, 0] * before[:, 1] - after[:, 1] * before[:, 0]
+        dot = np.einsum("ij,ij->i", after, before)
+        out.append(np.mod(np.arctan2(cross, dot), 2 * math.pi))
+    return out

@@ -40,3 +40,32 @@ SVG_COLORS = {"Mountain": "#ff0000", "Valley": "#0000ff", "Boundary": "#000000",
 
 #: Millimetres per pattern unit for each ``units`` value.
 UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
+
+#: Laser-flavour SVG colours by group (the sheet of the DXF).
+LASER_SVG_COLORS = SVG_COLORS
+
+#: Origami Simulator's SVG import (js/pattern.js typeForStroke): stroke colour of each kind.
+SIMULATOR_STROKES = {"B": "#000000", "M": "#ff0000", "V": "#0000ff", "C": "#00ff00", "F": "#ffff00"}
+
+#: Origami Simulator's default vertex merge tolerance for SVG import (js/globals.js vertTol),
+#: in SVG user units.
+SIMULATOR_VERTEX_TOLERANCE = 3.0
+
+#: Vertices of the gallery's FOLD sheets without the points that only split a straight line
+#: (issue 9 counted 327 vertices, 54 of them such points, in example1, and 1013 with 104 in
+#: puma).
+GALLERY_FOLD_VERTICES = {"example1": 327 - 54, "puma": 1013 - 104}
+
+#: A face corner within this of 180 degrees (radians) counts as straight.
+STRAIGHT_ANGLE_TOLERANCE = 1e-6
+
+#: Origami Simulator in CI: these designs, FOLD and SVG, must fold with an average vertex error
+#: below the limit (percent) within the given number of solver steps.
+SIMULATOR_CI_DESIGNS = ("example1", "puma", "cylindrical_joint")
+SIMULATOR_ERROR_LIMIT = 2.0
+SIMULATOR_MAX_STEPS = 60_000
+
+#: The SVG folds into the FOLD's shape: relative RMS distance after the best similarity, at most
+#: this, and at most this fraction of the distance to the FOLD's mirror image.
+SIMULATOR_SAME_TUBE = 0.2
+SIMULATOR_MIRROR_RATIO = 0.6

@@ -10,6 +10,7 @@ FOLD check; options, errors and atomic writing.
 
 from __future__ import annotations
 
+import functools
 import io
 import json
 import math
@@ -60,7 +61,9 @@ from kinegami.pattern.sheet import flatten
 from .fold_helpers import (
     chain_pieces,
     check_fold,
+    degree_two_vertices,
     face_congruence,
+    face_corner_angles,
     face_planarity,
     prismatic_offsets,
     rebo_rigid_length,
@@ -68,6 +71,7 @@ from .fold_helpers import (
     sheet_distance,
     signed_area,
 )
+from .reference_values import GALLERY_FOLD_VERTICES, STRAIGHT_ANGLE_TOLERANCE
 
 ISO = 1e-6  # isometry tolerance, times r (the requirement); exact modules reach ~1e-14
 RING = 1e-9  # module ends on their frames, times r
@@ -492,14 +496,20 @@ def check_chain_fold(chain, twistPortion: float = 0.2, frames: bool = True) -> d
     return {"form": form, "data": data}
 
 
+@functools.cache
+def gallery_fold(path: Path) -> tuple:
+    """(chain, design info, FOLD dict) of a gallery design, computed once per session."""
+    chain, info = load_design_with_info(path)
+    return chain, info, fold_dict(chain, units=info.units, twistPortion=info.twistPortion)
+
+
 @pytest.mark.parametrize("path", DESIGNS, ids=[p.stem for p in DESIGNS])
 def test_gallery_designs_fold_isometrically(path):
     """Every design of the gallery: every FOLD edge (creases, outline, glue line) keeps its
     sheet length in the folded form to 1e-6 r, every face is a planar rigid copy of its flat
     polygon, and the file passes the independent FOLD check."""
-    chain, info = load_design_with_info(path)
+    chain, info, data = gallery_fold(path)
     r_mm = chain.r * UNITS_IN_MM[info.units]
-    data = fold_dict(chain, units=info.units, twistPortion=info.twistPortion)
     assert check_fold(data) == []
     # from the file itself (mm, rounded to 12 significant digits)
     assert fold_edge_errors(data).max() <= ISO * r_mm
@@ -513,6 +523,110 @@ def test_gallery_designs_fold_isometrically(path):
     assert planar <= PLANAR * chain.r
     assert rigid <= 1e-12 * chain.r
     assert folded_form(chain, twistPortion=info.twistPortion).repairedVertices == 0
+
+
+@pytest.mark.parametrize("path", DESIGNS, ids=[p.stem for p in DESIGNS])
+def test_gallery_fold_has_no_point_that_splits_a_straight_line(path):
+    """Origami Simulator triangulates a face with a straight corner into zero-area triangles and
+    its solver blows up (issue 9): the only vertices with two edges are sheet corners."""
+    _, _, data = gallery_fold(path)
+    V = np.array(data["vertices_coords"])
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    two = degree_two_vertices(data)
+    assert two, "the sheet corners have two edges each"
+    for v, angle in two:
+        assert angle < PI - STRAIGHT_ANGLE_TOLERANCE, (v, angle)
+        on_x = min(abs(V[v, 0] - lo[0]), abs(V[v, 0] - hi[0]))
+        on_y = min(abs(V[v, 1] - lo[1]), abs(V[v, 1] - hi[1]))
+        assert max(on_x, on_y) <= 1e-9 * np.abs(V).max(), f"vertex {v} is not a sheet corner"
+    if path.stem in GALLERY_FOLD_VERTICES:
+        assert len(V) == GALLERY_FOLD_VERTICES[path.stem]
+
+
+@pytest.mark.parametrize("path", DESIGNS, ids=[p.stem for p in DESIGNS])
+def test_gallery_fold_faces_have_no_straight_corner(path):
+    """Every face corner is strictly between 0 and 180 degrees or reflex, never straight; the
+    faces still tile the sheet counter-clockwise."""
+    _, _, data = gallery_fold(path)
+    V = np.array(data["vertices_coords"])
+    angles = np.concatenate(face_corner_angles(data))
+    assert np.abs(angles - PI).min() > STRAIGHT_ANGLE_TOLERANCE
+    assert angles.min() > 0.0
+    areas = np.array([signed_area(V[f]) for f in data["faces_vertices"]])
+    assert (areas > 0).all()
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    assert_allclose(areas.sum(), np.prod(hi - lo), rtol=1e-9)
+
+
+def _hand_made(n: int, points, creases, labels) -> TubularPattern:
+    """A pattern of height 1 without module records (only ``sheet_graph(..., folded=False)``
+    can draw it): vertex k < n is corner k of the bottom ring, n + k of the top ring, and
+    2 n + i the i-th of ``points``; ``creases`` index them."""
+    b = 2 * math.sin(PI / n)
+    ring = [((k + 0.5) * b, 0.0) for k in range(n)]
+    top = [((k + 0.5) * b, 1.0) for k in range(n)]
+    return TubularPattern(
+        n, 1.0, ring + top + list(points), list(creases), labels,
+        list(range(n)), list(range(n, 2 * n)), (0.0, 0.0), (0.0, 1.0), 1.0,
+    )  # fmt: skip
+
+
+def _straight_corners(graph) -> int:
+    data = {"vertices_coords": graph.vertices.tolist(), "faces_vertices": graph.faces}
+    angles = np.concatenate(face_corner_angles(data))
+    return int((np.abs(angles - PI) <= STRAIGHT_ANGLE_TOLERANCE).sum())
+
+
+def test_collinear_pieces_of_one_label_are_merged():
+    """A straight crease drawn as three collinear pieces is one edge."""
+    b = 2 * math.sin(PI / 4)
+    x = 1.0 * b  # the middle of the first panel
+    points = [(x, 0.0), (x, 0.25), (x, 0.5), (x, 1.0)]
+    creases = [(8, 9), (9, 10), (10, 11)]
+    graph = sheet_graph(_hand_made(4, points, creases, ["V"] * 3), folded=False)
+    valleys = graph.edges[graph.assignment == "V"]
+    assert valleys.shape[0] == 1
+    assert_allclose(np.sort(graph.vertices[valleys[0], 1]), [0.0, 1.0])
+    assert not np.isclose(graph.vertices[:, 1], 0.25).any()
+    assert _straight_corners(graph) == 0
+
+
+def test_collinear_pieces_with_different_labels_are_kept_and_the_corner_split():
+    """A mountain piece continuing a valley piece keeps its point; the faces on both sides get
+    a flat diagonal from it, so no face has a straight corner."""
+    b = 2 * math.sin(PI / 4)
+    x = 1.0 * b
+    points = [(x, 0.0), (x, 0.5), (x, 1.0)]
+    graph = sheet_graph(_hand_made(4, points, [(8, 9), (9, 10)], ["V", "M"]), folded=False)
+    middle = np.flatnonzero(np.all(np.isclose(graph.vertices, [x, 0.5]), axis=1))
+    assert middle.size == 1
+    at_middle = (graph.edges == middle[0]).any(axis=1)
+    assert sorted(graph.assignment[at_middle].tolist()) == ["F", "F", "M", "V"]
+    assert _straight_corners(graph) == 0
+    areas = graph.face_areas()
+    assert (areas > 0).all()
+    xmin, ymin, xmax, ymax = graph.bounds
+    assert_allclose(areas.sum(), (xmax - xmin) * (ymax - ymin), rtol=1e-12)
+
+
+def test_t_junction_gets_a_flat_diagonal():
+    """A crease ending on the middle of a straight crease (a T) makes a straight corner in the
+    face across; a flat (F) diagonal from the T point splits that face. Here the valley ends on
+    both mountains and the stem on the valley: three T points, three diagonals."""
+    b = 2 * math.sin(PI / 4)
+    x0, x1, xt = 0.5 * b, 1.5 * b, 1.0 * b
+    points = [(x0, 0.5), (xt, 0.5), (x1, 0.5), (xt, 0.0)]  # 8 to 11
+    # mountains up columns 0 and 1, a valley between them at half height, a stem down from it
+    creases = [(0, 8), (8, 4), (1, 10), (10, 5), (8, 9), (9, 10), (9, 11)]
+    labels = ["M", "M", "M", "M", "V", "V", "V"]
+    graph = sheet_graph(_hand_made(4, points, creases, labels), folded=False)
+    flat = graph.edges[graph.assignment == "F"]
+    assert flat.shape[0] == 3
+    for corner in ([x0, 0.5], [xt, 0.5], [x1, 0.5]):
+        t = np.flatnonzero(np.all(np.isclose(graph.vertices, corner), axis=1))[0]
+        assert (flat == t).any(axis=1).sum() == 1
+    assert _straight_corners(graph) == 0
+    assert (graph.crease[graph.assignment == "F"] == -1).all()
 
 
 def _link_omits_something(link, n: int, twistPortion: float) -> bool:

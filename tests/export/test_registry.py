@@ -69,13 +69,14 @@ def test_every_format_from_a_chain(tmp_path, example_1a, suffix):
 
 
 def test_fold_is_registered_lazily(tmp_path, example_1a, monkeypatch):
-    """.fold is imported on first use; without kinegami/export/fold.py only .fold fails."""
+    """.fold is imported on first use; without kinegami/export/fold.py only .fold (and the
+    Origami Simulator SVG, drawn from the FOLD export's graph) fails."""
     assert FORMATS[".fold"].func == "kinegami.export.fold:write_fold"
     monkeypatch.setitem(sys.modules, "kinegami.export.fold", None)  # as if the file were missing
     with pytest.raises(ExporterUnavailableError, match="kinegami.export.fold"):
         export(example_1a, tmp_path / "chain.fold")
     assert listing(tmp_path) == []
-    export(example_1a, tmp_path / "chain.svg")
+    export(example_1a, tmp_path / "chain.svg", flavour="laser")
     assert listing(tmp_path) == ["chain.svg"]
 
 
