@@ -6,6 +6,16 @@ the joints, ``LinkCSC``, ``TubularPattern``, ``SE3`` (spatialmath) and ``np`` (n
 file suffix (DXF, SVG, FOLD, PDF, STL, OBJ, URDF).
 """
 
+from kinegami import _startup
+
+if _startup.running_the_command():  # Ctrl-C while the rest imports: one line, no traceback
+    _startup.quiet_interrupts()
+
+from kinegami import _mplconfig
+
+if _mplconfig.running_the_command():  # before spatialmath imports matplotlib
+    _mplconfig.use_private_folder_if_needed()
+
 import numpy as np
 from spatialmath import SE3
 

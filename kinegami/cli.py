@@ -13,16 +13,20 @@ written), 2 a usage error (argparse).
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import signal
+import stat
 import sys
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from kinegami import __version__
+from kinegami import __version__, _startup
+from kinegami._startup import INTERRUPTED
 from kinegami.errors import KinegamiError
+from kinegami.validation import shown
 
 #: Millimetres per design length unit.
 UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
@@ -125,14 +129,14 @@ def _parse_formats(text: str) -> list[OutputFormat]:
     known = output_formats()
     names = [item.strip().lower().lstrip(".") for item in text.split(",") if item.strip()]
     if not names:
-        raise CommandError(f"--formats: no format given; known: {', '.join(known)}")
+        raise CommandError(f"--formats: no format given; known: {', '.join(known)}, all")
+    unknown = [name for name in names if name not in known and name != "all"]
+    if unknown:  # also next to "all": a typo is never silently ignored
+        raise CommandError(
+            f"--formats: unknown format {shown(unknown[0])}; known: {', '.join(known)}, all"
+        )
     if "all" in names:
         return list(known.values())
-    unknown = [name for name in names if name not in known]
-    if unknown:
-        raise CommandError(
-            f"--formats: unknown format {unknown[0]!r}; known: {', '.join(known)}, all"
-        )
     return [known[name] for name in dict.fromkeys(names)]
 
 
@@ -192,16 +196,51 @@ def _plain_stem(stem: str) -> str:
         or (os.altsep and os.altsep in stem)
         or any(ord(c) < 32 for c in stem)
     ):
-        raise CommandError(f"--name: {stem!r} is not a plain file name (no folders, no dot first)")
+        raise CommandError(
+            f"--name: {shown(stem)} is not a plain file name (no folders, no dot first)"
+        )
     return stem
+
+
+def _check_output(out: Path) -> None:
+    """Fail before building when ``-o`` cannot become a folder: it, or a folder on the way to
+    it, is a file, a symbolic link to nothing (dangling) or a symbolic link loop. A missing
+    folder is fine (the build creates it)."""
+    steps = [*reversed(out.parents), out]
+    for path in steps:
+        try:
+            info = os.lstat(path)
+        except FileNotFoundError:
+            return  # the rest is created by the build
+        except OSError:
+            return  # not ours to judge (permissions...): the build reports what fails
+        shown_path = shown(str(path))
+        if stat.S_ISLNK(info.st_mode):
+            try:
+                info = os.stat(path)
+            except OSError as error:
+                if error.errno == errno.ELOOP:
+                    raise CommandError(
+                        f"-o: {shown_path} is a symbolic link loop (following it never ends); "
+                        "give a folder"
+                    ) from None
+                if error.errno == errno.ENOENT:
+                    target = shown(os.readlink(path))
+                    raise CommandError(
+                        f"-o: {shown_path} is a symbolic link to {target}, which does not "
+                        "exist (dangling); create that folder or give another"
+                    ) from None
+                return
+        if not stat.S_ISDIR(info.st_mode):
+            where = "exists and is not a folder" if path == out else "is not a folder"
+            raise CommandError(f"-o: {shown_path} {where}")
 
 
 def cmd_build(args: argparse.Namespace) -> int:
     formats = _parse_formats(args.formats)
     stem = _plain_stem(args.name if args.name is not None else Path(args.design).stem)
     out = Path(args.output)
-    if out.exists() and not out.is_dir():
-        raise CommandError(f"-o: {str(out)!r} exists and is not a folder")
+    _check_output(out)
     chain, info = _load(args.design)
     job = BuildJob(chain, info)
     _check_pattern(job)
@@ -341,8 +380,14 @@ def make_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``kinegami`` console script; returns the exit code."""
-    parser = make_parser()
-    args = parser.parse_args(argv)
+    _encoding_safe_output()
+    try:
+        parser = make_parser()
+        args = parser.parse_args(argv)
+    except KeyboardInterrupt:  # a Ctrl-C while starting up (main called from Python)
+        _interrupted("")
+        return INTERRUPTED
+    _startup.restore_interrupts()  # from here on Ctrl-C is a KeyboardInterrupt, handled below
     if args.command is None:
         parser.print_help()
         return 0
@@ -365,7 +410,8 @@ def main(argv: list[str] | None = None) -> int:
         _fail(args.command, f"{error.strerror or error}{where}")
         return 1
     except KeyboardInterrupt:
-        return 130
+        _interrupted(args.command)
+        return INTERRUPTED
     except Exception as error:  # a bug: still one line, and how to report it
         _fail(
             args.command,
@@ -379,9 +425,36 @@ def main(argv: list[str] | None = None) -> int:
                 signal.signal(signum, handler)
 
 
+#: Longest error line (a safety net: messages shorten the values they echo themselves).
+MAX_MESSAGE = 1000
+
+
 def _fail(command: str, message: str) -> None:
     text = _printable(" ".join(message.split()))
+    if len(text) > MAX_MESSAGE:
+        text = text[: MAX_MESSAGE - 3] + "..."
     print(f"kinegami {command}: error: {text}", file=sys.stderr)
+
+
+def _interrupted(command: str) -> None:
+    """The one line of a command ended by Ctrl-C (exit status 130)."""
+    try:
+        print(f"kinegami{' ' if command else ''}{command}: interrupted", file=sys.stderr)
+    except (OSError, ValueError):  # stderr closed
+        pass
+
+
+def _encoding_safe_output() -> None:
+    """Characters the terminal cannot show (PYTHONIOENCODING=ascii, a C locale) are written
+    as backslash escapes instead of failing: a design named "Bras à 3 axes" still prints."""
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is None:  # replaced by a non-text stream (tests, embedding)
+            continue
+        try:
+            reconfigure(errors="backslashreplace")
+        except (ValueError, OSError):  # detached or closed
+            pass
 
 
 def _note(command: str, message: str) -> None:

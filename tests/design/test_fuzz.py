@@ -57,15 +57,20 @@ values = st.recursive(
 )
 
 
-def _places(node, path=()):
-    """Every (path, value) of a document, the document itself first."""
-    yield path, node
-    if isinstance(node, dict):
-        for key, value in node.items():
-            yield from _places(value, (*path, key))
-    elif isinstance(node, list):
-        for index, value in enumerate(node):
-            yield from _places(value, (*path, index))
+def _places(document):
+    """Every (path, value) of a document, the document itself first (no recursion: earlier
+    mutations may have nested a value a thousand levels deep)."""
+    stack = [((), document)]
+    while stack:
+        path, node = stack.pop()
+        yield path, node
+        if isinstance(node, dict):
+            items = list(node.items())
+        elif isinstance(node, list):
+            items = list(enumerate(node))
+        else:
+            items = []
+        stack.extend(((*path, key), value) for key, value in reversed(items))
 
 
 def _parent(document, path):
@@ -125,7 +130,7 @@ def mutated_designs(draw, splice: bool = True):
             else:
                 document = node
         elif kind == "copy" and isinstance(node, list) and node:
-            node.extend(copy.deepcopy(node[: draw(st.integers(1, 3))]))
+            node.extend(node[: draw(st.integers(1, 3))])  # shared items: like JSON copies
         elif kind == "delete":
             del parent[path[-1]]
         elif kind == "rename" and isinstance(parent, dict):
