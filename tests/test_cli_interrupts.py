@@ -16,7 +16,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from test_cli import DESIGN, command
+from test_cli import DESIGN, command, source_env
 
 from kinegami.export import publish
 
@@ -80,8 +80,7 @@ def is_new_build(folder: Path, also: tuple[str, ...] = ()) -> bool:
 
 def paused_build(design: Path, out: Path, step: int) -> subprocess.Popen:
     """A ``kinegami build`` process paused before publishing step ``step``."""
-    env = dict(os.environ, MPLBACKEND="Agg", **{publish.PAUSE_HOOK: str(step)})
-    env.pop("DISPLAY", None)
+    env = source_env(**{publish.PAUSE_HOOK: str(step)})
     process = subprocess.Popen(
         [*command(), "build", str(design), "-o", str(out), "--formats", "dxf,svg"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env,
