@@ -5,9 +5,10 @@ Commands::
     kinegami build DESIGN -o DIR [--formats dxf,svg,png] [--name STEM]
     kinegami show DESIGN [--pattern]
     kinegami validate DESIGN
+    kinegami check DESIGN [--motion N] [--seed S] [--json]
 
 Exit codes: 0 success, 1 a design or export error (one line on stderr, no traceback, no file
-written), 2 a usage error (argparse).
+written), 2 a usage error (argparse), 3 ``check``: the design self-intersects at its states.
 """
 
 from __future__ import annotations
@@ -54,12 +55,20 @@ class BuildJob:
     chain: object
     info: object
     _pattern: object = None
+    _clearance: object = None
 
     @property
     def pattern(self):
         if self._pattern is None:
             self._pattern = self.chain.creasePattern(twistPortion=self.info.twistPortion)
         return self._pattern
+
+    @property
+    def clearance(self):
+        """The chain's ClearanceReport at its states (parts named with the joint names)."""
+        if self._clearance is None:
+            self._clearance = _clearance(self.chain)
+        return self._clearance
 
 
 def _write_pattern_file(job: BuildJob, paths: list[Path]) -> None:
@@ -184,7 +193,93 @@ def _summary(job: BuildJob, design: str) -> list[str]:
         f"  sheet: {(xmax - xmin) * factor:.1f} mm x {(ymax - ymin) * factor:.1f} mm",
         f"  total tube length: {tube * factor:.1f} mm "
         f"(links {links_length * factor:.1f} mm, joints {joints_length * factor:.1f} mm)",
+        "  clearance: "
+        + _printable(_clearance_summary(job.clearance, _Lengths(chain.r, info.units))),
     ]
+
+
+# --- clearance (`check` and the build summary) -------------------------------------------------
+#: Exit code of ``check`` when the design self-intersects at its states.
+SELF_INTERSECTS = 3
+#: Most configurations ``check --motion`` samples.
+MAX_MOTION = 1_000_000
+#: Most overlapping pairs ``check`` lists in words (``--json`` lists them all).
+LISTED_PAIRS = 20
+
+
+def _joint_names(chain) -> tuple | None:
+    """The joint names of a chain loaded from a design (one line, shortened), or None."""
+    from kinegami.design.reader import origin_of
+    from kinegami.validation import shorten
+
+    origin = origin_of(chain)
+    if origin is None:
+        return None
+    return tuple(None if name is None else shorten(name) for name in origin.names)
+
+
+def _clearance(chain):
+    from kinegami.clearance import chain_clearance
+
+    return chain_clearance(chain, names=_joint_names(chain))
+
+
+class _Lengths:
+    """Lengths of a design in words: in millimetres as ``build`` prints every size, with the
+    design's own unit beside them when it is not mm; to about r / 100."""
+
+    def __init__(self, r: float, units: str):
+        import math
+
+        self.units = units
+        self.factor = UNITS_IN_MM[units]
+        self.mm_digits = max(0, 2 - math.floor(math.log10(r * self.factor)))
+        self.own_digits = max(0, 2 - math.floor(math.log10(r)))
+
+    @staticmethod
+    def _fixed(value: float, digits: int) -> str:
+        value = round(value, digits)
+        return f"{value if value else 0.0:.{digits}f}"  # no "-0.00"
+
+    def mm(self, value: float) -> str:
+        """``value`` (design units) in mm only: "9.9 mm"."""
+        return f"{self._fixed(value * self.factor, self.mm_digits)} mm"
+
+    def __call__(self, value: float) -> str:
+        """``value`` (design units) in mm and in the design's unit: "9.9 mm (0.99 cm)"."""
+        if self.units == "mm":
+            return self.mm(value)
+        return f"{self.mm(value)} ({self._fixed(value, self.own_digits)} {self.units})"
+
+    def span(self, low: float, high: float) -> str:
+        """An interval: "-8.8 to 12.4 mm (-0.88 to 1.24 cm)"."""
+        f, d = self.factor, self.mm_digits
+        text = f"{self._fixed(low * f, d)} to {self._fixed(high * f, d)} mm"
+        if self.units != "mm":
+            d = self.own_digits
+            text += f" ({self._fixed(low, d)} to {self._fixed(high, d)} {self.units})"
+        return text
+
+
+def _angle_span(low: float, high: float) -> str:
+    import math
+
+    return f"{math.degrees(low):.1f} to {math.degrees(high):.1f} deg"
+
+
+def _clearance_summary(report, lengths: _Lengths) -> str:
+    """The build summary's clearance: "9.9 mm (clear)" or "-0.35 mm: self-intersects (A and
+    B)", in mm like the other sizes of the summary."""
+    if report.closest is None:
+        return "clear (no two parts are far enough apart along the tube to collide)"
+    if report.ok:
+        return f"{lengths.mm(report.min_clearance)} (clear)"
+    first = report.pairs[0]
+    more = f"; {len(report.pairs)} pairs overlap" if len(report.pairs) > 1 else ""
+    return (
+        f"{lengths.mm(report.min_clearance)}: self-intersects "
+        f"({first.first} and {first.second}{more})"
+    )
 
 
 # --- commands ----------------------------------------------------------------------------------
@@ -245,6 +340,8 @@ def cmd_build(args: argparse.Namespace) -> int:
     job = BuildJob(chain, info)
     _check_pattern(job)
     lines = _summary(job, args.design)
+    if not job.clearance.ok:
+        _warn(args.command, _overlap_warning(job, args.design))
     # write everything into a hidden staging folder in the target, then publish it as one
     # transaction (kinegami.export.publish): a failure or an interrupt leaves the folder as
     # it was, and a build killed earlier is recovered first
@@ -319,6 +416,171 @@ def cmd_validate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _overlap_warning(job: BuildJob, design: str) -> str:
+    report = job.clearance
+    first = report.pairs[0]
+    more = f"; {len(report.pairs)} pairs overlap" if len(report.pairs) > 1 else ""
+    depth = _Lengths(job.chain.r, job.info.units).mm(-first.clearance)
+    return (
+        f"{design} self-intersects at its states: {first.first} and {first.second} overlap "
+        f"by {depth}{more} (the files are written all the same; 'kinegami check' lists every "
+        "pair)"
+    )
+
+
+def _integer(option: str, text: str, low: int, high: int | None = None) -> int:
+    """The integer value of an option given as ``text``, within [low, high], or a
+    CommandError naming the option, the value and the valid range."""
+    import re
+
+    from kinegami.validation import shorten
+
+    valid = f"an integer >= {low}" if high is None else f"an integer in [{low}, {high}]"
+    if not re.fullmatch(r"[+-]?[0-9]{1,30}", text.strip()):
+        raise CommandError(f"{option}: must be {valid}, got {shorten(text)!r}")
+    value = int(text)
+    if value < low or (high is not None and value > high):
+        raise CommandError(f"{option}: must be {valid}, got {value}")
+    return value
+
+
+def _pair_json(pair) -> dict:
+    return {
+        "first": pair.first,
+        "second": pair.second,
+        "clearance": pair.clearance,
+        "points": [list(point) for point in pair.points],
+    }
+
+
+def _movable(chain) -> list[int]:
+    """Indices of the joints that move (a state range that is not a single point)."""
+    ranges = [joint.stateRange() for joint in chain.Joints]
+    return [i for i, (low, high) in enumerate(ranges) if high > low]
+
+
+def _check_json(chain, info, design, report, motion, seed) -> dict:
+    from kinegami.design.reader import origin_of
+    from kinegami.joints import RevoluteJoint
+
+    origin = origin_of(chain)
+    data = {
+        "design": design,
+        "name": info.name,
+        "units": info.units,
+        "r": chain.r,
+        "ok": report.ok,
+        "min_clearance": report.min_clearance if report.closest is not None else None,
+        "closest": None if report.closest is None else _pair_json(report.closest),
+        "pairs": [_pair_json(pair) for pair in report.pairs],
+        "states": list(report.states),
+        "motion": None,
+    }
+    if motion is not None:
+        intervals = []
+        for i in _movable(chain):
+            joint = chain.Joints[i]
+            free = motion.free_intervals[i]
+            intervals.append({
+                "joint": i,
+                "type": type(joint).__name__,
+                "name": None if origin is None else origin.names[i],
+                "kind": "revolute" if isinstance(joint, RevoluteJoint) else "prismatic",
+                "state": motion.states[i],
+                "range": list(joint.stateRange()),
+                "free": None if free is None else list(free),
+            })  # fmt: skip
+        data["motion"] = {
+            "samples": motion.samples,
+            "seed": seed,
+            "colliding": motion.colliding,
+            "colliding_fraction": motion.colliding_fraction,
+            "worst_pairs": [dict(_pair_json(pair), count=count)
+                            for pair, count in motion.worst_pairs],
+            "free_intervals": intervals,
+        }  # fmt: skip
+    return data
+
+
+def _check_lines(chain, info, design, report, motion, seed) -> list[str]:
+    from kinegami.joints import RevoluteJoint
+
+    lengths = _Lengths(chain.r, info.units)
+    title = f"{_printable(info.name)} ({design})" if info.name else design
+    lines = []
+    if report.ok:
+        lines.append(f"{title}: clear at its states")
+        if report.closest is None:
+            lines.append("  minimum clearance: none (no two parts are far enough apart along the "
+                         "tube to collide)")  # fmt: skip
+        else:
+            closest = report.closest
+            lines.append(f"  minimum clearance: {lengths(report.min_clearance)}, between "
+                         f"{closest.first} and {closest.second}")  # fmt: skip
+    else:
+        count = len(report.pairs)
+        lines.append(f"{title}: self-intersects at its states "
+                     f"({count} pair{'s' if count > 1 else ''} of parts overlap)")  # fmt: skip
+        lines.append(f"  minimum clearance: {lengths(report.min_clearance)}")
+        lines.append("  overlapping parts (deepest first):")
+        for pair in report.pairs[:LISTED_PAIRS]:
+            lines.append(f"    {pair.first} and {pair.second}: overlap "
+                         f"{lengths(-pair.clearance)}")  # fmt: skip
+        if count > LISTED_PAIRS:
+            lines.append(f"    ... and {count - LISTED_PAIRS} more (--json lists them all)")
+    if motion is None:
+        return [_printable(line) for line in lines]
+    lines.append(
+        f"  motion: {motion.colliding} of {motion.samples} sampled configurations "
+        f"self-intersect ({100.0 * motion.colliding_fraction:.1f}%; seed {seed})"
+    )
+    if motion.worst_pairs:
+        lines.append("  pairs that overlap most over the motion:")
+        for pair, n in motion.worst_pairs:
+            lines.append(f"    {pair.first} and {pair.second}: the deepest overlap in {n} "
+                         f"configuration{'s' if n > 1 else ''}, up to "
+                         f"{lengths(-pair.clearance)}")  # fmt: skip
+    movable = _movable(chain)
+    if not movable:
+        lines.append("  free intervals: none (no joint moves)")
+    elif motion.free_intervals[movable[0]] is None:
+        lines.append("  free intervals: none (the design self-intersects at its states)")
+    else:
+        lines.append("  free intervals (each joint moved alone from its state, the others kept):")
+        names = _joint_names(chain)
+        for i in movable:
+            joint = chain.Joints[i]
+            low, high = motion.free_intervals[i]
+            lo, hi = joint.stateRange()
+            span = _angle_span if isinstance(joint, RevoluteJoint) else lengths.span
+            whole = low <= lo and high >= hi
+            label = f" '{names[i]}'" if names is not None and names[i] is not None else ""
+            lines.append(
+                f"    joint {i}, {type(joint).__name__}{label}: {span(low, high)}, "
+                + ("its whole range" if whole else f"of its range {span(lo, hi)}")
+            )
+    return [_printable(line) for line in lines]
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    import json
+
+    from kinegami.clearance import chain_clearance, sweep
+
+    samples = None if args.motion is None else _integer("--motion", args.motion, 1, MAX_MOTION)
+    seed = _integer("--seed", args.seed, 0)
+    chain, info = _load(args.design)
+    names = _joint_names(chain)
+    report = chain_clearance(chain, names=names)
+    motion = None if samples is None else sweep(chain, samples, seed, names=names)
+    if args.json:
+        data = _check_json(chain, info, args.design, report, motion, seed)
+        print(json.dumps(data, indent=2, allow_nan=False))
+    else:
+        print("\n".join(_check_lines(chain, info, args.design, report, motion, seed)))
+    return 0 if report.ok else SELF_INTERSECTS
+
+
 # --- parser ------------------------------------------------------------------------------------
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
@@ -375,6 +637,31 @@ def make_parser() -> argparse.ArgumentParser:
         "--build", action="store_true", help="also build the chain (every placement and edit)"
     )
     validate.set_defaults(run=cmd_validate)
+
+    check = commands.add_parser(
+        "check",
+        help="check that a design does not pass through itself",
+        description="Build a design and report its self-intersections: the minimum clearance "
+        "between its parts (mm, and the design's units), every pair of parts that overlap, and "
+        "with --motion the share of sampled configurations that self-intersect and the free "
+        "interval of each joint. Exit code 0: clear at its states; 3: self-intersects; 1: a "
+        "design error. Nothing is written.",
+    )
+    check.add_argument("design", metavar="DESIGN", help="design file (.json)")
+    check.add_argument(
+        "--motion",
+        metavar="N",
+        help=f"also sample N configurations within the joints' ranges (1 to {MAX_MOTION}) and "
+        "find each joint's free interval",
+    )
+    check.add_argument(
+        "--seed", metavar="S", default="0", help="seed of the sampled configurations (an "
+        "integer >= 0, default: %(default)s)"
+    )  # fmt: skip
+    check.add_argument(
+        "--json", action="store_true", help="print one JSON object instead (see docs/cli.md)"
+    )
+    check.set_defaults(run=cmd_check)
     return parser
 
 
@@ -455,6 +742,11 @@ def _encoding_safe_output() -> None:
             reconfigure(errors="backslashreplace")
         except (ValueError, OSError):  # detached or closed
             pass
+
+
+def _warn(command: str, message: str) -> None:
+    text = _printable(" ".join(message.split()))
+    print(f"kinegami {command}: warning: {text}", file=sys.stderr)
 
 
 def _note(command: str, message: str) -> None:
