@@ -127,12 +127,20 @@ def save_outputs(chain, name: str, folder: Path) -> list[Path]:
     ]
 
 
-def report(chain, name: str, written: list[Path]) -> None:
-    """Print the chain's size, its crease pattern's size and the files written."""
+def report(chain, name: str, written: list[Path], units: str = "mm") -> None:
+    """Print the chain's size, the sizes of its crease pattern (without the glue tab) and of
+    its sheet (with it), in ``units`` (the gallery's scripts use mm), and the files written."""
+    from kinegami.pattern.sheet import flatten
+
     pattern = chain.creasePattern()
+    xmin, ymin, xmax, ymax = flatten(pattern).bounds
     print(
-        f"{name}: {len(chain.Joints)} joints, total path length {chain.totalPathLength():.4f}, "
-        f"crease pattern {pattern.width:.4f} x {pattern.height:.4f}"
+        f"{name}: {len(chain.Joints)} joints, total path length "
+        f"{chain.totalPathLength():.2f} {units}"
+    )
+    print(
+        f"  crease pattern: {pattern.width:.1f} {units} x {pattern.height:.1f} {units}, without "
+        f"the glue tab; sheet: {xmax - xmin:.1f} {units} x {ymax - ymin:.1f} {units} with it"
     )
     print("wrote:")
     for path in written:

@@ -2,10 +2,17 @@
 
 The listing below is the paper's, line for line, after ``from kinegami import *``. Each
 ``chain.show(...)`` draws a figure; this script saves them (and the pattern) under
-``examples/output/`` and prints where they went. Run: ``python examples/example1.py``.
+``examples/output/`` (or the folder given as its one argument), prints the sizes of the crease
+pattern (without the glue tab) and of the sheet (with it) and where the files went.
+Run: ``python examples/example1.py [folder]``.
+
+Lengths are in units of r, and the paper's r = 1 is 1 cm (as in examples/designs/example1.json,
+whose sheet ``kinegami build`` prints in mm). The listing's ``pattern.save`` writes the DXF with
+save()'s default of 1 unit = 1 mm; ``pattern.save(dxfName=..., units="cm")`` would give true size.
 """
 
 import os
+import sys
 from pathlib import Path
 
 import matplotlib
@@ -16,7 +23,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from kinegami import *  # noqa: E402, F403
 
-OUTPUT = Path(__file__).resolve().parent / "output"
+if len(sys.argv) > 2:
+    sys.exit("usage: python example1.py [output-folder]")
+OUTPUT = Path(sys.argv[1] if len(sys.argv) == 2 else Path(__file__).parent / "output").resolve()
 OUTPUT.mkdir(parents=True, exist_ok=True)
 os.chdir(OUTPUT)  # the listing writes "examplePatterns/example1.dxf" relative to here
 written = []
@@ -74,8 +83,15 @@ save_figure("figure5f_example1C.png")
 pattern.show()
 save_figure("figure5g_pattern.png")
 
+from kinegami.pattern.sheet import flatten  # noqa: E402
+
+xmin, ymin, xmax, ymax = flatten(pattern).bounds
 print(f"Example 1: {len(chain.Joints)} joints, total path length "
-      f"{chain.totalPathLength():.6f}, pattern {pattern.width:.4f} x {pattern.height:.4f}")
+      f"{chain.totalPathLength():.4f} cm (r = 1 cm)")
+print(f"  crease pattern: {pattern.width:.3f} cm x {pattern.height:.3f} cm, without the glue tab")
+print(f"  sheet: {xmax - xmin:.3f} cm x {ymax - ymin:.3f} cm with the glue tab "
+      f"(kinegami build prints it as {10 * (xmax - xmin):.1f} mm x {10 * (ymax - ymin):.1f} mm)")
+print("  (the listing's DXF counts 1 unit as 1 mm, save()'s default; units='cm' gives true size)")
 print("wrote:")
 for path in written:
     print(f"  {path}")

@@ -452,3 +452,25 @@ def test_gallery_pictures_do_not_depend_on_the_process_or_the_cpu(tmp_path):
     assert pictures[0] == pictures[1]
     for data in pictures[0].values():
         assert b"Software" not in data and b"atplotlib" not in data
+
+
+def test_example1_script_says_which_size_is_which(tmp_path):
+    """examples/example1.py prints the crease pattern without the glue tab and the sheet with
+    it, in cm, and the sheet in mm as ``kinegami build`` prints it for the design file."""
+    from kinegami.pattern.sheet import flatten
+
+    result = subprocess.run(
+        [sys.executable, str(EXAMPLES / "example1.py"), str(tmp_path / "out")],
+        capture_output=True, text=True, cwd=tmp_path, env=source_env(), timeout=600,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    chain, info = load_design_with_info(DESIGNS / "example1.json")
+    assert info.units == "cm"
+    pattern = chain.creasePattern()
+    xmin, ymin, xmax, ymax = flatten(pattern).bounds
+    w, h, sw, sh = pattern.width, pattern.height, xmax - xmin, ymax - ymin
+    text = result.stdout
+    assert f"crease pattern: {w:.3f} cm x {h:.3f} cm, without the glue tab" in text
+    assert f"sheet: {sw:.3f} cm x {sh:.3f} cm with the glue tab" in text
+    assert f"{10 * sw:.1f} mm x {10 * sh:.1f} mm" in text
+    assert (tmp_path / "out" / "examplePatterns" / "example1.dxf").is_file()
