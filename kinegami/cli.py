@@ -5,6 +5,7 @@ Commands::
     kinegami build DESIGN -o DIR [--formats dxf,svg,png] [--name STEM]
     kinegami show DESIGN [--pattern]
     kinegami validate DESIGN
+    kinegami new DESIGN [--force]
     kinegami check DESIGN [--motion N] [--seed S] [--json]
 
 Exit codes: 0 success, 1 a design or export error (one line on stderr, no traceback, no file
@@ -190,7 +191,9 @@ def _summary(job: BuildJob, design: str) -> list[str]:
         f"  joints: {len(chain.Joints)} ({kinds})",
         f"  links: {links}",
         f"  tube: {chain.numSides} sides, r = {chain.r * factor:g} mm",
-        f"  sheet: {(xmax - xmin) * factor:.1f} mm x {(ymax - ymin) * factor:.1f} mm",
+        f"  sheet: {(xmax - xmin) * factor:.1f} mm x {(ymax - ymin) * factor:.1f} mm with the glue "
+        f"tab (the crease pattern alone: {job.pattern.width * factor:.1f} mm x "
+        f"{job.pattern.height * factor:.1f} mm)",
         f"  total tube length: {tube * factor:.1f} mm "
         f"(links {links_length * factor:.1f} mm, joints {joints_length * factor:.1f} mm)",
         "  clearance: "
@@ -389,6 +392,26 @@ def cmd_show(args: argparse.Namespace) -> int:
     if args.pattern:
         chain.creasePattern(twistPortion=info.twistPortion).show()
     plt.show()
+    return 0
+
+
+def cmd_new(args: argparse.Namespace) -> int:
+    from kinegami.design.starter import DesignFileExistsError, write_starter_design
+
+    try:
+        path = write_starter_design(args.design, overwrite=args.force)
+    except DesignFileExistsError:
+        raise CommandError(
+            f"{_printable(repr(args.design))} exists already and was left as it is; "
+            "--force replaces it"
+        ) from None
+    name = _printable(str(path))
+    print(
+        f"wrote {name}: a starter design (a start tip, a revolute joint, a prismatic joint, an "
+        "end tip; units mm). Change it, then:"
+    )
+    print(f"  kinegami validate --build {name}")
+    print(f"  kinegami build {name} -o out/")
     return 0
 
 
@@ -637,6 +660,18 @@ def make_parser() -> argparse.ArgumentParser:
         "--build", action="store_true", help="also build the chain (every placement and edit)"
     )
     validate.set_defaults(run=cmd_validate)
+
+    new = commands.add_parser(
+        "new",
+        help="write a starter design file to change",
+        description="Write a small design file that validates and builds (a start tip, a "
+        "revolute joint, a prismatic joint and an end tip on a square tube of radius 10 mm), "
+        "named after the file. The file appears whole or not at all; an existing file is kept "
+        "unless --force.",
+    )
+    new.add_argument("design", metavar="DESIGN", help="the design file to write (.json)")
+    new.add_argument("--force", action="store_true", help="replace DESIGN if it exists")
+    new.set_defaults(run=cmd_new)
 
     check = commands.add_parser(
         "check",

@@ -83,7 +83,7 @@ def assert_clean_failure(result, *words):
 
 # --- help and version ----------------------------------------------------------------------
 @pytest.mark.parametrize("args", [[], ["--help"], ["build", "--help"], ["show", "--help"],
-                                  ["validate", "--help"]])  # fmt: skip
+                                  ["validate", "--help"], ["new", "--help"]])  # fmt: skip
 def test_help_everywhere(args):
     result = run(*args)
     assert result.returncode == 0
@@ -146,7 +146,12 @@ def test_summary_numbers_match_the_library(design, tmp_path):
     xmin, ymin, xmax, ymax = sheet.bounds
     tube = chain.totalPathLength() + sum(j.neutralLength for j in chain.Joints)
     result = run("build", design, "-o", tmp_path / "o", "--formats", "dxf")
-    assert f"sheet: {xmax - xmin:.1f} mm x {ymax - ymin:.1f} mm" in result.stdout
+    pattern = chain.creasePattern()
+    assert (
+        f"sheet: {xmax - xmin:.1f} mm x {ymax - ymin:.1f} mm with the glue tab (the crease "
+        f"pattern alone: {pattern.width:.1f} mm x {pattern.height:.1f} mm)"
+    ) in result.stdout
+    assert xmax - xmin > pattern.width + 0.05  # the two sizes differ by the tab
     assert f"total tube length: {tube:.1f} mm" in result.stdout
 
 
@@ -242,6 +247,37 @@ def test_validate_does_not_build_unless_asked(tmp_path):
     path = write(tmp_path / "bad.json", data)
     assert run("validate", path).returncode == 0
     assert_clean_failure(run("validate", path, "--build"), "edits[0]")
+
+
+# --- new --------------------------------------------------------------------------------------
+def test_new_writes_a_starter_that_validates_and_builds(tmp_path):
+    result = run("new", "my_robot.json", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "wrote my_robot.json" in result.stdout
+    assert "kinegami validate --build my_robot.json" in result.stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["my_robot.json"]
+    result = run("validate", "--build", "my_robot.json", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    result = run("build", "my_robot.json", "-o", "out", "--formats", "dxf", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("my_robot (my_robot.json)")
+    assert (tmp_path / "out" / "my_robot.dxf").stat().st_size > 0
+
+
+def test_new_keeps_an_existing_file_unless_forced(tmp_path):
+    path = write(tmp_path / "arm.json", "my own design")
+    result = run("new", path)
+    assert_clean_failure(result, "arm.json", "exists", "--force")
+    assert path.read_text() == "my own design"
+    result = run("new", path, "--force")
+    assert result.returncode == 0, result.stderr
+    assert json.loads(path.read_text())["name"] == "arm"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["arm.json"]
+
+
+def test_new_needs_a_json_name(tmp_path):
+    assert_clean_failure(run("new", tmp_path / "arm.txt"), ".json", "arm.txt")
+    assert list(tmp_path.iterdir()) == []
 
 
 # --- start-up without a writable home folder -------------------------------------------------
