@@ -482,7 +482,8 @@ def _register_builtin() -> None:
         ".svg",
         _pattern_exporter(".svg"),
         "pattern",
-        description="SVG of the flat sheet (mm; Origami Simulator colours)",
+        description="SVG of the flat sheet, true size in mm: for Origami Simulator (fold angles "
+        "as opacity), or for cutting with flavour='laser'",
     )
     register(
         ".fold",

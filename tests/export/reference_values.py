@@ -35,14 +35,11 @@ DXF_MEASUREMENT_METRIC = 1
 DXF_VERSION_CODE = "AC1027"  # R2013
 DXF_LAYER_COLORS = {"Mountain": 5, "Valley": 1, "Boundary": 2, "Cut": 3}
 
-#: Origami Simulator colours written to SVG.
+#: Laser-flavour SVG colours by group (mountain red, valley blue, boundary black, cut green).
 SVG_COLORS = {"Mountain": "#ff0000", "Valley": "#0000ff", "Boundary": "#000000", "Cut": "#00ff00"}
 
 #: Millimetres per pattern unit for each ``units`` value.
 UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
-
-#: Laser-flavour SVG colours by group (the sheet of the DXF).
-LASER_SVG_COLORS = SVG_COLORS
 
 #: Origami Simulator's SVG import (js/pattern.js typeForStroke): stroke colour of each kind.
 SIMULATOR_STROKES = {"B": "#000000", "M": "#ff0000", "V": "#0000ff", "C": "#00ff00", "F": "#ffff00"}
