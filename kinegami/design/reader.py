@@ -682,12 +682,12 @@ def _check_document(document, file) -> _Plan:
     # bulky ones, so that a huge design with a wrong "units" fails in no time
     _check_header(document, file)
     for key, value in document.items():
-        if key not in _BULKY:
-            _check_values(value, file, root=(key,))
+        if key not in _BULKY or not isinstance(value, dict if key == "dh" else list):
+            _check_values(value, file, root=(key,))  # small, or a wrong type (walked whole)
     dh = document.get("dh")
     if isinstance(dh, dict):
         for key, value in dh.items():
-            if key != "rows":
+            if key != "rows" or not isinstance(value, list):
                 _check_values(value, file, root=("dh", key))
     check_top_level(document, file)
     _check_values(document, file)

@@ -107,6 +107,14 @@ def test_deep_nesting_is_a_design_error(depth, old, prefix):
     assert "nested too deeply" in error.reason and str(limits.MAX_DEPTH) in error.reason
 
 
+@pytest.mark.parametrize("key", ["joints", "edits", "states", "dh"])
+def test_deep_nesting_in_a_bulky_field_of_the_wrong_type(key):
+    document = {**BASE, key: "PLACE"}
+    text = json.dumps(document).replace('"PLACE"', '{"a": ' + _nested(950, "") + "}")
+    error = _error(text)
+    assert error.field.startswith(key) and "nested too deeply" in error.reason
+
+
 @pytest.mark.parametrize("depth", [980, 100_000])
 def test_deeply_nested_objects(depth):
     inner = '{"a": ' * depth + "1" + "}" * depth
