@@ -20,7 +20,7 @@ import numpy as np
 from spatialmath import SE3
 
 from kinegami import export
-from kinegami.chain import KinematicChain, PlacementWarning
+from kinegami.chain import ClearanceWarning, KinematicChain, PlacementWarning
 from kinegami.errors import (
     IncompatibleJointError,
     InvalidParameterError,
@@ -65,5 +65,6 @@ __all__ = [
     "NoPathError",
     "IncompatibleJointError",
     "PlacementWarning",
+    "ClearanceWarning",
     "export",
 ]

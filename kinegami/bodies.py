@@ -35,11 +35,13 @@ them turns by at least pi.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from kinegami.geometry.segments import segment_distances
 from kinegami.joints import (
     EndTip,
     ExtendedRevoluteJoint,
@@ -61,6 +63,12 @@ __all__ = [
     "CapsuleModel",
     "capsule_model",
     "joint_label",
+    "appended_clearance",
+    "deepest_overlap",
+    "worst_overlap",
+    "Overlap",
+    "CONTACT_TOLERANCE",
+    "TURN_TOLERANCE",
     "JOINT_FIXED",
     "JOINT_REVOLUTE",
     "JOINT_PRISMATIC",
@@ -174,6 +182,11 @@ def elbow_rings(arc, n: int) -> np.ndarray | None:
 
 
 # --- capsules --------------------------------------------------------------------------------
+#: Overlaps shallower than this many r count as contact, not collision.
+CONTACT_TOLERANCE = 1e-9
+#: Two capsules are tested when the centreline between them turns by at least pi minus this.
+TURN_TOLERANCE = 1e-9
+
 #: Joint motion codes of :class:`CapsuleModel`.
 JOINT_FIXED, JOINT_REVOLUTE, JOINT_PRISMATIC = 0, 1, 2
 
@@ -381,6 +394,152 @@ def _joint_capsules(out: _Builder, joint: Joint, j: int, turning: float, text: s
     out.add(proximal, distal, j - 1, body_b, turning, 2 * j, [], [text])
 
 
+@functools.lru_cache(maxsize=16384)
+def _link_rows(link, i: int, r: float, twistPortion: float) -> tuple[tuple, float]:
+    """Capsule rows of link i with turning measured from the link's start, and its turning."""
+    out = _Builder(r)
+    turning = _link_capsules(out, link, i, 0.0, twistPortion)
+    return tuple(out.rows), turning
+
+
+@functools.lru_cache(maxsize=16384)
+def _joint_rows(joint, j: int, r: float, text: str) -> tuple:
+    """Capsule rows of joint j with turning 0 (the chain adds the turning before it)."""
+    out = _Builder(r)
+    _joint_capsules(out, joint, j, 0.0, text)
+    return tuple(out.rows)
+
+
+def _chain_rows(joints, links, r: float, names, twistPortion: float) -> tuple[list, list]:
+    """All capsule rows in order along the tube, and the index of every joint's first row."""
+    rows: list = []
+    first: list[int] = []
+    turning = 0.0
+    for j, joint in enumerate(joints):
+        if j > 0:
+            link_rows, turn = _link_rows(links[j], j, r, twistPortion)
+            rows += [row[:4] + (row[4] + turning,) + row[5:] for row in link_rows]
+            turning += turn
+        first.append(len(rows))
+        text = f"joint {j}, {type(joint).__name__}"
+        if names is not None and j < len(names) and names[j] is not None:
+            text += f" '{names[j]}'"
+        rows += [row[:4] + (row[4] + turning,) + row[5:] for row in _joint_rows(joint, j, r, text)]
+    return rows, first
+
+
+def _kink_prefix(joints) -> np.ndarray:
+    """Turning added by the revolute hinges up to body b (index b + 1; b = -1: 0)."""
+    kinks = [abs(j.state) if isinstance(j, RevoluteJoint) else 0.0 for j in joints]
+    return np.concatenate([[0.0], np.cumsum(kinks)])
+
+
+def appended_clearance(joints, links, r: float, first_new: int) -> float:
+    """Smallest clearance between the parts of joints ``first_new``... (and the links into
+    them) and every part before them, at the current configuration, by the pair rule of
+    :mod:`kinegami.clearance`; inf when no such pair is tested.
+
+    Used by placement to check an extension before it is accepted: the chain before
+    ``first_new`` is not re-checked.
+    """
+    rows, first = _chain_rows(joints, links, r, None, 0.2)
+    if not rows:
+        return math.inf
+    # the new parts start with the link into joint first_new
+    start_new = first[first_new - 1] + len(
+        _joint_rows(joints[first_new - 1], first_new - 1, r,
+                    f"joint {first_new - 1}, {type(joints[first_new - 1]).__name__}")
+    )  # fmt: skip
+    if start_new >= len(rows):
+        return math.inf
+    a = np.array([row[0] for row in rows])
+    b = np.array([row[1] for row in rows])
+    body = np.array([row[2] for row in rows], dtype=np.int64)
+    tau = np.array([row[4] for row in rows]) + _kink_prefix(joints)[body + 1]
+    S = len(rows)
+    i, j = np.meshgrid(np.arange(S), np.arange(start_new, S), indexing="ij")
+    i, j = i.ravel(), j.ravel()
+    keep = (i < j) & (tau[j] - tau[i] >= math.pi - TURN_TOLERANCE)
+    if not keep.any():
+        return math.inf
+    i, j = i[keep], j[keep]
+    # capsule balls first
+    centre = 0.5 * (a + b)
+    half = 0.5 * np.linalg.norm(b - a, axis=1)
+    gap = np.linalg.norm(centre[i] - centre[j], axis=1) - half[i] - half[j]
+    bound = max(float(gap.min()), 2.0 * r)
+    near = gap <= bound
+    d, _, _ = segment_distances(a[i[near]], b[i[near]], a[j[near]], b[j[near]])
+    return float(d.min()) - 2.0 * r
+
+
+@dataclass(frozen=True)
+class Overlap:
+    """The deepest overlap of a chain: its clearance (< 0, chain units) and the two parts."""
+
+    clearance: float
+    first: str
+    second: str
+
+    def __str__(self) -> str:
+        return f"{self.first} and {self.second} overlap by {-self.clearance:.4g}"
+
+
+def worst_overlap(joints, links, r: float, names=None) -> Overlap | None:
+    """The deepest overlap of a chain at its current configuration (the pair rule of
+    :mod:`kinegami.clearance`), or None when no tested capsules overlap.
+
+    A fast test for placement, edits and searches: only pairs whose capsule balls overlap are
+    measured exactly.
+    """
+    rows, _ = _chain_rows(joints, links, r, None if names is None else tuple(names), 0.2)
+    S = len(rows)
+    if S < 2:
+        return None
+    a = np.array([row[0] for row in rows])
+    b = np.array([row[1] for row in rows])
+    body = np.array([row[2] for row in rows], dtype=np.int64)
+    tau = np.array([row[4] for row in rows]) + _kink_prefix(joints)[body + 1]
+    # turning is non-decreasing along the tube: the pairs (i, j >= first[i]) are the tested ones
+    first = np.maximum(
+        np.searchsorted(tau, tau + math.pi - TURN_TOLERANCE, side="left"), np.arange(S) + 1
+    )
+    counts = np.maximum(S - first, 0)
+    total = int(counts.sum())
+    if total == 0:
+        return None
+    i = np.repeat(np.arange(S), counts)
+    j = np.repeat(first - np.cumsum(counts) + counts, counts) + np.arange(total)
+    centre = 0.5 * (a + b)
+    half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
+    d = centre[i] - centre[j]
+    near = np.sqrt(np.einsum("ij,ij->i", d, d)) - half[i] - half[j] < 2.0 * r
+    if not near.any():
+        return None
+    i, j = i[near], j[near]
+    dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
+    k = int(np.argmin(dist))
+    worst = float(dist[k]) - 2.0 * r
+    if worst >= -CONTACT_TOLERANCE * r:
+        return None
+
+    def label(row, param: float) -> str:
+        breaks, labels = row[6], row[7]
+        at = param * float(np.linalg.norm(row[1] - row[0]))
+        for n, x in enumerate(breaks):
+            if at < x:
+                return labels[n]
+        return labels[-1]
+
+    return Overlap(worst, label(rows[int(i[k])], float(s[k])), label(rows[int(j[k])], float(t[k])))
+
+
+def deepest_overlap(joints, links, r: float) -> float:
+    """The clearance of :func:`worst_overlap` (< 0), or +inf when nothing overlaps."""
+    found = worst_overlap(joints, links, r)
+    return math.inf if found is None else found.clearance
+
+
 def capsule_model(chain, names=None, twistPortion: float = 0.2) -> CapsuleModel:
     """The :class:`CapsuleModel` of ``chain`` at its current configuration.
 
@@ -393,9 +552,9 @@ def capsule_model(chain, names=None, twistPortion: float = 0.2) -> CapsuleModel:
         Fraction of a straight part taken by its twist fitting (labels only); default 0.2.
     """
     joints = chain.Joints
-    links = chain.Links
-    out = _Builder(float(chain.r))
-    turning = 0.0
+    r = float(chain.r)
+    rows, _ = _chain_rows(joints, chain.Links, r, None if names is None else tuple(names),
+                          twistPortion)  # fmt: skip
     count = len(joints)
     kinds = np.zeros(count, dtype=np.int64)
     points = np.zeros((count, 3))
@@ -410,16 +569,12 @@ def capsule_model(chain, names=None, twistPortion: float = 0.2) -> CapsuleModel:
             kinds[j] = JOINT_REVOLUTE
         elif isinstance(joint, PrismaticJoint):
             kinds[j] = JOINT_PRISMATIC
-        if j > 0:
-            turning = _link_capsules(out, links[j], j, turning, twistPortion)
-        _joint_capsules(out, joint, j, turning, joint_label(chain, j, names))
-    rows = out.rows
 
     def column(k: int, dtype, shape: tuple = ()) -> np.ndarray:
         return np.array([row[k] for row in rows], dtype=dtype).reshape((len(rows), *shape))
 
     model = CapsuleModel(
-        r=out.r,
+        r=r,
         starts=column(0, float, (3,)),
         ends=column(1, float, (3,)),
         start_body=column(2, np.int64),

@@ -9,6 +9,7 @@ append, edit or state change leaves the chain bit-identical.
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import warnings
@@ -16,7 +17,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from kinegami.bodies import CONTACT_TOLERANCE, appended_clearance, worst_overlap
 from kinegami.errors import (
+    ClearanceWarning,
     InvalidParameterError,
     InvalidTypeError,
     JointIndexError,
@@ -41,7 +44,7 @@ from kinegami.validation import (
     shown,
 )
 
-__all__ = ["KinematicChain", "PlacementWarning"]
+__all__ = ["KinematicChain", "PlacementWarning", "ClearanceWarning"]
 
 
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
@@ -110,12 +113,18 @@ class KinematicChain:
     2
     """
 
-    def __init__(self, startJoint: Joint, maxAnglePerElbow: float = np.pi / 2):
+    def __init__(
+        self,
+        startJoint: Joint,
+        maxAnglePerElbow: float = np.pi / 2,
+        requireClearance: bool = False,
+    ):
         if not isinstance(startJoint, Joint):
             raise InvalidTypeError(f"startJoint must be a Joint, got {type(startJoint).__name__}")
         if isinstance(startJoint, EndTip):
             raise InvalidParameterError("startJoint cannot be an EndTip (nothing may follow it)")
         self.maxAnglePerElbow = check_max_angle_per_elbow(maxAnglePerElbow)
+        self.requireClearance = requireClearance
         self.numSides = startJoint.numSides
         self.r = startJoint.r
         root = startJoint._copy()
@@ -186,6 +195,16 @@ class KinematicChain:
             neutralLength=neutralLength, numLayers=numLayers, coneAngle=coneAngle,
             endTip=endTip, tipLength=tipLength, maxAnglePerElbow=maxAnglePerElbow,
         )  # fmt: skip
+
+    @property
+    def requireClearance(self) -> bool:
+        """Reject appends, edits and state changes that would make the chain pass through
+        itself (False: apply them and emit a ClearanceWarning naming the parts)."""
+        return self._require_clearance
+
+    @requireClearance.setter
+    def requireClearance(self, value: bool) -> None:
+        self._require_clearance = _check_bool("requireClearance", value)
 
     # --- published read-only views -----------------------------------------------------------
     @property
@@ -263,6 +282,25 @@ class KinematicChain:
             ball = merge_balls(ball, link.arc2Ball)
         return ball
 
+    def _accept(self, what: str, joints, links, ball: Ball | None = None) -> bool:
+        """Commit the new lists unless they pass through themselves and the chain requires
+        clearance (then warn PlacementWarning, keep the chain, return False); a commit that
+        leaves the chain self-intersecting emits a ClearanceWarning."""
+        found = worst_overlap(joints, links, self.r)
+        if found is not None and self._require_clearance:
+            self._reject(f"{what} failed: the chain would pass through itself ({found})")
+            return False
+        self._commit(joints, links, ball)
+        if found is not None:
+            warnings.warn(
+                ClearanceWarning(
+                    f"{what}: the chain passes through itself ({found})",
+                    found.clearance, found.first, found.second,
+                ),
+                stacklevel=_caller_level(),
+            )  # fmt: skip
+        return True
+
     def _commit(self, joints: list[Joint], links: list[LinkCSC], ball: Ball | None = None):
         if ball is None:
             ball = self._ball_of(joints, links)
@@ -338,7 +376,8 @@ class KinematicChain:
         except KinegamiError as error:
             self._reject(f"append failed: {error}")
             return None
-        self._commit(joints, links, ball)
+        if not self._accept("append", joints, links, ball):
+            return None
         return len(joints) - 1
 
     def _compact_extension(self, parent: Joint, joint: Joint, fixedOrientation: bool):
@@ -382,15 +421,24 @@ class KinematicChain:
         """Safe placement: the extended lists and ball (chain.md 4.3 and docs/placement.md).
 
         Candidates, in order: the published rule with the joint's path direction as given, then
-        reversed (chain.md 4.3 step 6). The first that succeeds and stays close (ball growth
-        at most SAFE_GROWTH_LIMIT r, new links at most SAFE_PATH_LIMIT r long) is kept, so the
-        published results are reproduced wherever the published rule works. Otherwise the
-        radial construction, which always succeeds and grows the ball by a bounded amount, is
-        used unless a published candidate is no worse on both counts.
+        reversed (chain.md 4.3 step 6). The first that succeeds, stays close (ball growth at
+        most SAFE_GROWTH_LIMIT r, new links at most SAFE_PATH_LIMIT r long) and does not pass
+        through the chain (its new parts clear of every part before them, docs/clearance.md)
+        is kept, so the published results are reproduced wherever the published rule works.
+        Otherwise the radial construction, which always succeeds and grows the ball by a
+        bounded amount, is used (its first variant that is clear, see RADIAL_VARIANTS) unless
+        a clear published candidate is no worse on both counts.
         """
         distal = parent.distal_frame()
         k = parent.pathIndex()
         limits = (SAFE_GROWTH_LIMIT * self.r, SAFE_PATH_LIMIT * self.r)
+        first_new = len(self._joints)
+
+        def clear(extended) -> bool:
+            joints, links, _ = extended
+            gap = appended_clearance(joints, links, self.r, first_new)
+            return gap >= -CONTACT_TOLERANCE * self.r
+
         fallbacks = []
         for reverse in (False, True):
             try:
@@ -400,20 +448,57 @@ class KinematicChain:
             except KinegamiError:
                 continue
             cost = self._cost(extended)
-            if cost[0] <= limits[0] and cost[1] <= limits[1]:
+            ok = clear(extended)
+            if ok and cost[0] <= limits[0] and cost[1] <= limits[1]:
                 return extended
-            fallbacks.append((cost, extended))
-        try:
-            radial = self._extended(radial_safe_placement(distal, k, joint, self._ball))
-        except KinegamiError:
-            if fallbacks:
-                return fallbacks[0][1]
-            raise
+            fallbacks.append((cost, ok, extended))
+        radial = None
+        error = None
+        for variant in self._radial_variants(distal, k):
+            try:
+                candidate = self._extended(
+                    radial_safe_placement(distal, k, joint, self._ball, **variant)
+                )
+            except KinegamiError as failure:
+                error = error or failure
+                continue
+            radial = radial or candidate
+            if clear(candidate):
+                radial = candidate
+                break
+        else:
+            # no radial variant is clear: a clear published candidate, if any, else the first
+            for _, ok, extended in fallbacks:
+                if ok:
+                    return extended
+            if radial is None:
+                if fallbacks:
+                    return fallbacks[0][2]
+                raise error
+            return radial
         growth_r, path_r = self._cost(radial)
-        for (growth, path), extended in fallbacks:
-            if growth <= max(growth_r, limits[0]) and path <= max(path_r, limits[1]):
+        for (growth, path), ok, extended in fallbacks:
+            if ok and growth <= max(growth_r, limits[0]) and path <= max(path_r, limits[1]):
                 return extended
         return radial
+
+    def _radial_variants(self, distal: np.ndarray, k: int):
+        """RADIAL_VARIANTS, then the same escaping sideways first: away from the tube that
+        arrived at the parent (for a parent reached by a U-turn), then out of the plane of
+        that U-turn on either side."""
+        yield from RADIAL_VARIANTS
+        A, d1 = distal[:3, 3], distal[:3, k]
+        path = self._links[-1].path
+        if path.length <= 0.0:
+            return
+        away = A - 0.5 * (np.asarray(path.q1) + np.asarray(path.q2))
+        away = away - float(away @ d1) * d1
+        if float(np.linalg.norm(away)) < 1e-9 * self.r:
+            return
+        side = np.cross(d1, away)
+        for escape in (away, side, -side):
+            for variant in RADIAL_VARIANTS:
+                yield {**variant, "escape": escape}
 
     def _cost(self, extended) -> tuple[float, float]:
         """(growth of the ball radius, length of the new links) of an extension."""
@@ -446,8 +531,7 @@ class KinematicChain:
         except KinegamiError as error:
             self._reject(f"{what} failed: {error}")
             return False
-        self._commit(joints, links, ball)
-        return True
+        return self._accept(what, joints, links, ball)
 
     def transformJoint(
         self,
@@ -599,8 +683,7 @@ class KinematicChain:
         for k in range(j + 1, len(joints)):
             joints[k] = joints[k].transformed(G)
             links[k] = links[k].transformed(G)
-        self._commit(joints, links)
-        return True
+        return self._accept("setJointState", joints, links)
 
     def setJointStates(self, states: Sequence[float]) -> bool:
         """Set every joint's state at once (one value per joint); all-or-nothing."""
@@ -629,8 +712,7 @@ class KinematicChain:
                 G = joint.state_transform(values[k] - joint.state)
                 joints[k] = joint.with_state(values[k])
                 accumulated = G if accumulated is None else G @ accumulated
-        self._commit(joints, links)
-        return True
+        return self._accept("setJointStates", joints, links)
 
     # --- output --------------------------------------------------------------------------------
     def creasePattern(self, twistPortion: float = 0.2):
@@ -662,3 +744,13 @@ class KinematicChain:
 #: the current ball's surface and its new links are at most SAFE_PATH_LIMIT r long.
 SAFE_GROWTH_LIMIT = 10.0
 SAFE_PATH_LIMIT = 40.0
+
+#: Variants of the radial safe placement, tried in order until one is clear of the chain
+#: (keyword arguments of :func:`kinegami.placement.radial_safe_placement`).
+RADIAL_VARIANTS = (
+    {},
+    {"two_arcs_above": math.pi / 2.0, "bend_straight": 2.0},
+    {"lead": 4.0},
+    {"lead": 4.0, "two_arcs_above": math.pi / 2.0, "bend_straight": 2.0},
+    {"lead": 8.0, "two_arcs_above": 0.0, "bend_straight": 4.0},
+)

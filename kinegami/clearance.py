@@ -28,7 +28,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kinegami.bodies import JOINT_REVOLUTE, CapsuleModel, capsule_model
+from kinegami.bodies import (
+    CONTACT_TOLERANCE,
+    JOINT_REVOLUTE,
+    TURN_TOLERANCE,
+    CapsuleModel,
+    capsule_model,
+)
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.segments import segment_distances
 from kinegami.validation import check_real
@@ -45,10 +51,6 @@ __all__ = [
     "engine_for",
 ]
 
-#: Overlaps shallower than this many r count as contact, not collision.
-CONTACT_TOLERANCE = 1e-9
-#: Two capsules are tested when the centreline between them turns by at least pi minus this.
-TURN_TOLERANCE = 1e-9
 #: Pairs x configurations evaluated at once (memory bound of the batched broad phase).
 _BATCH_PAIRS = 1_500_000
 
@@ -630,7 +632,9 @@ def sweep(
         if samples <= 0:
             raise InvalidParameterError(f"samples must be an integer > 0, got {samples!r}")
         if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
-            raise InvalidTypeError(f"seed must be an integer, got {seed!r}")
+            raise InvalidTypeError(f"seed must be an integer >= 0, got {seed!r}")
+        if seed < 0:
+            raise InvalidParameterError(f"seed must be an integer >= 0, got {seed!r}")
         rng = np.random.default_rng(int(seed))
         lo, hi = engine.ranges[:, 0], engine.ranges[:, 1]
         Q = lo + (hi - lo) * rng.random((int(samples), lo.size))

@@ -30,3 +30,16 @@ class NoPathError(KinegamiError, ValueError):
 
 class IncompatibleJointError(KinegamiError, ValueError):
     """A joint's ``numSides`` or ``r`` differs from the chain's."""
+
+
+class ClearanceWarning(UserWarning):
+    """An operation left the chain passing through itself (it was applied; the message names
+    the two parts). ``clearance`` is the overlap (negative, chain units); ``first`` and
+    ``second`` name the parts."""
+
+    def __init__(self, message: str, clearance: float = float("nan"), first: str = "",
+                 second: str = ""):  # fmt: skip
+        super().__init__(message)
+        self.clearance = clearance
+        self.first = first
+        self.second = second

@@ -1,18 +1,386 @@
-"""Making placed chains more compact without changing their kinematics.
+"""Making placed chains compact without changing their kinematics (docs/clearance.md).
 
-Sliding a joint along its axis of motion keeps every axis line, so the robot's kinematics are
-unchanged; only the tube between the joints gets shorter or longer (chain.md 5.2).
+Sliding a joint along its axis of motion or rolling it about that axis keeps every axis line,
+so the robot's kinematics are unchanged; only the tube between the joints changes. Waypoints
+carry no kinematics: they may move, appear (placement adds them) or disappear.
+
+:func:`compact` is a multi-start local search over those moves that never accepts a design
+that passes through itself (:mod:`kinegami.clearance`). :func:`shorten_by_axis_translations`
+is its slide-only, in-place form (the original greedy shortening, now clearance-aware).
 """
 
 from __future__ import annotations
 
+import concurrent.futures
+import copy
+import math
+import os
+import sys
+import time
 import warnings
+from dataclasses import dataclass
 
+import numpy as np
+
+from kinegami.bodies import deepest_overlap
 from kinegami.chain import KinematicChain, PlacementWarning
-from kinegami.errors import InvalidTypeError
+from kinegami.errors import (
+    ClearanceWarning,
+    InvalidParameterError,
+    InvalidTypeError,
+    KinegamiError,
+)
+from kinegami.geometry.frames import rotation_about_line
+from kinegami.joints import Waypoint
 from kinegami.validation import check_int, check_positive
 
-__all__ = ["shorten_by_axis_translations"]
+__all__ = ["compact", "CompactionError", "shorten_by_axis_translations", "tube_length"]
+
+
+class CompactionError(KinegamiError, ValueError):
+    """No clear design was found (the input passes through itself and no move fixed it)."""
+
+
+def tube_length(chain: KinematicChain) -> float:
+    """Total tube length: every link's centreline plus every joint's neutral length."""
+    return chain.totalPathLength() + float(sum(j.neutralLength for j in chain.Joints))
+
+
+def _objective(chain: KinematicChain, kind: str) -> float:
+    return chain.boundingBall.r if kind == "ball" else tube_length(chain)
+
+
+def _overlap(chain: KinematicChain) -> float:
+    """Depth of the deepest overlap (0 when the chain is clear)."""
+    worst = deepest_overlap(chain.Joints, chain.Links, chain.r)
+    return 0.0 if math.isinf(worst) else -worst
+
+
+@dataclass
+class _State:
+    chain: KinematicChain
+    overlap: float
+    value: float
+
+    def better_than(self, other: _State, tol: float) -> bool:
+        if self.overlap < other.overlap - tol:
+            return True
+        return self.overlap <= other.overlap + tol and self.value < other.value - tol
+
+
+def _evaluate(
+    chain: KinematicChain, overlap: float, kind: str, current: _State, tol: float
+) -> _State | None:
+    """The trial's state if it beats ``current``."""
+    state = _State(chain, overlap, _objective(chain, kind))
+    return state if state.better_than(current, tol) else None
+
+
+def _trial(chain: KinematicChain, edit, *args) -> tuple[KinematicChain | None, float]:
+    """A copy of ``chain`` with one edit applied and its overlap depth (0: clear), or
+    (None, inf) if the edit was rejected.
+
+    Edits replace the chain's joint and link lists, never change them in place, so a shallow
+    copy is an independent snapshot. The chain measures its clearance after every edit and
+    says so by a ClearanceWarning, which gives the overlap.
+    """
+    new = copy.copy(chain)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ok = getattr(new, edit)(*args)
+    if not ok:
+        return None, math.inf
+    overlap = 0.0
+    for w in caught:
+        if issubclass(w.category, ClearanceWarning):
+            overlap = max(overlap, -float(w.message.clearance))
+    return new, overlap
+
+
+def _moves(chain: KinematicChain, j: int, slide: float, roll: float, rolls: bool):
+    """Candidate edits of joint j: slides by +-slide, slides to the points of its axis nearest
+    its neighbours, rolls by +-roll (propagate=False: only its two links change)."""
+    joints = chain.Joints
+    T = joints[j].pose_matrix
+    p, z = T[:3, 3], T[:3, 2]
+    out = [("translateJointAlongAxisOfMotion", j, slide, False),
+           ("translateJointAlongAxisOfMotion", j, -slide, False)]  # fmt: skip
+    targets = []
+    if j > 0:
+        targets.append(float((joints[j - 1].pose_matrix[:3, 3] - p) @ z))
+    if j + 1 < len(joints):
+        targets.append(float((joints[j + 1].pose_matrix[:3, 3] - p) @ z))
+    if len(targets) == 2:
+        targets.append(0.5 * (targets[0] + targets[1]))
+    for t in targets:
+        if abs(t) > 1e-6 * chain.r:
+            out.append(("translateJointAlongAxisOfMotion", j, t, False))
+    if rolls:
+        out += [("rotateJointAboutAxisOfMotion", j, roll, False),
+                ("rotateJointAboutAxisOfMotion", j, -roll, False)]  # fmt: skip
+    return out
+
+
+def _descend(
+    chain: KinematicChain,
+    rng: np.random.Generator,
+    kind: str,
+    deadline: float | None,
+    *,
+    rolls: bool = True,
+    delete_waypoints: bool = True,
+    slide: float | None = None,
+    min_slide: float | None = None,
+    history: list | None = None,
+) -> tuple[_State, list]:
+    """Greedy descent from ``chain``: the best state found and the accepted edits."""
+    r = chain.r
+    tol = 1e-9 * r
+    state = _State(chain, _overlap(chain), _objective(chain, kind))
+    edits: list = []
+    slide = 4.0 * r if slide is None else slide
+    min_slide = r / 16.0 if min_slide is None else min_slide
+    roll = math.pi / 2.0
+
+    def out_of_time() -> bool:
+        return deadline is not None and time.monotonic() > deadline
+
+    def accept(new: _State, edit) -> None:
+        nonlocal state
+        state = new
+        edits.append(edit)
+        if history is not None:
+            history.append(new.chain)
+
+    if delete_waypoints:
+        for j in range(len(state.chain.Joints) - 1, 0, -1):
+            if out_of_time():
+                break
+            if not isinstance(state.chain.Joints[j], Waypoint):
+                continue
+            trial, overlap = _trial(state.chain, "delete", j)
+            new = None if trial is None else _evaluate(trial, overlap, kind, state, tol)
+            if new is not None:
+                accept(new, ("delete", j))
+    while slide >= min_slide and not out_of_time():
+        improved = False
+        order = rng.permutation(len(state.chain.Joints))
+        for j in order:
+            if out_of_time():
+                break
+            for name, *args in _moves(state.chain, int(j), slide, roll, rolls):
+                trial, overlap = _trial(state.chain, name, *args)
+                new = None if trial is None else _evaluate(trial, overlap, kind, state, tol)
+                if new is not None:
+                    accept(new, (name, *args))
+                    improved = True
+                    break
+        if not improved:
+            slide /= 2.0
+            roll /= 2.0
+    return state, edits
+
+
+def _compact_rebuild(
+    chain: KinematicChain, rng: np.random.Generator, jitter: bool
+) -> KinematicChain:
+    """The chain's joints (waypoints dropped) placed again by compact placement (safe
+    placement where compact placement finds no link), optionally rolled at random first."""
+    joints = [j for j in chain.Joints if not isinstance(j, Waypoint) or j is chain.Joints[0]]
+    rebuilt = KinematicChain(joints[0], chain.maxAnglePerElbow)
+    for joint in joints[1:]:
+        if jitter:
+            T = joint.pose_matrix
+            joint = joint.transformed(
+                rotation_about_line(T[:3, 2], T[:3, 3], float(rng.uniform(-math.pi, math.pi)))
+            )
+        if rebuilt.append(joint, relative=False, safe=False, fixedOrientation=jitter) is None:
+            if rebuilt.append(joint, relative=False, safe=False) is None:
+                rebuilt.append(joint, relative=False, safe=True)
+    return rebuilt
+
+
+def _motion_configurations(chain: KinematicChain, samples: int, seed: int) -> np.ndarray:
+    """(samples, movable joints) states drawn in the movable joints' ranges."""
+    ranges = np.array([j.stateRange() for j in chain.Joints if j.stateRange() != (0.0, 0.0)])
+    rng = np.random.default_rng([seed, 7919])
+    if ranges.size == 0:
+        return np.zeros((samples, 0))
+    return ranges[:, 0] + (ranges[:, 1] - ranges[:, 0]) * rng.random((samples, ranges.shape[0]))
+
+
+def _colliding_fraction(chain: KinematicChain, movable_states: np.ndarray) -> float:
+    from kinegami.clearance import engine_for
+
+    movable = [i for i, j in enumerate(chain.Joints) if j.stateRange() != (0.0, 0.0)]
+    Q = np.tile([j.state for j in chain.Joints], (movable_states.shape[0], 1))
+    Q[:, movable] = movable_states
+    engine = engine_for(chain)
+    return float(np.mean(engine.colliding(Q))) if Q.shape[0] else 0.0
+
+
+def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
+    """One start of :func:`compact` (a top-level function, so any executor can run it)."""
+    chain, k, seed, kind, deadline_seconds, motion = task
+    deadline = None if deadline_seconds is None else time.monotonic() + deadline_seconds
+    rng = np.random.default_rng([seed, k])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if k == 0:
+            start = copy.copy(chain)
+        else:
+            start = _compact_rebuild(chain, rng, jitter=k >= 2)
+        history: list = [start]
+        state, _ = _descend(start, rng, kind, deadline, history=history)
+        if motion is not None:
+            movable_states, limit = motion
+
+            def acceptable(candidate) -> bool:
+                return _overlap(candidate) == 0.0 and (
+                    _colliding_fraction(candidate, movable_states) <= limit + 1e-12
+                )
+
+            # the last accepted design (by bisection over the descent's history) whose motion
+            # collides no more often than the input's
+            if acceptable(history[-1]):
+                best = history[-1]
+            elif not acceptable(history[0]):
+                return math.inf, math.inf, k, None
+            else:
+                good, bad = 0, len(history) - 1
+                while bad - good > 1:
+                    mid = (good + bad) // 2
+                    if acceptable(history[mid]):
+                        good = mid
+                    else:
+                        bad = mid
+                best = history[good]
+            return _objective(best, kind), 0.0, k, best
+    return state.value, state.overlap, k, state.chain
+
+
+def _check_executor(executor):
+    if executor is not None and not isinstance(executor, concurrent.futures.Executor):
+        raise InvalidTypeError(
+            "executor must be a concurrent.futures.Executor (for example a "
+            "ProcessPoolExecutor, or a Dask distributed Client's get_executor()), got "
+            f"{type(executor).__name__}"
+        )
+
+
+def _progress_bar(progress, total: int):
+    show = sys.stderr.isatty() if progress is None else bool(progress)
+    if not show:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover - tqdm is a dependency
+        return None
+    return tqdm(total=total, desc="compact", unit="start", leave=False)
+
+
+def compact(
+    chain: KinematicChain,
+    *,
+    seed: int = 0,
+    motion: bool = False,
+    executor: concurrent.futures.Executor | None = None,
+    time_limit: float | None = None,
+    progress: bool | None = None,
+    objective: str = "length",
+    starts: int = 4,
+    samples: int = 200,
+) -> KinematicChain:
+    """A shorter chain with the same kinematics that does not pass through itself.
+
+    Every joint keeps its type, parameters and axis line (joints only slide along and roll
+    about their axes); waypoints may move, appear or disappear. The result is clear at the
+    chain's current states, and never longer than the input when the input is clear.
+
+    Parameters
+    ----------
+    chain : KinematicChain
+        Not changed.
+    seed : int
+        Seed of the search; the result depends only on it (and on ``time_limit``, when the
+        limit cuts the search short), not on the executor.
+    motion : bool
+        Also require that the fraction of ``samples`` random configurations in which the
+        chain collides is no larger than the input's.
+    executor : concurrent.futures.Executor, optional
+        Runs the starts (default: a local process pool). A Dask cluster works unchanged:
+        ``distributed.Client(...).get_executor()``.
+    time_limit : float, optional
+        Seconds each start may search (> 0); default: until no move improves.
+    progress : bool, optional
+        Show a progress bar (default: when stderr is a terminal).
+    objective : {"length", "ball"}
+        Minimise the total tube length (links plus joints) or the bounding-ball radius.
+    starts : int
+        Number of starts (>= 1): the input itself, its joints placed again by compact
+        placement, then that with random rolls.
+    samples : int
+        Configurations sampled for ``motion`` (>= 1).
+
+    Raises
+    ------
+    CompactionError
+        When the input passes through itself and no start found a clear design.
+
+    Examples
+    --------
+    >>> chain = KinematicChain.from_dh([(0, np.pi / 2, 0, 0), (0, 0, 4, 0)], 4, 1)
+    >>> shorter = compact(chain, executor=concurrent.futures.ThreadPoolExecutor(1))
+    >>> tube_length(shorter) <= tube_length(chain)
+    True
+    """
+    if not isinstance(chain, KinematicChain):
+        raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
+    seed = check_int("seed", seed)
+    if not isinstance(motion, bool):
+        raise InvalidTypeError(f"motion must be True or False, got {motion!r}")
+    _check_executor(executor)
+    if time_limit is not None:
+        time_limit = check_positive("time_limit", time_limit)
+    if objective not in ("length", "ball"):
+        raise InvalidParameterError(f"objective must be 'length' or 'ball', got {objective!r}")
+    starts = check_int("starts", starts, minimum=1)
+    samples = check_int("samples", samples, minimum=1)
+    motion_task = None
+    if motion:
+        movable_states = _motion_configurations(chain, samples, seed)
+        motion_task = (movable_states, _colliding_fraction(chain, movable_states))
+    tasks = [(chain, k, seed, objective, time_limit, motion_task) for k in range(starts)]
+    own = executor is None
+    if own:
+        workers = min(starts, os.cpu_count() or 1)
+        executor = concurrent.futures.ProcessPoolExecutor(max_workers=workers)
+    bar = _progress_bar(progress, starts)
+    results = []
+    futures = []
+    try:
+        futures = [executor.submit(_run_start, task) for task in tasks]
+        for future in concurrent.futures.as_completed(futures):
+            results.append(future.result())
+            if bar is not None:
+                bar.update(1)
+    except BaseException:
+        for future in futures:
+            future.cancel()
+        raise
+    finally:
+        if bar is not None:
+            bar.close()
+        if own:
+            executor.shutdown(wait=True, cancel_futures=True)
+    found = [res for res in results if res[3] is not None and res[1] == 0.0]
+    if not found:
+        raise CompactionError(
+            "compact found no design that is clear of itself (the input passes through itself "
+            f"and {starts} start(s) could not fix it); try more starts or another seed"
+        )
+    value, _, _, best = min(found, key=lambda res: (res[0], res[2]))
+    return best
 
 
 def shorten_by_axis_translations(
@@ -23,10 +391,11 @@ def shorten_by_axis_translations(
 ) -> list[tuple[int, float]]:
     """Shorten the chain's tube by sliding joints along their axes (greedy, in place).
 
-    Each round tries, for every joint after the root, the slides +step and -step (only that
-    joint moves; ``propagate=False``) and keeps a slide when the chain accepts it and the total
-    path length drops. The step halves after a round that improves nothing, down to
-    ``minStep``. Failed trial edits leave the chain unchanged and are not reported.
+    The slide-only, single-start form of :func:`compact`, kept under its original name: each
+    round tries, for every joint, slides by +-step and to the points of its axis nearest its
+    neighbours (only that joint moves; ``propagate=False``) and keeps the first that shortens
+    the tube without making the chain pass through itself. The step halves after a round
+    that improves nothing, ``rounds`` times or down to ``minStep``.
 
     Parameters
     ----------
@@ -43,26 +412,15 @@ def shorten_by_axis_translations(
     step = 4.0 * chain.r if step is None else check_positive("step", step)
     minStep = chain.r / 8.0 if minStep is None else check_positive("minStep", minStep)
     rounds = check_int("rounds", rounds, minimum=0)
-    accepted: list[tuple[int, float]] = []
-    halvings = 0
+    min_slide = max(minStep, step / 2.0**rounds)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PlacementWarning)
-        while step >= minStep:
-            improved = False
-            for j in range(1, len(chain.Joints)):
-                for distance in (step, -step):
-                    before = chain.totalPathLength()
-                    saved = (list(chain._joints), list(chain._links), chain._ball)
-                    if not chain.translateJointAlongAxisOfMotion(j, distance, propagate=False):
-                        continue
-                    if chain.totalPathLength() < before - 1e-9 * chain.r:
-                        accepted.append((j, distance))
-                        improved = True
-                        break
-                    chain._commit(*saved)  # exactly as before the trial
-            if not improved:
-                if halvings >= rounds:
-                    break
-                halvings += 1
-                step /= 2.0
-    return accepted
+        state, edits = _descend(
+            chain, np.random.default_rng(0), "length", None, rolls=False,
+            delete_waypoints=False, slide=step, min_slide=min_slide,
+        )  # fmt: skip
+    if state.chain is not chain:
+        for name, j, distance, _ in edits:
+            assert name == "translateJointAlongAxisOfMotion"
+            chain.translateJointAlongAxisOfMotion(j, distance, propagate=False)
+    return [(int(j), float(distance)) for _, j, distance, _ in edits]

@@ -158,7 +158,15 @@ def _arc_displacement(r: float, d: np.ndarray, axis: np.ndarray, angle: float) -
 
 
 def radial_safe_placement(
-    parent_distal: np.ndarray, parent_path_index: int, joint: Joint, ball: Ball
+    parent_distal: np.ndarray,
+    parent_path_index: int,
+    joint: Joint,
+    ball: Ball,
+    *,
+    lead: float = 0.0,
+    bend_straight: float = 0.5,
+    two_arcs_above: float = 2.0 * math.pi / 3.0,
+    escape: np.ndarray | None = None,
 ) -> list[Joint]:
     """Safe placement whose parts stay within a fixed distance of the ball (docs/placement.md).
 
@@ -178,12 +186,32 @@ def radial_safe_placement(
 
     Every link therefore exists with turns < pi; the joint lies at distance R' from c and every
     part within R' + 2 rho_N + 2r, so the ball grows by a bounded amount per joint.
+
+    Variants (tried by the chain when the default construction passes through the chain):
+    ``lead`` (in r) puts a waypoint that far straight ahead of A first, so the turn onto m
+    happens away from the parent; turns above ``two_arcs_above`` use two arcs with
+    ``bend_straight`` r of straight tube between them, which moves the tube coming back by
+    more than 2r away from the parent's axis. ``escape`` (a unit vector perpendicular to the
+    parent's path direction) first turns the tube by pi/2 towards it and runs 2r straight (a
+    waypoint), the way out when the tube arrived at the parent by a U-turn and anything leaving
+    the parent would otherwise run back along it.
     """
     r = joint.r
     c, R = ball.c, ball.r
     A = parent_distal[:3, 3]
     d1 = parent_distal[:3, parent_path_index]
     R_parent = parent_distal[:3, :3]
+    lead_waypoints = []
+    if escape is not None:
+        e = unit(np.asarray(escape, dtype=float) - float(np.asarray(escape) @ d1) * d1)
+        R_escape = rotation_matrix(np.cross(d1, e), math.pi / 2.0) @ R_parent
+        A = A + r * d1 + 3.0 * r * e
+        d1 = e
+        R_parent = R_escape
+        lead_waypoints.append(_waypoint(joint, R_parent, A, parent_path_index))
+    if lead > 0.0:
+        A = A + lead * r * d1
+        lead_waypoints.append(_waypoint(joint, R_parent, A, parent_path_index))
     rho = joint.bounding_radius()
     L = joint.neutralLength
     T = joint.pose_matrix
@@ -208,20 +236,20 @@ def radial_safe_placement(
         wb = B - 4.0 * r * m
 
         axis, psi = _turn(d1, m)
-        if psi <= 2.0 * math.pi / 3.0:  # arc, then r straight: a CSC path with theta2 = 0
+        if psi <= two_arcs_above:  # arc, then r straight: a CSC path with theta2 = 0
             wa = A + _arc_displacement(r, d1, axis, psi) + r * m
-        else:  # arc, 0.5 r straight, arc: a CSC path
+        else:  # arc, bend_straight r straight, arc: a CSC path
             half = psi / 2.0
             u_mid = rotation_matrix(axis, half) @ d1
             wa = (
                 A
                 + _arc_displacement(r, d1, axis, half)
-                + 0.5 * r * u_mid
+                + bend_straight * r * u_mid
                 + _arc_displacement(r, u_mid, axis, half)
             )
         if float((wb - wa) @ m) >= 2.0 * r:
             R_turned = rotation_matrix(axis, psi) @ R_parent
-            return [
+            return lead_waypoints + [
                 _waypoint(joint, R_turned, wa, parent_path_index),
                 _waypoint(joint, R_turned, wb, parent_path_index),
                 placed,

@@ -120,7 +120,10 @@ def build_safe(spec):
             warnings.simplefilter("error", PlacementWarning)
             index = chain.append(joint, relative=relative)  # safe placement never fails
         assert index == len(chain.Joints) - 1
-        assert index - old_len in (1, 2)  # one or two waypoints, then the joint
+        # one or two waypoints (published rule, radial placement), up to two more when the
+        # radial placement must lead out or escape sideways to stay clear; then the joint
+        assert index - old_len in (1, 2, 3, 4)
+        assert chain.clearance().ok, str(chain.clearance())  # safe placement stays clear
         for waypoint in chain.Joints[old_len:index]:
             assert isinstance(waypoint, Waypoint) and waypoint.pathIndex() == parent_index
         placed = chain.Joints[index]

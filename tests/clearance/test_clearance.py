@@ -234,6 +234,7 @@ def test_bad_states(states, error, words):
         ({"samples": -5}, InvalidParameterError, "got -5"),
         ({"samples": 2.5}, InvalidTypeError, "samples must be an integer"),
         ({"seed": "x"}, InvalidTypeError, "seed must be an integer"),
+        ({"seed": -1}, InvalidParameterError, "seed must be an integer >= 0, got -1"),
         ({"configurations": []}, InvalidParameterError, "must not be empty"),
         ({"configurations": [[0, 0]]}, InvalidParameterError, "configurations[0] must have"),
         ({"resolution": 0}, InvalidParameterError, "resolution must be an integer >= 1"),

@@ -1,0 +1,186 @@
+"""Compaction: same kinematics, clear, never longer, deterministic on any executor."""
+
+from __future__ import annotations
+
+import concurrent.futures
+import math
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from kinegami import KinematicChain, PrismaticJoint, RevoluteJoint, StartTip, Waypoint
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.optimize import CompactionError, compact, tube_length
+
+from .helpers import through
+
+PUMA = [(math.pi / 2, -math.pi / 2, 0, 0), (0, 0, 431.8, 149.09),
+        (math.pi / 2, math.pi / 2, -20.32, 0), (0, -math.pi / 2, 0, 433.07),
+        (0, math.pi / 2, 0, 0), (0, 0, 0, 56.25)]  # fmt: skip
+
+
+def serial():
+    return concurrent.futures.ThreadPoolExecutor(max_workers=1)
+
+
+def random_safe_chain(seed: int, n: int) -> KinematicChain:
+    rng = np.random.default_rng(seed)
+    chain = KinematicChain(StartTip(4, 1.0, np.eye(4), 1.0))
+    for i in range(n):
+        T = np.eye(4)
+        T[:3, :3] = Rotation.random(random_state=int(rng.integers(1 << 31))).as_matrix()
+        T[:3, 3] = rng.uniform(-4, 4, 3)
+        joint = RevoluteJoint(4, 1.0, math.pi, T) if i % 2 == 0 else PrismaticJoint(
+            4, 1.0, 3.0, 3, math.pi / 4, T
+        )  # fmt: skip
+        assert chain.append(joint) is not None
+    return chain
+
+
+def axis_lines(chain):
+    """(point nearest the origin, direction up to sign) of every non-waypoint joint's axis."""
+    out = []
+    for joint in chain.Joints:
+        if isinstance(joint, Waypoint):
+            continue
+        T = joint.pose_matrix
+        z = T[:3, 2]
+        p = T[:3, 3] - (T[:3, 3] @ z) * z
+        out.append((type(joint).__name__, p, z))
+    return out
+
+
+def assert_same_kinematics(before, after, r):
+    a, b = axis_lines(before), axis_lines(after)
+    assert [k for k, _, _ in a] == [k for k, _, _ in b]
+    for (_, p, z), (_, q, w) in zip(a, b, strict=True):
+        assert abs(abs(float(z @ w)) - 1.0) <= 1e-12
+        np.testing.assert_allclose(q, p, atol=1e-9 * r * max(1.0, float(np.abs(p).max())))
+    kept = [j for j in before.Joints if not isinstance(j, Waypoint)]
+    new = [j for j in after.Joints if not isinstance(j, Waypoint)]
+    for x, y in zip(kept, new, strict=True):
+        assert x.neutralLength == y.neutralLength and x.stateRange() == y.stateRange()
+        assert x.state == y.state
+
+
+def test_compaction_of_a_safe_chain_is_shorter_clear_and_keeps_the_axes():
+    chain = random_safe_chain(1, 6)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no stray warnings from trial edits
+        out = compact(chain, executor=serial(), starts=2)
+    assert out is not chain
+    assert out.clearance().ok
+    assert tube_length(out) < 0.8 * tube_length(chain)
+    assert_same_kinematics(chain, out, chain.r)
+    assert len(out.Joints) < len(chain.Joints)  # waypoints were dropped
+
+
+def test_the_input_is_not_changed():
+    chain = random_safe_chain(2, 4)
+    poses = [j.pose_matrix.copy() for j in chain.Joints]
+    compact(chain, executor=serial(), starts=1)
+    for joint, pose in zip(chain.Joints, poses, strict=True):
+        np.testing.assert_array_equal(joint.pose_matrix, pose)
+
+
+def test_puma_gets_shorter_without_collisions():
+    puma = KinematicChain.from_dh(PUMA, 6, 100)
+    out = compact(puma, executor=serial(), starts=2)
+    assert out.clearance().ok
+    assert tube_length(out) <= tube_length(puma)
+    assert_same_kinematics(puma, out, 100)
+
+
+def test_deterministic_on_any_executor():
+    chain = random_safe_chain(3, 3)
+    first = compact(chain, seed=5, executor=serial(), starts=3)
+    with concurrent.futures.ThreadPoolExecutor(max_workers=3) as pool:
+        second = compact(chain, seed=5, executor=pool, starts=3)
+    third = compact(chain, seed=5, starts=3)  # the default process pool
+    for other in (second, third):
+        assert len(other.Joints) == len(first.Joints)
+        for a, b in zip(first.Joints, other.Joints, strict=True):
+            np.testing.assert_array_equal(a.pose_matrix, b.pose_matrix)
+
+
+def test_dask_executor_works_unchanged():
+    distributed = pytest.importorskip("distributed")
+    chain = random_safe_chain(3, 3)
+    reference = compact(chain, seed=5, executor=serial(), starts=2)
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        out = compact(chain, seed=5, executor=client.get_executor(), starts=2)
+    for a, b in zip(reference.Joints, out.Joints, strict=True):
+        np.testing.assert_array_equal(a.pose_matrix, b.pose_matrix)
+
+
+def test_motion_keeps_the_colliding_fraction():
+    from kinegami.optimize import _colliding_fraction, _motion_configurations
+
+    chain = random_safe_chain(4, 4)
+    out = compact(chain, executor=serial(), starts=2, motion=True, samples=50)
+    configurations = _motion_configurations(chain, 50, 0)
+    assert _colliding_fraction(out, configurations) <= _colliding_fraction(chain, configurations)
+    assert out.clearance().ok
+
+
+def test_a_self_intersecting_chain_comes_out_clear():
+    """The end tip sits on the start tip's axis line, facing back, inside the outgoing tube:
+    compaction must move it (along its axis) to where the tube can reach it clear."""
+    points = [((0, 0, 0), (1, 0, 0)), ((10, 0, 0), (1, 0, 0)), ((10, 0, 4), (-1, 0, 0)),
+              ((4, 0, 0), (-1, 0, 0))]  # fmt: skip
+    chain = through(points, end=((2, 0, 0), (-1, 0, 0)))
+    assert not chain.clearance().ok
+    out = compact(chain, executor=serial(), starts=2)
+    assert out.clearance().ok
+    assert_same_kinematics(chain, out, 1.0)
+
+
+def test_compaction_error_when_no_start_is_clear(monkeypatch):
+    import kinegami.optimize as optimize
+
+    monkeypatch.setattr(optimize, "_overlap", lambda chain: 1.0)  # nothing is ever clear
+    with pytest.raises(CompactionError, match="no design that is clear of itself"):
+        compact(random_safe_chain(0, 1), executor=serial(), starts=1)
+
+
+@pytest.mark.parametrize(
+    "kwargs, error, words",
+    [
+        ({"executor": "pool"}, InvalidTypeError, "executor must be a concurrent.futures.Executor"),
+        ({"time_limit": -1}, InvalidParameterError, "time_limit must be > 0, got -1"),
+        ({"time_limit": 0}, InvalidParameterError, "time_limit must be > 0"),
+        ({"motion": 1}, InvalidTypeError, "motion must be True or False"),
+        ({"objective": "volume"}, InvalidParameterError, "objective must be 'length' or 'ball'"),
+        ({"starts": 0}, InvalidParameterError, "starts"),
+        ({"seed": "x"}, InvalidTypeError, "seed"),
+    ],
+)
+def test_bad_arguments(kwargs, error, words):
+    with pytest.raises(error) as info:
+        compact(random_safe_chain(0, 1), **kwargs)
+    assert words in str(info.value)
+
+
+def test_not_a_chain():
+    with pytest.raises(InvalidTypeError, match="chain must be a KinematicChain"):
+        compact([1, 2])
+
+
+def test_compaction_error_is_a_kinegami_value_error():
+    assert issubclass(CompactionError, ValueError)
+
+
+@settings(deadline=None, max_examples=8)
+@given(st.integers(0, 10_000), st.integers(1, 4))
+def test_random_chains_compact_clear_and_on_their_axes(seed, n):
+    chain = random_safe_chain(seed, n)
+    out = compact(chain, executor=serial(), starts=1, seed=seed)
+    assert out.clearance().ok
+    assert tube_length(out) <= tube_length(chain) + 1e-9
+    assert_same_kinematics(chain, out, 1.0)
