@@ -1,8 +1,9 @@
 """STL and OBJ of a chain's 3D model in its current configuration (docs/mesh.md).
 
-The model is made of closed triangle meshes, one per *part*, built from the shapes that
-``KinematicChain.show()`` draws (:mod:`kinegami.viz.chain_geometry`), but with the tube as the
-n-gon prism it really is (``numSides`` sides, circumradius r) instead of a round cylinder:
+The model is made of closed triangle meshes, one per *part*, built from the shapes of the
+body model (:mod:`kinegami.bodies`) that ``KinematicChain.show()`` also draws, but with the
+tube as the n-gon prism it really is (``numSides`` sides, circumradius r) instead of a round
+cylinder:
 
 ==========================  ========================================================  ==========
 part name                   shape                                                     convex
@@ -50,6 +51,12 @@ from typing import TYPE_CHECKING, Any, BinaryIO, TextIO
 
 import numpy as np
 
+from kinegami.bodies import (
+    elbow_rings,
+    regular_polygon,
+    revolute_hull_points,
+    tip_hull_points,
+)
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export._options import UNITS_IN_MM
 from kinegami.joints import (
@@ -62,11 +69,6 @@ from kinegami.joints import (
     Waypoint,
 )
 from kinegami.validation import check_positive, check_twist_portion
-from kinegami.viz.chain_geometry import (
-    regular_polygon,
-    revolute_hull_points,
-    tip_hull_points,
-)
 
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh
@@ -244,12 +246,6 @@ def _polygon(frame: np.ndarray, r: float, n: int) -> np.ndarray:
     return regular_polygon(frame, r, n)
 
 
-def _shifted(frame: np.ndarray, distance: float) -> np.ndarray:
-    out = np.array(frame)
-    out[:3, 3] += distance * frame[:3, 0]
-    return out
-
-
 # --- joints --------------------------------------------------------------------------------
 
 
@@ -312,26 +308,6 @@ def joint_parts(joint: Joint, index: int, split: bool = False) -> list[MeshPart]
 # --- links ---------------------------------------------------------------------------------
 
 
-def _arc_rings(arc, n: int) -> np.ndarray | None:
-    """Rings of an elbow arc: the n-gon at each elbow frame and the mitre between (2c+1, n, 3)."""
-    if arc.count == 0:
-        return None
-    r = arc.r
-    F = np.asarray(arc.frames)
-    delta = r * math.tan(arc.elbowAngle / 2.0)
-    rings = [_polygon(F[0], r, n)]
-    for j in range(arc.count):
-        a_in, a_out = F[j, :3, 0], F[j + 1, :3, 0]
-        start = _polygon(F[j], r, n) if j else rings[0]
-        vertex = F[j, :3, 3] + delta * a_in
-        normal = a_in + a_out
-        normal /= np.linalg.norm(normal)
-        lam = ((vertex - start) @ normal) / float(a_in @ normal)
-        rings.append(start + lam[:, None] * a_in)
-        rings.append(_polygon(F[j + 1], r, n))
-    return np.stack(rings)
-
-
 def _roll_count(twist: float, n: int, nearest: bool) -> int:
     """Whole 2 pi / n steps of ``twist``: floor (twist fitting, residual in [0, 2 pi / n)) or
     nearest (a straight tube whose end polygon is the start polygon up to round-off)."""
@@ -390,11 +366,11 @@ def link_parts(
             parts.append(MeshPart(f"link_{index}_{side}", *mesh, index, side, rings))
 
     if not merge1:
-        add("arc1", _arc_rings(arc1, n))
+        add("arc1", elbow_rings(arc1, n))
     for side, first, last, K in straight:
         add(side, np.stack([first, np.roll(last, K, axis=0)]))
     if not merge2:
-        add("arc2", _arc_rings(arc2, n))
+        add("arc2", elbow_rings(arc2, n))
     return parts
 
 

@@ -2,7 +2,10 @@
 
 Pure functions from joints and links to vertex arrays (world coordinates, units of r); no
 matplotlib. The drawing in :mod:`kinegami.viz.chain_plot` only hands these arrays to
-matplotlib, so everything drawn can be tested without rendering.
+matplotlib, so everything drawn can be tested without rendering. The shapes of the parts (the
+n-gons, the point sets whose hulls are the joints) come from :mod:`kinegami.bodies`, the body
+model shared with the mesh exporter and the clearance engine; their names stay importable from
+here.
 
 Polygons of a joint lie in the plane spanned by the second and third axes (b, c) of one of its
 Dubins frames (first axis a = path direction); vertex k sits at angle pi/n + 2 pi k/n from b
@@ -15,6 +18,16 @@ import math
 
 import numpy as np
 
+from kinegami.bodies import (
+    _hinge,
+    _shifted,
+    circle_points,
+    polygon_side,
+    prismatic_prism_vertices,
+    regular_polygon,
+    revolute_hull_points,
+    tip_hull_points,
+)
 from kinegami.geometry.frames import rotation
 from kinegami.joints import (
     EndTip,
@@ -56,31 +69,6 @@ __all__ = [
 
 
 # --- elementary shapes ---
-def polygon_side(r: float, n: int) -> float:
-    """Side length 2 r sin(pi/n) of the regular n-gon of circumradius r."""
-    return 2.0 * r * math.sin(math.pi / n)
-
-
-def regular_polygon(frame: np.ndarray, r: float, n: int) -> np.ndarray:
-    """(n, 3) vertices of the n-gon of circumradius ``r`` in the (b, c) plane of ``frame``.
-
-    ``frame`` is a 4x4 Dubins frame (first axis = path direction); the polygon is centred at
-    its origin and its vertex k lies at angle pi/n + 2 pi k/n from the frame's b axis.
-    """
-    psi = math.pi / n + 2.0 * math.pi * np.arange(n) / n
-    return circle_points(frame[:3, 3], frame[:3, 1], frame[:3, 2], r, psi)
-
-
-def circle_points(centre, e1, e2, r: float, angles) -> np.ndarray:
-    """Points ``centre + r (cos t e1 + sin t e2)`` for each t in ``angles``, shape (m, 3)."""
-    t = np.asarray(angles, dtype=float)[:, None]
-    return (
-        np.asarray(centre, dtype=float)
-        + r * np.cos(t) * np.asarray(e1, dtype=float)
-        + r * np.sin(t) * np.asarray(e2, dtype=float)
-    )
-
-
 def arc_points(centre, axis, start, angles) -> np.ndarray:
     """``start`` rotated about the line (``centre``, unit ``axis``) by each angle, shape (m, 3)."""
     centre = np.asarray(centre, dtype=float)
@@ -157,60 +145,6 @@ def prism_faces(bottom: np.ndarray, top: np.ndarray) -> list[np.ndarray]:
 
 
 # --- joints ---
-def prismatic_prism_vertices(joint: PrismaticJoint) -> np.ndarray:
-    """(2, n, 3): the prism of a prismatic joint, from its proximal origin along z, L + state.
-
-    The polygon lies in the joint's x-y plane (about the joint's own axis of motion).
-    """
-    frame = joint.proximal_dubins_frame()
-    bottom = regular_polygon(frame, joint.r, joint.numSides)
-    top = bottom + (joint.neutralLength + joint.state) * joint.pose_matrix[:3, 2]
-    return np.stack([bottom, top])
-
-
-def _hinge(centre, direction, length: float) -> np.ndarray:
-    d = 0.5 * length * np.asarray(direction, dtype=float)
-    return np.stack([centre - d, centre + d])
-
-
-def _shifted(frame: np.ndarray, distance: float) -> np.ndarray:
-    """``frame`` translated along its own first axis."""
-    out = np.array(frame)
-    out[:3, 3] += distance * frame[:3, 0]
-    return out
-
-
-def revolute_hull_points(joint: RevoluteJoint) -> tuple[np.ndarray, np.ndarray]:
-    """Point sets whose hulls are the two halves of a revolute joint's body, each (n + 2, 3).
-
-    Each half is the n-gon of the proximal (distal) frame plus the hinge segment
-    p +- (side/2) z at the joint centre. For an extended revolute joint the polygons sit at the
-    ends of its straight tubes, ``tubeLength`` inside the proximal and distal frames.
-    """
-    n, r = joint.numSides, joint.r
-    T = joint.pose_matrix
-    hinge = _hinge(T[:3, 3], T[:3, 2], polygon_side(r, n))
-    h = joint.tubeLength if isinstance(joint, ExtendedRevoluteJoint) else 0.0
-    proximal = _shifted(joint.proximal_dubins_frame(), h)
-    distal = _shifted(joint.distal_dubins_frame(), -h)
-    return (
-        np.vstack([regular_polygon(proximal, r, n), hinge]),
-        np.vstack([regular_polygon(distal, r, n), hinge]),
-    )
-
-
-def tip_hull_points(joint: StartTip | EndTip) -> np.ndarray:
-    """(n + 2, 3): the n-gon at a tip's open end plus a segment of one side's length at the
-    closed end (along the frame's c axis, parallel to two sides of the polygon)."""
-    n, r = joint.numSides, joint.r
-    if isinstance(joint, StartTip):
-        open_end, closed_end = joint.distal_dubins_frame(), joint.proximal_dubins_frame()
-    else:
-        open_end, closed_end = joint.proximal_dubins_frame(), joint.distal_dubins_frame()
-    segment = _hinge(closed_end[:3, 3], closed_end[:3, 2], polygon_side(r, n))
-    return np.vstack([regular_polygon(open_end, r, n), segment])
-
-
 def joint_body_faces(joint: Joint) -> list[np.ndarray]:
     """Polygons (each (k, 3)) of a joint's body; empty for a waypoint."""
     if isinstance(joint, Waypoint):
