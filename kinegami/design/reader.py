@@ -4,9 +4,11 @@ Building uses exactly the Python calls a user would type: ``KinematicChain(root,
 maxAnglePerElbow=...)``, ``append(joint, relative, safe, fixedPosition, fixedOrientation)`` per
 joint (or ``KinematicChain.from_dh`` for a DH table), the edit methods in order, then
 ``setJointStates``. A PlacementWarning or a rejected edit becomes a DesignError naming
-``joints[i]`` or ``edits[i]``; nothing is printed. All numeric work runs with numpy overflow,
-invalid and divide errors raised (see :func:`~kinegami.design.errors.numeric_errors`), so a
-RuntimeWarning cannot be printed either.
+``joints[i]`` or ``edits[i]``; nothing is printed. With ``"requireClearance": true`` the chain
+is built with ``requireClearance=True``, so a placement, edit or state that makes it pass
+through itself is rejected like any infeasible one (a DH design is checked once built). All
+numeric work runs with numpy overflow, invalid and divide errors raised (see
+:func:`~kinegami.design.errors.numeric_errors`), so a RuntimeWarning cannot be printed either.
 
 Every chain built here is remembered (weakly) with the ``joints`` entry each of its joints
 came from (:func:`origin_of`), so that joint names can be shown and saved.
@@ -38,7 +40,7 @@ from kinegami.design.limits import (
 )
 from kinegami.design.poses import pose_from_json, to_radians
 from kinegami.design.schema import PLACEMENT_KEYS, check_schema, check_top_level
-from kinegami.errors import JointIndexError, KinegamiError
+from kinegami.errors import ClearanceWarning, JointIndexError, KinegamiError
 from kinegami.joints import (
     EndTip,
     ExtendedRevoluteJoint,
@@ -481,6 +483,7 @@ class _Plan:
     edits: list  # (method name, args, kwargs); a joint is an index or a name until applied
     states: list | None
     names: tuple = ()  # the "name" of every entry of "joints" (None where it has none)
+    require_clearance: bool = False  # the design's "requireClearance"
 
 
 #: Top-level fields that library messages may name.
@@ -713,7 +716,10 @@ def _check_document(document, file) -> _Plan:
         dh = _plan_dh(document["dh"], units)
     edits = _plan_edits(document.get("edits", []), units)
     states = document.get("states")
-    return _Plan(numSides, r, units, chain_options, joints, dh, edits, states, names)
+    return _Plan(
+        numSides, r, units, chain_options, joints, dh, edits, states, names,
+        require_clearance=document.get("requireClearance", False),
+    )  # fmt: skip
 
 
 # --- where the joints of a built chain come from ---------------------------------------------
@@ -761,10 +767,11 @@ def origin_of(chain: KinematicChain) -> DesignOrigin | None:
 
 
 # --- building --------------------------------------------------------------------------------
-def _recorded(call, where: str, file):
+def _recorded(call, where: str, file, clearance_errors: bool = False):
     """Run ``call()`` with PlacementWarnings recorded, not shown; (result, last message).
 
-    Numeric errors (overflow, NaN) and RuntimeWarnings become DesignErrors at ``where``.
+    Numeric errors (overflow, NaN) and RuntimeWarnings become DesignErrors at ``where``; so
+    does a ClearanceWarning when ``clearance_errors`` (a design requiring clearance).
     """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PlacementWarning)
@@ -777,16 +784,33 @@ def _recorded(call, where: str, file):
             messages.append(str(w.message))
         elif issubclass(w.category, RuntimeWarning):
             raise DesignError(f"numeric problem: {w.message}", field=where, file=file)
+        elif clearance_errors and issubclass(w.category, ClearanceWarning):
+            raise DesignError(f"{w.message}{_REQUIRED}", field=where, file=file)
         else:  # not ours to swallow
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     return result, (messages[-1] if messages else None)
 
 
+#: Said after a rejection that only requireClearance makes an error.
+_REQUIRED = ' ("requireClearance": true rejects a chain that passes through itself)'
+
+
+def _reason(message: str | None, plan: _Plan, default: str) -> str:
+    """The rejection message of a placement, edit or states, saying when requireClearance
+    is why."""
+    if not message:
+        return default
+    if plan.require_clearance and "pass through itself" in message:
+        return message + _REQUIRED
+    return message
+
+
 def _build_from_joints(plan: _Plan, file) -> tuple[KinematicChain, list]:
     root, _ = plan.joints[0]
+    options = dict(plan.chain_options, requireClearance=plan.require_clearance)
     try:
         chain, _ = _recorded(
-            lambda: KinematicChain(root, **plan.chain_options), json_path(["joints", 0]), file
+            lambda: KinematicChain(root, **options), json_path(["joints", 0]), file
         )
     except DesignError:
         raise
@@ -804,7 +828,7 @@ def _build_from_joints(plan: _Plan, file) -> tuple[KinematicChain, list]:
         if index is None:
             raise DesignError(
                 f"infeasible placement of the {type(joint).__name__}: "
-                f"{message or 'append returned None'}",
+                f"{_reason(message, plan, 'append returned None')}",
                 field=where,
                 file=file,
             )
@@ -821,7 +845,10 @@ def _build_from_dh(plan: _Plan, file) -> tuple[KinematicChain, list]:
     names = set(options) | {"table", "convention", "jointTypes"}
     try:
         chain, _ = _recorded(
-            lambda: KinematicChain.from_dh(table, plan.numSides, plan.r, **options), "dh", file
+            lambda: KinematicChain.from_dh(table, plan.numSides, plan.r, **options),
+            "dh",
+            file,
+            clearance_errors=plan.require_clearance,
         )
     except DesignError:
         raise
@@ -835,6 +862,17 @@ def _build_from_dh(plan: _Plan, file) -> tuple[KinematicChain, list]:
         else:
             field = "dh"
         raise DesignError(message, field=field, file=file) from None
+    if plan.require_clearance:
+        from kinegami.bodies import worst_overlap
+
+        found = worst_overlap(chain.Joints, chain.Links, chain.r)
+        if found is not None:  # placement warns only when it adds an overlap
+            raise DesignError(
+                f"the chain of the DH table passes through itself ({found}){_REQUIRED}",
+                field="dh",
+                file=file,
+            )
+        chain.requireClearance = True
     return chain, [None] * len(chain)
 
 
@@ -880,7 +918,7 @@ def _apply_edits(chain: KinematicChain, plan: _Plan, file, sources: list) -> Non
             raise _library_error(error, where, set(_ARGUMENTS[op]), file) from None
         if not ok:
             raise DesignError(
-                f"infeasible edit {op}: {message or 'the chain rejected it'}",
+                f"infeasible edit {op}: {_reason(message, plan, 'the chain rejected it')}",
                 field=json_path(where),
                 file=file,
             )
@@ -929,8 +967,12 @@ def _apply_states(chain: KinematicChain, plan: _Plan, file) -> None:
             )
         values.append(state)
     ok, message = _recorded(lambda: chain.setJointStates(values), "states", file)
-    if not ok:  # pragma: no cover - ranges were checked above
-        raise DesignError(f"infeasible states: {message}", field="states", file=file)
+    if not ok:  # ranges were checked above: the chain requires clearance
+        raise DesignError(
+            f"infeasible states: {_reason(message, plan, 'the chain rejected them')}",
+            field="states",
+            file=file,
+        )
 
 
 def build_plan(plan: _Plan, file=None) -> tuple[KinematicChain, DesignOrigin]:

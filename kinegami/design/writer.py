@@ -6,7 +6,8 @@ fixedPosition: true, fixedOrientation: true``, so loading re-creates each joint 
 Non-zero states go to ``"states"``; loading builds the chain at state 0 and then sets them.
 A chain whose root is an EndTip (possible after deleting joint 0) is written as a waypoint
 root, the tip, and an edit deleting the waypoint. Joint names are kept for a chain loaded from a
-design (see :func:`kinegami.design.reader.origin_of`).
+design (see :func:`kinegami.design.reader.origin_of`). A chain with ``requireClearance`` is
+written with ``"requireClearance": true``.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import json
 import os
 from pathlib import Path
 
+from kinegami.bodies import worst_overlap
 from kinegami.chain import KinematicChain
 from kinegami.design.errors import DesignError
 from kinegami.design.reader import FORMAT, UNITS, check_document, origin_of
@@ -93,7 +95,9 @@ def design_to_dict(
 
     Poses are those of the state-0 configuration (computed on a copy of the chain); non-zero
     states are listed in ``"states"`` (radians for revolute joints, lengths for prismatic).
-    Angles are in radians (``"angleUnits": "rad"``). If the chain was loaded from a design
+    Angles are in radians (``"angleUnits": "rad"``). ``"requireClearance": true`` is written
+    when ``chain.requireClearance``; such a chain must be clear at its states and at state 0,
+    where loading builds it (InvalidParameterError otherwise). If the chain was loaded from a design
     whose joints have names, each joint keeps its ``"name"`` (as long as the chain's joints
     still have the types they were loaded with; waypoints added by placement have none).
     """
@@ -112,8 +116,18 @@ def design_to_dict(
     rest = chain
     if any(states):
         rest = copy.deepcopy(chain)
+        rest.requireClearance = False  # checked below, with a message for the file
         if not rest.setJointStates([0.0] * len(states)):  # pragma: no cover - 0 is in range
             raise InvalidParameterError("cannot return the chain to state 0")
+    if chain.requireClearance:  # loading builds the chain at state 0, then sets the states
+        for where, built in (("at state 0", rest), ("at its states", chain)):
+            found = worst_overlap(built.Joints, built.Links, built.r)
+            if found is not None:
+                raise InvalidParameterError(
+                    "a chain with requireClearance cannot be saved when it passes through "
+                    f"itself {where} ({found}): loading it would fail; set requireClearance "
+                    "to False or move it clear"
+                )
     document = {"format": FORMAT, "version": 1}
     if name is not None:
         document["name"] = name
@@ -126,6 +140,8 @@ def design_to_dict(
         r=float(chain.r),
         maxAnglePerElbow=float(chain.maxAnglePerElbow),
     )
+    if chain.requireClearance:
+        document["requireClearance"] = True
     if twistPortion is not None:
         document["twistPortion"] = check_twist_portion(twistPortion)
     joints = []
