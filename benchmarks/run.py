@@ -77,9 +77,87 @@ def compact_chain(n: int = 32, seed: int = 0, r: float = 1.0) -> KinematicChain:
     return chain
 
 
+def chain_pair(seed: int, n: int = 16, r: float = 1.0) -> tuple[KinematicChain, KinematicChain]:
+    """The issue's random chain built twice from the same joints: with safe placement, and
+    with compact placement (safe placement for a joint compact placement cannot reach)."""
+    rng = np.random.default_rng(seed)
+    joints = [random_joint(i, random_pose(rng, r), r=r) for i in range(n)]
+    safe = KinematicChain(StartTip(4, r, np.eye(4), r))
+    tight = KinematicChain(StartTip(4, r, np.eye(4), r))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for joint in joints:
+            safe.append(joint)
+            if tight.append(joint, safe=False) is None:
+                tight.append(joint)
+    return safe, tight
+
+
+def clearance_rows(compact_seeds: int) -> list[tuple[str, str, str]]:
+    """Clearance engine speed; safe placement clear at scale; compaction against its goals."""
+    from kinegami.clearance import engine_for, sweep
+    from kinegami.optimize import compact, tube_length
+
+    rows: list[tuple[str, str, str]] = []
+    chain = compact_chain(32)
+    states = [j.state for j in chain.Joints]
+    engine_for(chain)  # built once per chain shape, then cached
+    t = _median_seconds(lambda: chain.clearance(states), 20)
+    rows.append(("clearance, one configuration, 32 joints", f"{t * 1e3:.2f} ms", "<= 2 ms"))
+    other = compact_chain(32, seed=1)
+    t0 = time.perf_counter()
+    engine_for(other)
+    build = (time.perf_counter() - t0) * 1e3
+    rows.append(("  clearance engine build, 32 joints", f"{build:.1f} ms", "-"))
+    rng = np.random.default_rng(0)
+    engine = engine_for(chain)
+    lo, hi = engine.ranges[:, 0], engine.ranges[:, 1]
+    Q = lo + (hi - lo) * rng.random((1000, lo.size))
+    t = _median_seconds(lambda: engine.worst(Q), 3)
+    rows.append(("clearance, 1000 configurations, 32 joints", f"{t:.2f} s", "<= 1 s"))
+    t = _median_seconds(lambda: sweep(chain, 1000), 1)
+    rows.append(("  sweep (1000 samples + free intervals)", f"{t:.2f} s", "-"))
+
+    bad = {}
+    for n in (8, 16, 32, 48):
+        bad[n] = sum(not safe_chain(seed, n)[0].clearance().ok for seed in range(20))
+    rows.append(("safe chains self-intersecting (8/16/32/48 joints, 20 seeds)",
+                 "/".join(str(bad[n]) for n in (8, 16, 32, 48)), "0/0/0/0"))  # fmt: skip
+
+    if compact_seeds <= 0:
+        return rows
+    ratios_safe, ratios_tight, times, clear = [], [], [], 0
+    for seed in range(compact_seeds):
+        safe, tight = chain_pair(seed)
+        t0 = time.perf_counter()
+        out = compact(safe, seed=0, progress=False)
+        times.append(time.perf_counter() - t0)
+        clear += out.clearance().ok
+        ratios_safe.append(out.totalPathLength() / safe.totalPathLength())
+        ratios_tight.append(out.totalPathLength() / tight.totalPathLength())
+    rows.append((f"compact, 16-joint safe chains ({compact_seeds} seeds), time (max)",
+                 f"{max(times):.1f} s", "<= 10 s"))  # fmt: skip
+    rows.append(("  link length / safe chain's (max, median)",
+                 f"{max(ratios_safe):.2f}, {statistics.median(ratios_safe):.2f}", "<= 0.5"))
+    rows.append(("  link length / compact placement's (max, median)",
+                 f"{max(ratios_tight):.2f}, {statistics.median(ratios_tight):.2f}", "<= 0.8"))
+    rows.append(("  clear after compaction", f"{clear}/{compact_seeds}", "all"))
+    designs = Path(__file__).resolve().parents[1] / "examples" / "designs"
+    from kinegami.design import load_design
+
+    for path in sorted(designs.glob("*.json")):
+        design = load_design(path)
+        out = compact(design, seed=0, progress=False)
+        change = f"{tube_length(design):.4g} -> {tube_length(out):.4g}"
+        rows.append((f"  gallery {path.stem}: tube length", change, "not longer"))
+    return rows
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--seeds", type=int, default=10, help="random 48-joint safe chains")
+    parser.add_argument("--compact-seeds", type=int, default=20,
+                        help="random 16-joint chains compacted (0 skips compaction)")  # fmt: skip
     args = parser.parse_args(argv)
     rows: list[tuple[str, str, str]] = []
 
@@ -204,6 +282,8 @@ def main(argv: list[str] | None = None) -> None:
     rows.append(("  failed appends", str(fails), "0"))
     rows.append(("  ball radius per joint (max)", f"{max(balls):.2f} r", "<= 10 r"))
     rows.append(("  path length per joint (max)", f"{max(paths):.2f} r", "<= 60 r"))
+
+    rows += clearance_rows(args.compact_seeds)
 
     width = max(len(r[0]) for r in rows)
     print(f"{'measurement':<{width}}  {'result':>12}  goal")

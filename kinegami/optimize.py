@@ -200,6 +200,30 @@ def _compact_rebuild(
     return rebuilt
 
 
+def _nearest_rebuild(chain: KinematicChain) -> KinematicChain:
+    """The chain's joints (waypoints dropped), each slid to the point of its axis nearest the
+    previous joint, or as near to it as a clear link allows (slides of 2, 4, 8, ... r either
+    way); compact, then safe placement where none works."""
+    joints = [j for j in chain.Joints if not isinstance(j, Waypoint) or j is chain.Joints[0]]
+    rebuilt = KinematicChain(joints[0], chain.maxAnglePerElbow)
+    r = chain.r
+    offsets = [0.0] + [s * d * r for d in (2.0, 4.0, 8.0, 16.0) for s in (1.0, -1.0)]
+    for joint in joints[1:]:
+        T = joint.pose_matrix
+        base = float((rebuilt.Joints[-1].pose_matrix[:3, 3] - T[:3, 3]) @ T[:3, 2])
+        placed = False
+        for offset in offsets:
+            trial, overlap = _trial(rebuilt, "append", joint.translated_along_z(base + offset),
+                                    False, False, True, False)  # fmt: skip
+            if trial is not None and overlap == 0.0:
+                rebuilt, placed = trial, True
+                break
+        if not placed:
+            if rebuilt.append(joint, relative=False, safe=False) is None:
+                rebuilt.append(joint, relative=False, safe=True)
+    return rebuilt
+
+
 def _motion_configurations(chain: KinematicChain, samples: int, seed: int) -> np.ndarray:
     """(samples, movable joints) states drawn in the movable joints' ranges."""
     ranges = np.array([j.stateRange() for j in chain.Joints if j.stateRange() != (0.0, 0.0)])
@@ -228,8 +252,10 @@ def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
         warnings.simplefilter("ignore")
         if k == 0:
             start = copy.copy(chain)
+        elif k == 1:
+            start = _nearest_rebuild(chain)
         else:
-            start = _compact_rebuild(chain, rng, jitter=k >= 2)
+            start = _compact_rebuild(chain, rng, jitter=k >= 3)
         history: list = [start]
         state, _ = _descend(start, rng, kind, deadline, history=history)
         if motion is not None:
@@ -317,8 +343,8 @@ def compact(
     objective : {"length", "ball"}
         Minimise the total tube length (links plus joints) or the bounding-ball radius.
     starts : int
-        Number of starts (>= 1): the input itself, its joints placed again by compact
-        placement, then that with random rolls.
+        Number of starts (>= 1): the input itself, its joints placed again each nearest
+        the previous one, placed again by compact placement, then that with random rolls.
     samples : int
         Configurations sampled for ``motion`` (>= 1).
 
