@@ -36,6 +36,8 @@ __all__ = [
     "groundPlaneOpacityFactor",
     "linkSurfaceSides",
     "pathMarker",
+    "collisionColor",
+    "collisionOpacity",
     "CHAIN_PLOT_DEFAULTS",
 ]
 
@@ -78,6 +80,12 @@ sphereColor = "black"
 #: Alpha of each joint's bounding ball (the chain's ball is a wireframe).
 jointSphereOpacity = 0.05
 
+# --- collisions (showCollisions) ---
+#: Colliding parts and the line joining their closest points.
+collisionColor = "red"
+#: Alpha of the colliding parts' surfaces.
+collisionOpacity = 0.6
+
 # --- world frame and ground plane ---
 #: The world frame's arrows have length globalAxisScale*r.
 globalAxisScale = 10
@@ -115,6 +123,7 @@ CHAIN_PLOT_DEFAULTS = MappingProxyType(
         "groundPlaneScale": groundPlaneScale,
         "groundPlaneColor": groundPlaneColor,
         "showAxisGrids": False,
+        "showCollisions": False,
         "block": None,
         "ax": None,
     }

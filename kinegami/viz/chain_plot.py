@@ -9,6 +9,7 @@ from :mod:`kinegami.style`. matplotlib is imported only when a chain is drawn.
 from __future__ import annotations
 
 import math
+import re
 from numbers import Real
 from typing import TYPE_CHECKING, Any
 
@@ -57,6 +58,9 @@ ARTIST_GIDS = {
     "global-frame-y": "world y arrow",
     "global-frame-z": "world z arrow",
     "ground-plane": "the plane z = 0",
+    "collision-parts": "the colliding parts (showCollisions): their mesh parts, in red",
+    "collision-lines": "closest points of every colliding pair, joined (NaN between pairs)",
+    "collision-points": "the closest points themselves (showCollisions)",
 }
 
 _BOOL_OPTIONS = (
@@ -70,6 +74,7 @@ _BOOL_OPTIONS = (
     "showGlobalFrame",
     "showGroundPlane",
     "showAxisGrids",
+    "showCollisions",
 )
 _COLOR_OPTIONS = (
     "xColor",
@@ -399,6 +404,80 @@ def _draw_ground_plane(scene, chain, opts):
     )
 
 
+_JOINT_LABEL = re.compile(r"joint (\d+), ")
+_LINK_LABEL = re.compile(r"link (\d+), (.*)")
+_ELBOW_ORDINAL = re.compile(r"(\d+)(st|nd|rd|th) elbow|(\w+) elbow")
+
+
+def _labelled_parts(chain, label: str, parts) -> list:
+    """The mesh parts (:func:`kinegami.export.mesh.chain_parts`) of a part named in words by
+    the clearance engine ("link 3, second elbow", "joint 5, RevoluteJoint, distal half"): the
+    arc that holds the elbow, the twist or tube, the joint or its half. Falls back to every
+    part of the chain element when the named piece has no mesh part of its own (an arc too
+    small to be modelled)."""
+    from kinegami.bodies import _ORDINALS
+
+    link = _LINK_LABEL.match(label)
+    if link:
+        index, piece = int(link.group(1)), link.group(2)
+        mine = [p for p in parts if not p.is_joint and p.index == index]
+        side = {"twist": "twist", "straight tube": "tube"}.get(piece)
+        if side is None and (elbow := _ELBOW_ORDINAL.match(piece)):
+            if elbow.group(1):
+                k = int(elbow.group(1))
+            else:
+                k = _ORDINALS.index(elbow.group(3)) + 1
+            side = "arc1" if k <= chain.Links[index].elbows1.count else "arc2"
+    else:
+        joint = _JOINT_LABEL.match(label)
+        if joint is None:
+            return []
+        index = int(joint.group(1))
+        mine = [p for p in parts if p.is_joint and p.index == index]
+        side = next((h for h in ("proximal", "distal") if label.endswith(f", {h} half")), "")
+    chosen = [p for p in mine if p.side == side]
+    return chosen or mine
+
+
+def _clearance_title(report) -> str:
+    if report.closest is None:
+        return "clearance: no parts far enough apart along the tube to collide"
+    if report.ok:
+        return f"clearance: {report.min_clearance:.3g} (clear)"
+    count = len(report.pairs)
+    return (
+        f"clearance: {report.min_clearance:.3g} ({count} colliding pair{'s' if count != 1 else ''})"
+    )
+
+
+def _draw_collisions(scene, chain) -> str:
+    """The colliding pairs of ``chain.clearance()`` in red; returns the title text."""
+    report = chain.clearance()
+    if report.pairs:
+        from kinegami.export.mesh import chain_parts
+
+        parts = chain_parts(chain)
+        chosen: dict[str, object] = {}
+        for pair in report.pairs:
+            for label in (pair.first, pair.second):
+                for part in _labelled_parts(chain, label, parts):
+                    chosen[part.name] = part
+        faces = [mesh.vertices[mesh.faces] for mesh in chosen.values()]
+        if faces:
+            triangles = np.concatenate(faces)
+            scene.polygons(
+                triangles,
+                "collision-parts",
+                style.collisionColor,
+                style.collisionOpacity,
+                shade=True,
+            )
+        segments = [np.array(pair.points, dtype=float) for pair in report.pairs]
+        scene.polyline(segments, "collision-lines", style.collisionColor, linewidth=2.5)
+        scene.markers(np.concatenate(segments), "collision-points", style.collisionColor, size=6.0)
+    return _clearance_title(report)
+
+
 def _legend(ax, opts, frame_axes: bool, link_axes: bool):
     from matplotlib.lines import Line2D
 
@@ -487,6 +566,10 @@ def show_chain(chain: KinematicChain, **options) -> tuple[Figure, Axes3D]:
         _draw_global_frame(scene, chain, opts)
     if opts["showGroundPlane"]:
         _draw_ground_plane(scene, chain, opts)
+    if opts["showCollisions"]:
+        title = _draw_collisions(scene, chain)
+        # inside the figure when the axes fill it (no axis grids)
+        ax.set_title(title, y=1.0 if opts["showAxisGrids"] else 0.95)
 
     _legend(ax, opts, opts["showJointPoses"] or opts["showGlobalFrame"], link_axes)
     _set_equal_limits(ax, scene, had_data, chain.r)
