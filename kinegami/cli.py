@@ -7,9 +7,11 @@ Commands::
     kinegami validate DESIGN
     kinegami new DESIGN [--force]
     kinegami check DESIGN [--motion N] [--seed S] [--json]
+    kinegami compact DESIGN -o OUT.json [--seed S] [--motion] [--time-limit T] [--force]
 
 Exit codes: 0 success, 1 a design or export error (one line on stderr, no traceback, no file
-written), 2 a usage error (argparse), 3 ``check``: the design self-intersects at its states.
+written), 2 a usage error (argparse), 3 ``check``: the design self-intersects at its states;
+``compact``: no clear design was found.
 """
 
 from __future__ import annotations
@@ -170,17 +172,26 @@ def _printable(text: str) -> str:
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
+def _sheet_size(job: BuildJob) -> str:
+    """The sheet in mm: "310.2 mm x 94.2 mm with the glue tab (the crease pattern alone: ...)"."""
+    from kinegami.pattern.sheet import flatten
+
+    factor = UNITS_IN_MM[job.info.units]
+    xmin, ymin, xmax, ymax = flatten(job.pattern).bounds
+    return (
+        f"{(xmax - xmin) * factor:.1f} mm x {(ymax - ymin) * factor:.1f} mm with the glue tab "
+        f"(the crease pattern alone: {job.pattern.width * factor:.1f} mm x "
+        f"{job.pattern.height * factor:.1f} mm)"
+    )
+
+
 def _summary(job: BuildJob, design: str) -> list[str]:
     from collections import Counter
-
-    from kinegami.pattern.sheet import flatten
 
     chain, info = job.chain, job.info
     factor = UNITS_IN_MM[info.units]
     counts = Counter(type(joint).__name__ for joint in chain.Joints)
     kinds = ", ".join(f"{count} {name}" for name, count in counts.items())
-    sheet = flatten(job.pattern)
-    xmin, ymin, xmax, ymax = sheet.bounds
     links = len(chain.Joints) - 1
     joints_length = sum(joint.neutralLength for joint in chain.Joints)
     links_length = chain.totalPathLength()
@@ -191,9 +202,7 @@ def _summary(job: BuildJob, design: str) -> list[str]:
         f"  joints: {len(chain.Joints)} ({kinds})",
         f"  links: {links}",
         f"  tube: {chain.numSides} sides, r = {chain.r * factor:g} mm",
-        f"  sheet: {(xmax - xmin) * factor:.1f} mm x {(ymax - ymin) * factor:.1f} mm with the glue "
-        f"tab (the crease pattern alone: {job.pattern.width * factor:.1f} mm x "
-        f"{job.pattern.height * factor:.1f} mm)",
+        f"  sheet: {_sheet_size(job)}",
         f"  total tube length: {tube * factor:.1f} mm "
         f"(links {links_length * factor:.1f} mm, joints {joints_length * factor:.1f} mm)",
         "  clearance: "
@@ -270,17 +279,19 @@ def _angle_span(low: float, high: float) -> str:
     return f"{math.degrees(low):.1f} to {math.degrees(high):.1f} deg"
 
 
-def _clearance_summary(report, lengths: _Lengths) -> str:
+def _clearance_summary(report, lengths: _Lengths, own_units: bool = False) -> str:
     """The build summary's clearance: "9.9 mm (clear)" or "-0.35 mm: self-intersects (A and
-    B)", in mm like the other sizes of the summary."""
+    B)", in mm like the other sizes of the summary (``own_units``: and in the design's unit,
+    as ``check`` prints lengths)."""
+    length = lengths if own_units else lengths.mm
     if report.closest is None:
         return "clear (no two parts are far enough apart along the tube to collide)"
     if report.ok:
-        return f"{lengths.mm(report.min_clearance)} (clear)"
+        return f"{length(report.min_clearance)}{': clear' if own_units else ' (clear)'}"
     first = report.pairs[0]
     more = f"; {len(report.pairs)} pairs overlap" if len(report.pairs) > 1 else ""
     return (
-        f"{lengths.mm(report.min_clearance)}: self-intersects "
+        f"{length(report.min_clearance)}: self-intersects "
         f"({first.first} and {first.second}{more})"
     )
 
@@ -604,6 +615,123 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0 if report.ok else SELF_INTERSECTS
 
 
+#: Exit code of ``compact`` when no clear design was found (kinegami.optimize.CompactionError).
+COMPACTION_FAILED = 3
+
+
+def _seconds(option: str, text: str) -> float:
+    """A positive, finite number of seconds given as ``text``, or a CommandError."""
+    import math
+
+    from kinegami.validation import shorten
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise CommandError(f"{option}: must be a number of seconds > 0, got {shorten(text)!r}")
+    return value
+
+
+def _check_design_output(out: Path, design: str, force: bool) -> None:
+    """Fail before the (long) compaction when ``-o`` cannot be written: not a .json name, a
+    folder or a special file, a file or an unwritable folder on the way, or the design itself
+    without --force."""
+    shown_out = shown(str(out))
+    if out.suffix.lower() != ".json":
+        raise CommandError(f"-o: {shown_out}: a design file name must end in .json")
+    try:
+        info = os.stat(out)
+    except (FileNotFoundError, NotADirectoryError):  # a file on the way: reported below
+        info = None
+    except OSError as error:
+        raise CommandError(f"-o: cannot write {shown_out}: {error.strerror or error}") from None
+    if info is not None:
+        if stat.S_ISDIR(info.st_mode):
+            raise CommandError(f"-o: {shown_out} is a folder; give a file name")
+        if not stat.S_ISREG(info.st_mode):
+            raise CommandError(f"-o: {shown_out} exists and is not a regular file")
+        try:
+            same = os.path.samefile(out, design)
+        except OSError:
+            same = False
+        if same and not force:
+            raise CommandError(
+                f"-o: {shown_out} is the design itself; --force replaces it (atomically) with "
+                "the compacted design"
+            )
+    folder = out.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent  # missing folders are created when writing
+    if not folder.is_dir():
+        raise CommandError(f"-o: {shown(str(folder))} is not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise CommandError(f"-o: cannot write in {shown(str(folder))}: permission denied")
+
+
+def _compaction_lines(job: BuildJob, before: BuildJob | None = None) -> list[str]:
+    """The joints, tube length, sheet and clearance of a design (``before``: the input, for
+    the change in length)."""
+    from collections import Counter
+
+    from kinegami.optimize import tube_length
+
+    chain = job.chain
+    lengths = _Lengths(chain.r, job.info.units)
+    counts = Counter(type(joint).__name__ for joint in chain.Joints)
+    kinds = ", ".join(f"{count} {name}" for name, count in counts.items())
+    tube = f"{lengths(tube_length(chain))}"
+    if before is not None:
+        old, new = tube_length(before.chain), tube_length(chain)
+        change = 100.0 * (old - new) / old
+        tube += f", {change:.1f}% shorter" if change >= 0 else f", {-change:.1f}% longer"
+    return [
+        f"    joints: {len(chain.Joints)} ({kinds})",
+        f"    total tube length: {tube}",
+        f"    sheet: {_sheet_size(job)}",
+        f"    clearance: {_clearance_summary(job.clearance, lengths, own_units=True)}",
+    ]
+
+
+def cmd_compact(args: argparse.Namespace) -> int:
+    from kinegami.design import save_design
+    from kinegami.design.reader import carry_origin
+    from kinegami.optimize import CompactionError, compact
+
+    seed = _integer("--seed", args.seed, 0)
+    limit = None if args.time_limit is None else _seconds("--time-limit", args.time_limit)
+    out = Path(args.output)
+    _check_design_output(out, args.design, args.force)
+    chain, info = _load(args.design)
+    before = BuildJob(chain, info)
+    _check_pattern(before)
+    try:
+        compacted = compact(chain, seed=seed, motion=args.motion, time_limit=limit)
+    except CompactionError as error:
+        _fail(args.command, f"{args.design}: {error}")
+        return COMPACTION_FAILED
+    compacted.requireClearance = chain.requireClearance
+    carry_origin(chain, compacted)  # the joint names, for the summary and the file
+    after = BuildJob(compacted, info)
+    _check_pattern(after)
+    title = f"{_printable(info.name)} ({args.design})" if info.name else args.design
+    lines = [
+        f"{title}: compacted (seed {seed}{', motion kept' if args.motion else ''})",
+        "  before:",
+        *_compaction_lines(before),
+        "  after:",
+        *_compaction_lines(after, before),
+    ]
+    written = save_design(
+        compacted, out, name=info.name, description=info.description, units=info.units,
+        twistPortion=info.twistPortion,
+    )  # fmt: skip
+    lines.append(f"  written: {written}")
+    print("\n".join(_printable(line) for line in lines))
+    return 0
+
+
 # --- parser ------------------------------------------------------------------------------------
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
@@ -697,6 +825,37 @@ def make_parser() -> argparse.ArgumentParser:
         "--json", action="store_true", help="print one JSON object instead (see docs/cli.md)"
     )
     check.set_defaults(run=cmd_check)
+
+    compact = commands.add_parser(
+        "compact",
+        help="shorten a design without changing its kinematics or making it collide",
+        description="Build a design, shorten its tube by sliding and rolling joints along and "
+        "about their axes (kinegami.optimize.compact: same kinematics, clear of itself) and "
+        "write the compacted design to OUT; print the tube length, sheet size and clearance "
+        "before and after. Exit code 0: written; 3: no clear design was found; 1: a design or "
+        "option error. Nothing is written unless it succeeds.",
+    )
+    compact.add_argument("design", metavar="DESIGN", help="design file (.json)")
+    compact.add_argument(
+        "-o", "--output", metavar="OUT", required=True,
+        help="the compacted design file to write (.json; missing folders are created)",
+    )  # fmt: skip
+    compact.add_argument(
+        "--seed", metavar="S", default="0", help="seed of the search (an integer >= 0, "
+        "default: %(default)s); the same seed gives the same design"
+    )  # fmt: skip
+    compact.add_argument(
+        "--motion", action="store_true", help="also keep the share of sampled configurations "
+        "that self-intersect no larger than the design's"
+    )  # fmt: skip
+    compact.add_argument(
+        "--time-limit", metavar="T", help="seconds each start of the search may take (> 0; "
+        "default: until no move shortens the tube)"
+    )  # fmt: skip
+    compact.add_argument(
+        "--force", action="store_true", help="allow OUT to be DESIGN itself (replaced atomically)"
+    )
+    compact.set_defaults(run=cmd_compact)
     return parser
 
 

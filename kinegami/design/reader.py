@@ -61,6 +61,7 @@ __all__ = [
     "check_document",
     "build_chain",
     "origin_of",
+    "carry_origin",
     "DesignOrigin",
 ]
 
@@ -764,6 +765,32 @@ def origin_of(chain: KinematicChain) -> DesignOrigin | None:
     if origin is None or origin.types != _type_names(chain):
         return None
     return origin
+
+
+def carry_origin(source: KinematicChain, target: KinematicChain) -> DesignOrigin | None:
+    """Give ``target`` the origin (joint names, design entries) of ``source`` and return it.
+
+    For a chain made from a loaded one with the same joints in the same order apart from
+    waypoints (:func:`kinegami.optimize.compact`: waypoints may move, appear or disappear):
+    each non-waypoint joint of ``target`` takes the origin of the matching joint of ``source``;
+    waypoints have none. None (and nothing remembered) when ``source`` has no origin or the
+    non-waypoint joints do not match by type.
+    """
+    origin = origin_of(source)
+    if origin is None:
+        return None
+    kept = [i for i, joint in enumerate(source.Joints) if type(joint) is not Waypoint]
+    others = [i for i, joint in enumerate(target.Joints) if type(joint) is not Waypoint]
+    if [origin.types[i] for i in kept] != [type(target.Joints[i]).__name__ for i in others]:
+        return None
+    sources = [None] * len(target.Joints)
+    names = [None] * len(target.Joints)
+    for i, k in zip(others, kept, strict=True):
+        sources[i], names[i] = origin.sources[k], origin.names[k]
+    carried = DesignOrigin(origin.kind, tuple(sources), tuple(names), _type_names(target),
+                           origin.file)  # fmt: skip
+    _ORIGINS[target] = carried
+    return carried
 
 
 # --- building --------------------------------------------------------------------------------
