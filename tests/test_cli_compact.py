@@ -176,3 +176,15 @@ def test_ctrl_c_during_the_search_writes_nothing(small_design, monkeypatch, caps
     assert capsys.readouterr().err == "kinegami compact: interrupted\n"
     assert out.read_text() == before  # an existing OUT is left as it was
     assert sorted(p.name for p in small_design.parent.iterdir()) == ["fold_back.json", "out.json"]
+
+
+def test_require_clearance_and_names_are_kept(tmp_path):
+    design = write(tmp_path / "clear.json", dict(fold_back(2.5), requireClearance=True))
+    out = tmp_path / "out.json"
+    result = run("compact", design, "-o", out, "--seed", "1", "--time-limit", TIME_LIMIT)
+    assert result.returncode == 0, result.stderr
+    document = json.loads(out.read_text())
+    assert document["requireClearance"] is True
+    assert [entry.get("name") for entry in document["joints"]][::len(document["joints"]) - 1] \
+        == ["base", "tool"]  # fmt: skip
+    assert load_design(out).requireClearance is True
