@@ -329,7 +329,8 @@ def compact(
         Not changed.
     seed : int
         Seed of the search; the result depends only on it (and on ``time_limit``, when the
-        limit cuts the search short), not on the executor.
+        limit cuts the search short), not on the executor (up to the last bit of rounding,
+        which numpy may do differently in another process).
     motion : bool
         Also require that the fraction of ``samples`` random configurations in which the
         chain collides is no larger than the input's.

@@ -101,10 +101,12 @@ def test_deterministic_on_any_executor():
     with concurrent.futures.ThreadPoolExecutor(max_workers=3) as pool:
         second = compact(chain, seed=5, executor=pool, starts=3)
     third = compact(chain, seed=5, starts=3)  # the default process pool
+    # the same design; poses agree to rounding (numpy's vector loops may round the last bit
+    # differently in another process, depending on how an array happens to be aligned)
     for other in (second, third):
-        assert len(other.Joints) == len(first.Joints)
+        assert [type(j) for j in other.Joints] == [type(j) for j in first.Joints]
         for a, b in zip(first.Joints, other.Joints, strict=True):
-            np.testing.assert_array_equal(a.pose_matrix, b.pose_matrix)
+            np.testing.assert_allclose(a.pose_matrix, b.pose_matrix, rtol=0, atol=1e-12)
 
 
 def test_dask_executor_works_unchanged():
@@ -115,8 +117,9 @@ def test_dask_executor_works_unchanged():
         n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
     ) as cluster, distributed.Client(cluster) as client:
         out = compact(chain, seed=5, executor=client.get_executor(), starts=2)
+    assert [type(j) for j in out.Joints] == [type(j) for j in reference.Joints]
     for a, b in zip(reference.Joints, out.Joints, strict=True):
-        np.testing.assert_array_equal(a.pose_matrix, b.pose_matrix)
+        np.testing.assert_allclose(a.pose_matrix, b.pose_matrix, rtol=0, atol=1e-12)
 
 
 def test_motion_keeps_the_colliding_fraction():
