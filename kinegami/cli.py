@@ -154,9 +154,14 @@ def _parse_formats(text: str) -> list[OutputFormat]:
 
 # --- helpers -----------------------------------------------------------------------------------
 def _load(design: str):
+    """The chain and info of a design; the chain's ClearanceWarnings are not printed (build,
+    check and compact report the clearance themselves, in one line or in words)."""
     from kinegami.design import load_design_with_info
+    from kinegami.errors import ClearanceWarning
 
-    return load_design_with_info(design)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        return load_design_with_info(design)
 
 
 def _check_pattern(job: BuildJob) -> None:
