@@ -81,20 +81,13 @@ def _trial(chain: KinematicChain, edit, *args) -> tuple[KinematicChain | None, f
     (None, inf) if the edit was rejected.
 
     Edits replace the chain's joint and link lists, never change them in place, so a shallow
-    copy is an independent snapshot. The chain measures its clearance after every edit and
-    says so by a ClearanceWarning, which gives the overlap.
+    copy is an independent snapshot. The overlap is measured here, not read from the chain's
+    ClearanceWarning: recording warnings is not thread-safe, and starts may run in threads.
     """
     new = copy.copy(chain)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        ok = getattr(new, edit)(*args)
-    if not ok:
+    if not getattr(new, edit)(*args):
         return None, math.inf
-    overlap = 0.0
-    for w in caught:
-        if issubclass(w.category, ClearanceWarning):
-            overlap = max(overlap, -float(w.message.clearance))
-    return new, overlap
+    return new, _overlap(new)
 
 
 def _moves(chain: KinematicChain, j: int, slide: float, roll: float, rolls: bool):
@@ -248,40 +241,43 @@ def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
     chain, k, seed, kind, deadline_seconds, motion = task
     deadline = None if deadline_seconds is None else time.monotonic() + deadline_seconds
     rng = np.random.default_rng([seed, k])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        if k == 0:
-            start = copy.copy(chain)
-        elif k == 1:
-            start = _nearest_rebuild(chain)
+    # trial edits that fail or collide warn; nobody wants thousands of those. Not a
+    # catch_warnings block: it is not thread-safe, and starts may run in threads (compact
+    # restores the caller's filters around the whole search; worker processes keep these).
+    warnings.filterwarnings("ignore", category=PlacementWarning)
+    warnings.filterwarnings("ignore", category=ClearanceWarning)
+    if k == 0:
+        start = copy.copy(chain)
+    elif k == 1:
+        start = _nearest_rebuild(chain)
+    else:
+        start = _compact_rebuild(chain, rng, jitter=k >= 3)
+    history: list = [start]
+    state, _ = _descend(start, rng, kind, deadline, history=history)
+    if motion is not None:
+        movable_states, limit = motion
+
+        def acceptable(candidate) -> bool:
+            return _overlap(candidate) == 0.0 and (
+                _colliding_fraction(candidate, movable_states) <= limit + 1e-12
+            )
+
+        # the last accepted design (by bisection over the descent's history) whose motion
+        # collides no more often than the input's
+        if acceptable(history[-1]):
+            best = history[-1]
+        elif not acceptable(history[0]):
+            return math.inf, math.inf, k, None
         else:
-            start = _compact_rebuild(chain, rng, jitter=k >= 3)
-        history: list = [start]
-        state, _ = _descend(start, rng, kind, deadline, history=history)
-        if motion is not None:
-            movable_states, limit = motion
-
-            def acceptable(candidate) -> bool:
-                return _overlap(candidate) == 0.0 and (
-                    _colliding_fraction(candidate, movable_states) <= limit + 1e-12
-                )
-
-            # the last accepted design (by bisection over the descent's history) whose motion
-            # collides no more often than the input's
-            if acceptable(history[-1]):
-                best = history[-1]
-            elif not acceptable(history[0]):
-                return math.inf, math.inf, k, None
-            else:
-                good, bad = 0, len(history) - 1
-                while bad - good > 1:
-                    mid = (good + bad) // 2
-                    if acceptable(history[mid]):
-                        good = mid
-                    else:
-                        bad = mid
-                best = history[good]
-            return _objective(best, kind), 0.0, k, best
+            good, bad = 0, len(history) - 1
+            while bad - good > 1:
+                mid = (good + bad) // 2
+                if acceptable(history[mid]):
+                    good = mid
+                else:
+                    bad = mid
+            best = history[good]
+        return _objective(best, kind), 0.0, k, best
     return state.value, state.overlap, k, state.chain
 
 
@@ -382,7 +378,20 @@ def compact(
     if own:
         workers = min(starts, os.cpu_count() or 1)
         executor = concurrent.futures.ProcessPoolExecutor(max_workers=workers)
-    bar = _progress_bar(progress, starts)
+    with warnings.catch_warnings():  # the caller's filters, back after the search
+        results = _run_all(executor, own, tasks, _progress_bar(progress, starts))
+    found = [res for res in results if res[3] is not None and res[1] == 0.0]
+    if not found:
+        raise CompactionError(
+            "compact found no design that is clear of itself (the input passes through itself "
+            f"and {starts} start(s) could not fix it); try more starts or another seed"
+        )
+    value, _, _, best = min(found, key=lambda res: (res[0], res[2]))
+    return best
+
+
+def _run_all(executor, own: bool, tasks: list, bar) -> list:
+    """Run every start on ``executor``; cancel the rest and re-raise on any error or Ctrl-C."""
     results = []
     futures = []
     try:
@@ -400,14 +409,7 @@ def compact(
             bar.close()
         if own:
             executor.shutdown(wait=True, cancel_futures=True)
-    found = [res for res in results if res[3] is not None and res[1] == 0.0]
-    if not found:
-        raise CompactionError(
-            "compact found no design that is clear of itself (the input passes through itself "
-            f"and {starts} start(s) could not fix it); try more starts or another seed"
-        )
-    value, _, _, best = min(found, key=lambda res: (res[0], res[2]))
-    return best
+    return results
 
 
 def shorten_by_axis_translations(
