@@ -384,8 +384,9 @@ class KinematicChain:
         """Compact placement (chain.md 4.4): the extended lists and ball; raises on failure.
 
         The joint slides along its axis to the point the published rule picks. If no link
-        reaches it there, the clearance boundary on the other side of the ball is tried
-        before giving up (the rule's side choice is arbitrary in the tie case).
+        reaches it there, or its link passes through the chain, the clearance boundary on the
+        other side of the ball is tried (the rule's side choice is arbitrary in the tie case);
+        a self-intersecting result is kept only when neither side is clear.
         """
         p = joint.pose_matrix[:3, 3]
         z = joint.pose_matrix[:3, 2]
@@ -393,6 +394,7 @@ class KinematicChain:
         lam = compact_lambda(parent.pose_matrix[:3, 3], p, z, self._ball, clearance, self.r)
         other = compact_lambda_other_side(p, z, self._ball, clearance, self.r)
         error = None
+        first = None
         for slide in (lam, other):
             if slide is None:
                 continue
@@ -400,9 +402,17 @@ class KinematicChain:
             if not fixedOrientation:
                 placed = orient_by_common_normal(placed, parent.pose_matrix)
             try:
-                return self._extended([placed])
+                extended = self._extended([placed])
             except KinegamiError as failure:
                 error = error or failure
+                continue
+            # the rule's choice if it is clear of the chain, else the other side if that is
+            gap = appended_clearance(extended[0], extended[1], self.r, len(self._joints))
+            if gap >= -CONTACT_TOLERANCE * self.r:
+                return extended
+            first = first or extended
+        if first is not None:
+            return first  # nothing clear: kept, and append warns (ClearanceWarning)
         raise error
 
     def _extended(self, new_joints: list[Joint]):

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinegami.bodies import deepest_overlap
+from kinegami.bodies import deepest_overlap, worst_overlap
 from kinegami.chain import KinematicChain, PlacementWarning
 from kinegami.errors import (
     ClearanceWarning,
@@ -442,14 +442,25 @@ def shorten_by_axis_translations(
     minStep = chain.r / 8.0 if minStep is None else check_positive("minStep", minStep)
     rounds = check_int("rounds", rounds, minimum=0)
     min_slide = max(minStep, step / 2.0**rounds)
-    with warnings.catch_warnings():
+    with warnings.catch_warnings():  # trial edits: rejected ones and colliding ones warn
         warnings.simplefilter("ignore", PlacementWarning)
+        warnings.simplefilter("ignore", ClearanceWarning)
         state, edits = _descend(
             chain, np.random.default_rng(0), "length", None, rolls=False,
             delete_waypoints=False, slide=step, min_slide=min_slide,
         )  # fmt: skip
     if state.chain is not chain:
-        for name, j, distance, _ in edits:
-            assert name == "translateJointAlongAxisOfMotion"
-            chain.translateJointAlongAxisOfMotion(j, distance, propagate=False)
+        with warnings.catch_warnings():  # the intermediate designs were measured already
+            warnings.simplefilter("ignore", ClearanceWarning)
+            for _, j, distance, _ in edits:
+                chain.translateJointAlongAxisOfMotion(j, distance, propagate=False)
+        if state.overlap > 0.0:
+            found = worst_overlap(chain.Joints, chain.Links, chain.r)
+            warnings.warn(
+                ClearanceWarning(
+                    f"shorten_by_axis_translations: the chain still passes through itself "
+                    f"({found})", found.clearance, found.first, found.second,
+                ),
+                stacklevel=2,
+            )  # fmt: skip
     return [(int(j), float(distance)) for _, j, distance, _ in edits]
