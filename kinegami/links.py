@@ -16,7 +16,7 @@ from functools import cached_property
 import numpy as np
 from spatialmath import SE3
 
-from kinegami.errors import NoPathError
+from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
 from kinegami.geometry.balls import Ball, merge_balls
 from kinegami.geometry.csc import CSCPath, solve_csc
 from kinegami.geometry.frames import rotation_matrix, signed_angle
@@ -153,6 +153,49 @@ class LinkCSC:
         start.setflags(write=False)
         end.setflags(write=False)
         return cls._from_parts(r, max_angle, start, end, _solved_path(r, start, end))
+
+    @classmethod
+    def from_path(
+        cls, r, StartDubinsPose, EndDubinsPose, path: CSCPath, maxAnglePerElbow=np.pi / 2
+    ) -> LinkCSC:
+        """The link along a given CSC path (e.g. one of ``solve_csc_all``'s), without re-solving.
+
+        The path must join the two frames: start at the start frame's origin along its x axis and
+        end at the end frame's origin along its x axis (within 1e-9 r and 1e-9), with turning
+        radius ``r``; InvalidParameterError otherwise.
+
+        Examples
+        --------
+        >>> from kinegami.geometry.csc import solve_csc_all
+        >>> end = SE3.Trans(10, 4, 0)
+        >>> paths = solve_csc_all((0, 0, 0), (1, 0, 0), (10, 4, 0), (1, 0, 0), 1.0)
+        >>> round(LinkCSC.from_path(1, SE3(), end, paths[0]).length, 6)
+        10.789582
+        """
+        r = check_radius(r)
+        max_angle = check_max_angle_per_elbow(maxAnglePerElbow)
+        start = pose_array(StartDubinsPose, "StartDubinsPose")
+        end = pose_array(EndDubinsPose, "EndDubinsPose")
+        if not isinstance(path, CSCPath):
+            raise InvalidTypeError(f"path must be a CSCPath, got {type(path).__name__}")
+        if abs(path.r - r) > 1e-12 * r:
+            raise InvalidParameterError(f"path has turning radius {path.r}, the link r = {r}")
+        scale = max(1.0, float(np.max(np.abs(end[:3, 3] - start[:3, 3]))) / r)
+        for name, frame, point, tangent in (
+            ("start", start, path.p1, path.d1),
+            ("end", end, path.p2, path.d2),
+        ):
+            if (
+                float(np.max(np.abs(point - frame[:3, 3]))) > 1e-9 * r * scale
+                or float(np.max(np.abs(tangent - frame[:3, 0]))) > 1e-9
+            ):
+                raise InvalidParameterError(
+                    f"path does not meet the {name} frame: it passes "
+                    f"{np.round(point, 6).tolist()} along {np.round(tangent, 6).tolist()}, "
+                    f"the frame is at {np.round(frame[:3, 3], 6).tolist()} with x axis "
+                    f"{np.round(frame[:3, 0], 6).tolist()}"
+                )
+        return cls._from_parts(r, max_angle, start, end, path)
 
     def _init(self, r, max_angle, start, end, path):
         self.r = r

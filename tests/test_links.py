@@ -252,3 +252,45 @@ def test_random_links(link_checker, r, max_angle, q1, q2, origin, offset):
             continue
         for x in tube_points_of_arc(link, which):
             assert np.linalg.norm(x - ball.c) <= ball.r + 1e-9 * r
+
+
+# --- a link along a chosen path (LinkCSC.from_path) ---------------------------------------------
+
+
+def test_link_from_a_chosen_path_is_the_solved_link():
+    from kinegami.geometry.csc import solve_csc_all
+
+    case = ref.CSC_3D
+    link, S, E = link_of(case)
+    (path,) = solve_csc_all(case["p1"], case["d1"], case["p2"], case["d2"], 1.0)
+    chosen = LinkCSC.from_path(1.0, S, E, path)
+    assert chosen.path is path
+    np.testing.assert_allclose(
+        [chosen.path.theta1, chosen.path.tMag, chosen.path.theta2, chosen.twistAngle],
+        [link.path.theta1, link.path.tMag, link.path.theta2, link.twistAngle],
+        rtol=0,
+        atol=1e-12,
+    )
+    assert (chosen.elbows1.count, chosen.elbows2.count) == (link.elbows1.count, link.elbows2.count)
+    np.testing.assert_allclose(chosen.elbows2.frames, link.elbows2.frames, rtol=0, atol=1e-12)
+    kinds = [type(m).__name__ for m in link.pattern_modules(4, 0.2)]
+    assert [type(m).__name__ for m in chosen.pattern_modules(4, 0.2)] == kinds
+
+
+@pytest.mark.parametrize("what", ["start point", "end tangent", "radius"])
+def test_link_from_path_rejects_a_path_that_misses_its_frames(what):
+    from kinegami import InvalidParameterError
+
+    case = ref.CSC_3D
+    _, S, E = link_of(case)
+    path = solve_csc(case["p1"], case["d1"], case["p2"], case["d2"], 1.0)
+    r = 1.0
+    if what == "start point":
+        S = S.copy()
+        S[0, 3] += 1e-6
+    elif what == "end tangent":
+        E = E @ np.block([[rotation_matrix((0, 0, 1), 1e-6), np.zeros((3, 1))], [0, 0, 0, 1]])
+    else:
+        r = 1.1
+    with pytest.raises(InvalidParameterError, match="path"):
+        LinkCSC.from_path(r, S, E, path)

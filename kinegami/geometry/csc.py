@@ -15,6 +15,11 @@ left are two scalar equations in (a, b):
 solved by Newton's method with the analytic Jacobian from the reference's initial guess
 (u along p2 - p1), with a deterministic grid of restarts if that fails. Each link takes a few
 Newton steps of scalar arithmetic (tens of microseconds).
+
+``solve_csc_all`` returns every (short, short) path, sorted by length. It climbs a function of
+``u`` whose critical points are exactly the paths, and whose paths with s > 0 are strict
+maxima, from the summits of a fixed grid of directions (docs/theory/csc.md, which also says how
+many paths there can be: in practice never more than one).
 """
 
 from __future__ import annotations
@@ -268,15 +273,22 @@ def solve_csc(p1, d1, p2, d2, r: float) -> CSCPath | None:
     V = D - a * d1 - b * d2
     u = V / nV
     path = _build(r, p1, d1, p2, d2, a, b, u)
-    if path is None:
-        return None
-    # Near a U-turn (a or b ~ 1e6) a root with tiny angle residuals can still miss the end
-    # point: such a path is not one (chain.md 2.3's residual check, in lengths).
-    end, tangent = path.reconstruct_end()
-    miss = float(np.max(np.abs(end - p2)))
-    if miss > END_TOLERANCE * r + 1e-12 * nD * r or float(np.max(np.abs(tangent - d2))) > 1e-10:
+    if path is None or not _closes(path, p2, d2, r, nD):
         return None
     return path
+
+
+def _closes(path: CSCPath, p2: np.ndarray, d2: np.ndarray, r: float, nD: float) -> bool:
+    """True if following the path really ends at (p2, d2).
+
+    Near a U-turn (a or b ~ 1e6) a root with tiny angle residuals can still miss the end point:
+    such a path is not one (chain.md 2.3's residual check, in lengths).
+    """
+    end, tangent = path.reconstruct_end()
+    miss = float(np.max(np.abs(end - p2)))
+    return not (
+        miss > END_TOLERANCE * r + 1e-12 * nD * r or float(np.max(np.abs(tangent - d2))) > 1e-10
+    )
 
 
 def _centre_direction(u: np.ndarray, d: np.ndarray, c: float) -> np.ndarray:
@@ -312,3 +324,313 @@ def _build(r, p1, d1, p2, d2, a, b, u) -> CSCPath | None:
     k1 = np.cross(d1, w1)
     k2 = np.cross(d2, w2)
     return CSCPath(r, p1, d1, p2, d2, theta1, theta2, s, u, q1, q2, w1, w2, k1, k2)
+
+
+# --- every (short, short) path: solve_csc_all --------------------------------------------------
+#
+# docs/theory/csc.md explains the search. In short: with F(u) = D.u + f(theta1(u)) + f(theta2(u)),
+# f(t) = t - sin t, theta1(u) = angle(d1, u), theta2(u) = angle(u, d2), the paths are exactly the
+# critical points of F on the unit sphere of straight directions u, and every path with s > 0
+# is a strict local maximum (Hessian -s I - a T1 - b T2). So the search climbs F from every local
+# maximum of a fixed geodesic grid and polishes each summit with the Newton iteration above.
+
+#: Subdivision level of the icosahedral grid of directions (2562 points, ~4 degrees apart).
+SPHERE_LEVEL = 4
+#: Paths whose turns, straight lengths (/ r) and directions differ by less than this are one.
+DUPLICATE_TOLERANCE = 1e-9
+_ASCENT_ITERATIONS = 60
+_ASCENT_MAX_STEP = 0.5  # radians of u per step
+_CONE_LIMIT = 2.0 * math.atan(_MAX_TAN)  # a climb that reaches theta = pi - 2e-6 is a U-turn
+_CONE_REACH = 0.2  # rad: paths farther than this from a cone point are left to the grid
+
+
+def _icosphere(level: int) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (n, 3) of the subdivided icosahedron and a (n, 6) array of their neighbours.
+
+    The 12 vertices with five neighbours repeat their first neighbour in the sixth column.
+    """
+    t = (1.0 + math.sqrt(5.0)) / 2.0
+    verts = [
+        (-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
+        (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1),
+    ]  # fmt: skip
+    faces = [
+        (0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+        (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+        (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1),
+    ]  # fmt: skip
+    points = [
+        np.array(v, dtype=float) / math.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2) for v in verts
+    ]
+    midpoints: dict[tuple[int, int], int] = {}  # edge -> index of its midpoint
+
+    def middle(i: int, j: int) -> int:
+        key = (min(i, j), max(i, j))
+        if key not in midpoints:
+            m = points[i] + points[j]
+            points.append(m / np.linalg.norm(m))
+            midpoints[key] = len(points) - 1
+        return midpoints[key]
+
+    for _ in range(level):
+        finer = []
+        for i, j, k in faces:
+            ij, jk, ki = middle(i, j), middle(j, k), middle(k, i)
+            finer += [(i, ij, ki), (j, jk, ij), (k, ki, jk), (ij, jk, ki)]
+        faces = finer
+    neighbours: list[set[int]] = [set() for _ in points]
+    for i, j, k in faces:
+        neighbours[i] |= {j, k}
+        neighbours[j] |= {i, k}
+        neighbours[k] |= {i, j}
+    rows = [sorted(n) for n in neighbours]
+    table = np.array([row + row[:1] * (6 - len(row)) for row in rows], dtype=np.intp)
+    return np.array(points), table
+
+
+_SPHERE: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+
+
+def _sphere() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The grid (built once): points (n, 3), the same as (3, n), neighbours as (6, n)."""
+    global _SPHERE
+    if _SPHERE is None:
+        points, neighbours = _icosphere(SPHERE_LEVEL)
+        _SPHERE = (points, np.ascontiguousarray(points.T), np.ascontiguousarray(neighbours.T))
+    return _SPHERE
+
+
+def _grid_summits(D: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
+    """Grid directions where F is at least as high as at every grid neighbour (one pass)."""
+    points, columns, neighbours = _sphere()
+    dots = np.array((D, d1, d2)) @ columns  # D.u, d1.u, d2.u for every grid direction u
+    c = np.clip(dots[1:], -1.0, 1.0)
+    theta = np.arccos(c)
+    F = dots[0] + (theta - np.sqrt(1.0 - c * c)).sum(axis=0)  # sin theta = sqrt(1 - c^2)
+    summit = F >= F[neighbours].max(axis=0)
+    # a summit next to u = -d1 or -d2 is the cone point of F there (theta = pi), not a path
+    summit &= (theta < math.pi - 1e-3).all(axis=0)
+    return points[summit]
+
+
+def _cone_starts(D: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> list[np.ndarray]:
+    """Starts just beside the cone points u = -d1 and u = -d2 of F, where a summit can sit.
+
+    At -d1, F is a smooth part S(u) = D.u + f(theta2(u)) plus f(theta1) ~ pi - 2 rho, a cone of
+    slope 2 in the distance rho from -d1. When the gradient G of S there is longer than 2 the cone
+    point is no summit and F rises away from it along G up to a path, possibly closer to -d1 than
+    the grid spacing; a climb that starts on the far side of the cone could run into the cone, so
+    one climb starts on the near side, at rho = 1e-3 along G (F rises from there to the path).
+    """
+    starts = []
+    nD = float(np.linalg.norm(D))
+    for cone, other in ((-d1, d2), (-d2, d1)):
+        c = float(cone @ other)
+        if c < -1.0 + 1e-9:
+            continue  # d1 = d2: both cone points coincide; no smooth part to climb
+        tan_half = math.sqrt(max(0.0, 1.0 - c * c)) / (1.0 + c)
+        G = D - tan_half * other
+        G = G - float(G @ cone) * cone
+        nG = float(np.linalg.norm(G))
+        # s = D.u - sin theta1 - sin theta2 changes by at most (|D| + 2) per radian of u, so
+        # no path (s >= 0) lies within _CONE_REACH of the cone if s is too negative there
+        s_cone = float(D @ cone) - math.sqrt(max(0.0, 1.0 - c * c))
+        if nG > 1.99 and s_cone > -(nD + 2.0) * _CONE_REACH:
+            v = cone * math.cos(1e-3) + (G / nG) * math.sin(1e-3)
+            starts.append(v / np.linalg.norm(v))
+    return starts
+
+
+def _objective(D, d1, d2, u):
+    """F(u) and what its gradient and Hessian need at the unit direction ``u`` (tuples).
+
+    Returns (F, theta1, theta2, s, d1 x u, |d1 x u|, d2 x u, |d2 x u|), with
+    s = D.u - sin theta1 - sin theta2 (the straight length / r if u is a path's).
+    """
+    u0, u1, u2 = u
+    c1 = d1[0] * u0 + d1[1] * u1 + d1[2] * u2
+    c2 = d2[0] * u0 + d2[1] * u1 + d2[2] * u2
+    x1 = (d1[1] * u2 - d1[2] * u1, d1[2] * u0 - d1[0] * u2, d1[0] * u1 - d1[1] * u0)
+    x2 = (d2[1] * u2 - d2[2] * u1, d2[2] * u0 - d2[0] * u2, d2[0] * u1 - d2[1] * u0)
+    S1 = math.sqrt(x1[0] * x1[0] + x1[1] * x1[1] + x1[2] * x1[2])
+    S2 = math.sqrt(x2[0] * x2[0] + x2[1] * x2[1] + x2[2] * x2[2])
+    theta1 = math.atan2(S1, c1)
+    theta2 = math.atan2(S2, c2)
+    Du = D[0] * u0 + D[1] * u1 + D[2] * u2
+    F = Du + (theta1 - S1) + (theta2 - S2)
+    return F, theta1, theta2, Du - S1 - S2, x1, S1, x2, S2
+
+
+def _climb(D, d1, d2, u) -> tuple[float, float] | None:
+    """Climb F from the unit direction ``u`` to its summit; (a, b) there, or None at a cone.
+
+    Newton's method on the sphere with the analytic gradient P_u (D - a d1 - b d2) and Hessian
+    -s I - a t1 t1' - b t2 t2' (t_i the unit vector of d_i x u), shifted to stay negative
+    definite, steps of at most 0.5 rad, and halving until F does not decrease.
+    """
+    sqrt = math.sqrt
+    F, theta1, theta2, s, x1, S1, x2, S2 = _objective(D, d1, d2, u)
+    for _ in range(_ASCENT_ITERATIONS):
+        if theta1 >= _CONE_LIMIT or theta2 >= _CONE_LIMIT:
+            return None
+        a = math.tan(theta1 / 2.0)
+        b = math.tan(theta2 / 2.0)
+        u0, u1, u2 = u
+        W = (D[0] - a * d1[0] - b * d2[0], D[1] - a * d1[1] - b * d2[1],
+             D[2] - a * d1[2] - b * d2[2])  # fmt: skip
+        Wu = W[0] * u0 + W[1] * u1 + W[2] * u2
+        g = (W[0] - Wu * u0, W[1] - Wu * u1, W[2] - Wu * u2)
+        # tangent basis e, f at u
+        if abs(u0) < 0.9:
+            e = (0.0, u2, -u1)  # (1, 0, 0) x u
+        else:
+            e = (-u2, 0.0, u0)  # (0, 1, 0) x u
+        ne = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+        e = (e[0] / ne, e[1] / ne, e[2] / ne)
+        f = (u1 * e[2] - u2 * e[1], u2 * e[0] - u0 * e[2], u0 * e[1] - u1 * e[0])
+        ge = g[0] * e[0] + g[1] * e[1] + g[2] * e[2]
+        gf = g[0] * f[0] + g[1] * f[1] + g[2] * f[2]
+        h11 = h22 = -s
+        h12 = 0.0
+        for w, S, x in ((a, S1, x1), (b, S2, x2)):
+            if S > 0.0 and w > 0.0:
+                te = (x[0] * e[0] + x[1] * e[1] + x[2] * e[2]) / S
+                tf = (x[0] * f[0] + x[1] * f[1] + x[2] * f[2]) / S
+                h11 -= w * te * te
+                h12 -= w * te * tf
+                h22 -= w * tf * tf
+        # Newton step with the Hessian's eigenvalues made negative, -max(|lambda|, floor): a
+        # step that climbs, long along flat ridges (then cut by the step limit and the halving)
+        mean = 0.5 * (h11 + h22)
+        half = sqrt(0.25 * (h11 - h22) ** 2 + h12 * h12)
+        floor = 1e-9 * (abs(mean) + half + 1.0)
+        xe = xf = 0.0
+        for lam in (mean + half, mean - half):
+            q1, q2 = (h12, lam - h11) if abs(lam - h11) >= abs(lam - h22) else (lam - h22, h12)
+            nq = sqrt(q1 * q1 + q2 * q2)
+            if nq == 0.0:  # a multiple of the identity: any basis is an eigenbasis
+                q1, q2, nq = (1.0, 0.0, 1.0) if lam == mean + half else (0.0, 1.0, 1.0)
+            q1 /= nq
+            q2 /= nq
+            weight = (ge * q1 + gf * q2) / max(abs(lam), floor)
+            xe += weight * q1
+            xf += weight * q2
+        length = sqrt(xe * xe + xf * xf)
+        if length > _ASCENT_MAX_STEP:
+            xe *= _ASCENT_MAX_STEP / length
+            xf *= _ASCENT_MAX_STEP / length
+            length = _ASCENT_MAX_STEP
+        if length < 1e-13:
+            return a, b
+        for _ in range(30):
+            v = (u0 + xe * e[0] + xf * f[0], u1 + xe * e[1] + xf * f[1], u2 + xe * e[2] + xf * f[2])
+            nv = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+            v = (v[0] / nv, v[1] / nv, v[2] / nv)
+            state = _objective(D, d1, d2, v)
+            if state[0] >= F - 1e-15 * (abs(F) + 1.0):
+                break
+            xe *= 0.5
+            xf *= 0.5
+        else:
+            return a, b  # no step climbs any more: at the summit to rounding
+        u = v
+        F, theta1, theta2, s, x1, S1, x2, S2 = state
+    return math.tan(theta1 / 2.0), math.tan(theta2 / 2.0)
+
+
+def _same_path(p: CSCPath, q: CSCPath, tol_length: float) -> bool:
+    """True if two solved paths are one: equal turns, straight length and direction, or the same
+    single arc split differently between the two turns (straight part 0, one circle)."""
+    t = DUPLICATE_TOLERANCE
+    if (
+        abs(p.theta1 - q.theta1) <= t
+        and abs(p.theta2 - q.theta2) <= t
+        and abs(p.tMag - q.tMag) <= tol_length
+        and float(np.max(np.abs(p.tUnit - q.tUnit))) <= t
+    ):
+        return True
+    return (
+        _single_arc(p, tol_length)
+        and _single_arc(q, tol_length)
+        and (
+            abs((p.theta1 + p.theta2) - (q.theta1 + q.theta2)) <= t
+            and float(np.max(np.abs(_arc_axis(p) - _arc_axis(q)))) <= 1e-6
+        )
+    )
+
+
+def _single_arc(p: CSCPath, tol_length: float) -> bool:
+    """The path is one circular arc: no straight part and both turns about one axis."""
+    if p.tMag > tol_length:
+        return False
+    return (
+        p.theta1 <= DUPLICATE_TOLERANCE
+        or p.theta2 <= DUPLICATE_TOLERANCE
+        or float(np.max(np.abs(p.k1 - p.k2))) <= 1e-6
+    )
+
+
+def _arc_axis(p: CSCPath) -> np.ndarray:
+    return p.k1 if p.theta1 >= p.theta2 else p.k2
+
+
+def solve_csc_all(p1, d1, p2, d2, r: float) -> list[CSCPath]:
+    """Every (short, short) CSC path from (p1, d1) to (p2, d2) with turning radius ``r``.
+
+    Both turns in [0, pi), straight part >= 0, each path checked like :func:`solve_csc`'s (it
+    ends within ``END_TOLERANCE`` r of p2, its tangent within 1e-10 of d2). Paths that differ by
+    less than ``DUPLICATE_TOLERANCE`` in theta1, theta2, tMag / r and u are merged, and so are
+    the splits of one single arc. Sorted by length, then theta1, theta2 and u. The path
+    :func:`solve_csc` returns, when it returns one, is in the list as the very same object.
+
+    The search climbs the function F of docs/theory/csc.md from the summits of a fixed grid of
+    2562 directions (~4 degrees apart) and from beside its two cone points (turns of pi):
+    deterministic, and a few times the cost of solve_csc. Directions need not be normalised.
+    In practice the list has one path or none (docs/theory/csc.md: no second path was ever
+    seen, though none is proven impossible).
+
+    Examples
+    --------
+    >>> paths = solve_csc_all((0, 0, 0), (1, 0, 0), (10, 4, 0), (1, 0, 0), 1.0)
+    >>> [round(p.length, 6) for p in paths]
+    [10.789582]
+    """
+    first = solve_csc(p1, d1, p2, d2, r)
+    p1 = np.asarray(p1, dtype=float)
+    p2 = np.asarray(p2, dtype=float)
+    d1 = np.asarray(d1, dtype=float)
+    d2 = np.asarray(d2, dtype=float)
+    d1 = d1 / math.sqrt(float(d1 @ d1))
+    d2 = d2 / math.sqrt(float(d2 @ d2))
+    D = (p2 - p1) / r
+    nD = math.sqrt(float(D @ D))
+    paths = [] if first is None else [first]
+    if nD < 1e-12 and float(d1 @ d2) > 1.0 - 1e-15:
+        return paths  # identical frames: only the empty path (docs/theory/csc.md)
+    tol_length = DUPLICATE_TOLERANCE * r + 1e-12 * nD * r
+    d1t = (float(d1[0]), float(d1[1]), float(d1[2]))
+    d2t = (float(d2[0]), float(d2[1]), float(d2[2]))
+    Dt = (float(D[0]), float(D[1]), float(D[2]))
+    for start in [*_grid_summits(D, d1, d2), *_cone_starts(D, d1, d2)]:
+        summit = _climb(Dt, d1t, d2t, (float(start[0]), float(start[1]), float(start[2])))
+        if summit is None:
+            continue
+        found = _accepted(_newton(Dt, d1t, d2t, *summit))
+        if found is None:
+            continue
+        _, a, b, nV = found
+        theta1, theta2, tMag = 2.0 * math.atan(a), 2.0 * math.atan(b), r * (nV - a - b)
+        if any(
+            abs(theta1 - p.theta1) <= 1e-12 + DUPLICATE_TOLERANCE
+            and abs(theta2 - p.theta2) <= 1e-12 + DUPLICATE_TOLERANCE
+            and abs(tMag - p.tMag) <= tol_length
+            for p in paths
+        ):
+            continue  # a path found already (its u agrees too: u is fixed by a and b)
+        path = _build(r, p1, d1, p2, d2, a, b, (D - a * d1 - b * d2) / nV)
+        if path is None or not _closes(path, p2, d2, r, nD):
+            continue
+        if not any(_same_path(path, known, tol_length) for known in paths):
+            paths.append(path)
+    paths.sort(key=lambda p: (p.length, p.theta1, p.theta2, *p.tUnit.tolist()))
+    return paths
