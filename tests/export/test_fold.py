@@ -838,10 +838,10 @@ SNAPPED_CHAINS = {
     "b6_elbow_column": (
         4,
         ["W", "R"],
-        [
-            ((-0.69, -2.56, 0.94), (3.9, -1.5, -3.9)),
-            ((0.72, -2.24, 2.35), (-3.8, -1.4, -0.1)),
-            ((-2.29, -1.09, -1.35), (2.1, 4.9, -1.4)),
+        [  # (safe placement that stays clear changed the earlier search find; found again)
+            ((2.26, -1.37, -0.33), (-4.4, -5.0, -3.0)),
+            ((-0.98, 2.65, 2.42), (-0.2, -0.5, 1.7)),
+            ((2.22, -1.01, 1.82), (-1.0, 0.9, 2.4)),
         ],
     ),
     # vertices snapped onto the seam (spec 2.1) and no B6 column (former error 5.2e-6 r)
