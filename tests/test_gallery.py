@@ -84,7 +84,7 @@ PUMA_560 = [
     (0, 0, 0, 56.25),
 ]
 PUMA_COMPACT_LENGTH = 1714.666427  # from_dh(PUMA_560, 6, 25) before the slides (mm)
-PUMA_SHORTENED_LENGTH = 1367.768238
+PUMA_SHORTENED_LENGTH = 1367.768999  # clearance-aware shortening (was 1367.768238)
 LIMB_LENGTH = 143.839746  # the straight tube of the spherical limb (mm)
 
 #: The table of docs/gallery.md: joints, structural joints, total path length, sheet w x h
