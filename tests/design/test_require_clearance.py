@@ -25,7 +25,7 @@ FIXED = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientat
 #: A revolute state (degrees) at which the fold-back chain passes through itself.
 COLLIDING_DEG = 20.0
 #: A DH table (degrees) whose compact placement brings link 2 back through link 1.
-COLLIDING_DH = [[4, 162, -1.4, 1.8], [-65, 162, -0.3, 1.3], [-31, -90, -1.9, 1.0]]
+COLLIDING_DH = [[149, 2, 1.1, -0.8], [143, 96, 0.1, -1.4], [-149, 167, -0.4, -0.8]]
 
 
 def frame(p, x) -> np.ndarray:
@@ -131,7 +131,9 @@ def test_a_dh_table_that_places_into_itself_fails_when_clearance_is_required():
     with pytest.raises(DesignError) as caught:
         chain_from_dict(dh_design(requireClearance=True))
     message = str(caught.value)
-    assert message.startswith("dh: the chain of the DH table passes through itself (link 1")
+    assert message.startswith(
+        "dh: the chain of the DH table passes through itself (joint 0, RevoluteJoint"
+    )
     assert "requireClearance" in message
 
 
