@@ -68,8 +68,8 @@ SIMULATOR_HANDEDNESS = 0.9
 
 #: Gallery designs whose shortest creases (0.005 mm, elbow columns with a tiny tuck) make the
 #: simulator's time step, which scales with the square root of the shortest edge, some 30 times
-#: smaller: their error is still above the limit after the step budget (measured: the spherical
-#: joint's FOLD at 5.0 %, the spherical limb's at 3.3 % after 60 000 steps).
+#: smaller: their error is still above the limit after the step budget (measured after 60 000
+#: steps, FOLD and SVG: spherical joint 5.0 and 4.8 %, limb 3.3 and 2.7 %, series 4.9 and 5.1 %).
 SIMULATOR_SLOW_TO_SETTLE = {
     name: "creases of 0.005 mm: the simulator's time step is ~30 times smaller, so the error "
     "is still above 2 % after 60 000 steps"
