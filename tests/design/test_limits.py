@@ -14,6 +14,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from kinegami import ClearanceWarning
 from kinegami.design import (
     DesignError,
     chain_from_dict,
@@ -425,6 +426,8 @@ def test_designs_within_the_bounds_never_warn_or_crash(document):
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        # a design that passes through itself is reported, not a crash
+        warnings.simplefilter("ignore", ClearanceWarning)
         try:
             chain = chain_from_dict(document)
             check_pattern(chain)

@@ -42,7 +42,7 @@ def test_schema_and_loader_agree_on_names():
     top = design.design_schema()["properties"]
     assert set(top) == {
         "format", "version", "name", "description", "units", "angleUnits", "numSides", "r",
-        "maxAnglePerElbow", "twistPortion", "joints", "dh", "edits", "states",
+        "maxAnglePerElbow", "twistPortion", "joints", "dh", "edits", "states", "requireClearance",
     }  # fmt: skip
     assert top["units"]["enum"] == list(design.UNITS)
 
