@@ -390,7 +390,7 @@ def test_solution_scales_with_r(r, scale, p1, offset, d1, d2):
         [b.theta1, b.theta2, b.tMag / (r * scale)],
         [a.theta1, a.theta2, a.tMag / r],
         rtol=0,
-        atol=1e-9,
+        atol=2e-9,  # a straight part of ~3e-7 r next to near-pi turns moves by 1.2e-9 r (find)
     )
 
 
