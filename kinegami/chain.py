@@ -1,4 +1,6 @@
-"""KinematicChain: append joints, place them, edit them, set their states (chain.md 4-5).
+"""KinematicChain: append joints, place them, edit them, set their states.
+
+See docs/theory/chain.md (frames, balls, edits) and docs/placement.md (placement).
 
 The chain holds joints in world coordinates and, for every joint i >= 1, the link ``Links[i]``
 from joint i-1's distal Dubins frame to joint i's proximal Dubins frame (``Links[0]`` is the
@@ -165,8 +167,8 @@ class KinematicChain:
             ``"modified"`` (Craig: joint i moves about z of frame i). See :mod:`kinegami.dh`.
         jointTypes : None (all revolute), a string such as ``"RRP"``, or a sequence of
             ``"revolute"``/``"prismatic"``, one per row.
-        placement : ``"compact"`` (default; chain.md 4.4, DH roll kept) or ``"safe"``
-            (chain.md 4.3; never fails). Joints only slide along their DH axes.
+        placement : ``"compact"`` (default; docs/placement.md, DH roll kept) or ``"safe"``
+            (docs/placement.md; never fails). Joints only slide along their DH axes.
         totalBendingAngle, numSinkLayers : of every revolute joint (default pi, 1).
         neutralLength, numLayers, coneAngle : of every prismatic joint (default 3r, 3, pi/4).
         endTip : add an EndTip on the tool frame (standard: frame n; modified: frame n
@@ -273,7 +275,7 @@ class KinematicChain:
 
     @staticmethod
     def _ball_of(joints: Sequence[Joint], links: Sequence[LinkCSC]) -> Ball:
-        """The chain ball in the reference's recompute order (chain.md 3.3)."""
+        """The chain ball in the reference's recompute order (docs/theory/chain.md §2)."""
         ball = joints[0].boundingBall()
         for joint in joints[1:]:
             ball = merge_balls(ball, joint.boundingBall())
@@ -307,7 +309,7 @@ class KinematicChain:
         self._joints, self._links, self._ball = joints, links, ball
 
     def recomputeBoundingBall(self) -> Ball:
-        """Recompute the ball from every joint and link (chain.md 3.3) and return it."""
+        """Recompute the ball from every joint and link (docs/theory/chain.md §2) and return it."""
         self._ball = self._ball_of(self._joints, self._links)
         return self._ball
 
@@ -381,7 +383,7 @@ class KinematicChain:
         return len(joints) - 1
 
     def _compact_extension(self, parent: Joint, joint: Joint, fixedOrientation: bool):
-        """Compact placement (chain.md 4.4): the extended lists and ball; raises on failure.
+        """Compact placement (docs/placement.md): the extended lists and ball; raises on failure.
 
         The joint slides along its axis to the point the published rule picks. If no link
         reaches it there, or its link passes through the chain, the clearance boundary on the
@@ -428,10 +430,10 @@ class KinematicChain:
         return joints, links, ball
 
     def _safe_extension(self, parent: Joint, joint: Joint):
-        """Safe placement: the extended lists and ball (chain.md 4.3 and docs/placement.md).
+        """Safe placement: the extended lists and ball (docs/placement.md).
 
         Candidates, in order: the published rule with the joint's path direction as given, then
-        reversed (chain.md 4.3 step 6). The first that succeeds, stays close (ball growth at
+        reversed (docs/placement.md). The first that succeeds, stays close (ball growth at
         most SAFE_GROWTH_LIMIT r, new links at most SAFE_PATH_LIMIT r long) and does not pass
         through the chain (its new parts clear of every part before them, docs/clearance.md)
         is kept, so the published results are reproduced wherever the published rule works.
@@ -518,7 +520,10 @@ class KinematicChain:
 
     # --- edits ---------------------------------------------------------------------------------
     def _moved(self, j: int, T: np.ndarray, propagate: bool):
-        """New joint and link lists with joint j moved by world transform T (chain.md 5.1)."""
+        """New joint and link lists with joint j moved by world transform T.
+
+        See docs/theory/chain.md §5.
+        """
         joints = list(self._joints)
         links = list(self._links)
         joints[j] = joints[j].transformed(T)
@@ -726,7 +731,7 @@ class KinematicChain:
 
     # --- output --------------------------------------------------------------------------------
     def creasePattern(self, twistPortion: float = 0.2):
-        """The chain's tubular crease pattern (patterns.md 4.3) as a TubularPattern."""
+        """The chain's tubular crease pattern (docs/fabrication.md) as a TubularPattern."""
         from kinegami.pattern import TubularPattern
 
         twistPortion = check_twist_portion(twistPortion)

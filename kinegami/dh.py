@@ -1,4 +1,4 @@
-"""Chains from Denavit-Hartenberg tables (chain.md section 8).
+"""Chains from Denavit-Hartenberg tables (docs/theory/chain.md §8).
 
 A DH table has one row (theta, alpha, a, d) per joint; angles in radians, lengths in the chain's
 unit. Two conventions are supported:
@@ -11,7 +11,7 @@ unit. Two conventions are supported:
 
 The joints are placed on those axes: joint k of the chain (0-based) moves about the z axis of the
 k-th joint frame returned by :func:`dh_joint_frames`. Placement may slide a joint along its axis
-(compact or safe placement) and compact placement keeps the DH roll (chain.md 8.5).
+(compact or safe placement) and compact placement keeps the DH roll (docs/theory/chain.md §8).
 """
 
 from __future__ import annotations
@@ -117,7 +117,7 @@ def dh_tool_frame(table, convention: str = "standard") -> np.ndarray:
     """The frame an end tip is placed on, its z axis pointing out of the chain.
 
     Standard: the tool frame G_n. Modified: G_n turned so that its z axis is G_n's x axis
-    (the MATLAB fingertip 'x' of chain.md 8.5), since G_n's z is the last joint's axis.
+    (the MATLAB fingertip 'x', docs/theory/chain.md §8), since G_n's z is the last joint's axis.
     """
     frames = dh_frames(table, convention)
     if convention == "standard":
@@ -176,7 +176,7 @@ def chain_from_dh(
     tipLength: float | None = None,
     maxAnglePerElbow: float = math.pi / 2,
 ) -> KinematicChain:
-    """Build a chain whose joints move about the axes of a DH table (chain.md 8.5).
+    """Build a chain whose joints move about the axes of a DH table (docs/theory/chain.md §8).
 
     See :meth:`kinegami.chain.KinematicChain.from_dh`. Raises NoPathError (a ValueError) when
     compact placement cannot link a joint; nothing is returned half-built.

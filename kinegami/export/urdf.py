@@ -22,8 +22,8 @@ Frames
     kinematics at a configuration q (one value per URDF joint, i.e. per movable chain joint in
     chain order) reproduces the chain after ``chain.setJointStates`` with those states: a
     revolute joint turns everything after it about its z axis through its centre, a prismatic
-    joint slides it along z (chain.md 1.2). The exported zero configuration is the chain with
-    all states 0, whatever the chain's current states are.
+    joint slides it along z (docs/theory/chain.md §1). The exported zero configuration is the
+    chain with all states 0, whatever the chain's current states are.
 
 Geometry
     With ``meshes=True`` (default) every part of :mod:`kinegami.export.mesh` (prismatic joints

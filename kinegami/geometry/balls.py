@@ -1,4 +1,4 @@
-"""Bounding balls and their greedy merge (chain.md section 3)."""
+"""Bounding balls and their greedy merge (docs/theory/chain.md §2)."""
 
 from __future__ import annotations
 
@@ -45,8 +45,9 @@ class Ball:
 
 
 def merge_balls(b1: Ball, b2: Ball) -> Ball:
-    """The smallest ball containing two balls (chain.md 3.1; order of the arguments matters
-    only through which one is called "smaller" when the radii tie, as in the reference)."""
+    """The smallest ball containing two balls (docs/theory/chain.md §2; the order of the
+    arguments matters only through which one is "smaller" when the radii tie, as in the
+    reference)."""
     small, large = (b1, b2) if b1.r <= b2.r else (b2, b1)
     v = large.c - small.c
     dist = math.sqrt(float(v @ v))

@@ -1,9 +1,11 @@
-"""3D CSC Dubins paths of turning radius r between two frames (chain.md section 2).
+"""3D CSC Dubins paths of turning radius r between two frames.
+
+See docs/theory/csc.md and docs/theory/chain.md §3.
 
 A CSC path leaves ``p1`` along ``d1``, turns on a circle of radius r through ``theta1`` until
 its tangent is ``u``, runs straight for ``tMag`` along ``u`` and turns through ``theta2`` onto
 ``d2``, ending at ``p2``. Only the (short, short) family matters to kinegami: links reject turns
-of pi or more, and long turns are always more than pi (chain.md 2.2 [FIX]).
+of pi or more, and long turns are always more than pi (docs/theory/chain.md §3).
 
 The solver. With the scaled tangent lengths a = tan(theta1/2) and b = tan(theta2/2), the
 closure equation ``p2 - p1 = r a (d1 + u) + s u + r b (u + d2)`` says that ``u`` is the unit
@@ -256,7 +258,7 @@ def solve_csc(p1, d1, p2, d2, r: float) -> CSCPath | None:
         # Identical frames: the empty path (the root's link).
         return _build(r, p1, d1, p2, d2, 0.0, 0.0, d1.copy())
 
-    # The reference's initial guess: u along p2 - p1 (chain.md 2.2). Its root is unique in
+    # The reference's initial guess: u along p2 - p1 (docs/theory/chain.md §3). Its root is unique in
     # practice; only when it fails are the best points of a grid tried as restarts.
     u0 = D / nD if nD > 0.0 else d1
     g1 = math.atan2(float(np.linalg.norm(np.cross(d1, u0))), float(d1 @ u0))
@@ -282,7 +284,7 @@ def _closes(path: CSCPath, p2: np.ndarray, d2: np.ndarray, r: float, nD: float) 
     """True if following the path really ends at (p2, d2).
 
     Near a U-turn (a or b ~ 1e6) a root with tiny angle residuals can still miss the end point:
-    such a path is not one (chain.md 2.3's residual check, in lengths).
+    such a path is not one (the residual check of docs/theory/chain.md §3, in lengths).
     """
     end, tangent = path.reconstruct_end()
     miss = float(np.max(np.abs(end - p2)))
