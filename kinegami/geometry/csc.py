@@ -258,8 +258,8 @@ def solve_csc(p1, d1, p2, d2, r: float) -> CSCPath | None:
         # Identical frames: the empty path (the root's link).
         return _build(r, p1, d1, p2, d2, 0.0, 0.0, d1.copy())
 
-    # The reference's initial guess: u along p2 - p1 (docs/theory/chain.md §3). Its root is unique in
-    # practice; only when it fails are the best points of a grid tried as restarts.
+    # The reference's initial guess: u along p2 - p1 (docs/theory/chain.md §3). Its root is
+    # unique in practice; only when it fails are the best points of a grid tried as restarts.
     u0 = D / nD if nD > 0.0 else d1
     g1 = math.atan2(float(np.linalg.norm(np.cross(d1, u0))), float(d1 @ u0))
     g2 = math.atan2(float(np.linalg.norm(np.cross(u0, d2))), float(u0 @ d2))
