@@ -63,7 +63,6 @@ __all__ = [
     "CapsuleModel",
     "capsule_model",
     "joint_label",
-    "appended_clearance",
     "deepest_overlap",
     "worst_overlap",
     "Overlap",
@@ -410,6 +409,11 @@ def _joint_rows(joint, j: int, r: float, text: str) -> tuple:
     return tuple(out.rows)
 
 
+def _joint_row_count(joint, j: int, r: float) -> int:
+    """How many capsules joint j has (0 for a waypoint, 2 for a revolute joint, else 1)."""
+    return len(_joint_rows(joint, j, r, f"joint {j}, {type(joint).__name__}"))
+
+
 def _chain_rows(joints, links, r: float, names, twistPortion: float) -> tuple[list, list]:
     """All capsule rows in order along the tube, and the index of every joint's first row."""
     rows: list = []
@@ -434,45 +438,6 @@ def _kink_prefix(joints) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(kinks)])
 
 
-def appended_clearance(joints, links, r: float, first_new: int) -> float:
-    """Smallest clearance between the parts of joints ``first_new``... (and the links into
-    them) and every part before them, at the current configuration, by the pair rule of
-    :mod:`kinegami.clearance`; inf when no such pair is tested.
-
-    Used by placement to check an extension before it is accepted: the chain before
-    ``first_new`` is not re-checked.
-    """
-    rows, first = _chain_rows(joints, links, r, None, 0.2)
-    if not rows:
-        return math.inf
-    # the new parts start with the link into joint first_new
-    start_new = first[first_new - 1] + len(
-        _joint_rows(joints[first_new - 1], first_new - 1, r,
-                    f"joint {first_new - 1}, {type(joints[first_new - 1]).__name__}")
-    )  # fmt: skip
-    if start_new >= len(rows):
-        return math.inf
-    a = np.array([row[0] for row in rows])
-    b = np.array([row[1] for row in rows])
-    body = np.array([row[2] for row in rows], dtype=np.int64)
-    tau = np.array([row[4] for row in rows]) + _kink_prefix(joints)[body + 1]
-    S = len(rows)
-    i, j = np.meshgrid(np.arange(S), np.arange(start_new, S), indexing="ij")
-    i, j = i.ravel(), j.ravel()
-    keep = (i < j) & (tau[j] - tau[i] >= math.pi - TURN_TOLERANCE)
-    if not keep.any():
-        return math.inf
-    i, j = i[keep], j[keep]
-    # capsule balls first
-    centre = 0.5 * (a + b)
-    half = 0.5 * np.linalg.norm(b - a, axis=1)
-    gap = np.linalg.norm(centre[i] - centre[j], axis=1) - half[i] - half[j]
-    bound = max(float(gap.min()), 2.0 * r)
-    near = gap <= bound
-    d, _, _ = segment_distances(a[i[near]], b[i[near]], a[j[near]], b[j[near]])
-    return float(d.min()) - 2.0 * r
-
-
 @dataclass(frozen=True)
 class Overlap:
     """The deepest overlap of a chain: its clearance (< 0, chain units) and the two parts."""
@@ -485,17 +450,24 @@ class Overlap:
         return f"{self.first} and {self.second} overlap by {-self.clearance:.4g}"
 
 
-def worst_overlap(joints, links, r: float, names=None) -> Overlap | None:
+def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overlap | None:
     """The deepest overlap of a chain at its current configuration (the pair rule of
     :mod:`kinegami.clearance`), or None when no tested capsules overlap.
 
     A fast test for placement, edits and searches: only pairs whose capsule balls overlap are
-    measured exactly.
+    measured exactly. With ``since`` = k > 0 only pairs with a part of joint k or later (or of
+    the link into it) are measured: placement checks an extension without re-checking the
+    chain it extends.
     """
-    rows, _ = _chain_rows(joints, links, r, None if names is None else tuple(names), 0.2)
+    rows, first_rows = _chain_rows(joints, links, r, None if names is None else tuple(names),
+                                   0.2)  # fmt: skip
     S = len(rows)
     if S < 2:
         return None
+    # the parts from the link into joint `since` on: the rows after joint since - 1's own
+    start_new = 0
+    if since > 0:
+        start_new = first_rows[since - 1] + _joint_row_count(joints[since - 1], since - 1, r)
     a = np.array([row[0] for row in rows])
     b = np.array([row[1] for row in rows])
     body = np.array([row[2] for row in rows], dtype=np.int64)
@@ -504,6 +476,7 @@ def worst_overlap(joints, links, r: float, names=None) -> Overlap | None:
     first = np.maximum(
         np.searchsorted(tau, tau + math.pi - TURN_TOLERANCE, side="left"), np.arange(S) + 1
     )
+    first = np.maximum(first, start_new)
     counts = np.maximum(S - first, 0)
     total = int(counts.sum())
     if total == 0:

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from kinegami.bodies import CONTACT_TOLERANCE, appended_clearance, worst_overlap
+from kinegami.bodies import worst_overlap
 from kinegami.errors import (
     ClearanceWarning,
     InvalidParameterError,
@@ -409,8 +409,7 @@ class KinematicChain:
                 error = error or failure
                 continue
             # the rule's choice if it is clear of the chain, else the other side if that is
-            gap = appended_clearance(extended[0], extended[1], self.r, len(self._joints))
-            if gap >= -CONTACT_TOLERANCE * self.r:
+            if worst_overlap(extended[0], extended[1], self.r, since=len(self._joints)) is None:
                 return extended
             first = first or extended
         if first is not None:
@@ -448,8 +447,7 @@ class KinematicChain:
 
         def clear(extended) -> bool:
             joints, links, _ = extended
-            gap = appended_clearance(joints, links, self.r, first_new)
-            return gap >= -CONTACT_TOLERANCE * self.r
+            return worst_overlap(joints, links, self.r, since=first_new) is None
 
         fallbacks = []
         for reverse in (False, True):
