@@ -15,23 +15,16 @@ checked against the capsules moved by the translations of the prismatic joints b
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from export.test_mesh import random_chains  # the mesh tests' random chains
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from scipy.spatial.transform import Rotation
 
 from kinegami import (
-    SE3,
-    EndTip,
-    KinematicChain,
     PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
 )
 from kinegami.bodies import capsule_model
 from kinegami.design import load_design
@@ -155,38 +148,10 @@ def test_the_folded_prismatic_joint_is_longer_than_its_capsule():
 
 
 # --- random chains ---------------------------------------------------------------------------
-# the generators of tests/export/test_mesh.py. Folded forms are checked on the gallery only:
+# random chains from tests/export/test_mesh.py. Folded forms are checked on the gallery only:
 # on random safe chains the folded form drifts from the kinematic model by up to ~1e-3 r
 # (a 12-joint chain: 7.4e-4 r at its end tip), more than the 1e-6 r of these checks; see the
 # folded form's omissions (turns and twists <= 0.01 rad, tubes < 1e-4 b) in pattern/folded.py.
-
-quaternions = st.tuples(*[st.floats(-1, 1)] * 4).filter(lambda q: math.hypot(*q) > 0.1)
-translations = st.tuples(*[st.floats(-4, 4)] * 3)
-
-
-@st.composite
-def random_chains(draw, max_joints: int = 4):
-    """A StartTip, revolute / prismatic / waypoint joints with random poses (safe placement)
-    and maybe an EndTip; r in [0.5, 5], n in {4, 6, 8}."""
-    r = draw(st.floats(0.5, 5))
-    n = draw(st.sampled_from([4, 6, 8]))
-    chain = KinematicChain(StartTip(n, r, SE3(), 1.5 * r))
-    for _ in range(draw(st.integers(1, max_joints))):
-        T = np.eye(4)
-        T[:3, :3] = Rotation.from_quat(draw(quaternions)).as_matrix()
-        T[:3, 3] = np.array(draw(translations)) * r
-        kind = draw(st.sampled_from("RPW"))
-        if kind == "R":
-            joint = RevoluteJoint(n, r, draw(st.floats(0.5, 3.0)), T)
-        elif kind == "P":
-            joint = PrismaticJoint(n, r, 2 * r, 2, draw(st.floats(math.pi / 6, 1.4)), T)
-        else:
-            joint = Waypoint(n, r, T, pathIndex=draw(st.sampled_from([0, 1, 2])))
-        chain.append(joint)
-    if draw(st.booleans()):
-        chain.append(EndTip(n, r, SE3.Trans(0, 0, 3 * r), 1.5 * r))
-    return chain
-
 
 @settings(deadline=None, max_examples=30)
 @given(chain=random_chains(), data=st.data())
