@@ -30,7 +30,7 @@ from pathlib import Path
 from kinegami import __version__, _startup
 from kinegami._startup import INTERRUPTED
 from kinegami.errors import KinegamiError
-from kinegami.validation import shown
+from kinegami.validation import shown, shown_path
 
 #: Millimetres per design length unit.
 UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
@@ -328,26 +328,26 @@ def _check_output(out: Path) -> None:
             return  # the rest is created by the build
         except OSError:
             return  # not ours to judge (permissions...): the build reports what fails
-        shown_path = shown(str(path))
+        named = shown_path(path)
         if stat.S_ISLNK(info.st_mode):
             try:
                 info = os.stat(path)
             except OSError as error:
                 if error.errno == errno.ELOOP:
                     raise CommandError(
-                        f"-o: {shown_path} is a symbolic link loop (following it never ends); "
+                        f"-o: {named} is a symbolic link loop (following it never ends); "
                         "give a folder"
                     ) from None
                 if error.errno == errno.ENOENT:
-                    target = shown(os.readlink(path))
+                    target = shown_path(os.readlink(path))
                     raise CommandError(
-                        f"-o: {shown_path} is a symbolic link to {target}, which does not "
+                        f"-o: {named} is a symbolic link to {target}, which does not "
                         "exist (dangling); create that folder or give another"
                     ) from None
                 return
         if not stat.S_ISDIR(info.st_mode):
             where = "exists and is not a folder" if path == out else "is not a folder"
-            raise CommandError(f"-o: {shown_path} {where}")
+            raise CommandError(f"-o: {named} {where}")
 
 
 def cmd_build(args: argparse.Namespace) -> int:
@@ -643,7 +643,7 @@ def _check_design_output(out: Path, design: str, force: bool) -> None:
     """Fail before the (long) compaction when ``-o`` cannot be written: not a .json name, a
     folder or a special file, a file or an unwritable folder on the way, or the design itself
     without --force."""
-    shown_out = shown(str(out))
+    shown_out = shown_path(out)
     if out.suffix.lower() != ".json":
         raise CommandError(f"-o: {shown_out}: a design file name must end in .json")
     try:
@@ -670,9 +670,9 @@ def _check_design_output(out: Path, design: str, force: bool) -> None:
     while not folder.exists() and folder != folder.parent:
         folder = folder.parent  # missing folders are created when writing
     if not folder.is_dir():
-        raise CommandError(f"-o: {shown(str(folder))} is not a folder")
+        raise CommandError(f"-o: {shown_path(folder)} is not a folder")
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise CommandError(f"-o: cannot write in {shown(str(folder))}: permission denied")
+        raise CommandError(f"-o: cannot write in {shown_path(folder)}: permission denied")
 
 
 def _compaction_lines(job: BuildJob, before: BuildJob | None = None) -> list[str]:

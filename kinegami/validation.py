@@ -51,6 +51,16 @@ def shorten(text: str, limit: int = SHOWN_LIMIT) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+def shown_path(path, limit: int = SHOWN_LIMIT) -> str:
+    """A file path for messages, at most ``limit`` characters: a long one keeps its start and
+    its end (the name that usually matters) with "..." between them."""
+    text = repr(" ".join(str(path).split()))
+    if len(text) <= limit:
+        return text
+    tail = (limit - 3) * 2 // 3
+    return text[: limit - 3 - tail] + "..." + text[-tail:]
+
+
 def shown(value, limit: int = SHOWN_LIMIT) -> str:
     """A one-line ``repr`` of a user value for messages, at most ``limit`` characters.
 

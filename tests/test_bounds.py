@@ -25,7 +25,7 @@ from kinegami import (
     Waypoint,
 )
 from kinegami.dh import dh_transform
-from kinegami.validation import LENGTH_FACTOR, R_MAX, R_MIN, shorten, shown
+from kinegami.validation import LENGTH_FACTOR, R_MAX, R_MIN, shorten, shown, shown_path
 
 HUGE = 10**400  # a Python int beyond the float range
 ENORMOUS = 10**5000  # beyond int -> str conversion (4300 digits)
@@ -231,3 +231,12 @@ def test_shown_values_are_short():
         deep = [deep]
     assert len(shown(deep)) <= 80
     assert shorten("a\nb " * 100, 10) == "a b a b..."
+
+
+def test_long_paths_in_messages_keep_their_name():
+    """A path too long to show keeps its start and its end, so the name the user gave stays."""
+    path = "/check/work/" + "/".join(["pytest-of-root-popen-gw1"] * 6) + "/file.txt/out.json"
+    text = shown_path(path)
+    assert len(text) == 80 and text.startswith("'/check/") and text.endswith("file.txt/out.json'")
+    assert "..." in text
+    assert shown_path("/tmp/a b\nc") == "'/tmp/a b c'"
