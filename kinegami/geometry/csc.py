@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinegami.geometry.frames import any_perpendicular, rotation_matrix
+from kinegami.geometry.frames import any_perpendicular, cross3, rotation_matrix
 
 #: Newton stops when both angle residuals are below this (radians).
 ANGLE_TOLERANCE = 1e-13
@@ -121,7 +121,7 @@ class CSCPath:
         """End point and tangent obtained by actually following arc 1, the straight and arc 2."""
         q1, u = self.end_of_arc1()
         q2 = q1 + self.tMag * u
-        centre2 = q2 + self.r * np.cross(self.k2, u)
+        centre2 = q2 + self.r * cross3(self.k2, u)
         R2 = rotation_matrix(self.k2, self.theta2)
         return centre2 + R2 @ (q2 - centre2), R2 @ u
 
@@ -261,8 +261,8 @@ def solve_csc(p1, d1, p2, d2, r: float) -> CSCPath | None:
     # The reference's initial guess: u along p2 - p1 (docs/theory/chain.md §3). Its root is
     # unique in practice; only when it fails are the best points of a grid tried as restarts.
     u0 = D / nD if nD > 0.0 else d1
-    g1 = math.atan2(float(np.linalg.norm(np.cross(d1, u0))), float(d1 @ u0))
-    g2 = math.atan2(float(np.linalg.norm(np.cross(u0, d2))), float(u0 @ d2))
+    g1 = math.atan2(float(np.linalg.norm(cross3(d1, u0))), float(d1 @ u0))
+    g2 = math.atan2(float(np.linalg.norm(cross3(u0, d2))), float(u0 @ d2))
     best = _accepted(_newton(Dt, d1t, d2t, min(math.tan(g1 / 2), 1e3), min(math.tan(g2 / 2), 1e3)))
     if best is None:
         for a0, b0 in _grid_starts(D, d1, d2):
@@ -310,8 +310,8 @@ def _centre_direction(u: np.ndarray, d: np.ndarray, c: float) -> np.ndarray:
 def _build(r, p1, d1, p2, d2, a, b, u) -> CSCPath | None:
     c1 = float(d1 @ u)
     c2 = float(d2 @ u)
-    cr1 = np.cross(d1, u)
-    cr2 = np.cross(u, d2)
+    cr1 = cross3(d1, u)
+    cr2 = cross3(u, d2)
     theta1 = math.atan2(float(np.linalg.norm(cr1)), c1)
     theta2 = math.atan2(float(np.linalg.norm(cr2)), c2)
     if theta1 >= math.pi or theta2 >= math.pi:
@@ -323,8 +323,8 @@ def _build(r, p1, d1, p2, d2, a, b, u) -> CSCPath | None:
         s = 0.0
     w1 = _centre_direction(u, d1, c1)
     w2 = -_centre_direction(u, d2, c2)
-    k1 = np.cross(d1, w1)
-    k2 = np.cross(d2, w2)
+    k1 = cross3(d1, w1)
+    k2 = cross3(d2, w2)
     return CSCPath(r, p1, d1, p2, d2, theta1, theta2, s, u, q1, q2, w1, w2, k1, k2)
 
 

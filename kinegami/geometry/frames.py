@@ -15,6 +15,14 @@ import numpy as np
 WRAP_SNAP = 1e-5
 
 
+def cross3(a, b) -> np.ndarray:
+    """a x b of two 3-vectors: np.cross's arithmetic (bit for bit), without its per-call
+    overhead (about 20x faster on single vectors, which the CSC solver builds by thousands)."""
+    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
+    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 def translation(v) -> np.ndarray:
     """Trans(v): the 4x4 translation by the 3-vector ``v``."""
     T = np.eye(4)
@@ -103,7 +111,7 @@ def angle_between(a, b) -> float:
     """Unsigned angle in [0, pi] between two vectors (atan2 of |a x b| and a.b)."""
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)
-    return math.atan2(float(np.linalg.norm(np.cross(a, b))), float(a @ b))
+    return math.atan2(float(np.linalg.norm(cross3(a, b))), float(a @ b))
 
 
 def signed_angle(a, b, normal) -> float:
@@ -111,7 +119,7 @@ def signed_angle(a, b, normal) -> float:
     a = unit(a)
     b = unit(b)
     n = unit(normal)
-    return math.atan2(float(np.cross(a, b) @ n), float(a @ b))
+    return math.atan2(float(cross3(a, b) @ n), float(a @ b))
 
 
 def wrap_angle(angle: float) -> float:
@@ -130,13 +138,13 @@ def any_perpendicular(a, b=None) -> np.ndarray:
     """
     a = np.asarray(a, dtype=float)
     if b is not None:
-        c = np.cross(a, np.asarray(b, dtype=float))
+        c = cross3(a, np.asarray(b, dtype=float))
         n = float(np.linalg.norm(c))
         if n > 1e-12:
             return c / n
     axis = np.zeros(3)
     axis[int(np.argmin(np.abs(a)))] = 1.0
-    return unit(np.cross(a, axis))
+    return unit(cross3(a, axis))
 
 
 def dubins_frame(T: np.ndarray, path_index: int) -> np.ndarray:
