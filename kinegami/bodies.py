@@ -440,11 +440,16 @@ def _kink_prefix(joints) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Overlap:
-    """The deepest overlap of a chain: its clearance (< 0, chain units) and the two parts."""
+    """The deepest overlap of a chain: its clearance (< 0, chain units) and the two parts.
+
+    ``elements`` are the two parts' places along the tube (2 i: joint i, 2 i - 1: link i, the
+    link into joint i), in the order of ``first`` and ``second``.
+    """
 
     clearance: float
     first: str
     second: str
+    elements: tuple[int, int] = (-1, -1)
 
     def __str__(self) -> str:
         return f"{self.first} and {self.second} overlap by {-self.clearance:.4g}"
@@ -504,7 +509,9 @@ def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overla
                 return labels[n]
         return labels[-1]
 
-    return Overlap(worst, label(rows[int(i[k])], float(s[k])), label(rows[int(j[k])], float(t[k])))
+    first_row, second_row = rows[int(i[k])], rows[int(j[k])]
+    return Overlap(worst, label(first_row, float(s[k])), label(second_row, float(t[k])),
+                   (int(first_row[5]), int(second_row[5])))  # fmt: skip
 
 
 def deepest_overlap(joints, links, r: float) -> float:

@@ -68,12 +68,16 @@ class CollidingPair:
         Distance between the parts' capsules (chain units); negative: overlap depth.
     points : tuple of two tuples
         The closest points of the two capsule axes (world coordinates, chain units).
+    elements : tuple of two ints
+        The parts' places along the tube: 2 i for joint i, 2 i - 1 for link i (the link into
+        joint i).
     """
 
     first: str
     second: str
     clearance: float
     points: tuple
+    elements: tuple = (-1, -1)
 
     def __str__(self) -> str:
         if self.clearance < 0.0:
@@ -376,6 +380,7 @@ class ClearanceEngine:
             self.model.label(j, t),
             float(clearance),
             (tuple(map(float, p)), tuple(map(float, q))),
+            (int(self.model.element[i]), int(self.model.element[j])),
         )
 
     def _static_at(self, k_static: int, a, b) -> CollidingPair:

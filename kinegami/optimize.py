@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinegami.bodies import deepest_overlap, worst_overlap
+from kinegami.bodies import worst_overlap
 from kinegami.chain import KinematicChain, PlacementWarning
 from kinegami.errors import (
     ClearanceWarning,
@@ -30,6 +30,7 @@ from kinegami.errors import (
     InvalidTypeError,
     KinegamiError,
 )
+from kinegami.geometry.csc import csc_lengths
 from kinegami.geometry.frames import rotation_about_line
 from kinegami.joints import Waypoint
 from kinegami.validation import check_int, check_positive
@@ -52,8 +53,8 @@ def _objective(chain: KinematicChain, kind: str) -> float:
 
 def _overlap(chain: KinematicChain) -> float:
     """Depth of the deepest overlap (0 when the chain is clear)."""
-    worst = deepest_overlap(chain.Joints, chain.Links, chain.r)
-    return 0.0 if math.isinf(worst) else -worst
+    found = worst_overlap(chain.Joints, chain.Links, chain.r)
+    return 0.0 if found is None else -found.clearance
 
 
 @dataclass
@@ -174,47 +175,258 @@ def _descend(
     return state, edits
 
 
-def _compact_rebuild(
-    chain: KinematicChain, rng: np.random.Generator, jitter: bool
-) -> KinematicChain:
-    """The chain's joints (waypoints dropped) placed again by compact placement (safe
-    placement where compact placement finds no link), optionally rolled at random first."""
-    joints = [j for j in chain.Joints if not isinstance(j, Waypoint) or j is chain.Joints[0]]
-    rebuilt = KinematicChain(joints[0], chain.maxAnglePerElbow)
-    for joint in joints[1:]:
-        if jitter:
+# --- the search over slides and rolls: dynamic programming with bans ----------------------------
+#
+# The tube length is a sum over links, and link k depends only on joints k - 1 and k. Over a
+# finite set of candidate poses per joint (slides along and rolls about its axis), the shortest
+# chain is therefore a shortest path through a layered graph (Viterbi), whose edge weights are
+# the CSC lengths of all candidate pairs, computed at once by csc_lengths. Clearance is not a
+# sum over links: the chosen chain is built and checked, and a collision bans the candidate of
+# one of the joints it involves (the ban that costs least) before the next shortest path. The
+# result then seeds finer and finer candidate sets around it (docs/clearance.md).
+
+#: Slides (in r) around the points of a joint's axis nearest its neighbours' axes.
+_COARSE_OFFSETS = (0.0, 1.0, -1.0, 2.0, -2.0, 4.0, -4.0)
+#: Refinement: slide steps (in r) and roll steps (rad), one level each.
+_FINE_SLIDES = (1.0, 0.5, 0.25, 0.125, 0.0625)
+_FINE_ROLLS = (math.pi / 8, math.pi / 16, math.pi / 32, math.pi / 64, math.pi / 128)
+#: Bans tried per level before the level gives up (keeping the previous level's chain).
+_MAX_BANS = 60
+
+
+def _axis_foot(p: np.ndarray, z: np.ndarray, q: np.ndarray, w: np.ndarray) -> float:
+    """Parameter t of the point p + t z of line (p, z) nearest the line (q, w)."""
+    c = float(z @ w)
+    d = q - p
+    den = 1.0 - c * c
+    if den < 1e-9:  # parallel axes: the foot of q
+        return float(d @ z)
+    return float((d @ z - c * (d @ w)) / den)
+
+
+class _Layers:
+    """Candidate poses of every joint (slide t, roll theta from the joint's pose) and the CSC
+    length of every candidate link."""
+
+    def __init__(self, chain: KinematicChain, joints: list, options: list, restarts: bool):
+        self.r = chain.r
+        self.max_angle = chain.maxAnglePerElbow
+        self.base = joints
+        self.options = options  # per joint: (K, 2) array of (t, theta)
+        self.joints = [[self._pose(j, t, th) for t, th in opts] for j, opts in enumerate(options)]
+        self.costs = []
+        for j in range(len(joints) - 1):
+            A, B = self.joints[j], self.joints[j + 1]
+            Fa = np.array([c.distal_dubins_frame() for c in A])
+            Fb = np.array([c.proximal_dubins_frame() for c in B])
+            nA, nB = len(A), len(B)
+            lengths = csc_lengths(
+                np.repeat(Fa[:, :3, 3], nB, axis=0), np.repeat(Fa[:, :3, 0], nB, axis=0),
+                np.tile(Fb[:, :3, 3], (nA, 1)), np.tile(Fb[:, :3, 0], (nA, 1)),
+                self.r, restarts=restarts,
+            )  # fmt: skip
+            self.costs.append(lengths.reshape(nA, nB))
+
+    def _pose(self, j: int, t: float, theta: float):
+        joint = self.base[j]
+        if t != 0.0:
+            joint = joint.translated_along_z(t)
+        if theta != 0.0:
             T = joint.pose_matrix
-            joint = joint.transformed(
-                rotation_about_line(T[:3, 2], T[:3, 3], float(rng.uniform(-math.pi, math.pi)))
-            )
-        if rebuilt.append(joint, relative=False, safe=False, fixedOrientation=jitter) is None:
-            if rebuilt.append(joint, relative=False, safe=False) is None:
-                rebuilt.append(joint, relative=False, safe=True)
-    return rebuilt
+            joint = joint.transformed(rotation_about_line(T[:3, 2], T[:3, 3], theta))
+        return joint
+
+    def shortest(self, bans: set) -> tuple[float, list[int]]:
+        """The shortest choice of one candidate per joint avoiding the banned (joint,
+        candidate) pairs (Viterbi; ties go to the lower index)."""
+        best = np.zeros(len(self.joints[0]))
+        for bj, bc in bans:
+            if bj == 0:
+                best[bc] = np.inf
+        back = []
+        for j, cost in enumerate(self.costs):
+            C = cost + best[:, None]
+            for bj, bc in bans:
+                if bj == j + 1:
+                    C[:, bc] = np.inf
+            k = np.argmin(C, axis=0)
+            back.append(k)
+            best = C[k, np.arange(C.shape[1])]
+        last = int(np.argmin(best))
+        total = float(best[last])
+        choice = [last]
+        for k in reversed(back):
+            choice.append(int(k[choice[-1]]))
+        return total, choice[::-1]
+
+    def build(self, choice: list[int], require: bool) -> tuple[KinematicChain | None, int]:
+        """The chain of the chosen candidates (compact placement at exactly those poses), or
+        (None, j) when the link into joint j cannot be built."""
+        chain = KinematicChain(self.joints[0][choice[0]], self.max_angle)
+        for j in range(1, len(choice)):
+            if chain.append(self.joints[j][choice[j]], False, False, True, True) is None:
+                return None, j
+        chain.requireClearance = require
+        return chain, 0
 
 
-def _nearest_rebuild(chain: KinematicChain) -> KinematicChain:
-    """The chain's joints (waypoints dropped), each slid to the point of its axis nearest the
-    previous joint, or as near to it as a clear link allows (slides of 2, 4, 8, ... r either
-    way); compact, then safe placement where none works."""
-    joints = [j for j in chain.Joints if not isinstance(j, Waypoint) or j is chain.Joints[0]]
-    rebuilt = KinematicChain(joints[0], chain.maxAnglePerElbow)
-    r = chain.r
-    offsets = [0.0] + [s * d * r for d in (2.0, 4.0, 8.0, 16.0) for s in (1.0, -1.0)]
-    for joint in joints[1:]:
-        T = joint.pose_matrix
-        base = float((rebuilt.Joints[-1].pose_matrix[:3, 3] - T[:3, 3]) @ T[:3, 2])
-        placed = False
-        for offset in offsets:
-            trial, overlap = _trial(rebuilt, "append", joint.translated_along_z(base + offset),
-                                    False, False, True, False)  # fmt: skip
-            if trial is not None and overlap == 0.0:
-                rebuilt, placed = trial, True
-                break
-        if not placed:
-            if rebuilt.append(joint, relative=False, safe=False) is None:
-                rebuilt.append(joint, relative=False, safe=True)
-    return rebuilt
+def _involved(elements: tuple[int, int], count: int) -> list[int]:
+    """The joints whose candidates decide the two parts' poses."""
+    out = set()
+    for e in elements:
+        if e < 0:
+            continue
+        if e % 2 == 0:
+            out.add(e // 2)
+        else:
+            out.update(((e - 1) // 2, (e + 1) // 2))
+    return sorted(j for j in out if 0 <= j < count)
+
+
+def _clear_choice(layers: _Layers, motion, require: bool, deadline: float | None, keep=None):
+    """The shortest clear chain over ``layers`` (bans on collisions), or None.
+
+    ``keep``: a choice that must stay reachable (its candidates are never banned).
+    """
+    bans: set = set()
+    protected = set() if keep is None else set(enumerate(keep))
+    for _ in range(_MAX_BANS):
+        if deadline is not None and time.monotonic() > deadline:
+            return None
+        total, choice = layers.shortest(bans)
+        if not math.isfinite(total):
+            return None
+        chain, failed = layers.build(choice, require)
+        if chain is None:  # the chain's own solver found no link where the estimate did
+            culprits = [failed - 1, failed]
+        else:
+            found = worst_overlap(chain.Joints, chain.Links, chain.r)
+            elements = None if found is None else found.elements
+            if elements is None and motion is not None:
+                elements = _motion_collision(chain, motion)
+            if elements is None:
+                return chain, choice
+            culprits = _involved(elements, len(choice))
+        options = []
+        for j in culprits:
+            ban = (j, choice[j])
+            if ban in protected:
+                continue
+            value, _ = layers.shortest(bans | {ban})
+            options.append((value, j, ban))
+        if not options:
+            return None
+        value, _, ban = min(options)
+        if not math.isfinite(value):
+            return None
+        bans.add(ban)
+    return None
+
+
+def _motion_collision(chain: KinematicChain, motion) -> tuple[int, int] | None:
+    """The most frequent colliding pair of parts (elements) when the chain collides in more
+    sampled configurations than allowed, else None."""
+    from kinegami.clearance import engine_for
+
+    movable_states, limit = motion
+    movable = [i for i, j in enumerate(chain.Joints) if j.stateRange() != (0.0, 0.0)]
+    if not movable or movable_states.shape[1] != len(movable):
+        return None
+    Q = np.tile([j.state for j in chain.Joints], (movable_states.shape[0], 1))
+    Q[:, movable] = movable_states
+    clearance, pairs = engine_for(chain).worst(Q)
+    if float(np.mean(np.isfinite(clearance))) <= limit + 1e-12:
+        return None
+    counts: dict = {}
+    for pair in pairs:
+        if pair is not None:
+            counts[pair.elements] = counts.get(pair.elements, 0) + 1
+    return max(counts, key=lambda e: (counts[e], e))
+
+
+def _coarse_options(joints: list, r: float, rng: np.random.Generator | None) -> list:
+    """Per joint, the first candidate set: slides around the feet of the common normals with
+    its neighbours' axes (and the point itself), times four rolls when rolling matters. With
+    ``rng``, the offsets are scaled and the rolls turned at random."""
+    options = []
+    for j in range(len(joints)):
+        if isinstance(joints[j], Waypoint) and j > 0:  # kept where it is
+            options.append(np.zeros((1, 2)))
+            continue
+        T = joints[j].pose_matrix
+        p, z = T[:3, 3], T[:3, 2]
+        feet = []
+        for k in (j - 1, j + 1):
+            if 0 <= k < len(joints):
+                U = joints[k].pose_matrix
+                feet.append(_axis_foot(p, z, U[:3, 3], U[:3, 2]))
+        scale = 1.0 if rng is None else float(rng.uniform(0.6, 1.4))
+        slides = {0.0}
+        for foot in feet:
+            slides.update(round(foot + scale * o * r, 12) for o in _COARSE_OFFSETS)
+        if len(feet) == 2:
+            slides.add(round(0.5 * (feet[0] + feet[1]), 12))
+        if joints[j].pathIndex() != 2:  # the path crosses the axis: rolling turns it
+            phase = 0.0 if rng is None else float(rng.uniform(0.0, math.pi / 2))
+            rolls = [phase + k * math.pi / 2 for k in range(4)]
+            if rng is not None:
+                rolls.append(0.0)  # the joint as given stays a candidate
+        else:
+            rolls = [0.0]
+        options.append(np.array([(t, th) for t in sorted(slides) for th in rolls]))
+    return options
+
+
+def _fine_options(layers: _Layers, choice: list[int], level: int) -> list:
+    """Candidates around the chosen ones: slides of 0, +-h, +-2h and rolls of 0, +-delta."""
+    h = _FINE_SLIDES[level] * layers.r
+    delta = _FINE_ROLLS[level]
+    options = []
+    for j in range(len(choice)):
+        t, th = layers.options[j][choice[j]]
+        if isinstance(layers.base[j], Waypoint) and j > 0:
+            options.append(np.array([(t, th)]))
+            continue
+        rolls = [th] if layers.base[j].pathIndex() == 2 else [th, th - delta, th + delta]
+        slides = [t, t - h, t + h, t - 2 * h, t + 2 * h]
+        options.append(np.array([(a, b) for a in slides for b in rolls]))
+    return options
+
+
+def _dp_search(chain: KinematicChain, rng: np.random.Generator | None, motion, deadline):
+    """The shortest clear chain the layered search finds from ``chain``'s joints, or None.
+
+    The waypoints are dropped; when no clear chain is found without them, they are tried
+    where they are.
+    """
+    joints = [j for i, j in enumerate(chain.Joints) if i == 0 or not isinstance(j, Waypoint)]
+    found = _dp_search_joints(chain, joints, rng, motion, deadline)
+    if found is None and len(joints) < len(chain.Joints):
+        found = _dp_search_joints(chain, list(chain.Joints), rng, motion, deadline)
+    return found
+
+
+def _dp_search_joints(chain: KinematicChain, joints: list, rng, motion, deadline):
+    if len(joints) < 2:
+        return None
+    require = chain.requireClearance
+    layers = _Layers(chain, joints, _coarse_options(joints, chain.r, rng), restarts=False)
+    found = _clear_choice(layers, motion, require, deadline)
+    if found is None:
+        return None
+    best, choice = found
+    for level in range(len(_FINE_SLIDES)):
+        if deadline is not None and time.monotonic() > deadline:
+            break
+        fine = _Layers(chain, joints, _fine_options(layers, choice, level), restarts=False)
+        keep = [0] * len(choice)  # candidate 0 of every layer is the current one
+        found = _clear_choice(fine, motion, require, deadline, keep=keep)
+        if found is None:
+            continue
+        candidate, fine_choice = found
+        if candidate.totalPathLength() < best.totalPathLength():
+            best, choice, layers = candidate, fine_choice, fine
+    return best
 
 
 def _motion_configurations(chain: KinematicChain, samples: int, seed: int) -> np.ndarray:
@@ -237,30 +449,28 @@ def _colliding_fraction(chain: KinematicChain, movable_states: np.ndarray) -> fl
 
 
 def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
-    """One start of :func:`compact` (a top-level function, so any executor can run it)."""
+    """One start of :func:`compact` (a top-level function, so any executor can run it):
+    (objective, overlap, start, chain), chain None when the start found no clear design."""
     chain, k, seed, kind, deadline_seconds, motion = task
     deadline = None if deadline_seconds is None else time.monotonic() + deadline_seconds
     rng = np.random.default_rng([seed, k])
-    # trial edits that fail or collide warn; nobody wants thousands of those. Not a
+    # trial builds and edits that fail or collide warn; nobody wants thousands of those. Not a
     # catch_warnings block: it is not thread-safe, and starts may run in threads (compact
     # restores the caller's filters around the whole search; worker processes keep these).
     warnings.filterwarnings("ignore", category=PlacementWarning)
     warnings.filterwarnings("ignore", category=ClearanceWarning)
-    if k == 0:
-        start = copy.copy(chain)
-    elif k == 1:
-        start = _nearest_rebuild(chain)
-    else:
-        start = _compact_rebuild(chain, rng, jitter=k >= 3)
+    found = _dp_search(chain, None if k == 0 else rng, motion, deadline)
+    if kind == "length" and found is not None:
+        return tube_length(found), 0.0, k, found
+    # the ball (or no clear design found): greedy descent from the shortest design (or the
+    # input)
+    start = found if found is not None else copy.copy(chain)
     history: list = [start]
     state, _ = _descend(start, rng, kind, deadline, history=history)
     if motion is not None:
-        movable_states, limit = motion
 
         def acceptable(candidate) -> bool:
-            return _overlap(candidate) == 0.0 and (
-                _colliding_fraction(candidate, movable_states) <= limit + 1e-12
-            )
+            return _overlap(candidate) == 0.0 and _motion_collision(candidate, motion) is None
 
         # the last accepted design (by bisection over the descent's history) whose motion
         # collides no more often than the input's
@@ -340,8 +550,9 @@ def compact(
     objective : {"length", "ball"}
         Minimise the total tube length (links plus joints) or the bounding-ball radius.
     starts : int
-        Number of starts (>= 1): the input itself, its joints placed again each nearest
-        the previous one, placed again by compact placement, then that with random rolls.
+        Number of starts (>= 1) of the layered search: the first from the joints as given,
+        the others with candidate slides and rolls drawn from the seed. The input itself
+        competes too when it is clear.
     samples : int
         Configurations sampled for ``motion`` (>= 1).
 
@@ -381,6 +592,9 @@ def compact(
     with warnings.catch_warnings():  # the caller's filters, back after the search
         results = _run_all(executor, own, tasks, _progress_bar(progress, starts))
     found = [res for res in results if res[3] is not None and res[1] == 0.0]
+    if _overlap(chain) == 0.0 and (motion_task is None or _motion_collision(chain, motion_task)
+                                   is None):  # fmt: skip
+        found.append((_objective(chain, objective), 0.0, starts, copy.copy(chain)))
     if not found:
         raise CompactionError(
             "compact found no design that is clear of itself (the input passes through itself "

@@ -636,3 +636,98 @@ def solve_csc_all(p1, d1, p2, d2, r: float) -> list[CSCPath]:
             paths.append(path)
     paths.sort(key=lambda p: (p.length, p.theta1, p.theta2, *p.tUnit.tolist()))
     return paths
+
+
+# --- many lengths at once: csc_lengths ----------------------------------------------------------
+
+
+def csc_lengths(p1, d1, p2, d2, r: float, restarts: bool = True) -> np.ndarray:
+    """Lengths of the (short, short) CSC paths of N frame pairs at once (inf: none found).
+
+    ``p1, d1, p2, d2`` are (N, 3) arrays (directions need not be normalised). The iteration is
+    :func:`solve_csc`'s Newton method from the reference's start, run on all pairs together
+    as numpy arrays (about 100x faster per pair than calling :func:`solve_csc` in a loop), so
+    the lengths agree with ``solve_csc(...).length`` to about 1e-12 r wherever that start
+    converges. Pairs where it does not (rare: :func:`solve_csc` then tries restarts) are
+    solved one by one with :func:`solve_csc` (``restarts=False``: left at inf, which is much
+    faster when many pairs have no path). Meant for searches that compare many candidate
+    links; build the chosen link with the chain as usual.
+    """
+    p1 = np.atleast_2d(np.asarray(p1, dtype=float))
+    p2 = np.atleast_2d(np.asarray(p2, dtype=float))
+    d1 = np.atleast_2d(np.asarray(d1, dtype=float))
+    d2 = np.atleast_2d(np.asarray(d2, dtype=float))
+    d1 = d1 / np.sqrt(np.einsum("ij,ij->i", d1, d1))[:, None]
+    d2 = d2 / np.sqrt(np.einsum("ij,ij->i", d2, d2))[:, None]
+    D = (p2 - p1) / r
+    nD = np.sqrt(np.einsum("ij,ij->i", D, D))
+    n = D.shape[0]
+    out = np.full(n, np.inf)
+    same = (nD < 1e-12) & (np.einsum("ij,ij->i", d1, d2) > 1.0 - 1e-15)
+    out[same] = 0.0
+    u0 = np.where(nD[:, None] > 0.0, D / np.where(nD > 0.0, nD, 1.0)[:, None], d1)
+    g1 = np.arctan2(np.linalg.norm(np.cross(d1, u0), axis=1), np.einsum("ij,ij->i", d1, u0))
+    g2 = np.arctan2(np.linalg.norm(np.cross(u0, d2), axis=1), np.einsum("ij,ij->i", u0, d2))
+    a = np.minimum(np.tan(g1 / 2.0), 1e3)
+    b = np.minimum(np.tan(g2 / 2.0), 1e3)
+    e = np.cross(d1, d2)
+    d12 = np.einsum("ij,ij->i", d1, d2)
+    active = ~same
+    done = np.zeros(n, dtype=bool)
+    prev = np.full(n, np.inf)
+    nV_done = np.zeros(n)
+    for _ in range(_MAX_ITERATIONS):
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
+            break
+        A, B = a[idx], b[idx]
+        x, y = d1[idx], d2[idx]
+        V = D[idx] - A[:, None] * x - B[:, None] * y
+        nV = np.sqrt(np.einsum("ij,ij->i", V, V))
+        bad = nV < 1e-300
+        nV = np.where(bad, 1.0, nV)
+        u = V / nV[:, None]
+        c1 = np.einsum("ij,ij->i", x, u)
+        c2 = np.einsum("ij,ij->i", y, u)
+        w1 = np.cross(x, u)
+        w2 = np.cross(u, y)
+        S1 = np.sqrt(np.einsum("ij,ij->i", w1, w1))
+        S2 = np.sqrt(np.einsum("ij,ij->i", w2, w2))
+        h1 = np.arctan2(S1, c1) - 2.0 * np.arctan(A)
+        h2 = np.arctan2(S2, c2) - 2.0 * np.arctan(B)
+        norm = np.maximum(np.abs(h1), np.abs(h2))
+        converged = (norm < ANGLE_TOLERANCE) & ~bad
+        ee = e[idx]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            we1 = np.where(S1 > 0.0, np.einsum("ij,ij->i", w1, ee) / S1, 0.0)
+            we2 = np.where(S2 > 0.0, np.einsum("ij,ij->i", w2, ee) / S2, 0.0)
+        dc = -(d12[idx] - c1 * c2) / nV
+        dS1_db = (-we1 + c2 * S1) / nV
+        dS2_da = (-we2 + c1 * S2) / nV
+        j11 = S1 / nV - 2.0 / (1.0 + A * A)
+        j12 = c1 * dS1_db - S1 * dc
+        j21 = c2 * dS2_da - S2 * dc
+        j22 = S2 / nV - 2.0 / (1.0 + B * B)
+        det = j11 * j22 - j12 * j21
+        failed = bad | (~converged & ((det == 0.0) | ~np.isfinite(det)))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            da = -(j22 * h1 - j12 * h2) / det
+            db = -(-j21 * h1 + j11 * h2) / det
+        step = np.where((norm > 0.5 * prev[idx]) & (norm > 1e-6), 0.5, 1.0)
+        prev[idx] = norm
+        moving = ~converged & ~failed
+        a[idx[moving]] = np.clip(A[moving] + step[moving] * da[moving], 0.0, _MAX_TAN)
+        b[idx[moving]] = np.clip(B[moving] + step[moving] * db[moving], 0.0, _MAX_TAN)
+        ok = idx[converged]
+        done[ok] = True
+        nV_done[ok] = nV[converged]
+        active[idx[converged | failed]] = False
+    s_over_r = nV_done - a - b
+    good = done & (s_over_r >= -1e-12)
+    out[good] = r * (2.0 * np.arctan(a[good]) + np.maximum(s_over_r[good], 0.0)
+                     + 2.0 * np.arctan(b[good]))  # fmt: skip
+    for i in np.flatnonzero(~good & ~same) if restarts else ():
+        path = solve_csc(p1[i], d1[i], p2[i], d2[i], r)
+        if path is not None:
+            out[i] = path.length
+    return out

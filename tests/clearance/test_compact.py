@@ -146,8 +146,12 @@ def test_a_self_intersecting_chain_comes_out_clear():
 
 def test_compaction_error_when_no_start_is_clear(monkeypatch):
     import kinegami.optimize as optimize
+    from kinegami.bodies import Overlap
 
-    monkeypatch.setattr(optimize, "_overlap", lambda chain: 1.0)  # nothing is ever clear
+    def always(joints, links, r, *args, **kwargs):  # nothing is ever clear
+        return Overlap(-1.0, "link 1, straight tube", "link 3, first elbow", (1, 5))
+
+    monkeypatch.setattr(optimize, "worst_overlap", always)
     with pytest.raises(CompactionError, match="no design that is clear of itself"):
         compact(random_safe_chain(0, 1), executor=serial(), starts=1)
 
