@@ -191,3 +191,48 @@ def test_random_chains_compact_clear_and_on_their_axes(seed, n):
     assert out.clearance().ok
     assert tube_length(out) <= tube_length(chain) + 1e-9
     assert_same_kinematics(chain, out, 1.0)
+
+
+def test_a_shortest_choice_that_collides_is_banned_away(monkeypatch):
+    """On the cylindrical joint, shortest choices of candidate poses pass through themselves:
+    the search bans culprits until the design is clear, and it is still shorter."""
+    from pathlib import Path
+
+    import kinegami.optimize as optimize
+    from kinegami.bodies import worst_overlap
+    from kinegami.design import load_design
+
+    collided = []
+    build = optimize._Layers.build
+
+    def recording(self, choice, require):
+        chain, failed = build(self, choice, require)
+        if chain is not None:
+            collided.append(worst_overlap(chain.Joints, chain.Links, chain.r) is not None)
+        return chain, failed
+
+    monkeypatch.setattr(optimize._Layers, "build", recording)
+    design = Path(__file__).resolve().parents[2] / "examples" / "designs" / "cylindrical_joint.json"
+    chain = load_design(design)
+    out = compact(chain, executor=serial(), starts=1)
+    assert any(collided) and not all(collided)
+    assert out.clearance().ok
+    assert tube_length(out) < tube_length(chain) - chain.r
+    assert_same_kinematics(chain, out, chain.r)
+
+
+def test_a_banned_candidate_is_never_chosen():
+    chain = random_safe_chain(4, 4)
+    joints = [j for i, j in enumerate(chain.Joints) if i == 0 or not isinstance(j, Waypoint)]
+    import kinegami.optimize as optimize
+
+    layers = optimize._Layers(chain, joints, optimize._coarse_options(joints, chain.r, None),
+                              restarts=False)  # fmt: skip
+    total, choice = layers.shortest(set())
+    bans = {(j, choice[j]) for j in range(len(choice))}
+    worse, other = layers.shortest(bans)
+    assert worse >= total
+    assert all(other[j] != choice[j] for j in range(len(choice)))
+    # the Viterbi total is the sum of the chosen links' lengths
+    assert math.isclose(total, sum(layers.costs[j][choice[j], choice[j + 1]]
+                                   for j in range(len(choice) - 1)), rel_tol=1e-12)  # fmt: skip
