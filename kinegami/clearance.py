@@ -14,7 +14,7 @@ Examples
 --------
 >>> chain = KinematicChain(StartTip(4, 1, Pose=SE3(), length=1.5))
 >>> chain.append(RevoluteJoint(4, 1, np.pi, SE3.Trans(0, 0, 4) @ SE3.Ry(np.pi / 2)))
-1
+3
 >>> chain.clearance().ok
 True
 """

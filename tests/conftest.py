@@ -8,14 +8,27 @@ modules never import this file and hypothesis tests can use them.
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 import pytest
 import reference_values as ref
+from hypothesis import HealthCheck, settings
 from spatialmath import SE3
 
 from kinegami import EndTip, KinematicChain, PrismaticJoint, RevoluteJoint, StartTip
 from kinegami.geometry.frames import rotation_matrix
+
+# --- hypothesis profiles ------------------------------------------------------------------------
+# "quick" (the default) for working on the code, "ci" (thorough: .ci/run sets
+# KINEGAMI_HYPOTHESIS_PROFILE=ci). Tests that need a particular budget set max_examples
+# themselves; the profile sets it for all others.
+settings.register_profile("quick", max_examples=20, deadline=None)
+settings.register_profile(
+    "ci", max_examples=100, deadline=None, print_blob=True,
+    suppress_health_check=[HealthCheck.too_slow],
+)  # fmt: skip
+settings.load_profile(os.environ.get("KINEGAMI_HYPOTHESIS_PROFILE", "quick"))
 
 # --- snapshot ---------------------------------------------------------------------------------
 
