@@ -26,6 +26,7 @@ from kinegami.errors import (
     InvalidTypeError,
     JointIndexError,
     KinegamiError,
+    PlacementWarning,
 )
 from kinegami.geometry.balls import Ball, merge_balls
 from kinegami.geometry.frames import rotation_about_line, translation
@@ -39,6 +40,7 @@ from kinegami.placement import (
     radial_safe_placement,
 )
 from kinegami.validation import (
+    check_bool,
     check_max_angle_per_elbow,
     check_real,
     check_translation,
@@ -62,16 +64,6 @@ def _caller_level() -> int:
     return level
 
 
-class PlacementWarning(UserWarning):
-    """A placement, edit or state change was rejected; the chain is unchanged."""
-
-
-def _check_bool(name: str, value) -> bool:
-    if not isinstance(value, bool | np.bool_):
-        raise InvalidTypeError(f"{name} must be True or False, got {shown(value)}")
-    return bool(value)
-
-
 class _DefaultTrue:
     """The default of ``propogate``: True, but distinguishable from an explicit True."""
 
@@ -90,8 +82,8 @@ def _propagate_flag(propogate, propagate) -> bool:
     if propagate is None:
         if propogate is _PROPAGATE_DEFAULT:
             return True
-        return _check_bool("propogate", propogate)
-    propagate = _check_bool("propagate", propagate)
+        return check_bool("propogate", propogate)
+    propagate = check_bool("propagate", propagate)
     if propogate is not _PROPAGATE_DEFAULT:
         raise InvalidParameterError(
             f"give only one of propogate (the paper's spelling) and propagate, got "
@@ -206,7 +198,7 @@ class KinematicChain:
 
     @requireClearance.setter
     def requireClearance(self, value: bool) -> None:
-        self._require_clearance = _check_bool("requireClearance", value)
+        self._require_clearance = check_bool("requireClearance", value)
 
     # --- published read-only views -----------------------------------------------------------
     @property
@@ -341,10 +333,10 @@ class KinematicChain:
         Returns the new joint's index, or None (with a PlacementWarning, chain unchanged) when
         no link with turns < pi reaches it.
         """
-        relative = _check_bool("relative", relative)
-        safe = _check_bool("safe", safe)
-        fixedPosition = _check_bool("fixedPosition", fixedPosition)
-        fixedOrientation = _check_bool("fixedOrientation", fixedOrientation)
+        relative = check_bool("relative", relative)
+        safe = check_bool("safe", safe)
+        fixedPosition = check_bool("fixedPosition", fixedPosition)
+        fixedOrientation = check_bool("fixedOrientation", fixedOrientation)
         if safe and fixedPosition:
             raise InvalidParameterError(
                 "safe=True and fixedPosition=True cannot be combined: safe placement moves the "
@@ -579,7 +571,7 @@ class KinematicChain:
     ) -> bool:
         j = self._index(jointIndex)
         prop = _propagate_flag(propogate, propagate)
-        applyToPreviousWaypoint = _check_bool("applyToPreviousWaypoint", applyToPreviousWaypoint)
+        applyToPreviousWaypoint = check_bool("applyToPreviousWaypoint", applyToPreviousWaypoint)
         T = T_of_joint(self._joints[j])
         if applyToPreviousWaypoint and j > 0 and isinstance(self._joints[j - 1], Waypoint):
             w = j - 1

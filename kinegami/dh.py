@@ -27,6 +27,7 @@ from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.frames import rot_x, rot_z, translation
 from kinegami.joints import EndTip, PrismaticJoint, RevoluteJoint
 from kinegami.validation import (
+    check_bool,
     check_num_sides,
     check_radius,
     check_real,
@@ -181,8 +182,7 @@ def chain_from_dh(
     See :meth:`kinegami.chain.KinematicChain.from_dh`. Raises NoPathError (a ValueError) when
     compact placement cannot link a joint; nothing is returned half-built.
     """
-    from kinegami.chain import PlacementWarning
-    from kinegami.errors import NoPathError
+    from kinegami.errors import NoPathError, PlacementWarning
 
     convention = _check_convention(convention)
     if placement not in PLACEMENTS:
@@ -191,8 +191,7 @@ def chain_from_dh(
         )
     numSides = check_num_sides(numSides)
     r = check_radius(r)
-    if not isinstance(endTip, bool | np.bool_):
-        raise InvalidTypeError(f"endTip must be True or False, got {endTip!r}")
+    endTip = check_bool("endTip", endTip)
     rows = _check_table(table)
     for i, (_, _, a, d) in enumerate(rows):
         check_translation(f"table row {i} a", a, r)

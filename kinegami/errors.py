@@ -1,25 +1,80 @@
-"""The kinegami exception hierarchy.
+"""The kinegami exception and warning hierarchy, in one place (docs/errors.md).
 
 Every error raised on purpose by kinegami is a :class:`KinegamiError`. The subclasses also
 inherit the matching builtin, so ``except ValueError`` keeps working (as ezdxf does with
-``DXFValueError``).
+``DXFValueError``)::
+
+    KinegamiError(Exception)
+    +-- InvalidParameterError(ValueError)    a value outside its valid range
+    |   +-- FoldedFormError                  a pattern that cannot be folded
+    +-- InvalidTypeError(TypeError)          a value of the wrong type, an unknown option
+    +-- ReadOnlyError(AttributeError)        assignment to a joint's or link's attribute
+    +-- JointIndexError(IndexError)          no joint with that index
+    +-- NoPathError(ValueError)              no CSC link joins two frames
+    +-- IncompatibleJointError(ValueError)   another numSides or r than the chain's
+    +-- CompactionError(ValueError)          compaction found no clear design
+    +-- DesignError(ValueError)              a design file is unreadable or invalid
+    +-- DesignFileExistsError(FileExistsError)
+    +-- FoldExportError(ValueError)          a pattern FOLD export cannot write
+    +-- ExporterUnavailableError(ImportError)
+    +-- ExportError(OSError)                 a file could not be written
+        +-- PublishError                     a build could not be published
+
+    UserWarning
+    +-- PlacementWarning                     a placement, edit or state change was rejected
+    +-- ClearanceWarning                     an operation left the chain passing through itself
+
+The classes keep their old import locations too (``kinegami.chain.PlacementWarning``,
+``kinegami.design.DesignError``, ``kinegami.export.ExportError``, ...).
 """
 
 from __future__ import annotations
+
+import os
+
+__all__ = [
+    "KinegamiError",
+    "InvalidParameterError",
+    "InvalidTypeError",
+    "ReadOnlyError",
+    "JointIndexError",
+    "NoPathError",
+    "IncompatibleJointError",
+    "CompactionError",
+    "FoldedFormError",
+    "DesignError",
+    "DesignFileExistsError",
+    "ExportError",
+    "PublishError",
+    "ExporterUnavailableError",
+    "FoldExportError",
+    "PlacementWarning",
+    "ClearanceWarning",
+]
 
 
 class KinegamiError(Exception):
     """Base class of every error kinegami raises on purpose."""
 
 
+# --- parameters ----------------------------------------------------------------------------
 class InvalidParameterError(KinegamiError, ValueError):
     """A parameter has a value outside its valid range (the message names both)."""
 
 
 class InvalidTypeError(KinegamiError, TypeError):
-    """A parameter has the wrong type."""
+    """A parameter has the wrong type (or an option name is unknown)."""
 
 
+class ReadOnlyError(KinegamiError, AttributeError):
+    """An attribute of a value (a joint, a link) was assigned or deleted.
+
+    Joints and links are values: build a new one, or edit the chain (its edit methods swap in
+    new joints and links).
+    """
+
+
+# --- chains --------------------------------------------------------------------------------
 class JointIndexError(KinegamiError, IndexError):
     """A joint index does not name a joint of the chain."""
 
@@ -30,6 +85,112 @@ class NoPathError(KinegamiError, ValueError):
 
 class IncompatibleJointError(KinegamiError, ValueError):
     """A joint's ``numSides`` or ``r`` differs from the chain's."""
+
+
+class CompactionError(KinegamiError, ValueError):
+    """No clear design was found (the input passes through itself and no move fixed it)."""
+
+
+# --- patterns ------------------------------------------------------------------------------
+class FoldedFormError(InvalidParameterError):
+    """A pattern cannot be folded (no module records, or records that do not rebuild it)."""
+
+
+# --- design files --------------------------------------------------------------------------
+#: Marker for "no offending value" (``None`` is a valid JSON value: ``null``).
+_NO_VALUE = object()
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+class DesignError(KinegamiError, ValueError):
+    """A design file cannot be read, is invalid, or describes an infeasible chain.
+
+    Attributes
+    ----------
+    file : str or None
+        The design file (None for a design given as text or as a dict without a file name).
+    field : str
+        JSON path of the problem, e.g. ``joints[2].totalBendingAngle``; ``$`` is the document.
+    value : object
+        The offending value (None if there is none; see ``has_value``).
+    reason : str
+        What is wrong and what is allowed.
+
+    ``str(error)`` is one line: ``<file>: <field>: <reason> (got <value>)``.
+    """
+
+    def __init__(
+        self,
+        reason: str,
+        *,
+        field: str = "$",
+        value=_NO_VALUE,
+        file: str | os.PathLike | None = None,
+    ):
+        self.reason = _one_line(reason)
+        self.field = field
+        self.has_value = value is not _NO_VALUE
+        self.value = value if self.has_value else None
+        self.file = None if file is None else os.fspath(file)
+        super().__init__(str(self))
+
+    def with_file(self, file) -> DesignError:
+        """The same error attributed to ``file`` (used when a file name becomes known)."""
+        value = self.value if self.has_value else _NO_VALUE
+        return DesignError(self.reason, field=self.field, value=value, file=file)
+
+    def __str__(self) -> str:
+        from kinegami.validation import format_value  # validation imports this module
+
+        text = f"{self.field}: {self.reason}"
+        if self.has_value:
+            text += f" (got {format_value(self.value)})"
+        if self.file is not None:
+            text = f"{self.file}: {text}"
+        return text
+
+    def __reduce__(self):
+        return (_rebuild, (self.reason, self.field, self.has_value, self.value, self.file))
+
+
+def _rebuild(reason, field, has_value, value, file):
+    return DesignError(reason, field=field, value=value if has_value else _NO_VALUE, file=file)
+
+
+class DesignFileExistsError(KinegamiError, FileExistsError):
+    """The file to write a new design to exists already (and was left as it was)."""
+
+
+# --- export --------------------------------------------------------------------------------
+class ExportError(KinegamiError, OSError):
+    """A pattern could not be written (folder not writable, disk full, ...).
+
+    ``errno`` and ``filename`` are those of the underlying :class:`OSError`.
+    """
+
+
+class PublishError(ExportError):
+    """A build could not be published, or an earlier interrupted one not recovered.
+
+    The message says what failed and where the earlier files are.
+    """
+
+
+class ExporterUnavailableError(KinegamiError, ImportError):
+    """The exporter of a registered format cannot be imported (its module is missing)."""
+
+
+class FoldExportError(KinegamiError, ValueError):
+    """The pattern's sheet is not a valid planar crease pattern (crossing or overlapping creases,
+    or a sheet of zero area)."""
+
+
+# --- warnings ------------------------------------------------------------------------------
+class PlacementWarning(UserWarning):
+    """A placement, edit or state change was rejected; the chain is unchanged."""
 
 
 class ClearanceWarning(UserWarning):

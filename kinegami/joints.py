@@ -11,7 +11,9 @@ Lengths lie in (0, 1e6 r] and Pose translations within +-1e6 r (see
 bound otherwise.
 
 Joints are values: a chain never changes a joint in place, it swaps in modified copies
-(``with_pose``, ``with_state``), which is what makes its edits transactions.
+(``with_pose``, ``with_state``), which is what makes its edits transactions. Their public
+attributes are read-only: ``joint.totalBendingAngle = 0.1`` raises ReadOnlyError (a KinegamiError
+and an AttributeError; docs/errors.md) instead of silently changing the state range.
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from kinegami.geometry.frames import (
     unit,
 )
 from kinegami.validation import (
+    ReadOnlyAttributes,
     check_in_range,
     check_int,
     check_length,
@@ -97,8 +100,18 @@ def _frozen(T: np.ndarray) -> np.ndarray:
     return T
 
 
-class Joint:
-    """Base class of all joints (abstract: use one of the subclasses)."""
+class Joint(ReadOnlyAttributes):
+    """Base class of all joints (abstract: use one of the subclasses).
+
+    Joints are values: assigning or deleting a public attribute (``joint.r = 5``) raises
+    :class:`~kinegami.errors.ReadOnlyError` (docs/errors.md).
+    """
+
+    _READ_ONLY_ADVICE = (
+        "joints are values; build a new joint with the value you want, or change the chain's "
+        "joint with its edit methods (translateJointAlongAxisOfMotion, "
+        "rotateJointAboutAxisOfMotion, transformJoint, setJointState)"
+    )
 
     #: Index of the Pose column that is the path direction (overridden by Waypoint).
     _PATH_INDEX = 2
@@ -312,8 +325,10 @@ class RevoluteJoint(Joint):
         B = check_in_range(
             "totalBendingAngle", totalBendingAngle, 0.0, 2.0 * math.pi, range_text="(0, 2pi)"
         )
-        self.totalBendingAngle = B
-        self.numSinkLayers = check_int("numSinkLayers", numSinkLayers, minimum=1)
+        self._set_attribute("totalBendingAngle", B)
+        self._set_attribute(
+            "numSinkLayers", check_int("numSinkLayers", numSinkLayers, minimum=1)
+        )
         L = 2.0 * r * math.cos(math.pi / n) * math.tan(B / 4.0)
         super().__init__(n, r, L, Pose)
 
@@ -339,7 +354,7 @@ class ExtendedRevoluteJoint(RevoluteJoint):
     """A revolute joint with a straight tube of length ``tubeLength`` on each side."""
 
     def __init__(self, numSides, r, totalBendingAngle, tubeLength, Pose, numSinkLayers=1):
-        self.tubeLength = check_length("tubeLength", tubeLength, check_radius(r))
+        self._set_attribute("tubeLength", check_length("tubeLength", tubeLength, check_radius(r)))
         super().__init__(numSides, r, totalBendingAngle, Pose, numSinkLayers)
         self._neutralLength += 2.0 * self.tubeLength
 
@@ -370,8 +385,8 @@ class PrismaticJoint(Joint):
         n = check_num_sides(numSides)
         r = check_radius(r)
         d = check_length("neutralLength", neutralLength, r)
-        self.numLayers = check_int("numLayers", numLayers, minimum=1)
-        self.coneAngle = check_in_range(
+        self._set_attribute("numLayers", check_int("numLayers", numLayers, minimum=1))
+        cone = check_in_range(
             "coneAngle",
             coneAngle,
             math.pi / 6.0,
@@ -379,6 +394,7 @@ class PrismaticJoint(Joint):
             low_inclusive=True,
             range_text="[pi/6, pi/2)",
         )
+        self._set_attribute("coneAngle", cone)
         super().__init__(n, r, d, Pose)
 
     def stateRange(self) -> tuple[float, float]:
@@ -452,7 +468,7 @@ class Tip(Joint):
     def __init__(self, numSides, r, Pose, length):
         n = check_num_sides(numSides)
         r = check_radius(r)
-        self.length = check_length("length", length, r)
+        self._set_attribute("length", check_length("length", length, r))
         super().__init__(n, r, self.length, Pose)
 
     def _describe(self) -> str:

@@ -22,6 +22,7 @@ from kinegami.geometry.csc import CSCPath, solve_csc
 from kinegami.geometry.frames import rotation_matrix, signed_angle
 from kinegami.joints import pose_array
 from kinegami.validation import (
+    ReadOnlyAttributes,
     check_max_angle_per_elbow,
     check_num_sides,
     check_radius,
@@ -118,8 +119,11 @@ def _solved_path(r: float, start: np.ndarray, end: np.ndarray) -> CSCPath:
     return path
 
 
-class LinkCSC:
+class LinkCSC(ReadOnlyAttributes):
     """A link: the CSC Dubins path from ``StartDubinsPose`` to ``EndDubinsPose``.
+
+    Links are values: assigning or deleting a public attribute (``link.r = 5``) raises
+    :class:`~kinegami.errors.ReadOnlyError` (docs/errors.md).
 
     Parameters
     ----------
@@ -136,6 +140,16 @@ class LinkCSC:
     >>> round(link.path.length, 6)
     10.789582
     """
+
+    r: float
+    maxAnglePerElbow: float
+    path: CSCPath
+
+    _READ_ONLY_ADVICE = (
+        "links are values; build a new LinkCSC(r, StartDubinsPose, EndDubinsPose, "
+        "maxAnglePerElbow), or edit the chain's joints (translateJointAlongAxisOfMotion, "
+        "transformJoint, setJointState, ...) and it builds new links"
+    )
 
     def __init__(self, r, StartDubinsPose, EndDubinsPose, maxAnglePerElbow=np.pi / 2):
         r = check_radius(r)
@@ -198,11 +212,11 @@ class LinkCSC:
         return cls._from_parts(r, max_angle, start, end, path)
 
     def _init(self, r, max_angle, start, end, path):
-        self.r = r
-        self.maxAnglePerElbow = max_angle
+        self._set_attribute("r", r)
+        self._set_attribute("maxAnglePerElbow", max_angle)
         self._start = start
         self._end = end
-        self.path: CSCPath = path
+        self._set_attribute("path", path)
 
     @classmethod
     def _from_parts(cls, r, max_angle, start, end, path) -> LinkCSC:

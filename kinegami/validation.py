@@ -19,12 +19,15 @@ overflows.
 
 from __future__ import annotations
 
+import json
 import math
 import numbers
+from collections.abc import Iterable, Mapping
+from typing import Any
 
 import numpy as np
 
-from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.errors import InvalidParameterError, InvalidTypeError, ReadOnlyError
 
 #: Smallest and largest tube radius r (in the chain's length unit), as in design files.
 R_MIN = 1e-6
@@ -77,6 +80,41 @@ def shown(value, limit: int = SHOWN_LIMIT) -> str:
     except Exception:  # a repr that fails (recursion, huge ints inside a container)
         text = f"<{type(value).__name__}>"
     return shorten(text, limit)
+
+
+def check_bool(name: str, value) -> bool:
+    """``value`` as a bool, or InvalidTypeError unless it is True or False (numpy's too).
+
+    Integers are refused: ``endTip=1`` is more likely a mistake than a choice.
+    """
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidTypeError(f"{name} must be True or False, got {shown(value)}")
+    return bool(value)
+
+
+def check_options(options: Mapping[str, Any], valid: Iterable[str], what: str) -> None:
+    """Raise InvalidTypeError if ``options`` has a name not in ``valid``.
+
+    The message is ``<what> got unknown option(s) 'a', 'b'; valid options are: x, y`` (the
+    unknown names sorted, the valid ones in their order), e.g. with ``what="DXF export"``.
+    """
+    valid = tuple(valid)
+    unknown = sorted(set(options) - set(valid))
+    if unknown:
+        raise InvalidTypeError(
+            f"{what} got unknown option{'s' if len(unknown) > 1 else ''} "
+            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(valid)}"
+        )
+
+
+def resolve_options(
+    options: Mapping[str, Any], defaults: Mapping[str, Any], what: str
+) -> dict[str, Any]:
+    """``defaults`` updated by ``options`` (a new dict), after :func:`check_options`."""
+    check_options(options, defaults, what)
+    values = dict(defaults)
+    values.update(options)
+    return values
 
 
 def check_real(name: str, value) -> float:
@@ -213,3 +251,133 @@ def check_max_angle_per_elbow(value) -> float:
 def check_twist_portion(value) -> float:
     """twistPortion (share of a link's straight part given to its twist) in [0, 1)."""
     return check_in_range("twistPortion", value, 0.0, 1.0, low_inclusive=True, range_text="[0, 1)")
+
+
+# --- values in messages ------------------------------------------------------------------
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def format_value(value, limit: int = 100) -> str:
+    """A short one-line JSON-like rendering of ``value`` for messages (at most ``limit``
+    characters, ending in "..." when cut).
+
+    Only the first ``limit`` characters are ever produced: a list of a million joints, a value
+    nested a thousand levels deep or an integer of 5000 digits costs no more than a number.
+    """
+    pieces = []
+    size = 0
+    for piece in _pieces(value, limit):
+        pieces.append(piece)
+        size += len(piece)
+        if size > limit:
+            break
+    text = _one_line("".join(pieces))
+    if len(text) > limit:
+        text = text[: limit - 3] + "..."
+    return text
+
+
+class _Text(str):
+    """A piece of punctuation in :func:`_pieces` (not a value to render)."""
+
+
+def _pieces(value, limit: int):
+    """The rendering of ``value`` piece by piece, without recursion (lazily)."""
+    stack = [iter((value,))]
+    while stack:
+        item = next(stack[-1], _END)
+        if item is _END:
+            stack.pop()
+        elif type(item) is _Text:
+            yield item
+        elif isinstance(item, dict):
+            stack.append(_object_pieces(item))
+        elif isinstance(item, list | tuple) or (
+            isinstance(item, np.ndarray) and item.ndim > 0
+        ):
+            stack.append(_array_pieces(item))
+        else:
+            yield _scalar(item, limit)
+
+
+_END = object()
+
+
+def _object_pieces(obj: dict):
+    yield _Text("{")
+    for k, (key, value) in enumerate(obj.items()):
+        key = key if isinstance(key, str) else str(key)
+        yield _Text((", " if k else "") + _string(key, 100) + ": ")
+        yield value
+    yield _Text("}")
+
+
+def _array_pieces(items):
+    yield _Text("[")
+    for k, value in enumerate(items):
+        if k:
+            yield _Text(", ")
+        yield value
+    yield _Text("]")
+
+
+def _string(text: str, limit: int) -> str:
+    return json.dumps(text[: limit + 1], ensure_ascii=False)
+
+
+def _scalar(value, limit: int) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool | np.bool_):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return _string(value, limit)
+    if isinstance(value, int | np.integer):
+        return shown(int(value))  # digits counted, not printed, for huge ints
+    if isinstance(value, float | np.floating):
+        value = float(value)
+        if math.isnan(value):
+            return "NaN"
+        if math.isinf(value):
+            return "Infinity" if value > 0 else "-Infinity"
+        return repr(value)
+    return shown(value, limit)
+
+
+# --- values ---------------------------------------------------------------------------------
+class ReadOnlyAttributes:
+    """Mixin of value classes (joints, links) whose public attributes cannot be changed.
+
+    Assigning or deleting a public attribute (one whose name does not start with ``_``)
+    raises :class:`~kinegami.errors.ReadOnlyError`, whose message ends with the class's
+    ``_READ_ONLY_ADVICE`` (what to do instead). Construction sets public attributes with
+    :meth:`_set_attribute`; private ones (``_T``, ``_state``) are set as usual, which is how
+    ``with_pose`` and ``with_state`` build their copies.
+    """
+
+    __slots__ = ()
+
+    #: What to do instead of assigning; subclasses say it for their kind of value.
+    _READ_ONLY_ADVICE = "build a new object instead"
+
+    def _set_attribute(self, name: str, value) -> None:
+        """Set a public attribute during construction."""
+        object.__setattr__(self, name, value)
+
+    def __setattr__(self, name: str, value) -> None:
+        if name.startswith("_"):
+            object.__setattr__(self, name, value)
+            return
+        raise ReadOnlyError(
+            f"{type(self).__name__}.{name} is read-only: {self._READ_ONLY_ADVICE}"
+        )
+
+    def __delattr__(self, name: str) -> None:
+        if name.startswith("_"):
+            object.__delattr__(self, name)
+            return
+        raise ReadOnlyError(
+            f"{type(self).__name__}.{name} is read-only and cannot be deleted: "
+            f"{self._READ_ONLY_ADVICE}"
+        )

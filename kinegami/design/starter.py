@@ -16,7 +16,7 @@ import secrets
 from importlib import resources
 from pathlib import Path
 
-from kinegami.errors import InvalidParameterError, KinegamiError
+from kinegami.errors import DesignFileExistsError, InvalidParameterError
 from kinegami.export import discard, write_atomic
 
 __all__ = [
@@ -25,10 +25,6 @@ __all__ = [
     "starter_text",
     "write_starter_design",
 ]
-
-
-class DesignFileExistsError(KinegamiError, FileExistsError):
-    """The file to write a new design to exists already (and was left as it was)."""
 
 
 def starter_document(name: str | None = None) -> dict:
