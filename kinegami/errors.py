@@ -7,6 +7,7 @@ inherit the matching builtin, so ``except ValueError`` keeps working (as ezdxf d
     KinegamiError(Exception)
     +-- InvalidParameterError(ValueError)    a value outside its valid range
     |   +-- FoldedFormError                  a pattern that cannot be folded
+    |   +-- UnknownModuleKindError(KeyError) no catalog entry for a module kind
     +-- InvalidTypeError(TypeError)          a value of the wrong type, an unknown option
     +-- ReadOnlyError(AttributeError)        assignment to a joint's or link's attribute
     +-- JointIndexError(IndexError)          no joint with that index
@@ -42,6 +43,7 @@ __all__ = [
     "IncompatibleJointError",
     "CompactionError",
     "FoldedFormError",
+    "UnknownModuleKindError",
     "DesignError",
     "DesignFileExistsError",
     "ExportError",
@@ -94,6 +96,13 @@ class CompactionError(KinegamiError, ValueError):
 # --- patterns ------------------------------------------------------------------------------
 class FoldedFormError(InvalidParameterError):
     """A pattern cannot be folded (no module records, or records that do not rebuild it)."""
+
+
+class UnknownModuleKindError(InvalidParameterError, KeyError):
+    """No catalog entry is registered under a module kind."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0]) if self.args else ""
 
 
 # --- design files --------------------------------------------------------------------------

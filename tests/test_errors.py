@@ -48,6 +48,196 @@ def test_hierarchy():
         assert issubclass(cls, KinegamiError)
 
 
+# --- one hierarchy, in kinegami.errors (docs/errors.md) ----------------------------------------
+
+#: Every class of kinegami.errors and the builtins it must also be.
+HIERARCHY = {
+    "KinegamiError": (Exception,),
+    "InvalidParameterError": (ValueError,),
+    "InvalidTypeError": (TypeError,),
+    "ReadOnlyError": (AttributeError,),
+    "JointIndexError": (IndexError,),
+    "NoPathError": (ValueError,),
+    "IncompatibleJointError": (ValueError,),
+    "CompactionError": (ValueError,),
+    "FoldedFormError": (ValueError,),
+    "UnknownModuleKindError": (ValueError, KeyError),
+    "DesignError": (ValueError,),
+    "DesignFileExistsError": (FileExistsError,),
+    "ExportError": (OSError,),
+    "PublishError": (OSError,),
+    "ExporterUnavailableError": (ImportError,),
+    "FoldExportError": (ValueError,),
+    "PlacementWarning": (UserWarning,),
+    "ClearanceWarning": (UserWarning,),
+}
+
+#: Old import locations (module, name) that must give the class of kinegami.errors.
+OLD_LOCATIONS = [
+    ("kinegami", "KinegamiError"),
+    ("kinegami", "InvalidParameterError"),
+    ("kinegami.chain", "PlacementWarning"),
+    ("kinegami.chain", "ClearanceWarning"),
+    ("kinegami.design", "DesignError"),
+    ("kinegami.design.errors", "DesignError"),
+    ("kinegami.design.starter", "DesignFileExistsError"),
+]
+
+#: Old locations whose module still defines its own class (owned by other modules' authors;
+#: each should become ``from kinegami.errors import <name>``). xfail until then, not strict.
+PENDING_LOCATIONS = [
+    ("kinegami.optimize", "CompactionError"),
+    ("kinegami.pattern.folded", "FoldedFormError"),
+    ("kinegami.pattern.catalog", "UnknownModuleKindError"),
+    ("kinegami.export", "ExportError"),
+    ("kinegami.export.publish", "PublishError"),
+    ("kinegami.export.registry", "ExporterUnavailableError"),
+    ("kinegami.export.fold", "FoldExportError"),
+]
+
+
+def test_errors_module_lists_the_whole_hierarchy():
+    import kinegami.errors as errors
+
+    assert sorted(errors.__all__) == sorted(HIERARCHY)
+    for name in HIERARCHY:
+        assert name in errors.__doc__, name
+
+
+@pytest.mark.parametrize("name", sorted(HIERARCHY))
+def test_every_error_is_a_kinegami_error_and_its_builtin(name):
+    import kinegami.errors as errors
+
+    cls = getattr(errors, name)
+    assert cls.__module__ == "kinegami.errors"
+    for builtin in HIERARCHY[name]:
+        assert issubclass(cls, builtin)
+    assert issubclass(cls, Warning) or issubclass(cls, KinegamiError)
+
+
+@pytest.mark.parametrize(("module", "name"), OLD_LOCATIONS)
+def test_old_import_locations_give_the_same_class(module, name):
+    import importlib
+
+    import kinegami.errors as errors
+
+    assert getattr(importlib.import_module(module), name) is getattr(errors, name)
+
+
+@pytest.mark.parametrize(
+    ("module", "name"),
+    [pytest.param(*where, marks=pytest.mark.xfail(reason="defined in a module of another "
+                                                   "author; to import from kinegami.errors"))
+     for where in PENDING_LOCATIONS],
+)  # fmt: skip
+def test_pending_import_locations_give_the_same_class(module, name):
+    import importlib
+
+    import kinegami.errors as errors
+
+    assert getattr(importlib.import_module(module), name) is getattr(errors, name)
+
+
+def _package_classes():
+    """(module, class) of every public exception or warning class defined in the package,
+    except front ends (the CLI's CommandError is how it leaves a command, never raised to a
+    user of the library)."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    import kinegami
+
+    found = []
+    for info in pkgutil.walk_packages(kinegami.__path__, "kinegami."):
+        if info.name in ("kinegami.cli", "kinegami.__main__") or "._" in info.name:
+            continue
+        module = importlib.import_module(info.name)
+        for name, obj in vars(module).items():
+            if (
+                inspect.isclass(obj)
+                and issubclass(obj, BaseException)
+                and not name.startswith("_")
+                and obj.__module__ == info.name
+            ):
+                found.append((info.name, name))
+    return found
+
+
+def test_no_module_but_errors_defines_a_public_error_class():
+    pending = {name for _, name in PENDING_LOCATIONS}
+    stray = [
+        f"{module}.{name}"
+        for module, name in _package_classes()
+        if module != "kinegami.errors" and name not in pending
+    ]
+    assert stray == []
+
+
+def test_the_version_is_the_one_of_pyproject():
+    import pathlib
+    import tomllib
+
+    import kinegami
+    from kinegami._version import __version__
+
+    root = pathlib.Path(__file__).resolve().parent.parent
+    project = tomllib.loads((root / "pyproject.toml").read_text("utf-8"))["project"]
+    assert __version__ == project["version"] == kinegami.__version__
+
+
+# --- shared parameter checks (kinegami.validation) ---------------------------------------------
+
+
+@pytest.mark.parametrize("value", [True, False, np.True_, np.False_])
+def test_check_bool_accepts_python_and_numpy_booleans(value):
+    from kinegami.validation import check_bool
+
+    result = check_bool("flag", value)
+    assert type(result) is bool and result == bool(value)
+
+
+@pytest.mark.parametrize("value", [0, 1, 1.0, "yes", None, [True], np.array([True, False])])
+def test_check_bool_refuses_everything_else(value):
+    from kinegami.validation import check_bool
+
+    with pytest.raises(InvalidTypeError) as excinfo:
+        check_bool("endTip", value)
+    check_error(excinfo, TypeError, "endTip")
+    assert str(excinfo.value).startswith("endTip must be True or False, got ")
+
+
+def test_check_options_names_the_unknown_and_the_valid_options():
+    from kinegami.validation import check_options
+
+    check_options({"units": "mm"}, ("units", "scale"), "DXF export")
+    with pytest.raises(InvalidTypeError) as excinfo:
+        check_options({"unit": "mm"}, ("units", "scale"), "DXF export")
+    assert str(excinfo.value) == (
+        "DXF export got unknown option 'unit'; valid options are: units, scale"
+    )
+    with pytest.raises(InvalidTypeError) as excinfo:
+        check_options({"b": 1, "a": 2, "units": 3}, ("units", "scale"), "show()")
+    assert str(excinfo.value) == (
+        "show() got unknown options 'a', 'b'; valid options are: units, scale"
+    )
+
+
+def test_resolve_options_fills_in_the_defaults():
+    from kinegami.validation import resolve_options
+
+    defaults = {"units": "mm", "scale": 1.0}
+    assert resolve_options({"scale": 2.0}, defaults, "SVG export") == {"units": "mm", "scale": 2.0}
+    assert defaults == {"units": "mm", "scale": 1.0}
+    with pytest.raises(InvalidTypeError, match="SVG export got unknown option 'colour'"):
+        resolve_options({"colour": "red"}, defaults, "SVG export")
+
+
+def test_dh_end_tip_uses_the_shared_bool_check():
+    with pytest.raises(InvalidTypeError, match=r"^endTip must be True or False, got 1$"):
+        KinematicChain.from_dh([[0.0, 0.0, 0.0, 0.0]], 4, 1.0, endTip=1)
+
+
 # --- joint constructors ----------------------------------------------------------------------
 
 CONSTRUCTORS = {
