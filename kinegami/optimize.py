@@ -77,17 +77,26 @@ def _evaluate(
     return state if state.better_than(current, tol) else None
 
 
-def _trial(chain: KinematicChain, edit, *args) -> tuple[KinematicChain | None, float]:
+def _trial(
+    chain: KinematicChain, edit, *args, clear_only: bool = False
+) -> tuple[KinematicChain | None, float]:
     """A copy of ``chain`` with one edit applied and its overlap depth (0: clear), or
     (None, inf) if the edit was rejected.
 
     Edits replace the chain's joint and link lists, never change them in place, so a shallow
-    copy is an independent snapshot. The overlap is measured here, not read from the chain's
-    ClearanceWarning: recording warnings is not thread-safe, and starts may run in threads.
+    copy is an independent snapshot. With ``clear_only`` the copy requires clearance, so the
+    chain's own check rejects a colliding edit and nothing is measured twice; otherwise the
+    overlap is measured here, not read from the chain's ClearanceWarning (recording warnings
+    is not thread-safe, and starts may run in threads).
     """
     new = copy.copy(chain)
+    if clear_only:
+        new.requireClearance = True
     if not getattr(new, edit)(*args):
         return None, math.inf
+    if clear_only:
+        new.requireClearance = chain.requireClearance
+        return new, 0.0
     return new, _overlap(new)
 
 
@@ -152,7 +161,7 @@ def _descend(
                 break
             if not isinstance(state.chain.Joints[j], Waypoint):
                 continue
-            trial, overlap = _trial(state.chain, "delete", j)
+            trial, overlap = _trial(state.chain, "delete", j, clear_only=state.overlap == 0.0)
             new = None if trial is None else _evaluate(trial, overlap, kind, state, tol)
             if new is not None:
                 accept(new, ("delete", j))
@@ -163,7 +172,8 @@ def _descend(
             if out_of_time():
                 break
             for name, *args in _moves(state.chain, int(j), slide, roll, rolls):
-                trial, overlap = _trial(state.chain, name, *args)
+                trial, overlap = _trial(state.chain, name, *args,
+                                        clear_only=state.overlap == 0.0)  # fmt: skip
                 new = None if trial is None else _evaluate(trial, overlap, kind, state, tol)
                 if new is not None:
                     accept(new, (name, *args))
