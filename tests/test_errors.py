@@ -238,6 +238,14 @@ def test_dh_end_tip_uses_the_shared_bool_check():
         KinematicChain.from_dh([[0.0, 0.0, 0.0, 0.0]], 4, 1.0, endTip=1)
 
 
+def test_starter_design_overwrite_must_be_a_bool(tmp_path):
+    from kinegami.design.starter import write_starter_design
+
+    with pytest.raises(InvalidTypeError, match=r"^overwrite must be True or False, got 'no'$"):
+        write_starter_design(tmp_path / "robot.json", overwrite="no")
+    assert not (tmp_path / "robot.json").exists()
+
+
 # --- joint constructors ----------------------------------------------------------------------
 
 CONSTRUCTORS = {

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from kinegami.errors import DesignFileExistsError, InvalidParameterError
 from kinegami.export import discard, write_atomic
+from kinegami.validation import check_bool
 
 __all__ = [
     "DesignFileExistsError",
@@ -64,8 +65,10 @@ def write_starter_design(path: str | os.PathLike, *, overwrite: bool = False) ->
     ------
     DesignFileExistsError : ``path`` exists and ``overwrite`` is False.
     InvalidParameterError : ``path`` does not end in ``.json``.
+    InvalidTypeError : ``overwrite`` is not True or False.
     kinegami.export.ExportError : the file cannot be written (folder missing rights, disk full).
     """
+    overwrite = check_bool("overwrite", overwrite)
     path = Path(path)
     if path.suffix.lower() != ".json" or not path.stem:
         raise InvalidParameterError(f"a design file name ends in .json, got {str(path)!r}")
