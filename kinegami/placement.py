@@ -1,4 +1,6 @@
-"""Joint placement along the axis of motion (chain.md sections 4.3-4.5).
+"""Joint placement along the axis of motion.
+
+The published rules: docs/theory/placement.md; what kinegami adds: docs/placement.md.
 
 These functions only compute poses; the chain builds and checks the links. All frames are 4x4
 world arrays. A joint placed here keeps its axis-of-motion line: it only slides along its z
@@ -18,7 +20,7 @@ from kinegami.geometry.frames import angle_between, any_perpendicular, rotation_
 from kinegami.geometry.lines import common_normal
 from kinegami.joints import Joint, Waypoint
 
-#: Plane side tests and line/plane parallelism (chain.md 0, eps_plane).
+#: Plane side tests and line/plane parallelism (docs/theory/chain.md §0).
 PLANE_TOLERANCE = 1e-8
 
 
@@ -31,7 +33,7 @@ def slide_to_plane(
 ) -> float:
     """lambda minimising |target - (p + lambda z)| with (p + lambda z) on or beyond the plane.
 
-    Closed form of chain.md 4.3 step 5.
+    Closed form of docs/theory/placement.md §1 step 5.
     """
     lam_star = float((target - p) @ z)
     a = float(plane_normal @ z)
@@ -46,7 +48,7 @@ def slide_to_plane(
 def compact_lambda(
     p_parent: np.ndarray, p: np.ndarray, z: np.ndarray, ball: Ball, clearance: float, r: float
 ) -> float:
-    """Slide for compact placement (chain.md 4.4): nearest to the parent with
+    """Slide for compact placement (docs/theory/placement.md §2): nearest to the parent with
     |c - (p + lambda z)| >= clearance, staying on the side of the ball the user chose."""
     lam_star = float((p_parent - p) @ z)
     lam_c = float((ball.c - p) @ z)
@@ -79,7 +81,10 @@ def compact_lambda_other_side(
 
 
 def orient_by_common_normal(joint: Joint, parent_pose: np.ndarray) -> Joint:
-    """chain.md 4.5: x along the common normal from the parent's axis, path pointing away."""
+    """x along the common normal from the parent's axis, path pointing away.
+
+    See docs/theory/placement.md §3.
+    """
     T = joint.pose_matrix
     tol = 1e-9 * joint.r
     n = common_normal(parent_pose[:3, 3], parent_pose[:3, 2], T[:3, 3], T[:3, 2], tol)
@@ -105,12 +110,12 @@ def published_safe_placement(
     ball: Ball,
     reverse: bool = False,
 ) -> list[Joint]:
-    """The published safe placement (T-RO Algorithm 9, chain.md 4.3).
+    """The published safe placement (T-RO Algorithm 9, docs/theory/placement.md §1).
 
     ``parent_distal`` is the parent's distal frame (4x4, not permuted); its column
     ``parent_path_index`` is the direction n1 in which the tube leaves the parent. The joint
     keeps its path direction, or has it reversed when ``reverse`` is True (the caller tries
-    both: chain.md 4.3 step 6). Returns the waypoints and the placed joint, in order.
+    both: docs/theory/placement.md §1 step 6). Returns the waypoints and the placed joint, in order.
     """
     r = joint.r
     n1 = parent_distal[:3, parent_path_index]

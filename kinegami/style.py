@@ -1,4 +1,4 @@
-"""Default colours, opacities and scales of the drawings (chain.md section 6).
+"""Default colours, opacities and scales of the drawings (docs/theory/chain.md §6).
 
 One place for every visual default, so that ``KinematicChain.show`` and any other plotting
 backend agree. Colours are matplotlib colour specifications; opacities are alphas in [0, 1];

@@ -1,4 +1,4 @@
-"""Rigid transforms and angles on plain numpy arrays (chain.md section 0).
+"""Rigid transforms and angles on plain numpy arrays (docs/theory/chain.md §0).
 
 Frames are 4x4 homogeneous matrices ``T = [[R, p], [0, 1]]`` whose rotation columns are the frame
 axes (x, y, z) in world coordinates and whose translation is the frame origin. "Transform F by T"
@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-#: Angles within this of 2*pi wrap to 0 (chain.md section 0, eps_wrap).
+#: Angles within this of 2*pi wrap to 0 (docs/theory/chain.md §0).
 WRAP_SNAP = 1e-5
 
 
@@ -115,7 +115,10 @@ def angle_between(a, b) -> float:
 
 
 def signed_angle(a, b, normal) -> float:
-    """signedAngle(a, b, n): atan2((a x b).n, a.b) of the normalised vectors (chain.md 0)."""
+    """signedAngle(a, b, n): atan2((a x b).n, a.b) of the normalised vectors.
+
+    See docs/theory/chain.md §0.
+    """
     a = unit(a)
     b = unit(b)
     n = unit(normal)

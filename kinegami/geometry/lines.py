@@ -1,4 +1,4 @@
-"""Lines and the common normal of two axes (chain.md section 4.5)."""
+"""Lines and the common normal of two axes (docs/theory/placement.md §3)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ def common_normal(p_from, z_from, p_to, z_to, tol: float) -> np.ndarray | None:
     It points from the first line towards the second. Returns None when undefined:
     coincident axes, or axes that intersect (the normal would have no preferred sign).
     ``tol`` is a length tolerance (scaled by r by the caller); the direction tests use
-    1e-9 (chain.md 4.5 [FIX]: no exact-zero tests).
+    1e-9 (docs/theory/placement.md §3: no exact-zero tests).
     """
     v = np.asarray(p_to, dtype=float) - np.asarray(p_from, dtype=float)
     z1 = np.asarray(z_from, dtype=float)

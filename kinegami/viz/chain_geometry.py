@@ -1,4 +1,4 @@
-"""What ``KinematicChain.show`` draws, as plain numpy geometry (chain.md section 6).
+"""What ``KinematicChain.show`` draws, as plain numpy geometry (docs/theory/chain.md §6).
 
 Pure functions from joints and links to vertex arrays (world coordinates, units of r); no
 matplotlib. The drawing in :mod:`kinegami.viz.chain_plot` only hands these arrays to

@@ -1,4 +1,4 @@
-"""3D matplotlib view of a kinematic chain: ``KinematicChain.show`` (chain.md section 6).
+"""3D matplotlib view of a kinematic chain: ``KinematicChain.show`` (docs/theory/chain.md §6).
 
 The geometry comes from :mod:`kinegami.viz.chain_geometry`; this module only turns it into
 matplotlib artists, one collection per kind of thing (joint bodies, elbows, tubes, ...), each
@@ -512,7 +512,7 @@ def _set_equal_limits(ax, scene, had_data: bool, r: float):
 
 
 def show_chain(chain: KinematicChain, **options) -> tuple[Figure, Axes3D]:
-    """Draw a chain in 3D with matplotlib (chain.md section 6).
+    """Draw a chain in 3D with matplotlib (docs/theory/chain.md §6).
 
     Parameters
     ----------
