@@ -8,8 +8,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinegami.errors import InvalidParameterError
+from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
-from kinegami.pattern._prism import Prism, make_prism, wrap_x
+from kinegami.pattern._fold import (
+    MERGE_TOLERANCE,
+    assign,
+    corners,
+    match_vertices,
+    mod_w,
+    require_all,
+    rot_axis,
+)
+from kinegami.pattern._prism import Prism, make_prism, periodic_dx, wrap_x
+from kinegami.pattern.counts import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 from kinegami.validation import check_real
 
@@ -185,19 +196,174 @@ def _build_elbow(prism: Prism, geo: ElbowGeometry, record: ModuleRecord) -> Tubu
     vertices[Of[full], 1] = H_m
     vertices[L[has_l], 0], vertices[L[has_l], 1] = x[has_l], h[has_l]
     vertices[U[has_l], 0], vertices[U[has_l], 1] = x[has_l], H - h[has_l]
-    prev, nxt = (k - 1) % n, (k + 1) % n
-    # block order matters: where two collapsed columns are adjacent the lower boundary,
-    # upper boundary and midline coincide; the first (lower boundary, M) is kept (step 5)
-    blocks = [
-        crease_block(L[prev], L, "M"),  # lower tuck boundary
-        crease_block(P, L, "M"),  # proximal tube edge
-        crease_block(U[prev], U, "M"),  # upper tuck boundary
-        crease_block(U, D, "M"),  # distal tube edge
-        crease_block(M, Of, "V"),  # midline
-        crease_block(Of, M[nxt], "V"),  # midline
-        crease_block(L, M, "V"),  # lower half of the column line
-        crease_block(M, U, "M"),  # upper half of the column line
-        crease_block(L, Of, "M"),  # lower tuck diagonal
-        crease_block(U, Of, "V"),  # upper tuck diagonal
-    ]
+    blocks = [crease_block(a, c, label) for a, c, label in _crease_table(P, D, L, M, Of, U)]
     return assemble(prism, vertices, blocks, P, D, H, record)
+
+
+def _crease_table(P, D, L, M, Of, U) -> list:
+    """The elbow's creases as (first ends, second ends, label), one entry per column.
+
+    The arrays give, per column k, the indices of P_k, D_k and of the tuck vertices L_k, M_k,
+    O_k, U_k (the catalog reuses indices where fix B6 merges points; the unsnapped elbow does
+    not). The order matters: where two collapsed columns are adjacent the lower boundary, upper
+    boundary and midline coincide, and the first (lower boundary, M) is kept.
+    """
+    n = P.shape[0]
+    k = np.arange(n)
+    prev, nxt = (k - 1) % n, (k + 1) % n
+    return [
+        (L[prev], L, "M"),  # lower tuck boundary
+        (P, L, "M"),  # proximal tube edge
+        (U[prev], U, "M"),  # upper tuck boundary
+        (U, D, "M"),  # distal tube edge
+        (M, Of, "V"),  # midline
+        (Of, M[nxt], "V"),  # midline
+        (L, M, "V"),  # lower half of the column line
+        (M, U, "M"),  # upper half of the column line
+        (L, Of, "M"),  # lower tuck diagonal
+        (U, Of, "V"),  # upper tuck diagonal
+    ]
+
+
+# --------------------------------------------------------------------------------------------
+# Catalog entry: counts, unsnapped geometry and fold
+
+
+def _counts(prism: Prism, params) -> ModuleCounts:
+    """6n - 3c - 2z vertices and 10n - 5c - 2[c = 2] - 2z creases, c collapsed columns and z
+    low ones (fix B6)."""
+    n = prism.numSides
+    geo = elbow_geometry(prism, params["bendingAngle"], params["rotationalAxisAngle"])
+    c = int(np.count_nonzero(geo.collapsed))
+    z = int(np.count_nonzero(geo.low))
+    return ModuleCounts(6 * n - 3 * c - 2 * z, 10 * n - 5 * c - 2 * (c == 2) - 2 * z)
+
+
+def _unsnapped(prism: Prism, pattern: TubularPattern, params):
+    """The elbow with four tuck vertices on every column, and the catalog vertices in it."""
+    exact = _exact_elbow(
+        prism, params["bendingAngle"], params["rotationalAxisAngle"], pattern.modules
+    )
+    return exact, match_vertices(pattern.vertices_coords, exact.vertices_coords, prism)
+
+
+def _exact_elbow(prism: Prism, theta: float, phi: float, records) -> TubularPattern:
+    """The elbow with four tuck vertices L, M, O, U on every column (no eps rules).
+
+    Vertices closer than ``MERGE_TOLERANCE`` r are merged (exactly collapsed columns, h_k = 0),
+    the creases between merged vertices dropped and repeated creases kept once, the first in
+    the spec's order (so two adjacent collapsed columns share one M crease, as in step 5).
+    """
+    geo = elbow_geometry(prism, theta, phi)
+    n, W = prism.numSides, prism.W
+    x = prism.columns
+    h, H_m = geo.h, geo.H_m
+    H = 2.0 * H_m
+    k = np.arange(n)
+    P, D = k, n + k
+    L, M, Of, U = 2 * n + 4 * k, 2 * n + 4 * k + 1, 2 * n + 4 * k + 2, 2 * n + 4 * k + 3
+    xy = np.empty((6 * n, 2))
+    xy[P] = np.stack([x, np.zeros(n)], axis=1)
+    xy[D] = np.stack([x, np.full(n, H)], axis=1)
+    xy[L] = np.stack([x, h], axis=1)
+    xy[M] = np.stack([x, np.full(n, H_m)], axis=1)
+    xy[Of] = np.stack([mod_w(x + (H_m - h) * np.tan(geo.tuck), W), np.full(n, H_m)], axis=1)
+    xy[U] = np.stack([x, H - h], axis=1)
+    table = _crease_table(P, D, L, M, Of, U)
+    edges = np.concatenate([np.stack([a, c], axis=1) for a, c, _ in table])
+    labels = np.concatenate([np.full(n, lab, dtype="<U1") for _, _, lab in table])
+    # merge coincident vertices into the lowest index (P and D come first)
+    dx = periodic_dx(xy[:, None, 0] - xy[None, :, 0], W)
+    close = np.hypot(dx, xy[:, None, 1] - xy[None, :, 1]) < MERGE_TOLERANCE * prism.r
+    rep = np.argmax(close, axis=1)
+    while not np.array_equal(rep[rep], rep):
+        rep = rep[rep]
+    keep = np.flatnonzero(rep == np.arange(6 * n))
+    index = np.full(6 * n, -1)
+    index[keep] = np.arange(keep.size)
+    edges = index[rep[edges]]
+    lo, hi = edges.min(axis=1), edges.max(axis=1)
+    first = np.zeros(edges.shape[0], dtype=bool)
+    first[np.unique(lo * keep.size + hi, return_index=True)[1]] = True
+    first &= lo != hi
+    return TubularPattern._build(
+        n, prism.r, xy[keep], np.ascontiguousarray(edges[first]), labels[first], index[P],
+        index[D], np.zeros(2), np.array([0.0, H]), H, tuple(records),
+    )  # fmt: skip
+
+
+def _fold(prism: Prism, pattern: TubularPattern, params):
+    """The elbow at state 0: every vertex at the 3D position of the named point it is.
+
+    P on the base ring, D on the ring turned by theta about g, L and U on the bisecting plane,
+    and the tucked points O_k, M_{k+1} in the bisecting plane, each flat triangle of the tuck
+    laid rigidly into that plane from its edge L_k-L_{k+1} (docs/fold.md).
+    """
+    theta, phi = params["bendingAngle"], params["rotationalAxisAngle"]
+    geo = elbow_geometry(prism, theta, phi)
+    n, r, b = prism.numSides, prism.r, prism.b
+    theta, phi = geo.bendingAngle, geo.rotationalAxisAngle
+    h, H_m = geo.h, geo.H_m
+    H = 2.0 * H_m
+    x = prism.columns
+    g = np.array([math.cos(phi), math.sin(phi), 0.0])
+    w = np.cross(g, (0.0, 0.0, 1.0))
+    R = rot_axis(g, theta)
+    shift = r * w - R @ (r * w)
+    n_pi = rot_axis(g, theta / 2.0) @ np.array([0.0, 0.0, 1.0])
+    p = corners(prism)
+    q = p.copy()
+    q[:, 2] = h
+    offset = (H_m - h) * np.tan(geo.tuck)
+    names_xy = []
+    names_X = []
+
+    def add(points_xy, points_X):
+        names_xy.append(np.atleast_2d(points_xy))
+        names_X.append(np.atleast_2d(points_X))
+
+    add(np.stack([x, np.zeros(n)], axis=1), p)  # P
+    add(np.stack([x, np.full(n, H)], axis=1), p @ R.T + shift)  # D = E(p)
+    add(np.stack([x, h], axis=1), q)  # L
+    add(np.stack([x, H - h], axis=1), q)  # U
+    for k in range(n):
+        k1 = (k + 1) % n
+        e1 = np.array([b, h[k1] - h[k]])
+        e1 /= np.linalg.norm(e1)
+        e2 = np.array([-e1[1], e1[0]])
+        f1 = q[k1] - q[k]
+        f1 /= np.linalg.norm(f1)
+        f2 = np.cross(n_pi, f1)
+        L_k = np.array([x[k], h[k]])
+        O_k = np.array([x[k] + offset[k], H_m])
+        M_1 = np.array([x[k] + b, H_m])
+        for point in (O_k, M_1):
+            rel = point - L_k
+            image = q[k] + (rel @ e1) * f1 + (rel @ e2) * f2
+            wrapped = point.copy()
+            wrapped[0] = wrap_x(point[0:1], prism.W, 0.0)[0]
+            add(wrapped, image)
+    named_xy = np.concatenate(names_xy)
+    named_X = np.concatenate(names_X)
+    # the unsnapped elbow's vertices are named points (merged ones within MERGE_TOLERANCE r)
+    X, matched = assign(pattern.vertices_coords, named_xy, named_X, prism.W, MERGE_TOLERANCE * r)
+    require_all(matched, "elbow")
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = shift
+    return X, T
+
+
+# --- revolute joint and tips (spec 3.4-3.6) ------------------------------------------------
+
+
+catalog.register(
+    catalog.ModuleKind(
+        "elbow",
+        ElbowFittingPattern,
+        ("bendingAngle", "rotationalAxisAngle"),
+        _counts,
+        _fold,
+        _unsnapped,
+    )
+)

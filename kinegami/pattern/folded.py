@@ -36,20 +36,16 @@ creases by a damped least-squares solve; the faces next to them bend slightly (d
 from __future__ import annotations
 
 import functools
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.pattern._prism import Prism, make_prism, periodic_dx, wrap_x
-from kinegami.pattern.elbow import elbow_geometry
-from kinegami.pattern.prismatic import rebo_geometry
-from kinegami.pattern.revolute import revolute_geometry
-from kinegami.pattern.sheet import TOLERANCE_FACTOR
+from kinegami.pattern._fold import MERGE_TOLERANCE, FoldedFormError, mod_w
+from kinegami.pattern._prism import make_prism, periodic_dx
+from kinegami.pattern.catalog import module_kind
+from kinegami.pattern.prismatic import rebo_folded_length, rebo_tilt
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
-from kinegami.pattern.twist import twist_geometry
-from kinegami.validation import check_in_range, check_num_sides, check_positive
 
 __all__ = [
     "FoldedForm",
@@ -73,16 +69,6 @@ UVA_TO_DUBINS = np.array(
 
 #: Crease length errors above this many r trigger the Gauss-Newton repair.
 REPAIR_TOLERANCE = 1e-10
-
-#: Points of an unsnapped module closer than this many r are one vertex: they coincide to the
-#: tolerance of the flat sheet (kinegami.pattern.sheet.TOLERANCE_FACTOR), below which the sheet's
-#: planar graph cannot tell points apart.
-MERGE_TOLERANCE = TOLERANCE_FACTOR
-
-
-class FoldedFormError(InvalidParameterError):
-    """A pattern cannot be folded (no module records, or records that do not rebuild it)."""
-
 
 @dataclass(frozen=True, eq=False)
 class FoldedModule:
@@ -339,7 +325,7 @@ def _freeze(params) -> tuple:
 
 
 # ------------------------------------------------------------------------------------------------
-# Composition replay (spec section 2.2) and assembly
+# Placing the modules and assembling the folded form
 
 
 @dataclass(frozen=True, eq=False)
@@ -352,68 +338,50 @@ class _Placement:
     is_new: np.ndarray
 
 
-def _replay(pattern: TubularPattern) -> list[_Placement]:
-    """Replay the composition of ``pattern.modules`` (spec 2.2) and check that it rebuilds the
-    pattern's vertices; returns the placement of every module."""
+def _placements(pattern: TubularPattern) -> list[_Placement]:
+    """Every module of ``pattern`` with the vertices composition gave it
+    (``pattern.module_vertices``), checked against the module rebuilt from its record."""
     if not pattern.modules:
         raise FoldedFormError(
             "cannot fold a pattern without module records (kind 'custom'): only patterns made "
             "of catalog modules carry the information needed to fold them"
         )
+    placed = pattern.module_vertices
+    if placed is None:
+        raise FoldedFormError(
+            "the pattern's module records do not rebuild it: it does not know where its modules' "
+            "vertices are (was it reversed, or built by hand with several records?)"
+        )
     n, r = pattern.numSides, pattern.r
     prism = make_prism(n, r)
-    W, eps = prism.W, prism.eps
-    coords = np.full((pattern.numVertices, 2), np.nan)
+    tol = 8.0 * prism.eps
+    xy = pattern.vertices_coords
     placements = []
-    marker = np.array(pattern.proximalMarker, dtype=float)
-    distal_idx = None
-    distal_xy = None
-    next_index = 0
-    for m, record in enumerate(pattern.modules):
+    for m, (record, mapping) in enumerate(zip(pattern.modules, placed, strict=True)):
         local = _rebuild(n, r, record, m)
-        offset = marker - local.proximalMarker
-        xy = local.vertices_coords + offset
-        xy[:, 0] = wrap_x(xy[:, 0], W, eps)
-        mapping = np.empty(local.numVertices, dtype=np.intp)
+        if mapping.shape[0] != local.numVertices:
+            raise _mismatch(m, record, "vertex count differs")
+        # the module must sit in the pattern translated as a whole (composition moves it so)
+        d = xy[mapping] - local.vertices_coords
+        dx = periodic_dx(d[:, 0] - d[0, 0], prism.W)
+        dy = d[:, 1] - d[0, 1]
+        if np.abs(dx).max(initial=0.0) > tol or np.abs(dy).max(initial=0.0) > tol:
+            raise FoldedFormError(
+                "the pattern's module records do not rebuild its vertices (module "
+                f"{m}, {record.kind!r}, is off by {max(np.abs(dx).max(), np.abs(dy).max()):.3g}); "
+                "was it reversed or edited by hand?"
+            )
         is_new = np.ones(local.numVertices, dtype=bool)
         if m > 0:
-            if local.proximalBase is None or distal_idx is None:
-                raise FoldedFormError(
-                    f"module {m} ({record.kind}) cannot follow module {m - 1}: the records do "
-                    "not describe a valid composition"
-                )
-            base = local.proximalBase
-            j = _find_shift(distal_xy, xy[base], W, eps, m)
-            mapping[base] = distal_idx[(np.arange(n) + j) % n]
-            is_new[base] = False
-        count = int(np.count_nonzero(is_new))
-        mapping[is_new] = np.arange(next_index, next_index + count)
-        next_index += count
-        if next_index > pattern.numVertices:
-            raise _mismatch(m, record, "more vertices than the pattern has")
-        coords[mapping[is_new]] = xy[is_new]
+            if local.proximalBase is None:
+                raise _mismatch(m, record, "a module without a proximal base")
+            is_new[local.proximalBase] = False
         placements.append(_Placement(record, mapping, is_new))
-        marker = local.distalMarker + offset
-        marker[0] = wrap_x(marker[0:1], W, eps)[0]
-        if local.distalBase is None:
-            distal_idx = distal_xy = None
-        else:
-            distal_idx = mapping[local.distalBase]
-            distal_xy = xy[local.distalBase]
-    if next_index != pattern.numVertices or np.isnan(coords).any():
-        raise _mismatch(len(pattern.modules) - 1, pattern.modules[-1], "vertex count differs")
-    dx = periodic_dx(coords[:, 0] - pattern.vertices_coords[:, 0], W)
-    dy = coords[:, 1] - pattern.vertices_coords[:, 1]
-    if np.abs(dx).max(initial=0.0) > 2 * eps or np.abs(dy).max(initial=0.0) > 2 * eps:
-        raise FoldedFormError(
-            "the pattern's module records do not rebuild its vertices (largest difference "
-            f"{max(np.abs(dx).max(), np.abs(dy).max()):.3g}); was it reversed or edited by hand?"
-        )
     return placements
 
 
 def _fold(pattern: TubularPattern, G0: np.ndarray) -> FoldedForm:
-    placements = _replay(pattern)
+    placements = _placements(pattern)
     n, r = pattern.numSides, pattern.r
     X = np.full((pattern.numVertices, 3), np.nan)
     pinned = np.zeros(pattern.numVertices, dtype=bool)
@@ -458,7 +426,7 @@ def _fold_unsnapped(pattern: TubularPattern, G0: np.ndarray) -> UnsnappedForm:
     from the replay of the catalog composition); the vertices that only the unsnapped modules
     have follow, numbered in module order.
     """
-    placements = _replay(pattern)
+    placements = _placements(pattern)
     n, r = pattern.numSides, pattern.r
     prism = make_prism(n, r)
     W = prism.W
@@ -476,7 +444,7 @@ def _fold_unsnapped(pattern: TubularPattern, G0: np.ndarray) -> UnsnappedForm:
         exact = fold.exact
         offset = marker - exact.proximalMarker
         xy = exact.vertices_coords + offset
-        xy[:, 0] = _mod_w(xy[:, 0], W)
+        xy[:, 0] = mod_w(xy[:, 0], W)
         world = (G[:3, :3] @ fold.X_exact.T).T + G[:3, 3]
         emap = np.full(exact.numVertices, -1, dtype=np.intp)
         emap[fold.corr] = mapping
@@ -504,7 +472,7 @@ def _fold_unsnapped(pattern: TubularPattern, G0: np.ndarray) -> UnsnappedForm:
         G = G @ fold.T
         modules.append(FoldedModule(record, _readonly(emap), proximal, G @ UVA_TO_DUBINS.T))
         marker = exact.distalMarker + offset
-        marker[0] = _mod_w(marker[0:1], W)[0]
+        marker[0] = mod_w(marker[0:1], W)[0]
     if gap > 1e-9 * r:  # pragma: no cover - would be a bug in a module's unsnapped geometry
         raise FoldedFormError(f"unsnapped module ends do not meet (gap {gap:.3g})")
     coords = np.concatenate(coords)
@@ -552,46 +520,7 @@ def _rebuild(n: int, r: float, record: ModuleRecord, m: int) -> TubularPattern:
 
 @functools.lru_cache(maxsize=512)
 def _rebuild_cached(n: int, r: float, kind: str, params: tuple) -> TubularPattern:
-    import kinegami.pattern as catalog
-
-    p = dict(params)
-    if kind == "tube":
-        return catalog.TubeFittingPattern(n, r, p["height"])
-    if kind == "twist":
-        return catalog.TwistFittingPattern(n, r, p["twistAngle"], p["moduleHeight"])
-    if kind == "elbow":
-        return catalog.ElbowFittingPattern(n, r, p["bendingAngle"], p["rotationalAxisAngle"])
-    if kind == "revolute":
-        return catalog.RevoluteJointPattern(n, r, p["totalBendingAngle"], p["numSinkLayers"])
-    if kind == "prismatic":
-        return catalog.PrismaticJointPattern(
-            n, r, p["neutralLength"], p["numLayers"], p["coneAngle"]
-        )
-    if kind == "rebo":
-        return catalog.REBOPattern(
-            n, r, p["neutralLength"], p["numLayers"], p["coneAngle"], p["proximalValleys"]
-        )
-    if kind == "end_tip":
-        return catalog.EndTipPattern(n, r, p["length"])
-    if kind == "start_tip":
-        return catalog.StartTipPattern(n, r, p["length"])
-    if kind == "waypoint":
-        return catalog.WaypointPattern(n, r)
-    raise KeyError(f"unknown module kind {kind!r}")
-
-
-def _find_shift(target: np.ndarray, base_xy: np.ndarray, W: float, eps: float, m: int) -> int:
-    n = target.shape[0]
-    for j in range(n):
-        rolled = target[(np.arange(n) + j) % n] - base_xy
-        if (np.abs(periodic_dx(rolled[:, 0], W)) < eps).all() and (
-            np.abs(rolled[:, 1]) < eps
-        ).all():
-            return j
-    raise FoldedFormError(
-        f"module {m}'s proximal base does not meet the previous distal base in the replayed "
-        "composition; the pattern's module records do not rebuild it"
-    )
+    return module_kind(kind).rebuild(n, r, dict(params))
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -720,54 +649,18 @@ def _gauss_newton(X, edges, target, free, tol, weight=None, iterations: int = 10
 
 
 # ------------------------------------------------------------------------------------------------
-# Module geometry (spec section 3 and docs/fold.md); positions in (e_u, e_v, e_a) coordinates
-
-
-def _translation(a: float) -> np.ndarray:
-    T = np.eye(4)
-    T[2, 3] = a
-    return T
-
-
-def _rot_axis(axis, angle: float) -> np.ndarray:
-    k = np.asarray(axis, dtype=float)
-    k = k / np.linalg.norm(k)
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * (K @ K)
-
-
-def _polygon_point(prism: Prism, x: np.ndarray) -> np.ndarray:
-    """c(x) of spec 1.3: the point at arc length x on the polygon (a = 0), shape (m, 3)."""
-    x = np.asarray(x, dtype=float)
-    n, b, a = prism.numSides, prism.b, prism.a
-    m = np.round(x / b)
-    sigma = m * (2.0 * math.pi / n)
-    t = x - m * b
-    out = np.zeros(x.shape + (3,))
-    out[..., 0] = a * np.cos(sigma) - t * np.sin(sigma)
-    out[..., 1] = a * np.sin(sigma) + t * np.cos(sigma)
-    return out
-
-
-def _corners(prism: Prism, angle_offset: float = 0.0) -> np.ndarray:
-    beta = prism.vertex_angles + angle_offset
-    return prism.r * np.stack([np.cos(beta), np.sin(beta), np.zeros_like(beta)], axis=1)
-
-
-def _mod_w(x: np.ndarray, W: float) -> np.ndarray:
-    """x reduced into [0, W) without snapping (spec 2.1 less its eps rule)."""
-    x = np.mod(x, W)
-    return np.where(x >= W, 0.0, x)
+# One module folded (each kind's fold lives in its own file, see kinegami.pattern.catalog)
 
 
 @dataclass(frozen=True, eq=False)
 class _ModuleFold:
     """A catalog module folded at state 0, in its proximal frame (e_u, e_v, e_a).
 
-    ``exact`` is the module without the eps rules (:func:`_exact_module`) and ``X_exact`` its
-    exact, piecewise isometric fold; ``corr[j]`` is the vertex of ``exact`` that vertex j of the
-    catalog module stands for. ``X`` is the catalog module's fold: ``X_exact[corr]``, put back on
-    an isometry of its creases where the catalog moved vertices (``repaired``, local indices).
+    ``exact`` is the module without the eps rules (its catalog entry's ``unsnapped``) and
+    ``X_exact`` its exact, piecewise isometric fold; ``corr[j]`` is the vertex of ``exact`` that
+    vertex j of the catalog module stands for. ``X`` is the catalog module's fold:
+    ``X_exact[corr]``, put back on an isometry of its creases where the catalog moved vertices
+    (``repaired``, local indices).
     """
 
     catalog: TubularPattern
@@ -784,38 +677,10 @@ def _module_fold(n: int, r: float, kind: str, params: tuple) -> _ModuleFold:
     """The folded module of a record (cached): see :class:`_ModuleFold`."""
     prism = make_prism(n, r)
     catalog = _rebuild_cached(n, r, kind, params)
+    entry = module_kind(kind)
     p = dict(params)
-    exact, corr = _exact_module(prism, catalog, kind, p)
-    xy = exact.vertices_coords
-    if kind in ("tube", "waypoint"):
-        X = _polygon_point(prism, xy[:, 0])
-        X[:, 2] = xy[:, 1]
-        T = _translation(exact.height)
-    elif kind == "twist":
-        X, T = _fold_twist(prism, exact, p["twistAngle"], p["moduleHeight"])
-    elif kind == "elbow":
-        X, T = _fold_elbow(prism, exact, p["bendingAngle"], p["rotationalAxisAngle"])
-    elif kind == "revolute":
-        h_r = prism.a * math.tan(p["totalBendingAngle"] / 4.0)
-        X = _fold_revolute(prism, exact, h_r, with_distal=True)
-        T = _translation(2.0 * h_r)
-    elif kind == "end_tip":
-        X = _fold_revolute(prism, exact, p["length"], with_distal=False)
-        T = _translation(p["length"])
-    elif kind == "start_tip":
-        ell = p["length"]
-        mirrored = xy.copy()
-        mirrored[:, 1] = exact.height - xy[:, 1]
-        X = _fold_revolute(prism, exact, ell, with_distal=False, xy=mirrored)
-        X[:, 2] = ell - X[:, 2]
-        T = _translation(ell)
-    elif kind == "rebo":
-        X = _fold_rebo_vertices(prism, xy, p["neutralLength"], p["numLayers"], p["coneAngle"])
-        T = _translation(rebo_folded_length(n, p["neutralLength"], p["coneAngle"]))
-    elif kind == "prismatic":
-        X, T = _fold_prismatic(prism, exact, p["neutralLength"], p["numLayers"], p["coneAngle"])
-    else:  # pragma: no cover - _rebuild_cached rejects unknown kinds first
-        raise KeyError(kind)
+    exact, corr = entry.unsnapped(prism, catalog, p)
+    X, T = entry.fold(prism, exact, p)
     pinned = np.zeros(catalog.numVertices, dtype=bool)
     for base in (catalog.proximalBase, catalog.distalBase):
         if base is not None:
@@ -831,428 +696,3 @@ def _module_geometry(n: int, r: float, kind: str, params: tuple):
     transform and the local indices of the vertices moved by the isometry repair."""
     fold = _module_fold(n, r, kind, params)
     return fold.X, fold.T, fold.repaired
-
-
-def _exact_module(prism: Prism, catalog: TubularPattern, kind: str, p: dict):
-    """The module without the eps rules, and the vertex of it each catalog vertex stands for.
-
-    The catalog moves some points a little: it snaps points within eps = 1e-4 b of the seam
-    onto it (section 2.1; inside a module: a twist's distal base and marker, a REBO's pleat
-    offset points, an elbow's offset points) and, in an elbow, merges the tuck vertices of
-    columns with h_k < eps with P_k and D_k and collapses columns close to the midline into one
-    vertex (fix B6). The unsnapped module keeps those points where the module's formulas put
-    them, so that its exact fold is an isometry; only vertices closer than
-    ``MERGE_TOLERANCE`` r are one vertex. Every other module is its catalog module.
-    """
-    identity = np.arange(catalog.numVertices)
-    W, b = prism.W, prism.b
-    xy = catalog.vertices_coords.copy()
-    distal_marker = catalog.distalMarker.copy()
-    if kind == "elbow":
-        exact = _exact_elbow(prism, p["bendingAngle"], p["rotationalAxisAngle"], catalog.modules)
-        return exact, _match_vertices(catalog.vertices_coords, exact.vertices_coords, prism)
-    if kind == "twist":
-        geo = twist_geometry(prism, p["twistAngle"], p["moduleHeight"])
-        if geo.degenerate:
-            return catalog, identity
-        xy[catalog.distalBase, 0] = _mod_w(prism.columns + geo.shift, W)
-        distal_marker[0] = _mod_w(np.array([geo.K * b + geo.shift]), W)[0]
-    elif kind in ("rebo", "prismatic"):
-        geo = rebo_geometry(prism, p["neutralLength"], p["numLayers"], p["coneAngle"])
-        # the only points of these modules that can be snapped: the pleat offsets of column 0
-        snapped = xy[:, 0] == 0.0
-        if not snapped.any():
-            return catalog, identity
-        xy[snapped, 0] = _mod_w(prism.columns[:1] - geo.offset, W)[0]
-    else:
-        return catalog, identity
-    exact = TubularPattern._build(
-        prism.numSides, prism.r, xy, catalog.edges_vertices.copy(),
-        catalog.edges_assignment.copy(), catalog.proximalBase.copy(), catalog.distalBase.copy(),
-        catalog.proximalMarker.copy(), distal_marker, catalog.height, catalog.modules,
-    )  # fmt: skip
-    return exact, identity
-
-
-def _exact_elbow(prism: Prism, theta: float, phi: float, records) -> TubularPattern:
-    """The elbow of spec 3.3 with four tuck vertices L, M, O, U on every column (no eps rules).
-
-    Vertices closer than ``MERGE_TOLERANCE`` r are merged (exactly collapsed columns, h_k = 0),
-    the creases between merged vertices dropped and repeated creases kept once, the first in
-    the spec's order (so two adjacent collapsed columns share one M crease, as in step 5).
-    """
-    geo = elbow_geometry(prism, theta, phi)
-    n, W = prism.numSides, prism.W
-    x = prism.columns
-    h, H_m = geo.h, geo.H_m
-    H = 2.0 * H_m
-    k = np.arange(n)
-    P, D = k, n + k
-    L, M, Of, U = 2 * n + 4 * k, 2 * n + 4 * k + 1, 2 * n + 4 * k + 2, 2 * n + 4 * k + 3
-    xy = np.empty((6 * n, 2))
-    xy[P] = np.stack([x, np.zeros(n)], axis=1)
-    xy[D] = np.stack([x, np.full(n, H)], axis=1)
-    xy[L] = np.stack([x, h], axis=1)
-    xy[M] = np.stack([x, np.full(n, H_m)], axis=1)
-    xy[Of] = np.stack([_mod_w(x + (H_m - h) * np.tan(geo.tuck), W), np.full(n, H_m)], axis=1)
-    xy[U] = np.stack([x, H - h], axis=1)
-    prev, nxt = (k - 1) % n, (k + 1) % n
-    table = [  # spec 3.3 step 3, in the catalog's order
-        (L[prev], L, "M"), (P, L, "M"), (U[prev], U, "M"), (U, D, "M"), (M, Of, "V"),
-        (Of, M[nxt], "V"), (L, M, "V"), (M, U, "M"), (L, Of, "M"), (U, Of, "V"),
-    ]  # fmt: skip
-    edges = np.concatenate([np.stack([a, c], axis=1) for a, c, _ in table])
-    labels = np.concatenate([np.full(n, lab, dtype="<U1") for _, _, lab in table])
-    # merge coincident vertices into the lowest index (P and D come first)
-    dx = periodic_dx(xy[:, None, 0] - xy[None, :, 0], W)
-    close = np.hypot(dx, xy[:, None, 1] - xy[None, :, 1]) < MERGE_TOLERANCE * prism.r
-    rep = np.argmax(close, axis=1)
-    while not np.array_equal(rep[rep], rep):
-        rep = rep[rep]
-    keep = np.flatnonzero(rep == np.arange(6 * n))
-    index = np.full(6 * n, -1)
-    index[keep] = np.arange(keep.size)
-    edges = index[rep[edges]]
-    lo, hi = edges.min(axis=1), edges.max(axis=1)
-    first = np.zeros(edges.shape[0], dtype=bool)
-    first[np.unique(lo * keep.size + hi, return_index=True)[1]] = True
-    first &= lo != hi
-    return TubularPattern._build(
-        n, prism.r, xy[keep], np.ascontiguousarray(edges[first]), labels[first], index[P],
-        index[D], np.zeros(2), np.array([0.0, H]), H, tuple(records),
-    )  # fmt: skip
-
-
-def _match_vertices(catalog_xy: np.ndarray, exact_xy: np.ndarray, prism: Prism) -> np.ndarray:
-    """For every catalog vertex, the nearest unsnapped vertex (periodic in x): the same point
-    (a collapsed column's Q_k is M_k), or less than eps away for a point snapped onto the
-    seam."""
-    dx = periodic_dx(catalog_xy[:, None, 0] - exact_xy[None, :, 0], prism.W)
-    dist = np.hypot(dx, catalog_xy[:, None, 1] - exact_xy[None, :, 1])
-    nearest = np.argmin(dist, axis=1)
-    worst = dist[np.arange(catalog_xy.shape[0]), nearest].max(initial=0.0)
-    if worst > 3.0 * prism.eps or np.unique(nearest).size != nearest.size:
-        raise FoldedFormError(  # pragma: no cover - a catalog module changed its vertices
-            f"the catalog module's vertices do not match its unsnapped geometry ({worst:.3g})"
-        )
-    return nearest
-
-
-def _assign(
-    xy: np.ndarray, named_xy: np.ndarray, named_X: np.ndarray, W: float, tol: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Give each vertex the 3D position of the nearest named flat point (periodic in x).
-
-    Returns (X, matched): vertices farther than ``tol`` from every named point are unmatched
-    (their rows of X are NaN).
-    """
-    dx = periodic_dx(xy[:, None, 0] - named_xy[None, :, 0], W)
-    dy = xy[:, None, 1] - named_xy[None, :, 1]
-    dist = np.hypot(dx, dy)
-    nearest = np.argmin(dist, axis=1)
-    matched = dist[np.arange(xy.shape[0]), nearest] <= tol
-    X = np.full((xy.shape[0], 3), np.nan)
-    X[matched] = named_X[nearest[matched]]
-    return X, matched
-
-
-def _require_all(matched: np.ndarray, kind: str) -> None:
-    if not matched.all():  # pragma: no cover - a catalog module changed its vertices
-        raise FoldedFormError(
-            f"{int((~matched).sum())} vertices of a {kind} module have no known 3D position"
-        )
-
-
-# --- twist (spec 3.2) ----------------------------------------------------------------------
-
-
-def _fold_twist(prism: Prism, pattern: TubularPattern, alpha: float, h: float):
-    geo = twist_geometry(prism, alpha, h)
-    n = prism.numSides
-    p = _corners(prism)
-    xy = pattern.vertices_coords
-    R = np.eye(4)
-    if geo.degenerate:
-        columns = round(n * ((alpha % (2.0 * math.pi)) / (2.0 * math.pi))) % n
-        R[:3, :3] = _rot_axis((0.0, 0.0, 1.0), columns * 2.0 * math.pi / n)
-        X = _polygon_point(prism, xy[:, 0])
-        return X, R
-    X = np.empty((pattern.numVertices, 3))
-    X[pattern.proximalBase] = p
-    X[pattern.distalBase] = _corners(prism, geo.residual) + np.array([0.0, 0.0, h])
-    R[:3, :3] = _rot_axis((0.0, 0.0, 1.0), alpha)
-    R[2, 3] = h
-    return X, R
-
-
-# --- elbow (spec 3.3) ----------------------------------------------------------------------
-
-
-def _fold_elbow(prism: Prism, pattern: TubularPattern, theta: float, phi: float):
-    geo = elbow_geometry(prism, theta, phi)
-    n, r, b = prism.numSides, prism.r, prism.b
-    theta, phi = geo.bendingAngle, geo.rotationalAxisAngle
-    h, H_m = geo.h, geo.H_m
-    H = 2.0 * H_m
-    x = prism.columns
-    g = np.array([math.cos(phi), math.sin(phi), 0.0])
-    w = np.cross(g, (0.0, 0.0, 1.0))
-    R = _rot_axis(g, theta)
-    shift = r * w - R @ (r * w)
-    n_pi = _rot_axis(g, theta / 2.0) @ np.array([0.0, 0.0, 1.0])
-    p = _corners(prism)
-    q = p.copy()
-    q[:, 2] = h
-    offset = (H_m - h) * np.tan(geo.tuck)
-    names_xy = []
-    names_X = []
-
-    def add(points_xy, points_X):
-        names_xy.append(np.atleast_2d(points_xy))
-        names_X.append(np.atleast_2d(points_X))
-
-    add(np.stack([x, np.zeros(n)], axis=1), p)  # P
-    add(np.stack([x, np.full(n, H)], axis=1), p @ R.T + shift)  # D = E(p)
-    add(np.stack([x, h], axis=1), q)  # L
-    add(np.stack([x, H - h], axis=1), q)  # U
-    for k in range(n):
-        k1 = (k + 1) % n
-        e1 = np.array([b, h[k1] - h[k]])
-        e1 /= np.linalg.norm(e1)
-        e2 = np.array([-e1[1], e1[0]])
-        f1 = q[k1] - q[k]
-        f1 /= np.linalg.norm(f1)
-        f2 = np.cross(n_pi, f1)
-        L_k = np.array([x[k], h[k]])
-        O_k = np.array([x[k] + offset[k], H_m])
-        M_1 = np.array([x[k] + b, H_m])
-        for point in (O_k, M_1):
-            rel = point - L_k
-            image = q[k] + (rel @ e1) * f1 + (rel @ e2) * f2
-            wrapped = point.copy()
-            wrapped[0] = wrap_x(point[0:1], prism.W, 0.0)[0]
-            add(wrapped, image)
-    named_xy = np.concatenate(names_xy)
-    named_X = np.concatenate(names_X)
-    # the unsnapped elbow's vertices are named points (merged ones within MERGE_TOLERANCE r)
-    X, matched = _assign(pattern.vertices_coords, named_xy, named_X, prism.W, MERGE_TOLERANCE * r)
-    _require_all(matched, "elbow")
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = shift
-    return X, T
-
-
-# --- revolute joint and tips (spec 3.4-3.6) ------------------------------------------------
-
-
-def _fold_revolute(
-    prism: Prism,
-    pattern: TubularPattern,
-    h_r: float,
-    with_distal: bool,
-    xy: np.ndarray | None = None,
-) -> np.ndarray:
-    """Revolute joint at state 0 (or the end tip when ``with_distal`` is False).
-
-    Named points of spec 3.4; the crimp flap vertex M_k of a crimped column lies in the plane of
-    its lower fin (docs/fold.md); the nested sink vertices (N >= 2) lie on the N = 1 creases they
-    subdivide, at the same fraction of the way to the panel centre.
-    """
-    n, r, b = prism.numSides, prism.r, prism.b
-    geo = revolute_geometry(prism, h_r)
-    H, t = geo.H, geo.t
-    x = prism.columns
-    beta = prism.vertex_angles
-    sin_b, cos_b = np.sin(beta), np.cos(beta)
-    sgn = np.where(sin_b >= 0.0, 1.0, -1.0)
-    centre = np.array([0.0, 0.0, h_r])
-    ev = np.array([0.0, 1.0, 0.0])
-    p = _corners(prism)
-    s = r * sin_b - sgn * np.sqrt(np.maximum(t**2 - h_r**2 - (r * cos_b) ** 2, 0.0))
-    M3 = centre + np.outer(sgn * (b / 2.0), ev)
-    # crimped column: the flap (K, M, O) is a right triangle, |OM| = b/2, |KM| = H - t, right
-    # angle at M, hinged on the axis line. It lies in the plane of the lower fin (p_k, K, O):
-    # folded onto the fin where sin(beta) cos(beta) >= 0, continuing it beyond the axis line
-    # elsewhere; this is the choice under which every crimp crease folds the way its label
-    # says (docs/fold.md). A tip has no upper crimp: its flaps are all folded onto the fin.
-    for k in np.flatnonzero(geo.crimped):
-        along = (b * b / 4.0) / s[k]
-        radius = (b / 2.0) * (H - t[k]) / abs(s[k])
-        towards_fin = np.array([r * cos_b[k], 0.0, -h_r])
-        towards_fin /= np.linalg.norm(towards_fin)
-        if with_distal and sin_b[k] * cos_b[k] < -1e-12:
-            towards_fin = -towards_fin
-        M3[k] = centre + along * ev + radius * towards_fin
-    centres = prism.panel_centres
-    named_xy = [np.stack([x, np.zeros(n)], axis=1), np.stack([x, np.full(n, H)], axis=1)]
-    named_X = [p, M3]
-    named_xy.append(np.stack([centres, np.full(n, H)], axis=1))
-    named_X.append(np.repeat(centre[None], n, axis=0))
-    ck = np.flatnonzero(geo.crimped)
-    K3 = centre + np.outer(s[ck], ev)
-    named_xy.append(np.stack([x[ck], t[ck]], axis=1))
-    named_X.append(K3)
-    if with_distal:
-        top = p.copy()
-        top[:, 2] = 2.0 * h_r
-        named_xy.append(np.stack([x, np.full(n, 2.0 * H)], axis=1))
-        named_X.append(top)
-        named_xy.append(np.stack([x[ck], 2.0 * H - t[ck]], axis=1))
-        named_X.append(K3)
-    named_xy = np.concatenate(named_xy)
-    named_X = np.concatenate(named_X)
-    xy = pattern.vertices_coords if xy is None else xy
-    X, matched = _assign(xy, named_xy, named_X, prism.W, 1e-9 * r)
-    if not matched.all():
-        X = _fold_sink_chains(prism, xy, X, matched, centre, H)
-    return X
-
-
-def _fold_sink_chains(prism, xy, X, matched, centre, H):
-    """Nested sink vertices: on the segment from an outer point of their panel to its centre.
-
-    Every chain of spec 3.5 runs along an N = 1 crease from an outer point Y of the panel
-    (corner, crimp, midline point) to the panel centre C; its vertex at flat distance f |Y - C|
-    from C folds to O + f (Y3 - O), O = ``centre``, where the N = 1 fold is affine
-    (docs/fold.md).
-    """
-    b, W = prism.b, prism.W
-    outer_xy = xy[matched]
-    outer_X = X[matched]
-    tol = 1e-9 * prism.r
-    for i in np.flatnonzero(~matched):
-        px, py = xy[i]
-        p = math.floor(px / b - 0.5)  # sink panels lie between columns p and p + 1
-        cx = (p + 1) * b
-        rel = np.stack([periodic_dx(outer_xy[:, 0] - cx, W), outer_xy[:, 1] - H], axis=1)
-        v = np.array([periodic_dx(np.array([px - cx]), W)[0], py - H])
-        span = np.linalg.norm(rel, axis=1)
-        along = float(np.linalg.norm(v))
-        cross = np.abs(rel[:, 0] * v[1] - rel[:, 1] * v[0])
-        candidate = (
-            (np.abs(rel[:, 0]) <= 0.5 * b + tol)
-            & (rel @ v > 0.0)
-            & (span > along + tol)
-            & (cross <= tol * np.maximum(span, 1.0))
-        )
-        if not candidate.any():  # pragma: no cover - a catalog module changed its sink chains
-            raise FoldedFormError(f"sink vertex {i} at {xy[i]} lies on no crease to its centre")
-        best = np.flatnonzero(candidate)[np.argmin(span[candidate])]
-        X[i] = centre + (along / span[best]) * (outer_X[best] - centre)
-    return X
-
-
-# --- REBO (spec 3.7) and prismatic joint (3.8) ---------------------------------------------
-
-
-def rebo_tilt(numSides: int, coneAngle: float) -> float:
-    """Inclination gamma of the REBO's faces in its rigid folded state, radians.
-
-    Every layer folds as a rigid bellows (docs/fold.md): each quadrilateral face turns about its
-    layer-ring edge, inwards, until it makes the angle gamma with the cross-section plane, and
-    the pleat triangles close exactly when l1 cos(gamma) = o cot(pi/n), i.e.
-
-        cos(gamma) = cot(alpha_f) cot(pi/n) = tan(pi cos(beta) / n) / tan(pi / n),
-
-    with alpha_f = (pi/2)(1 - 2 cos(beta)/n) the flat cone angle of spec 3.7. Then beta <= gamma
-    < pi/2, and gamma -> beta as n grows. (The other rigid state, gamma = pi/2, is the unfolded
-    tube.)
-
-    Parameters
-    ----------
-    numSides : int
-        n, even and >= 4.
-    coneAngle : float
-        beta in (0, pi/2), radians.
-
-    Examples
-    --------
-    >>> round(rebo_tilt(4, math.pi / 4), 6)
-    0.90141
-    """
-    n = check_num_sides(numSides)
-    beta = check_in_range("coneAngle", coneAngle, 0.0, 0.5 * math.pi, range_text="(0, pi/2)")
-    ratio = math.tan(math.pi * math.cos(beta) / n) / math.tan(math.pi / n)
-    return math.acos(min(ratio, 1.0))
-
-
-def rebo_folded_length(numSides: int, neutralLength: float, coneAngle: float) -> float:
-    """Axial length of a REBO in its rigid folded state: d sin(gamma) / sin(beta) (>= d).
-
-    Each of the N layers is 2 l1 sin(gamma) long, l1 = d / (2 N sin(beta)); gamma is
-    :func:`rebo_tilt`. This is the length of the prismatic joint's bellows in the folded form
-    (same unit as ``neutralLength``; independent of r and of the number of layers).
-    """
-    gamma = rebo_tilt(numSides, coneAngle)
-    d = check_positive("neutralLength", neutralLength)
-    return d * math.sin(gamma) / math.sin(coneAngle)
-
-
-def _fold_rebo_vertices(prism: Prism, xy: np.ndarray, d: float, N: int, beta: float):
-    """Positions of REBO vertices given their local flat coordinates (y from 0 to H).
-
-    The rigid folded state (docs/fold.md): layer rings are the base polygon, 2 l1 sin(gamma)
-    apart and not twisted. The lower quadrilateral (B_{i,k}, B_{i,k+1}, O_{i,k+1}, A_{i,k}) of
-    panel k is the flat quadrilateral turned about its ring edge by gamma towards the axis, so
-    A_{i,k} = B_{i,k} + l1 (cos(gamma) nu_k + sin(gamma) e_a), nu_k the inward normal of panel k,
-    and O_{i,k+1} = A_{i,k} + (b - o) t_k, t_k the direction of the ring edge; the upper
-    quadrilateral is its mirror image in the waist plane. Every face is planar and every crease
-    keeps its length.
-    """
-    n, b = prism.numSides, prism.b
-    geo = rebo_geometry(prism, d, N, beta)
-    l1, o = geo.l1, geo.offset
-    gamma = rebo_tilt(n, beta)
-    layer = 2.0 * l1 * math.sin(gamma)
-    ring = _corners(prism)
-    normal_angle = (np.arange(n) + 1.0) * (2.0 * math.pi / n)  # outward normal of panel k
-    inward = -np.stack([np.cos(normal_angle), np.sin(normal_angle), np.zeros(n)], axis=1)
-    edge = np.roll(ring, -1, axis=0) - ring
-    edge /= np.linalg.norm(edge, axis=1)[:, None]
-    mid = ring + l1 * math.cos(gamma) * inward  # A_{0,k}
-    mid[:, 2] = 0.5 * layer
-    offset_mid = np.roll(mid + (b - o) * edge, 1, axis=0)  # O_{0,k+1} from panel k
-    x = prism.columns
-    names_xy = []
-    names_X = []
-    for i in range(N + 1):
-        names_xy.append(np.stack([x, np.full(n, 2.0 * i * l1)], axis=1))
-        names_X.append(ring + np.array([0.0, 0.0, i * layer]))
-    offset_x = _mod_w(x - o, prism.W)
-    for i in range(N):
-        mid_y = np.full(n, (2.0 * i + 1.0) * l1)
-        rise = np.array([0.0, 0.0, i * layer])
-        names_xy += [np.stack([x, mid_y], axis=1), np.stack([offset_x, mid_y], axis=1)]
-        names_X += [mid + rise, offset_mid + rise]
-    X, matched = _assign(
-        xy, np.concatenate(names_xy), np.concatenate(names_X), prism.W, 1e-9 * prism.r
-    )
-    _require_all(matched, "REBO")
-    return X
-
-
-def _fold_prismatic(prism: Prism, pattern: TubularPattern, d: float, N: int, beta: float):
-    """Sleeve, lining folded back inside it, REBO, piston (spec 3.8 folded reading, B7).
-
-    The bellows is in its rigid folded state, of length d' = :func:`rebo_folded_length`, so the
-    joint folds to d' + L.
-    """
-    geo = rebo_geometry(prism, d, N, beta)
-    L = geo.height
-    xy = pattern.vertices_coords
-    y = xy[:, 1]
-    X = _polygon_point(prism, xy[:, 0])
-    tol = 1e-9 * prism.r
-    sleeve = y <= L + tol
-    lining = (y > L + tol) & (y <= 2.0 * L + tol)
-    rebo = (y > 2.0 * L + tol) & (y <= 3.0 * L + tol)
-    piston = y > 3.0 * L + tol
-    X[sleeve, 2] = y[sleeve]
-    X[lining, 2] = 2.0 * L - y[lining]
-    local = xy[rebo].copy()
-    local[:, 1] -= 2.0 * L
-    X[rebo] = _fold_rebo_vertices(prism, local, d, N, beta)
-    length = rebo_folded_length(prism.numSides, d, beta)
-    X[piston, 2] = length + (y[piston] - 3.0 * L)
-    return X, _translation(length + L)

@@ -8,8 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinegami.errors import InvalidParameterError
+from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
-from kinegami.pattern._prism import Prism, make_prism
+from kinegami.pattern._fold import FoldedFormError, assign, corners, translation
+from kinegami.pattern._prism import Prism, make_prism, periodic_dx
+from kinegami.pattern.counts import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 from kinegami.validation import check_in_range, check_int, check_positive
 
@@ -428,3 +431,166 @@ def _sink_gadget(
                 labels.append(lab)
     vertices = np.concatenate([vertices, *new_points])
     return vertices, list(zip(edges, labels, strict=True))
+
+
+# --------------------------------------------------------------------------------------------
+# Catalog entries: counts and folds
+
+
+def _revolute_counts(prism: Prism, params) -> ModuleCounts:
+    """6n - 8 vertices and 16n - 32 creases for one sink layer; fix B2 for N >= 2 layers."""
+    n, N = prism.numSides, params["numSinkLayers"]
+    if N == 1:
+        return ModuleCounts(6 * n - 8, 16 * n - 32)
+    return ModuleCounts(
+        6 * n - 8 + (10 * n - 28) * (N - 1), 6 * n - 4 + (10 * n - 28) * (2 * N - 1)
+    )
+
+
+def _tip_counts(prism: Prism, params) -> ModuleCounts:
+    n = prism.numSides
+    return ModuleCounts(4 * n - 4, 9 * n - 16)
+
+
+def _fold_revolute(
+    prism: Prism,
+    pattern: TubularPattern,
+    h_r: float,
+    with_distal: bool,
+    xy: np.ndarray | None = None,
+) -> np.ndarray:
+    """Revolute joint at state 0 (or the end tip when ``with_distal`` is False).
+
+    Named points of docs/theory/patterns.md section 3.4; the crimp flap vertex M_k of a crimped
+    column lies in the plane of its lower fin (docs/fold.md); the nested sink vertices (N >= 2)
+    lie on the N = 1 creases they subdivide, at the same fraction of the way to the panel
+    centre.
+    """
+    n, r, b = prism.numSides, prism.r, prism.b
+    geo = revolute_geometry(prism, h_r)
+    H, t = geo.H, geo.t
+    x = prism.columns
+    beta = prism.vertex_angles
+    sin_b, cos_b = np.sin(beta), np.cos(beta)
+    sgn = np.where(sin_b >= 0.0, 1.0, -1.0)
+    centre = np.array([0.0, 0.0, h_r])
+    ev = np.array([0.0, 1.0, 0.0])
+    p = corners(prism)
+    s = r * sin_b - sgn * np.sqrt(np.maximum(t**2 - h_r**2 - (r * cos_b) ** 2, 0.0))
+    M3 = centre + np.outer(sgn * (b / 2.0), ev)
+    # crimped column: the flap (K, M, O) is a right triangle, |OM| = b/2, |KM| = H - t, right
+    # angle at M, hinged on the axis line. It lies in the plane of the lower fin (p_k, K, O):
+    # folded onto the fin where sin(beta) cos(beta) >= 0, continuing it beyond the axis line
+    # elsewhere; this is the choice under which every crimp crease folds the way its label
+    # says (docs/fold.md). A tip has no upper crimp: its flaps are all folded onto the fin.
+    for k in np.flatnonzero(geo.crimped):
+        along = (b * b / 4.0) / s[k]
+        radius = (b / 2.0) * (H - t[k]) / abs(s[k])
+        towards_fin = np.array([r * cos_b[k], 0.0, -h_r])
+        towards_fin /= np.linalg.norm(towards_fin)
+        if with_distal and sin_b[k] * cos_b[k] < -1e-12:
+            towards_fin = -towards_fin
+        M3[k] = centre + along * ev + radius * towards_fin
+    centres = prism.panel_centres
+    named_xy = [np.stack([x, np.zeros(n)], axis=1), np.stack([x, np.full(n, H)], axis=1)]
+    named_X = [p, M3]
+    named_xy.append(np.stack([centres, np.full(n, H)], axis=1))
+    named_X.append(np.repeat(centre[None], n, axis=0))
+    ck = np.flatnonzero(geo.crimped)
+    K3 = centre + np.outer(s[ck], ev)
+    named_xy.append(np.stack([x[ck], t[ck]], axis=1))
+    named_X.append(K3)
+    if with_distal:
+        top = p.copy()
+        top[:, 2] = 2.0 * h_r
+        named_xy.append(np.stack([x, np.full(n, 2.0 * H)], axis=1))
+        named_X.append(top)
+        named_xy.append(np.stack([x[ck], 2.0 * H - t[ck]], axis=1))
+        named_X.append(K3)
+    named_xy = np.concatenate(named_xy)
+    named_X = np.concatenate(named_X)
+    xy = pattern.vertices_coords if xy is None else xy
+    X, matched = assign(xy, named_xy, named_X, prism.W, 1e-9 * r)
+    if not matched.all():
+        X = _fold_sink_chains(prism, xy, X, matched, centre, H)
+    return X
+
+
+def _fold_sink_chains(prism, xy, X, matched, centre, H):
+    """Nested sink vertices: on the segment from an outer point of their panel to its centre.
+
+    Every chain of the nested sinks runs along an N = 1 crease from an outer point Y of the panel
+    (corner, crimp, midline point) to the panel centre C; its vertex at flat distance f |Y - C|
+    from C folds to O + f (Y3 - O), O = ``centre``, where the N = 1 fold is affine
+    (docs/fold.md).
+    """
+    b, W = prism.b, prism.W
+    outer_xy = xy[matched]
+    outer_X = X[matched]
+    tol = 1e-9 * prism.r
+    for i in np.flatnonzero(~matched):
+        px, py = xy[i]
+        p = math.floor(px / b - 0.5)  # sink panels lie between columns p and p + 1
+        cx = (p + 1) * b
+        rel = np.stack([periodic_dx(outer_xy[:, 0] - cx, W), outer_xy[:, 1] - H], axis=1)
+        v = np.array([periodic_dx(np.array([px - cx]), W)[0], py - H])
+        span = np.linalg.norm(rel, axis=1)
+        along = float(np.linalg.norm(v))
+        cross = np.abs(rel[:, 0] * v[1] - rel[:, 1] * v[0])
+        candidate = (
+            (np.abs(rel[:, 0]) <= 0.5 * b + tol)
+            & (rel @ v > 0.0)
+            & (span > along + tol)
+            & (cross <= tol * np.maximum(span, 1.0))
+        )
+        if not candidate.any():  # pragma: no cover - a catalog module changed its sink chains
+            raise FoldedFormError(f"sink vertex {i} at {xy[i]} lies on no crease to its centre")
+        best = np.flatnonzero(candidate)[np.argmin(span[candidate])]
+        X[i] = centre + (along / span[best]) * (outer_X[best] - centre)
+    return X
+
+
+# --- REBO (spec 3.7) and prismatic joint (3.8) ---------------------------------------------
+
+
+def _fold_joint(prism: Prism, pattern: TubularPattern, params):
+    h_r = prism.a * math.tan(params["totalBendingAngle"] / 4.0)
+    X = _fold_revolute(prism, pattern, h_r, with_distal=True)
+    return X, translation(2.0 * h_r)
+
+
+def _fold_end_tip(prism: Prism, pattern: TubularPattern, params):
+    ell = params["length"]
+    return _fold_revolute(prism, pattern, ell, with_distal=False), translation(ell)
+
+
+def _fold_start_tip(prism: Prism, pattern: TubularPattern, params):
+    """The end tip's fold mirrored through the cross-section plane at half its length."""
+    ell = params["length"]
+    xy = pattern.vertices_coords
+    mirrored = xy.copy()
+    mirrored[:, 1] = pattern.height - xy[:, 1]
+    X = _fold_revolute(prism, pattern, ell, with_distal=False, xy=mirrored)
+    X[:, 2] = ell - X[:, 2]
+    return X, translation(ell)
+
+
+catalog.register(
+    catalog.ModuleKind(
+        "revolute",
+        RevoluteJointPattern,
+        ("totalBendingAngle", "numSinkLayers"),
+        _revolute_counts,
+        _fold_joint,
+    )
+)
+catalog.register(
+    catalog.ModuleKind(
+        "end_tip", EndTipPattern, ("length",), _tip_counts, _fold_end_tip, mirror="start_tip"
+    )
+)
+catalog.register(
+    catalog.ModuleKind(
+        "start_tip", StartTipPattern, ("length",), _tip_counts, _fold_start_tip, mirror="end_tip"
+    )
+)

@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._fold import polygon_point, translation
 from kinegami.pattern._prism import make_prism
+from kinegami.pattern.counts import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 from kinegami.validation import check_nonnegative
 
@@ -68,3 +71,32 @@ def _tube(prism, h: float, label: str, record: ModuleRecord) -> TubularPattern:
     )
     k = np.arange(n)
     return assemble(prism, vertices, [crease_block(k, n + k, label)], k, n + k, h, record)
+
+
+# --------------------------------------------------------------------------------------------
+# Catalog entries: counts and fold
+
+
+def _empty_counts(prism, params) -> ModuleCounts:
+    return ModuleCounts(prism.numSides, 0, 0)
+
+
+def _tube_counts(prism, params) -> ModuleCounts:
+    n = prism.numSides
+    if params["height"] < prism.eps:
+        return ModuleCounts(n, 0, 0)
+    return ModuleCounts(2 * n, n, n)
+
+
+def fold_straight(prism, exact: TubularPattern, params):
+    """A straight tube (or the empty pattern) at state 0: vertex (x, y) at c(x) + y e_a."""
+    xy = exact.vertices_coords
+    X = polygon_point(prism, xy[:, 0])
+    X[:, 2] = xy[:, 1]
+    return X, translation(exact.height)
+
+
+catalog.register(
+    catalog.ModuleKind("tube", TubeFittingPattern, ("height",), _tube_counts, fold_straight)
+)
+catalog.register(catalog.ModuleKind("waypoint", WaypointPattern, (), _empty_counts, fold_straight))

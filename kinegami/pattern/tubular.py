@@ -27,7 +27,63 @@ from kinegami.validation import check_nonnegative
 _KEY_SHIFT = np.int64(1) << np.int64(32)
 _ASSIGNMENT_DTYPE = np.dtype("<U1")
 
-__all__ = ["ModuleRecord", "TubularPattern", "ValidationReport"]
+__all__ = ["FrozenParams", "ModuleRecord", "TubularPattern", "ValidationReport"]
+
+
+_FROZEN_PARAMS_HELP = (
+    "ModuleRecord.params is read-only: a pattern is a value shared (through the pattern caches) "
+    "by every joint and link built with the same parameters, so changing it would change them "
+    "all. Build a new record instead, e.g. ModuleRecord(record.kind, {**record.params, name: "
+    "value}), or a new pattern from the module's constructor"
+)
+
+
+class FrozenParams(Mapping):
+    """A read-only mapping of a module's parameters (what :attr:`ModuleRecord.params` holds).
+
+    Reads like a dict (``params["height"]``, ``dict(params)`` for a mutable copy); item
+    assignment and deletion raise :class:`~kinegami.errors.InvalidTypeError`. Hashable.
+    """
+
+    __slots__ = ("_data",)
+
+    def __init__(self, data: Mapping[str, Any] | Iterable = ()) -> None:
+        object.__setattr__(self, "_data", dict(data))
+
+    def __getitem__(self, key: str) -> Any:
+        return self._data[key]
+
+    def __iter__(self):
+        return iter(self._data)
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def __contains__(self, key) -> bool:
+        return key in self._data
+
+    def __setitem__(self, key, value) -> None:
+        raise InvalidTypeError(f"cannot set params[{key!r}]: {_FROZEN_PARAMS_HELP}")
+
+    def __delitem__(self, key) -> None:
+        raise InvalidTypeError(f"cannot delete params[{key!r}]: {_FROZEN_PARAMS_HELP}")
+
+    def __setattr__(self, name: str, value) -> None:
+        raise InvalidTypeError(f"cannot set {name!r}: {_FROZEN_PARAMS_HELP}")
+
+    def __hash__(self) -> int:
+        return hash(tuple(sorted(self._data.items())))
+
+    def __eq__(self, other) -> bool:
+        if isinstance(other, FrozenParams):
+            return self._data == other._data
+        return self._data == other if isinstance(other, Mapping) else NotImplemented
+
+    def __repr__(self) -> str:
+        return repr(self._data)
+
+    def __reduce__(self):
+        return (FrozenParams, (self._data,))
 
 
 @dataclass(frozen=True)
@@ -37,14 +93,21 @@ class ModuleRecord:
     Attributes
     ----------
     kind : str
-        One of ``"tube"``, ``"twist"``, ``"elbow"``, ``"revolute"``, ``"rebo"``,
-        ``"prismatic"``, ``"start_tip"``, ``"end_tip"``, ``"waypoint"``.
+        A kind registered in :mod:`kinegami.pattern.catalog`: ``"tube"``, ``"twist"``,
+        ``"elbow"``, ``"revolute"``, ``"rebo"``, ``"prismatic"``, ``"start_tip"``,
+        ``"end_tip"``, ``"waypoint"``.
     params : Mapping[str, Any]
-        The validated parameters the module was built with (same names as the constructor).
+        The validated parameters the module was built with (same names as the constructor),
+        stored read-only (:class:`FrozenParams`): records are shared by every pattern built
+        with the same parameters.
     """
 
     kind: str
-    params: Mapping[str, Any] = field(default_factory=dict)
+    params: Mapping[str, Any] = field(default_factory=FrozenParams)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.params, FrozenParams):
+            object.__setattr__(self, "params", FrozenParams(self.params))
 
 
 @dataclass(frozen=True)
@@ -142,6 +205,7 @@ class TubularPattern:
         "removedDuplicates",
         "_distal_keys",
         "_has_internal_duplicates",
+        "_module_vertices",
     )
 
     def __init__(
@@ -217,7 +281,7 @@ class TubularPattern:
             raise InvalidTypeError("modules must be ModuleRecord objects")
         self._init(
             n, prism.r, vertices, edges, assignment, bases[0], bases[1], markers[0], markers[1],
-            height, modules, 0, None, None,
+            height, modules, 0, None, None, None,
         )  # fmt: skip
 
     def _init(
@@ -236,6 +300,7 @@ class TubularPattern:
         removed: int,
         distal_keys: np.ndarray | None,
         internal_duplicates: bool | None,
+        module_vertices: tuple[np.ndarray, ...] | None,
     ) -> None:
         s = object.__setattr__
         s(self, "numSides", int(n))
@@ -253,14 +318,20 @@ class TubularPattern:
         s(self, "removedDuplicates", int(removed))
         s(self, "_distal_keys", None if distal_keys is None else _readonly(distal_keys))
         s(self, "_has_internal_duplicates", internal_duplicates)
+        s(self, "_module_vertices", module_vertices)
 
     @classmethod
     def _build(cls, n, r, vertices, edges, assignment, proximal, distal, pm, dm, height, modules,
-               removed=0, distal_keys=None, internal_duplicates=None):  # fmt: skip
-        """Internal constructor from arrays that are already valid (no checks, no copies)."""
+               removed=0, distal_keys=None, internal_duplicates=None,
+               module_vertices=None):  # fmt: skip
+        """Internal constructor from arrays that are already valid (no checks, no copies).
+
+        ``module_vertices``: see :attr:`module_vertices`; None for a single module (its own
+        vertices, in order) or when unknown.
+        """
         self = object.__new__(cls)
         self._init(n, r, vertices, edges, assignment, proximal, distal, pm, dm, height, modules,
-                   removed, distal_keys, internal_duplicates)  # fmt: skip
+                   removed, distal_keys, internal_duplicates, module_vertices)  # fmt: skip
         return self
 
     def __setattr__(self, name: str, value) -> None:
@@ -309,6 +380,22 @@ class TubularPattern:
         if len(self.modules) == 1:
             return self.modules[0].kind
         return "composite" if self.modules else "custom"
+
+    @property
+    def module_vertices(self) -> tuple[np.ndarray, ...] | None:
+        """Where every module's vertices went: one read-only int array per record of
+        :attr:`modules`, giving the vertex of this pattern that each of the module's own
+        vertices became (in the order the module's constructor numbers them).
+
+        Composition computes these; the folded form uses them to place every module. None when
+        they are not known: a reversed composite, or a pattern built by hand with several module
+        records (a single record stands for all the vertices, in order).
+        """
+        mv = self._module_vertices
+        if mv is None and len(self.modules) == 1:
+            mv = (_readonly(np.arange(self.numVertices)),)
+            object.__setattr__(self, "_module_vertices", mv)
+        return mv
 
     @property
     def isEmpty(self) -> bool:
@@ -376,6 +463,7 @@ class TubularPattern:
             self.height + other.height, self.modules + other.modules,
             self.removedDuplicates + other.removedDuplicates + step.removed,
             step.state.distal_keys, self._has_internal_duplicates,
+            _join_placements(self.module_vertices, _placed(other, step.mapping)),
         )  # fmt: skip
 
     @classmethod
@@ -408,6 +496,7 @@ class TubularPattern:
         height = first.height
         removed = first.removedDuplicates
         modules = list(first.modules)
+        placements = first.module_vertices
         for i, p in enumerate(patterns[1:], start=1):
             step = _compose_step(state, p, i)
             if step is None:
@@ -418,12 +507,13 @@ class TubularPattern:
             height += p.height
             removed += p.removedDuplicates + step.removed
             modules.extend(p.modules)
+            placements = _join_placements(placements, _placed(p, step.mapping))
             state = step.state
         return cls._build(
             first.numSides, first.r, np.concatenate(vertices), np.concatenate(edges),
             np.concatenate(assignment), first.proximalBase, state.distal_idx,
             first.proximalMarker, state.marker, height, tuple(modules), removed,
-            state.distal_keys, first._has_internal_duplicates,
+            state.distal_keys, first._has_internal_duplicates, placements,
         )  # fmt: skip
 
     def reversed(self) -> TubularPattern:
@@ -436,10 +526,15 @@ class TubularPattern:
         y0 = float(self.proximalMarker[1])
         vertices = self.vertices_coords.copy()
         vertices[:, 1] = 2.0 * y0 + self.height - vertices[:, 1]
-        swap = {"end_tip": "start_tip", "start_tip": "end_tip"}
-        modules = tuple(
-            ModuleRecord(swap.get(m.kind, m.kind), m.params) for m in reversed(self.modules)
-        )
+        from kinegami.pattern.catalog import find_kind
+
+        def mirrored(record: ModuleRecord) -> ModuleRecord:
+            entry = find_kind(record.kind)
+            if entry is None or entry.mirror is None:
+                return record
+            return ModuleRecord(entry.mirror, record.params)
+
+        modules = tuple(mirrored(m) for m in reversed(self.modules))
         return TubularPattern._build(
             self.numSides, self.r, vertices, self.edges_vertices.copy(),
             self.edges_assignment.copy(), _copy_or_none(self.distalBase),
@@ -499,6 +594,18 @@ class TubularPattern:
             value = bool(np.unique(keys).shape[0] != keys.shape[0])
             object.__setattr__(self, "_has_internal_duplicates", value)
         return self._has_internal_duplicates
+
+
+def _placed(pattern: TubularPattern, mapping: np.ndarray) -> tuple[np.ndarray, ...] | None:
+    """``pattern.module_vertices`` renumbered by ``mapping`` (its vertex -> composite vertex)."""
+    if pattern._module_vertices is None and len(pattern.modules) == 1:
+        return (_readonly(mapping),)
+    own = pattern.module_vertices
+    return None if own is None else tuple(_readonly(mapping[v]) for v in own)
+
+
+def _join_placements(first, second):
+    return None if first is None or second is None else first + second
 
 
 def _copy_or_none(array: np.ndarray | None) -> np.ndarray | None:
@@ -573,6 +680,7 @@ class _ComposeState:
 
 @dataclass(frozen=True)
 class _Step:
+    mapping: np.ndarray  # composite vertex of each of the module's vertices
     vertices: np.ndarray
     edges: np.ndarray
     assignment: np.ndarray
@@ -664,4 +772,4 @@ def _compose_step(state: _ComposeState, other: TubularPattern, index: int) -> _S
     new_state = _ComposeState(
         n, W, eps, marker, distal_idx, distal_xy, distal_keys, state.next_index + num_new
     )
-    return _Step(coords[is_new], edges, assignment, removed, new_state)
+    return _Step(mapping, coords[is_new], edges, assignment, removed, new_state)

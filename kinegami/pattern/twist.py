@@ -7,8 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._fold import corners, mod_w, moved_copy, polygon_point, rot_axis
 from kinegami.pattern._prism import Prism, make_prism, wrap_x
+from kinegami.pattern.counts import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 from kinegami.validation import check_nonnegative, check_real
 
@@ -113,3 +116,55 @@ def TwistFittingPattern(
     ]
     marker_x = float(wrap_x(np.array([geo.K * b + geo.shift]), prism.W, prism.eps)[0])
     return assemble(prism, vertices, blocks, P, D, H, record, distal_marker_x=marker_x)
+
+
+# --------------------------------------------------------------------------------------------
+# Catalog entry: counts, unsnapped geometry and fold
+
+
+def _counts(prism: Prism, params) -> ModuleCounts:
+    n = prism.numSides
+    if twist_geometry(prism, params["twistAngle"], params["moduleHeight"]).degenerate:
+        return ModuleCounts(n, 0, 0)
+    return ModuleCounts(2 * n, 4 * n, 2 * n)
+
+
+def _unsnapped(prism: Prism, pattern: TubularPattern, params):
+    """The twist with its distal base and marker not snapped onto the seam."""
+    identity = np.arange(pattern.numVertices)
+    geo = twist_geometry(prism, params["twistAngle"], params["moduleHeight"])
+    if geo.degenerate:
+        return pattern, identity
+    xy = pattern.vertices_coords.copy()
+    distal_marker = pattern.distalMarker.copy()
+    xy[pattern.distalBase, 0] = mod_w(prism.columns + geo.shift, prism.W)
+    distal_marker[0] = mod_w(np.array([geo.K * prism.b + geo.shift]), prism.W)[0]
+    return moved_copy(pattern, xy, distal_marker), identity
+
+
+def _fold(prism: Prism, pattern: TubularPattern, params):
+    """The band of triangles at state 0: the distal ring is the base turned by the residual."""
+    alpha, h = params["twistAngle"], params["moduleHeight"]
+    geo = twist_geometry(prism, alpha, h)
+    n = prism.numSides
+    p = corners(prism)
+    xy = pattern.vertices_coords
+    R = np.eye(4)
+    if geo.degenerate:
+        columns = round(n * ((alpha % (2.0 * math.pi)) / (2.0 * math.pi))) % n
+        R[:3, :3] = rot_axis((0.0, 0.0, 1.0), columns * 2.0 * math.pi / n)
+        X = polygon_point(prism, xy[:, 0])
+        return X, R
+    X = np.empty((pattern.numVertices, 3))
+    X[pattern.proximalBase] = p
+    X[pattern.distalBase] = corners(prism, geo.residual) + np.array([0.0, 0.0, h])
+    R[:3, :3] = rot_axis((0.0, 0.0, 1.0), alpha)
+    R[2, 3] = h
+    return X, R
+
+
+catalog.register(
+    catalog.ModuleKind(
+        "twist", TwistFittingPattern, ("twistAngle", "moduleHeight"), _counts, _fold, _unsnapped
+    )
+)

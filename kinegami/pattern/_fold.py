@@ -1,0 +1,125 @@
+"""Tools shared by the module folds (not public): frames, polygon points, named points.
+
+Every module file folds its own kind (its ``fold`` entry in :mod:`kinegami.pattern.catalog`);
+positions are in the module's proximal frame (e_u, e_v, e_a), see docs/theory/patterns.md
+("The folded form") and docs/fold.md.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from kinegami.errors import InvalidParameterError
+from kinegami.pattern._prism import Prism, periodic_dx
+from kinegami.pattern.sheet import TOLERANCE_FACTOR
+from kinegami.pattern.tubular import TubularPattern
+
+try:  # one class for the whole package once kinegami.errors defines it
+    from kinegami.errors import FoldedFormError
+except ImportError:  # pragma: no cover - older kinegami.errors
+
+    class FoldedFormError(InvalidParameterError):
+        """A pattern cannot be folded (no module records, or records that do not rebuild it)."""
+
+
+#: Points of an unsnapped module closer than this many r are one vertex: they coincide to the
+#: tolerance of the flat sheet (kinegami.pattern.sheet.TOLERANCE_FACTOR), below which the sheet's
+#: planar graph cannot tell points apart.
+MERGE_TOLERANCE = TOLERANCE_FACTOR
+
+
+def translation(a: float) -> np.ndarray:
+    """The 4x4 translation by ``a`` along the tube axis e_a."""
+    T = np.eye(4)
+    T[2, 3] = a
+    return T
+
+
+def rot_axis(axis, angle: float) -> np.ndarray:
+    """The 3x3 rotation by ``angle`` (radians) about ``axis`` (Rodrigues)."""
+    k = np.asarray(axis, dtype=float)
+    k = k / np.linalg.norm(k)
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * (K @ K)
+
+
+def polygon_point(prism: Prism, x: np.ndarray) -> np.ndarray:
+    """c(x): the point at arc length x on the polygon (a = 0), shape (m, 3).
+
+    See docs/theory/patterns.md, section 1.
+    """
+    x = np.asarray(x, dtype=float)
+    n, b, a = prism.numSides, prism.b, prism.a
+    m = np.round(x / b)
+    sigma = m * (2.0 * math.pi / n)
+    t = x - m * b
+    out = np.zeros(x.shape + (3,))
+    out[..., 0] = a * np.cos(sigma) - t * np.sin(sigma)
+    out[..., 1] = a * np.sin(sigma) + t * np.cos(sigma)
+    return out
+
+
+def corners(prism: Prism, angle_offset: float = 0.0) -> np.ndarray:
+    """The polygon's corners p_k at a = 0, turned by ``angle_offset`` about e_a, shape (n, 3)."""
+    beta = prism.vertex_angles + angle_offset
+    return prism.r * np.stack([np.cos(beta), np.sin(beta), np.zeros_like(beta)], axis=1)
+
+
+def mod_w(x: np.ndarray, W: float) -> np.ndarray:
+    """x reduced into [0, W) without snapping (the wrapping of composition, less its eps rule)."""
+    x = np.mod(x, W)
+    return np.where(x >= W, 0.0, x)
+
+
+def match_vertices(catalog_xy: np.ndarray, exact_xy: np.ndarray, prism: Prism) -> np.ndarray:
+    """For every catalog vertex, the nearest unsnapped vertex (periodic in x): the same point
+    (a collapsed column's Q_k is M_k), or less than eps away for a point snapped onto the
+    seam."""
+    dx = periodic_dx(catalog_xy[:, None, 0] - exact_xy[None, :, 0], prism.W)
+    dist = np.hypot(dx, catalog_xy[:, None, 1] - exact_xy[None, :, 1])
+    nearest = np.argmin(dist, axis=1)
+    worst = dist[np.arange(catalog_xy.shape[0]), nearest].max(initial=0.0)
+    if worst > 3.0 * prism.eps or np.unique(nearest).size != nearest.size:
+        raise FoldedFormError(  # pragma: no cover - a catalog module changed its vertices
+            f"the catalog module's vertices do not match its unsnapped geometry ({worst:.3g})"
+        )
+    return nearest
+
+
+def assign(
+    xy: np.ndarray, named_xy: np.ndarray, named_X: np.ndarray, W: float, tol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Give each vertex the 3D position of the nearest named flat point (periodic in x).
+
+    Returns (X, matched): vertices farther than ``tol`` from every named point are unmatched
+    (their rows of X are NaN).
+    """
+    dx = periodic_dx(xy[:, None, 0] - named_xy[None, :, 0], W)
+    dy = xy[:, None, 1] - named_xy[None, :, 1]
+    dist = np.hypot(dx, dy)
+    nearest = np.argmin(dist, axis=1)
+    matched = dist[np.arange(xy.shape[0]), nearest] <= tol
+    X = np.full((xy.shape[0], 3), np.nan)
+    X[matched] = named_X[nearest[matched]]
+    return X, matched
+
+
+def require_all(matched: np.ndarray, kind: str) -> None:
+    """Raise FoldedFormError unless every vertex got a position."""
+    if not matched.all():  # pragma: no cover - a catalog module changed its vertices
+        raise FoldedFormError(
+            f"{int((~matched).sum())} vertices of a {kind} module have no known 3D position"
+        )
+
+
+def moved_copy(
+    catalog: TubularPattern, xy: np.ndarray, distal_marker: np.ndarray
+) -> TubularPattern:
+    """``catalog`` with its vertices at ``xy`` and its distal marker at ``distal_marker``."""
+    return TubularPattern._build(
+        catalog.numSides, catalog.r, xy, catalog.edges_vertices.copy(),
+        catalog.edges_assignment.copy(), catalog.proximalBase.copy(), catalog.distalBase.copy(),
+        catalog.proximalMarker.copy(), distal_marker, catalog.height, catalog.modules,
+    )  # fmt: skip
