@@ -275,7 +275,8 @@ class Joint(ReadOnlyAttributes):
         return _catalog_pattern(*self._pattern_recipe())
 
     def _pattern_recipe(self) -> tuple:
-        """(catalog function name, its arguments) of this joint's pattern."""
+        """The pieces of this joint's pattern: (catalog module kind, its build arguments) each,
+        composed in order (see kinegami.pattern.catalog)."""
         raise InvalidTypeError(f"{type(self).__name__} has no crease pattern")
 
     def _describe(self) -> str:
@@ -339,12 +340,7 @@ class RevoluteJoint(Joint):
         return rotation_about_line(self._T[:3, 2], self._T[:3, 3], delta)
 
     def _pattern_recipe(self) -> tuple:
-        return "RevoluteJointPattern", (
-            self.numSides,
-            self.r,
-            self.totalBendingAngle,
-            self.numSinkLayers,
-        )
+        return (("revolute", (self.numSides, self.r, self.totalBendingAngle, self.numSinkLayers)),)
 
     def _describe(self) -> str:
         return f", totalBendingAngle={self.totalBendingAngle:.6g}"
@@ -359,13 +355,8 @@ class ExtendedRevoluteJoint(RevoluteJoint):
         self._neutralLength += 2.0 * self.tubeLength
 
     def _pattern_recipe(self) -> tuple:
-        return "ExtendedRevoluteJointPattern", (
-            self.numSides,
-            self.r,
-            self.totalBendingAngle,
-            self.numSinkLayers,
-            self.tubeLength,
-        )
+        tube = ("tube", (self.numSides, self.r, self.tubeLength))
+        return (tube, *super()._pattern_recipe(), tube)
 
 
 class PrismaticJoint(Joint):
@@ -419,13 +410,8 @@ class PrismaticJoint(Joint):
         )
 
     def _pattern_recipe(self) -> tuple:
-        return "PrismaticJointPattern", (
-            self.numSides,
-            self.r,
-            self.neutralLength,
-            self.numLayers,
-            self.coneAngle,
-        )
+        args = (self.numSides, self.r, self.neutralLength, self.numLayers, self.coneAngle)
+        return (("prismatic", args),)
 
     def _describe(self) -> str:
         return (
@@ -456,7 +442,7 @@ class Waypoint(Joint):
         return Ball(self._T[:3, 3], self._r)
 
     def _pattern_recipe(self) -> tuple:
-        return "WaypointPattern", (self.numSides, self.r)
+        return (("waypoint", (self.numSides, self.r)),)
 
     def _describe(self) -> str:
         return f", pathIndex={self._path_index}"
@@ -479,27 +465,30 @@ class StartTip(Tip):
     """The closed start of the tube (nothing may precede it). Path direction: Pose z."""
 
     def _pattern_recipe(self) -> tuple:
-        return "StartTipPattern", (self.numSides, self.r, self.length)
+        return (("start_tip", (self.numSides, self.r, self.length)),)
 
 
 class EndTip(Tip):
     """The closed end of the tube (nothing may follow it). Path direction: Pose z."""
 
     def _pattern_recipe(self) -> tuple:
-        return "EndTipPattern", (self.numSides, self.r, self.length)
+        return (("end_tip", (self.numSides, self.r, self.length)),)
 
 
 @functools.lru_cache(maxsize=256)
-def _catalog_pattern(name: str, args: tuple):
-    """A catalog pattern by function name and arguments (patterns are immutable: cached)."""
-    import kinegami.pattern as catalog
+def _catalog_pattern(*pieces: tuple):
+    """The pattern of (module kind, build arguments) pieces, composed in order; looked up in
+    the module catalog (patterns are immutable: cached)."""
+    from kinegami.pattern import TubularPattern
+    from kinegami.pattern.catalog import module_kind
 
-    if name == "ExtendedRevoluteJointPattern":
-        n, r, bending, sinks, tube_length = args
-        tube = catalog.TubeFittingPattern(n, r, tube_length)
-        joint = catalog.RevoluteJointPattern(n, r, bending, sinks)
-        return catalog.TubularPattern.concatenate([tube, joint, tube])
-    return getattr(catalog, name)(*args)
+    built: dict = {}
+    for piece in pieces:
+        if piece not in built:
+            kind, args = piece
+            built[piece] = module_kind(kind).build(*args)
+    patterns = [built[piece] for piece in pieces]
+    return patterns[0] if len(patterns) == 1 else TubularPattern.concatenate(patterns)
 
 
 def check_same_tube(joint: Joint, numSides: int, r: float) -> None:
