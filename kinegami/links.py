@@ -48,7 +48,7 @@ class ElbowArc:
     angle : total turn of the arc (radians); ``count`` elbows of ``angle / count`` each.
     rotationalAxisAngle : phi, the angle of the rotation axis from the start frame's y axis
         about its x axis (radians).
-    frames : (count + 1, 4, 4) array, the start frame and the frame after each elbow.
+    frames : (count + 1, 4, 4) read-only array, the start frame and the frame after each elbow.
     """
 
     angle: float
@@ -56,6 +56,9 @@ class ElbowArc:
     rotationalAxisAngle: float
     frames: np.ndarray
     r: float
+
+    def __post_init__(self) -> None:
+        self.frames.setflags(write=False)  # the arc is a value: its frames too
 
     @property
     def elbowAngle(self) -> float:
@@ -105,6 +108,11 @@ def _elbow_arc(
     for j in range(count):
         frames[j + 1] = frames[j] @ step
     return ElbowArc(theta, count, phi, frames, r)
+
+
+def _readonly(F: np.ndarray) -> np.ndarray:
+    F.setflags(write=False)
+    return F
 
 
 def _solved_path(r: float, start: np.ndarray, end: np.ndarray) -> CSCPath:
@@ -253,19 +261,19 @@ class LinkCSC(ReadOnlyAttributes):
     # --- fittings --------------------------------------------------------------------------
     @cached_property
     def arc1_end_frame(self) -> np.ndarray:
-        """F1: the start frame carried exactly along arc 1 (origin q1, x = u)."""
+        """F1: the start frame carried exactly along arc 1 (origin q1, x = u); read-only."""
         F = np.array(self._start)
         F[:3, :3] = rotation_matrix(self.path.k1, self.path.theta1) @ F[:3, :3]
         F[:3, 3] = self.path.q1
-        return F
+        return _readonly(F)
 
     @cached_property
     def arc2_start_frame(self) -> np.ndarray:
-        """F2: the end frame carried back along arc 2 (origin q2, x = u)."""
+        """F2: the end frame carried back along arc 2 (origin q2, x = u); read-only."""
         F = np.array(self._end)
         F[:3, :3] = rotation_matrix(self.path.k2, -self.path.theta2) @ F[:3, :3]
         F[:3, 3] = self.path.q2
-        return F
+        return _readonly(F)
 
     @cached_property
     def elbows1(self) -> ElbowArc:
@@ -342,7 +350,7 @@ class LinkCSC(ReadOnlyAttributes):
                 link.__dict__[name] = cache[name].transformed(T)
         for name in ("arc1_end_frame", "arc2_start_frame"):
             if name in cache:
-                link.__dict__[name] = T @ cache[name]
+                link.__dict__[name] = _readonly(T @ cache[name])
         if "twistAngle" in cache:
             link.__dict__["twistAngle"] = cache["twistAngle"]
         return link

@@ -202,3 +202,29 @@ def test_the_chain_stays_an_editor():
     assert chain.requireClearance is False
     chain.requireClearance = True
     assert chain.requireClearance is True
+
+
+def test_the_arrays_a_link_hands_out_are_read_only():
+    link = MAKERS["LinkCSC"]()
+    moved = link.transformed(SE3.Trans(1, 2, 3).A)
+    for value in (link, moved):
+        for array in (
+            value.start_frame,
+            value.end_frame,
+            value.arc1_end_frame,
+            value.arc2_start_frame,
+            value.elbows1.frames,
+            value.elbows2.frames,
+        ):
+            with pytest.raises(ValueError, match="read-only"):
+                array[0, 0] = 7.0
+
+
+@pytest.mark.parametrize("kind", [k for k in KINDS if k != "LinkCSC"])
+def test_a_joints_pose_array_is_read_only(kind):
+    joint = MAKERS[kind]()
+    with pytest.raises(ValueError, match="read-only"):
+        joint.pose_matrix[0, 3] = 7.0
+    pose = joint.Pose
+    pose.A[0, 3] = 7.0  # a new SE3 each time: changing it does not change the joint
+    assert joint.pose_matrix[0, 3] != 7.0
