@@ -1,0 +1,64 @@
+"""The design editor's model: a design as a document, commands with undo, and change events.
+
+Plain Python, no web code: the browser view (``kinegami edit``, to come) binds its widgets to
+these calls. See docs/editor.md.
+
+>>> from kinegami.editor import EditorModel
+>>> model = EditorModel()                      # the starter design of `kinegami new`
+>>> model.slide(1, 0.5).ok, model.dirty
+(True, True)
+>>> model.undo().ok, model.can_redo
+(True, True)
+"""
+
+from kinegami.editor.commands import (
+    JOINT_TYPES,
+    KEEP,
+    PLACEMENTS,
+    AddJoint,
+    Command,
+    CommandError,
+    Compact,
+    DeleteJoint,
+    Outcome,
+    RenameJoint,
+    RollJoint,
+    SetJointParameters,
+    SetJointState,
+    SetJointStates,
+    SetOptions,
+    SlideJoint,
+    TransformAll,
+    TransformJoint,
+)
+from kinegami.editor.document import Document, JointRow, joint_parameters
+from kinegami.editor.model import Change, CommandResult, EditorModel
+from kinegami.editor.patterns import PatternCache
+
+__all__ = [
+    "EditorModel",
+    "CommandResult",
+    "Change",
+    "Document",
+    "JointRow",
+    "joint_parameters",
+    "PatternCache",
+    "Command",
+    "CommandError",
+    "Outcome",
+    "AddJoint",
+    "DeleteJoint",
+    "SlideJoint",
+    "RollJoint",
+    "TransformJoint",
+    "TransformAll",
+    "SetJointParameters",
+    "RenameJoint",
+    "SetJointState",
+    "SetJointStates",
+    "Compact",
+    "SetOptions",
+    "JOINT_TYPES",
+    "PLACEMENTS",
+    "KEEP",
+]

@@ -1,0 +1,810 @@
+"""The editor's commands: every user action on a design, as a value that applies to a document.
+
+A command's :meth:`Command.apply` takes a :class:`~kinegami.editor.document.Document` and
+returns an :class:`Outcome` with a new document, or raises :class:`CommandError` whose message
+names the parameter, the value and what is allowed. It never changes the document it was
+given, so a failed command leaves nothing half done. :class:`~kinegami.editor.model.EditorModel`
+runs commands, keeps the undo history and tells views what changed. See docs/editor.md.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from kinegami.chain import KinematicChain
+from kinegami.design import limits
+from kinegami.design.reader import UNITS
+from kinegami.editor.document import Document, fork_chain, joint_parameters
+from kinegami.errors import ClearanceWarning, KinegamiError, PlacementWarning
+from kinegami.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    Joint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+from kinegami.validation import shown
+
+__all__ = [
+    "CommandError",
+    "Outcome",
+    "Command",
+    "AddJoint",
+    "DeleteJoint",
+    "SlideJoint",
+    "RollJoint",
+    "TransformJoint",
+    "TransformAll",
+    "SetJointParameters",
+    "RenameJoint",
+    "SetJointState",
+    "SetJointStates",
+    "Compact",
+    "SetOptions",
+    "JOINT_TYPES",
+    "PLACEMENTS",
+    "KEEP",
+]
+
+
+class CommandError(KinegamiError, ValueError):
+    """A command that cannot be applied; the message says why (parameter, value, range)."""
+
+
+class _Keep:
+    """Marker of an option a command leaves as it is."""
+
+    def __repr__(self) -> str:
+        return "KEEP"
+
+
+#: Default of :class:`SetOptions` fields: leave the option as it is.
+KEEP: Any = _Keep()
+
+#: The joint types the editor can add, by name.
+JOINT_TYPES = {
+    "RevoluteJoint": RevoluteJoint,
+    "ExtendedRevoluteJoint": ExtendedRevoluteJoint,
+    "PrismaticJoint": PrismaticJoint,
+    "Waypoint": Waypoint,
+    "EndTip": EndTip,
+    "StartTip": StartTip,
+}
+
+#: How a new joint is placed: ``"safe"`` (safe placement, waypoints; never fails), ``"compact"``
+#: (slides along its axis to just beyond the chain) or ``"pose"`` (exactly at the given pose).
+PLACEMENTS = ("safe", "compact", "pose")
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a command made: the new document, the joint to select (None: keep the selection
+    where it is) and the warnings it raised (e.g. the chain now passes through itself)."""
+
+    document: Document
+    selected: int | None = None
+    warnings: tuple[str, ...] = ()
+    sources: tuple | None = None  # per new joint, the old index it is (None: new or unknown)
+
+
+# --- checks ------------------------------------------------------------------------------------
+def _fail(message: str) -> None:
+    raise CommandError(message)
+
+
+def _number(name: str, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        _fail(f"{name} must be a number, got {shown(value)}")
+    value = float(value)
+    if not math.isfinite(value):
+        _fail(f"{name} must be a finite number, got {value!r}")
+    return value
+
+
+def _integer(name: str, value, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        _fail(f"{name} must be an integer in [{lo}, {hi}], got {shown(value)}")
+    if not lo <= int(value) <= hi:
+        _fail(f"{name} must be an integer in [{lo}, {hi}], got {int(value)}")
+    return int(value)
+
+
+def _flag(name: str, value) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        _fail(f"{name} must be True or False, got {shown(value)}")
+    return bool(value)
+
+
+def _length(name: str, value, r: float) -> float:
+    value = _number(name, value)
+    limit = limits.LENGTH_FACTOR * r
+    if not 0.0 < value <= limit:
+        _fail(f"{name} must be > 0 and <= 1e6 r = {limit:g}, got {value!r}")
+    return value
+
+
+def _distance(name: str, value, r: float) -> float:
+    value = _number(name, value)
+    limit = limits.LENGTH_FACTOR * r
+    if not abs(value) <= limit:
+        _fail(f"{name} must be within +-1e6 r = +-{limit:g}, got {value!r}")
+    return value
+
+
+def _pose(name: str, value, r: float) -> np.ndarray:
+    """A rigid 4x4 transform (array, nested lists or SE3), translation within 1e6 r."""
+    if value is None:
+        return np.eye(4)
+    if hasattr(value, "A") and not isinstance(value, np.ndarray):
+        value = value.A
+    try:
+        T = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        _fail(f"{name} must be a 4x4 rigid transform, got {shown(value)}")
+    if T.shape != (4, 4):
+        _fail(f"{name} must be a 4x4 rigid transform, got an array of shape {T.shape}")
+    if not np.isfinite(T).all():
+        _fail(f"{name} must contain finite numbers only, got {shown(value)}")
+    R = T[:3, :3]
+    error = float(np.abs(R.T @ R - np.eye(3)).max())
+    if error > 1e-9 or np.linalg.det(R) <= 0 or not np.array_equal(T[3], [0.0, 0.0, 0.0, 1.0]):
+        _fail(
+            f"{name} must be a rigid transform: orthonormal rotation to 1e-9 (max |R^T R - I| "
+            f"is {error:.3g}), determinant +1 and last row [0, 0, 0, 1]"
+        )
+    _distance(f"{name} translation", float(np.abs(T[:3, 3]).max()), r)
+    return T
+
+
+def _names_text(names: Sequence) -> str:
+    known = [n for n in names if n is not None]
+    if not known:
+        return "the joints have no names"
+    shown_names = ", ".join(repr(n) for n in known[:10])
+    return f"names: {shown_names}" + (", ..." if len(known) > 10 else "")
+
+
+def resolve_joint(document: Document, joint, name: str = "joint") -> int:
+    """The index of ``joint`` (an index, negative from the end, or a joint name)."""
+    n = len(document.chain.Joints)
+    if isinstance(joint, str):
+        if joint in document.names:
+            return document.names.index(joint)
+        _fail(f"{name}: no joint is named {joint!r} ({_names_text(document.names)})")
+    if isinstance(joint, bool) or not isinstance(joint, int | np.integer):
+        _fail(
+            f"{name} must be a joint index in [{-n}, {n - 1}] or a joint name, got {shown(joint)}"
+        )
+    if not -n <= int(joint) < n:
+        _fail(f"{name} must be a joint index in [{-n}, {n - 1}] or a joint name, got {int(joint)}")
+    return int(joint) % n
+
+
+def _label(document: Document, j: int) -> str:
+    joint = document.chain.Joints[j]
+    text = f"joint {j} ({type(joint).__name__}"
+    if document.names[j] is not None:
+        text += f" {document.names[j]!r}"
+    return text + ")"
+
+
+# --- running chain operations -----------------------------------------------------------------
+def _reason(message: str) -> str:
+    for tail in ("; the chain is unchanged",):
+        if message.endswith(tail):
+            message = message[: -len(tail)]
+    return message
+
+
+class _Run:
+    """Runs chain operations: numeric errors raised, PlacementWarnings turned into
+    CommandErrors, ClearanceWarnings collected (the last one is reported)."""
+
+    def __init__(self):
+        self.warnings: list[str] = []
+
+    def __call__(self, what: str, call):
+        with (
+            warnings.catch_warnings(record=True) as caught,
+            np.errstate(over="raise", invalid="raise", divide="raise"),
+        ):
+            warnings.simplefilter("always")
+            try:
+                result = call()
+            except CommandError:
+                raise
+            except (KinegamiError, ValueError, TypeError, IndexError, ArithmeticError) as error:
+                _fail(f"{what}: {_reason(str(error))}")
+        placement = [str(w.message) for w in caught if issubclass(w.category, PlacementWarning)]
+        clearance = [str(w.message) for w in caught if issubclass(w.category, ClearanceWarning)]
+        if result is False or result is None:
+            _fail(_reason(placement[-1]) if placement else f"{what} failed")
+        if clearance:
+            self.warnings[:] = [clearance[-1]]
+        return result
+
+    def clear_warning(self, chain: KinematicChain) -> tuple[str, ...]:
+        """The collected warnings that still hold for ``chain`` (it passes through itself)."""
+        if not self.warnings:
+            return ()
+        return tuple(self.warnings) if not chain.clearance().ok else ()
+
+
+_FIXED = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
+
+
+def _rebuilt(run: _Run, chain: KinematicChain, joints: Sequence[Joint], keep: int = 0,
+             maxAnglePerElbow: float | None = None) -> KinematicChain:  # fmt: skip
+    """A chain of ``joints`` at their exact poses and states: the first ``keep`` joints are
+    those of ``chain`` (its first ``keep`` links kept as they are when ``keep`` > 0 and
+    ``keep`` joints are left in the fork), the others appended at fixed poses."""
+    if keep >= len(chain.Joints) and maxAnglePerElbow is None:
+        new = fork_chain(chain)
+        start = len(chain.Joints)
+    elif keep > 0 and maxAnglePerElbow is None:
+        new = fork_chain(chain)
+        for _ in range(len(chain.Joints) - keep):
+            run("re-linking the chain", lambda: new.delete(-1))
+        start = keep
+    else:
+        root = joints[0]
+        if isinstance(root, EndTip):
+            _fail("a chain whose first joint is an EndTip cannot be rebuilt; add a joint first")
+        angle = chain.maxAnglePerElbow if maxAnglePerElbow is None else maxAnglePerElbow
+        new = run(
+            "rebuilding the chain",
+            lambda: KinematicChain(root, angle, requireClearance=chain.requireClearance),
+        )
+        start = 1
+    for k in range(start, len(joints)):
+        joint = joints[k]
+        run(
+            f"re-linking joint {k} ({type(joint).__name__})",
+            lambda j=joint: new.append(j, **_FIXED),
+        )
+    return new
+
+
+def _new_joint(kind: str, parameters: Mapping, pose: np.ndarray, numSides: int, r: float,
+               base: Mapping | None = None) -> Joint:  # fmt: skip
+    """A joint of type ``kind`` with ``parameters`` (others from ``base`` or the defaults),
+    checked against the bounds of design files."""
+    if kind not in JOINT_TYPES:
+        _fail(f"joint type must be one of {', '.join(JOINT_TYPES)}, got {shown(kind)}")
+    if not isinstance(parameters, Mapping):
+        _fail(f"parameters must be a mapping of parameter names to values, got {shown(parameters)}")
+    defaults = {
+        "RevoluteJoint": {"totalBendingAngle": math.pi, "numSinkLayers": 1},
+        "ExtendedRevoluteJoint": {
+            "totalBendingAngle": math.pi, "tubeLength": 2.0 * r, "numSinkLayers": 1,
+        },
+        "PrismaticJoint": {"neutralLength": 3.0 * r, "numLayers": 3, "coneAngle": math.pi / 4},
+        "Waypoint": {"pathIndex": 2},
+        "StartTip": {"length": 1.5 * r},
+        "EndTip": {"length": 1.5 * r},
+    }[kind]  # fmt: skip
+    unknown = [key for key in parameters if key not in defaults]
+    if unknown:
+        _fail(
+            f"unknown parameter {unknown[0]!r} of a {kind}; its parameters are "
+            f"{', '.join(defaults) or 'none'}"
+        )
+    p = {**defaults, **(base or {}), **parameters}
+    if kind in ("RevoluteJoint", "ExtendedRevoluteJoint"):
+        angle = _number("totalBendingAngle", p["totalBendingAngle"])
+        if not 0.0 < angle < 2.0 * math.pi:
+            _fail(f"totalBendingAngle must be in (0, 2pi) radians, got {angle!r}")
+        layers = _integer("numSinkLayers", p["numSinkLayers"], 1, limits.NUM_SINK_LAYERS_MAX)
+        if kind == "RevoluteJoint":
+            return RevoluteJoint(numSides, r, angle, pose, layers)
+        tube = _length("tubeLength", p["tubeLength"], r)
+        return ExtendedRevoluteJoint(numSides, r, angle, tube, pose, layers)
+    if kind == "PrismaticJoint":
+        length = _length("neutralLength", p["neutralLength"], r)
+        layers = _integer("numLayers", p["numLayers"], 1, limits.NUM_LAYERS_MAX)
+        cone = _number("coneAngle", p["coneAngle"])
+        if not math.pi / 6 <= cone < math.pi / 2:
+            _fail(f"coneAngle must be in [pi/6, pi/2) radians, got {cone!r}")
+        return PrismaticJoint(numSides, r, length, layers, cone, pose)
+    if kind == "Waypoint":
+        return Waypoint(numSides, r, pose, _integer("pathIndex", p["pathIndex"], 0, 2))
+    return JOINT_TYPES[kind](numSides, r, pose, _length("length", p["length"], r))
+
+
+def _check_name(document: Document, name, j: int | None = None):
+    if name is None:
+        return None
+    if not isinstance(name, str):
+        _fail(f"name must be a string or None, got {shown(name)}")
+    if not name.strip():
+        _fail(f"name must not be empty or blank, got {name!r}")
+    for i, other in enumerate(document.names):
+        if other == name and i != j:
+            _fail(f"name {name!r} is already the name of {_label(document, i)}; names are unique")
+    return name
+
+
+# --- commands ------------------------------------------------------------------------------------
+class Command:
+    """Base class of the editor's commands (frozen dataclasses; see docs/editor.md)."""
+
+    #: Short text for menus and the undo history.
+    label: ClassVar[str] = "command"
+
+    def apply(self, document: Document) -> Outcome:
+        """The document this command makes of ``document`` (raises CommandError)."""
+        raise NotImplementedError
+
+    def describe(self) -> str:
+        """One line for the undo history, e.g. ``slide joint 3 by 0.5``."""
+        return self.label
+
+
+@dataclass(frozen=True)
+class AddJoint(Command):
+    """Add a joint after joint ``after`` (default: the last one), placed as ``append`` does.
+
+    Parameters
+    ----------
+    kind : the joint type, one of :data:`JOINT_TYPES` (a StartTip only as a new root... never:
+        a chain has one root).
+    parameters : its parameters (defaults: totalBendingAngle pi, numSinkLayers 1, tubeLength 2r,
+        neutralLength 3r, numLayers 3, coneAngle pi/4, pathIndex 2, length 1.5r).
+    pose : its Pose, a 4x4 rigid transform (default the identity); relative to joint
+        ``after``'s Pose when ``relative``.
+    after : the joint it follows (index or name); the joints after it keep their poses and
+        are linked to it again.
+    placement : ``"safe"``, ``"compact"`` or ``"pose"`` (see :data:`PLACEMENTS`).
+    relative : the pose is relative to joint ``after`` (True) or global (False).
+    name : its name (unique) or None.
+    """
+
+    kind: str
+    parameters: Mapping = field(default_factory=dict)
+    pose: Any = None
+    after: int | str | None = None
+    placement: str = "safe"
+    relative: bool = True
+    name: str | None = None
+
+    label: ClassVar[str] = "add joint"
+
+    def describe(self) -> str:
+        return f"add {self.kind}"
+
+    def apply(self, document: Document) -> Outcome:
+        chain = document.chain
+        run = _Run()
+        if self.placement not in PLACEMENTS:
+            _fail(f"placement must be one of {', '.join(PLACEMENTS)}, got {shown(self.placement)}")
+        relative = _flag("relative", self.relative)
+        after = (
+            len(chain.Joints) - 1
+            if self.after is None
+            else resolve_joint(document, self.after, "after")
+        )
+        pose = _pose("pose", self.pose, chain.r)
+        joint = _new_joint(self.kind, self.parameters, pose, chain.numSides, chain.r)
+        name = _check_name(document, self.name)
+        if isinstance(joint, StartTip):
+            _fail("a StartTip can only be the first joint of a chain, which already has one")
+        if isinstance(chain.Joints[after], EndTip):
+            _fail(f"nothing can follow {_label(document, after)}: an EndTip ends the chain")
+        rest = chain.Joints[after + 1 :]
+        if isinstance(joint, EndTip) and rest:
+            _fail(
+                f"an EndTip can only be the last joint; after={after} is followed by "
+                f"{len(rest)} joint(s)"
+            )
+        options = {
+            "safe": {"safe": True},
+            "compact": {"safe": False},
+            "pose": {"safe": False, "fixedPosition": True, "fixedOrientation": True},
+        }[self.placement]
+        new = _rebuilt(run, chain, chain.Joints[: after + 1], keep=after + 1)
+        index = run(
+            f"adding the {self.kind}",
+            lambda: new.append(joint, relative=relative, **options),
+        )
+        for k, later in enumerate(rest, start=after + 1):
+            run(
+                f"re-linking joint {k} ({type(later).__name__}) after the new joint",
+                lambda j=later: new.append(j, **_FIXED),
+            )
+        added = index - after
+        names = (
+            document.names[: after + 1] + (None,) * (added - 1) + (name,)
+            + document.names[after + 1 :]
+        )  # fmt: skip
+        sources = (
+            tuple(range(after + 1)) + (None,) * added + tuple(range(after + 1, len(chain.Joints)))
+        )
+        return Outcome(document.replaced(chain=new, names=names), index,
+                       run.clear_warning(new), sources)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class DeleteJoint(Command):
+    """Remove a joint; its neighbours are joined by a new link."""
+
+    joint: int | str
+
+    label: ClassVar[str] = "delete joint"
+
+    def describe(self) -> str:
+        return f"delete joint {self.joint!r}"
+
+    def apply(self, document: Document) -> Outcome:
+        j = resolve_joint(document, self.joint)
+        if len(document.chain.Joints) == 1:
+            _fail("the chain's only joint cannot be deleted: a chain keeps at least one joint")
+        run = _Run()
+        new = fork_chain(document.chain)
+        run(f"deleting {_label(document, j)}", lambda: new.delete(j))
+        names = document.names[:j] + document.names[j + 1 :]
+        n = len(document.chain.Joints)
+        sources = tuple(k for k in range(n) if k != j)
+        return Outcome(document.replaced(chain=new, names=names), max(j - 1, 0),
+                       run.clear_warning(new), sources)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class _AxisMove(Command):
+    joint: int | str
+    amount: float
+    propagate: bool = True
+    applyToPreviousWaypoint: bool = False
+
+    _method: ClassVar[str] = ""
+    _amount: ClassVar[str] = ""
+
+    def describe(self) -> str:
+        return f"{self.label} {self.joint!r} by {self.amount!r}"
+
+    def _check_amount(self, r: float) -> float:
+        raise NotImplementedError
+
+    def apply(self, document: Document) -> Outcome:
+        j = resolve_joint(document, self.joint)
+        amount = self._check_amount(document.chain.r)
+        propagate = _flag("propagate", self.propagate)
+        previous = _flag("applyToPreviousWaypoint", self.applyToPreviousWaypoint)
+        run = _Run()
+        new = fork_chain(document.chain)
+        method = getattr(new, self._method)
+        run(
+            f"{self.label} {_label(document, j)}",
+            lambda: method(j, amount, applyToPreviousWaypoint=previous, propagate=propagate),
+        )
+        sources = tuple(range(len(new.Joints)))
+        return Outcome(document.replaced(chain=new), j, run.clear_warning(new), sources)
+
+
+@dataclass(frozen=True)
+class SlideJoint(_AxisMove):
+    """Slide a joint by ``amount`` (a length) along its axis of motion; the kinematics are kept.
+
+    ``propagate`` moves the later joints with it; ``applyToPreviousWaypoint`` moves a
+    waypoint just before it too.
+    """
+
+    label: ClassVar[str] = "slide joint"
+    _method: ClassVar[str] = "translateJointAlongAxisOfMotion"
+
+    def _check_amount(self, r: float) -> float:
+        return _distance("distance", self.amount, r)
+
+
+@dataclass(frozen=True)
+class RollJoint(_AxisMove):
+    """Turn a joint by ``amount`` (radians) about its axis of motion; the kinematics are kept."""
+
+    label: ClassVar[str] = "roll joint"
+    _method: ClassVar[str] = "rotateJointAboutAxisOfMotion"
+
+    def _check_amount(self, r: float) -> float:
+        return _number("angle", self.amount)
+
+
+#: The joints whose pose is not part of the kinematics (no range of motion).
+_FREE_TYPES = (Waypoint, StartTip, EndTip)
+
+
+@dataclass(frozen=True)
+class TransformJoint(Command):
+    """Move a waypoint or a tip by the world transform ``transform`` (4x4 rigid).
+
+    Moving a revolute or prismatic joint this way changes its axis of motion, i.e. the robot's
+    kinematics: that needs ``kinematic=True`` (use :class:`SlideJoint` and :class:`RollJoint`
+    to keep them).
+    """
+
+    joint: int | str
+    transform: Any
+    propagate: bool = True
+    kinematic: bool = False
+
+    label: ClassVar[str] = "transform joint"
+
+    def describe(self) -> str:
+        return f"transform joint {self.joint!r}"
+
+    def apply(self, document: Document) -> Outcome:
+        chain = document.chain
+        j = resolve_joint(document, self.joint)
+        T = _pose("transform", self.transform, chain.r)
+        propagate = _flag("propagate", self.propagate)
+        if not _flag("kinematic", self.kinematic) and not isinstance(chain.Joints[j], _FREE_TYPES):
+            _fail(
+                f"transform of {_label(document, j)} would change its axis of motion: "
+                "transform moves waypoints and tips; slide or roll a joint to keep the "
+                "kinematics, or pass kinematic=True"
+            )
+        run = _Run()
+        new = fork_chain(chain)
+        run(
+            f"transform {_label(document, j)}",
+            lambda: new.transformJoint(j, T, propagate=propagate),
+        )
+        sources = tuple(range(len(new.Joints)))
+        return Outcome(document.replaced(chain=new), j, run.clear_warning(new), sources)
+
+
+@dataclass(frozen=True)
+class TransformAll(Command):
+    """Move the whole chain rigidly by the world transform ``transform``."""
+
+    transform: Any
+
+    label: ClassVar[str] = "transform all"
+
+    def apply(self, document: Document) -> Outcome:
+        T = _pose("transform", self.transform, document.chain.r)
+        run = _Run()
+        new = fork_chain(document.chain)
+        run("transform all", lambda: new.transformAll(T))
+        return Outcome(document.replaced(chain=new), None, (), tuple(range(len(new.Joints))))
+
+
+@dataclass(frozen=True)
+class SetJointParameters(Command):
+    """Change a joint's parameters (e.g. ``{"numSinkLayers": 2}``); its pose and state stay,
+    its two links are solved again, the other joints stay where they are."""
+
+    joint: int | str
+    parameters: Mapping
+
+    label: ClassVar[str] = "change joint"
+
+    def describe(self) -> str:
+        keys = ", ".join(map(str, self.parameters)) if isinstance(self.parameters, Mapping) else ""
+        return f"change {keys} of joint {self.joint!r}"
+
+    def apply(self, document: Document) -> Outcome:
+        chain = document.chain
+        j = resolve_joint(document, self.joint)
+        old = chain.Joints[j]
+        kind = type(old).__name__
+        if kind not in JOINT_TYPES:
+            _fail(f"{_label(document, j)} has no parameters the editor can change")
+        joint = _new_joint(
+            kind, self.parameters, old.pose_matrix, chain.numSides, chain.r, joint_parameters(old)
+        )
+        lo, hi = joint.stateRange()
+        if not lo <= old.state <= hi:
+            _fail(
+                f"the state {old.state!r} of {_label(document, j)} would be outside the new "
+                f"range [{lo:.6g}, {hi:.6g}]; set the state within it first"
+            )
+        if old.state != 0.0:
+            joint = joint.with_state(old.state)
+        run = _Run()
+        joints = list(chain.Joints)
+        joints[j] = joint
+        new = _rebuilt(run, chain, joints, keep=j)
+        return Outcome(document.replaced(chain=new), j, run.clear_warning(new),
+                       tuple(range(len(new.Joints))))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class RenameJoint(Command):
+    """Give a joint a name (unique among the joints), or take it away with None."""
+
+    joint: int | str
+    name: str | None
+
+    label: ClassVar[str] = "rename joint"
+
+    def describe(self) -> str:
+        return f"rename joint {self.joint!r} to {self.name!r}"
+
+    def apply(self, document: Document) -> Outcome:
+        j = resolve_joint(document, self.joint)
+        name = _check_name(document, self.name, j)
+        names = document.names[:j] + (name,) + document.names[j + 1 :]
+        return Outcome(document.replaced(names=names), j, (), tuple(range(len(names))))
+
+
+def _check_state(document: Document, j: int, value, name: str) -> float:
+    s = _number(name, value)
+    joint = document.chain.Joints[j]
+    lo, hi = joint.stateRange()
+    if not lo <= s <= hi:
+        unit = "a length" if isinstance(joint, PrismaticJoint) else "radians"
+        _fail(
+            f"{name} of {_label(document, j)} must be in [{lo:.6g}, {hi:.6g}] ({unit}), got {s!r}"
+        )
+    return s
+
+
+@dataclass(frozen=True)
+class SetJointState(Command):
+    """Set a joint's state (radians or a length); the later joints follow rigidly."""
+
+    joint: int | str
+    state: float
+
+    label: ClassVar[str] = "set state"
+
+    def describe(self) -> str:
+        return f"set state of joint {self.joint!r} to {self.state!r}"
+
+    def apply(self, document: Document) -> Outcome:
+        j = resolve_joint(document, self.joint)
+        s = _check_state(document, j, self.state, "state")
+        run = _Run()
+        new = fork_chain(document.chain)
+        run(f"set state of {_label(document, j)}", lambda: new.setJointState(j, s))
+        return Outcome(document.replaced(chain=new), j, run.clear_warning(new),
+                       tuple(range(len(new.Joints))))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class SetJointStates(Command):
+    """Set every joint's state at once (one value per joint; 0 for joints that do not move)."""
+
+    states: Sequence[float]
+
+    label: ClassVar[str] = "set states"
+
+    def apply(self, document: Document) -> Outcome:
+        n = len(document.chain.Joints)
+        if isinstance(self.states, str | bytes) or not isinstance(
+            self.states, Sequence | np.ndarray
+        ):
+            _fail(f"states must be a sequence of {n} numbers, got {shown(self.states)}")
+        if len(self.states) != n:
+            _fail(f"states must have one value per joint ({n}), got {len(self.states)}")
+        values = [_check_state(document, i, s, f"states[{i}]") for i, s in enumerate(self.states)]
+        run = _Run()
+        new = fork_chain(document.chain)
+        run("set states", lambda: new.setJointStates(values))
+        return Outcome(document.replaced(chain=new), None, run.clear_warning(new),
+                       tuple(range(n)))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Compact(Command):
+    """Replace the chain by a shorter one with the same kinematics and no collisions
+    (:func:`kinegami.optimize.compact`, docs/clearance.md); names follow their joints."""
+
+    seed: int = 0
+    motion: bool = False
+    objective: str = "length"
+    starts: int = 4
+    time_limit: float | None = None
+    executor: Any = None
+
+    label: ClassVar[str] = "compact"
+
+    def apply(self, document: Document) -> Outcome:
+        from kinegami.optimize import compact
+
+        run = _Run()
+        chain = document.chain
+        new = run(
+            "compact",
+            lambda: compact(
+                chain, seed=self.seed, motion=self.motion, executor=self.executor,
+                time_limit=self.time_limit, progress=False, objective=self.objective,
+                starts=self.starts,
+            ),
+        )  # fmt: skip
+        old_kept = [i for i, joint in enumerate(chain.Joints) if type(joint) is not Waypoint]
+        new_kept = [i for i, joint in enumerate(new.Joints) if type(joint) is not Waypoint]
+        old_types = [type(chain.Joints[i]) for i in old_kept]
+        new_types = [type(new.Joints[i]) for i in new_kept]
+        if old_types != new_types:  # pragma: no cover - compact keeps the joints
+            _fail("compact changed the joints' types; the design is unchanged")
+        names = [None] * len(new.Joints)
+        sources: list = [None] * len(new.Joints)
+        for i, k in zip(new_kept, old_kept, strict=True):
+            names[i], sources[i] = document.names[k], k
+        return Outcome(document.replaced(chain=new, names=tuple(names)), None,
+                       run.clear_warning(new), tuple(sources))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class SetOptions(Command):
+    """Change the design's options; fields left at :data:`KEEP` stay as they are.
+
+    Parameters
+    ----------
+    requireClearance : reject every later command that makes the chain pass through itself
+        (the chain must be clear now to turn it on).
+    maxAnglePerElbow : largest turn of one elbow, in [pi/180, pi]; every link is solved again.
+    twistPortion : share of each link's straight part given to its twist, in [0, 1), or None
+        for the default (0.2).
+    name, description : the design's texts (or None).
+    units : the length unit, "mm", "cm", "m" or "in".
+    """
+
+    requireClearance: Any = KEEP
+    maxAnglePerElbow: Any = KEEP
+    twistPortion: Any = KEEP
+    name: Any = KEEP
+    description: Any = KEEP
+    units: Any = KEEP
+
+    label: ClassVar[str] = "set options"
+
+    def describe(self) -> str:
+        keys = [k for k in ("requireClearance", "maxAnglePerElbow", "twistPortion", "name",
+                            "description", "units") if getattr(self, k) is not KEEP]  # fmt: skip
+        return "set " + (", ".join(keys) or "no option")
+
+    def apply(self, document: Document) -> Outcome:
+        changes: dict = {}
+        chain = document.chain
+        for key in ("name", "description"):
+            value = getattr(self, key)
+            if value is not KEEP:
+                if value is not None and not isinstance(value, str):
+                    _fail(f"{key} must be a string or None, got {shown(value)}")
+                changes[key] = value
+        if self.units is not KEEP:
+            if self.units not in UNITS:
+                _fail(
+                    f"units must be one of {', '.join(map(repr, UNITS))}, got {shown(self.units)}"
+                )
+            changes["units"] = self.units
+        if self.twistPortion is not KEEP:
+            if self.twistPortion is not None:
+                value = _number("twistPortion", self.twistPortion)
+                if not 0.0 <= value < 1.0:
+                    _fail(f"twistPortion must be in [0, 1), got {value!r}")
+                changes["twistPortion"] = value
+            else:
+                changes["twistPortion"] = None
+        run = _Run()
+        new = chain
+        if self.maxAnglePerElbow is not KEEP:
+            angle = _number("maxAnglePerElbow", self.maxAnglePerElbow)
+            if not limits.MIN_ANGLE_PER_ELBOW <= angle <= math.pi:
+                _fail(f"maxAnglePerElbow must be in [pi/180, pi] radians, got {angle!r}")
+            if angle != chain.maxAnglePerElbow:
+                new = _rebuilt(run, chain, chain.Joints, maxAnglePerElbow=angle)
+        if self.requireClearance is not KEEP:
+            require = _flag("requireClearance", self.requireClearance)
+            if require != new.requireClearance:
+                if require:
+                    report = new.clearance()
+                    if not report.ok:
+                        _fail(
+                            "requireClearance cannot be turned on: the chain passes through "
+                            f"itself ({report.pairs[0]})"
+                        )
+                new = fork_chain(new) if new is chain else new
+                new.requireClearance = require
+        if new is not chain:
+            changes["chain"] = new
+        return Outcome(document.replaced(**changes), None, run.clear_warning(new),
+                       tuple(range(len(new.Joints))))  # fmt: skip

@@ -1,0 +1,320 @@
+"""The editor's document: a design (chain, joint names, options, file metadata) as a value.
+
+A :class:`Document` never changes once made: commands build a new one (see
+:mod:`kinegami.editor.commands`), so undo keeps the old one and gives it back bit for bit. Its
+chain is a private copy that nothing edits in place; its clearance report, joint table and
+design text are computed on first use and kept. See docs/editor.md.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import tempfile
+import warnings
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+
+from kinegami.chain import KinematicChain
+from kinegami.design import DesignInfo, design_to_dict, dumps_design
+from kinegami.design.reader import (
+    DEFAULT_TWIST_PORTION,
+    UNITS,
+    build_plan,
+    check_document,
+    origin_of,
+    parse_design_text,
+    read_design_file,
+)
+from kinegami.errors import ClearanceWarning, InvalidParameterError, InvalidTypeError
+from kinegami.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    Joint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+
+__all__ = ["Document", "JointRow", "joint_parameters", "fork_chain", "write_text_atomic"]
+
+
+def fork_chain(chain: KinematicChain) -> KinematicChain:
+    """A copy of ``chain`` that can be edited without touching ``chain``.
+
+    Joints and links are immutable values and every chain operation replaces the chain's lists
+    rather than changing them, so a shallow copy shares them safely (and costs microseconds).
+    """
+    return copy.copy(chain)
+
+
+def joint_parameters(joint: Joint) -> dict:
+    """The joint's constructor parameters (radians, chain lengths), as in a design file."""
+    if type(joint) is ExtendedRevoluteJoint:
+        return {
+            "totalBendingAngle": float(joint.totalBendingAngle),
+            "tubeLength": float(joint.tubeLength),
+            "numSinkLayers": int(joint.numSinkLayers),
+        }
+    if type(joint) is RevoluteJoint:
+        return {
+            "totalBendingAngle": float(joint.totalBendingAngle),
+            "numSinkLayers": int(joint.numSinkLayers),
+        }
+    if type(joint) is PrismaticJoint:
+        return {
+            "neutralLength": float(joint.neutralLength),
+            "numLayers": int(joint.numLayers),
+            "coneAngle": float(joint.coneAngle),
+        }
+    if type(joint) is Waypoint:
+        return {"pathIndex": int(joint.pathIndex())}
+    if type(joint) in (StartTip, EndTip):
+        return {"length": float(joint.length)}
+    return {}
+
+
+@dataclass(frozen=True)
+class JointRow:
+    """One row of the joint table.
+
+    Attributes
+    ----------
+    index : the joint's index in the chain (what commands use).
+    type : the joint's class name (``"RevoluteJoint"``, ...).
+    name : its name in the design, or None.
+    pose : the joint's Pose as a read-only 4x4 array (world coordinates, z = axis of motion).
+    state : its state (radians for revolute joints, a length for prismatic ones, else 0).
+    state_range : the closed interval of its states.
+    parameters : its constructor parameters (see :func:`joint_parameters`).
+    """
+
+    index: int
+    type: str
+    name: str | None
+    pose: np.ndarray
+    state: float
+    state_range: tuple[float, float]
+    parameters: dict
+
+    @property
+    def movable(self) -> bool:
+        """Whether the joint has a range of motion (revolute and prismatic joints)."""
+        return self.state_range[0] != self.state_range[1]
+
+
+def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically: a temporary file in the same folder,
+    flushed to disk, then ``os.replace``; a failure leaves no temporary file and ``path`` as
+    it was."""
+    target = Path(os.fspath(path)).expanduser()
+    folder = target.parent if str(target.parent) else Path(".")
+    fd, temporary = tempfile.mkstemp(dir=folder, prefix=f".{target.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)
+        os.replace(temporary, target)
+    except BaseException:
+        try:
+            os.unlink(temporary)
+        except FileNotFoundError:
+            pass
+        raise
+    return target
+
+
+def _check_text(key: str, value) -> str | None:
+    if value is not None and not isinstance(value, str):
+        raise InvalidTypeError(f"{key} must be a string or None, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True, eq=False)
+class Document:
+    """A design as the editor holds it: the built chain and what a design file adds to it.
+
+    Attributes
+    ----------
+    chain : the built chain (a private copy: never edit it; commands make new documents).
+    names : one name (or None) per joint of ``chain``.
+    name, description : the design's texts (None when absent).
+    units : the length unit ("mm", "cm", "m" or "in").
+    twistPortion : share of each link's straight part given to its twist (None: the default
+        0.2, not written to the file).
+
+    ``chain.requireClearance`` and ``chain.maxAnglePerElbow`` are the design's chain options;
+    the joints' states are the chain's.
+    """
+
+    chain: KinematicChain
+    names: tuple
+    name: str | None = None
+    description: str | None = None
+    units: str = "mm"
+    twistPortion: float | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.chain, KinematicChain):
+            raise InvalidTypeError(
+                f"chain must be a KinematicChain, got {type(self.chain).__name__}"
+            )
+        names = tuple(self.names)
+        if len(names) != len(self.chain.Joints):
+            raise InvalidParameterError(
+                f"names must have one entry per joint ({len(self.chain.Joints)}), got {len(names)}"
+            )
+        object.__setattr__(self, "names", names)
+        _check_text("name", self.name)
+        _check_text("description", self.description)
+        if self.units not in UNITS:
+            raise InvalidParameterError(
+                f"units must be one of {', '.join(map(repr, UNITS))}, got {self.units!r}"
+            )
+
+    # --- making documents ---------------------------------------------------------------------
+    @classmethod
+    def from_chain(
+        cls,
+        chain: KinematicChain,
+        names=None,
+        *,
+        name: str | None = None,
+        description: str | None = None,
+        units: str = "mm",
+        twistPortion: float | None = None,
+    ) -> Document:
+        """A document holding a copy of ``chain`` (later edits of ``chain`` do not reach it).
+
+        ``names`` defaults to the joint names the design loader remembers for ``chain``.
+        """
+        if not isinstance(chain, KinematicChain):
+            raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
+        if names is None:
+            origin = origin_of(chain)
+            names = origin.names if origin is not None else (None,) * len(chain.Joints)
+        return cls(fork_chain(chain), tuple(names), name, description, units, twistPortion)
+
+    @classmethod
+    def _from_parsed(cls, document, file) -> Document:
+        plan = check_document(document, file)
+        chain, origin = build_plan(plan, file)
+        info = DesignInfo.of(document, file)
+        return cls(
+            fork_chain(chain),
+            tuple(origin.names),
+            info.name,
+            info.description,
+            info.units,
+            document.get("twistPortion"),
+        )
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> Document:
+        """The document of the design file ``path`` (raises DesignError, see
+        docs/design-format.md)."""
+        document, file = read_design_file(path)
+        return cls._from_parsed(document, file)
+
+    @classmethod
+    def loads(cls, text: str, file: str | os.PathLike | None = None) -> Document:
+        """The document of design JSON ``text`` (``file`` only names it in errors)."""
+        return cls._from_parsed(parse_design_text(text, file), file)
+
+    def replaced(self, **changes) -> Document:
+        """A new document with some attributes replaced (``chain`` is used as given)."""
+        values = {
+            "chain": self.chain,
+            "names": self.names,
+            "name": self.name,
+            "description": self.description,
+            "units": self.units,
+            "twistPortion": self.twistPortion,
+        }
+        values.update(changes)
+        return Document(**values)
+
+    # --- derived values (computed once) -------------------------------------------------------
+    @property
+    def twist_portion(self) -> float:
+        """The twist portion the crease pattern uses (``twistPortion`` or the default 0.2)."""
+        return DEFAULT_TWIST_PORTION if self.twistPortion is None else float(self.twistPortion)
+
+    @cached_property
+    def clearance(self):
+        """The chain's ClearanceReport at its states (docs/clearance.md)."""
+        return self.chain.clearance()
+
+    @cached_property
+    def joint_table(self) -> tuple[JointRow, ...]:
+        """One :class:`JointRow` per joint, in chain order."""
+        rows = []
+        for i, joint in enumerate(self.chain.Joints):
+            lo, hi = joint.stateRange()
+            rows.append(
+                JointRow(
+                    i, type(joint).__name__, self.names[i], joint.pose_matrix,
+                    float(joint.state), (float(lo), float(hi)), joint_parameters(joint),
+                )
+            )  # fmt: skip
+        return tuple(rows)
+
+    @cached_property
+    def design_dict(self) -> dict:
+        """The design document (a JSON-ready dict) that loads as this document.
+
+        Raises InvalidParameterError when the chain cannot be written as a design (see
+        ``kinegami.design.design_to_dict``).
+        """
+        with warnings.catch_warnings():  # the writer's state-0 copy may pass through itself
+            warnings.simplefilter("ignore", ClearanceWarning)
+            document = design_to_dict(
+                self.chain,
+                name=self.name,
+                description=self.description,
+                units=self.units,
+                twistPortion=self.twistPortion,
+            )
+        entries = document["joints"]
+        offset = len(entries) - len(self.names)  # 1 when the root is an EndTip (see writer)
+        for i, label in enumerate(self.names):
+            entry = entries[i + offset]
+            entry.pop("name", None)
+            if label is not None:
+                entries[i + offset] = {"type": entry.pop("type"), "name": label, **entry}
+        return document
+
+    @cached_property
+    def design_text(self) -> str:
+        """The design file's text (see :attr:`design_dict`), checked against the format.
+
+        Raises InvalidParameterError when the chain cannot be saved as a design.
+        """
+        text = dumps_design(self.design_dict)
+        try:
+            check_document(json.loads(text))
+        except ValueError as error:
+            raise InvalidParameterError(f"the design cannot be saved: {error}") from None
+        return text
+
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write the design file ``path`` (suffix .json) atomically and return its path."""
+        if not isinstance(path, str | os.PathLike) or isinstance(os.fspath(path), bytes):
+            raise InvalidTypeError(f"path must be a str or a path, got {path!r}")
+        target = Path(os.fspath(path)).expanduser()
+        if target.suffix.lower() != ".json":
+            raise InvalidParameterError(
+                f"a design file name must end in .json, got {os.fspath(path)!r}"
+            )
+        if target.is_dir():
+            raise InvalidParameterError(f"{os.fspath(path)!r} is a directory, not a file name")
+        return write_text_atomic(target, self.design_text)

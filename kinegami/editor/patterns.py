@@ -1,0 +1,96 @@
+"""Incremental crease patterns for the editor: reuse what an edit did not change.
+
+``chain.creasePattern(twistPortion)`` composes the catalog modules of every joint and link in
+order (``TubularPattern.concatenate``, a left fold). An edit usually changes a few links and
+leaves the rest of the modules as they were, so :class:`PatternCache` keeps
+
+* the modules of each link, keyed by the numbers ``LinkCSC.pattern_modules`` reads (the link's
+  shape, not its place: a link moved rigidly has the same modules), and
+* the composite after every joint of the last chain it built, so a chain sharing the first k
+  parts with it starts from the composite of those k parts.
+
+The result is the pattern ``chain.creasePattern(twistPortion)`` returns, bit for bit
+(``concatenate`` of a composite and more modules equals the fold of all of them). See
+docs/editor.md.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+
+from kinegami.chain import KinematicChain
+from kinegami.links import LinkCSC
+from kinegami.pattern import TubularPattern
+
+__all__ = ["PatternCache", "link_shape_key"]
+
+
+def _arc_key(arc) -> tuple:
+    return (float(arc.angle), int(arc.count), float(arc.elbowAngle), float(arc.rotationalAxisAngle))
+
+
+def link_shape_key(link: LinkCSC) -> tuple:
+    """The numbers a link's crease pattern depends on (its shape, not its place)."""
+    return (
+        float(link.r),
+        _arc_key(link.elbows1),
+        float(link.path.tMag),
+        bool(link.hasTwist),
+        float(link.twistAngle),
+        _arc_key(link.elbows2),
+    )
+
+
+class PatternCache:
+    """Builds chains' crease patterns, reusing link modules and the last chain's composites.
+
+    Parameters
+    ----------
+    max_links : how many distinct link shapes to remember (least recently used dropped).
+    """
+
+    def __init__(self, max_links: int = 4096):
+        self._max_links = int(max_links)
+        self._links: OrderedDict = OrderedDict()
+        self._tube: tuple | None = None  # (numSides, r, twistPortion) of the checkpoints
+        self._parts: list[tuple] = []  # per joint i: the module objects of link i and joint i
+        self._composites: list[TubularPattern] = []  # composite after joint i
+
+    def link_modules(self, link: LinkCSC, numSides: int, twistPortion: float) -> tuple:
+        """``link.pattern_modules(numSides, twistPortion)``, remembered by the link's shape."""
+        key = (int(numSides), float(twistPortion), link_shape_key(link))
+        modules = self._links.get(key)
+        if modules is None:
+            modules = tuple(link.pattern_modules(numSides, twistPortion))
+            self._links[key] = modules
+            if len(self._links) > self._max_links:
+                self._links.popitem(last=False)
+        else:
+            self._links.move_to_end(key)
+        return modules
+
+    def _parts_of(self, chain: KinematicChain, twistPortion: float) -> list[tuple]:
+        joints, links = chain.Joints, chain.Links
+        parts = [(joints[0].pattern,)]
+        for link, joint in zip(links[1:], joints[1:], strict=True):
+            parts.append(self.link_modules(link, chain.numSides, twistPortion) + (joint.pattern,))
+        return parts
+
+    def pattern(self, chain: KinematicChain, twistPortion: float = 0.2) -> TubularPattern:
+        """The crease pattern of ``chain`` (equal to ``chain.creasePattern(twistPortion)``)."""
+        tube = (int(chain.numSides), float(chain.r), float(twistPortion))
+        parts = self._parts_of(chain, twistPortion)
+        same = 0
+        if tube == self._tube:
+            for old, new in zip(self._parts, parts, strict=False):
+                if len(old) != len(new) or any(a is not b for a, b in zip(old, new, strict=True)):
+                    break
+                same += 1
+        composites = self._composites[:same]
+        if not composites:
+            composites.append(parts[0][0])
+            same = 1
+        for part in parts[same:]:
+            composites.append(TubularPattern.concatenate([composites[-1], *part]))
+        self._tube, self._parts, self._composites = tube, parts, composites
+        return composites[-1]
