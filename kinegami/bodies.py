@@ -395,7 +395,16 @@ def _joint_capsules(out: _Builder, joint: Joint, j: int, turning: float, text: s
 
 @functools.lru_cache(maxsize=16384)
 def _link_rows(link, i: int, r: float, twistPortion: float) -> tuple[tuple, float]:
-    """Capsule rows of link i with turning measured from the link's start, and its turning."""
+    """Capsule rows of link i with turning measured from the link's start, and its turning.
+
+    A link that is a rigid copy of another (``LinkCSC.transformed``, as every state change
+    makes of the links after the joint) gets the other's rows moved by the same transform.
+    """
+    moved = link.__dict__.get("_moved_from")
+    if moved is not None:
+        rows, turning = _link_rows(moved[0], i, r, twistPortion)
+        R, t = moved[1][:3, :3], moved[1][:3, 3]
+        return tuple((R @ row[0] + t, R @ row[1] + t) + row[2:] for row in rows), turning
     out = _Builder(r)
     turning = _link_capsules(out, link, i, 0.0, twistPortion)
     return tuple(out.rows), turning
@@ -432,6 +441,69 @@ def _chain_rows(joints, links, r: float, names, twistPortion: float) -> tuple[li
     return rows, first
 
 
+def _arrays(rows) -> tuple:
+    """Segment starts (k, 3), ends (k, 3), bodies (k,) and turnings (k,) of capsule rows."""
+    if not rows:
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, dtype=np.int64), np.zeros(0)
+    return (np.array([row[0] for row in rows]), np.array([row[1] for row in rows]),
+            np.array([row[2] for row in rows], dtype=np.int64),
+            np.array([row[4] for row in rows], dtype=float))  # fmt: skip
+
+
+@functools.lru_cache(maxsize=16384)
+def _link_arrays(link, i: int, r: float, twistPortion: float) -> tuple:
+    """:func:`_arrays` of link i's rows, the rows whose labels they carry (those of the
+    link it is a rigid copy of: labels need only lengths along a segment) and its turning."""
+    moved = link.__dict__.get("_moved_from")
+    if moved is not None:
+        (A, B, body, turn), rows, total = _link_arrays(moved[0], i, r, twistPortion)
+        R, t = moved[1][:3, :3], moved[1][:3, 3]
+        return (A @ R.T + t, B @ R.T + t, body, turn), rows, total
+    rows, total = _link_rows(link, i, r, twistPortion)
+    return _arrays(rows), rows, total
+
+
+@functools.lru_cache(maxsize=16384)
+def _joint_arrays(joint, j: int, r: float) -> tuple:
+    """:func:`_arrays` of joint j's rows (labels without names) and the rows."""
+    rows = _joint_rows(joint, j, r, f"joint {j}, {type(joint).__name__}")
+    return _arrays(rows), rows
+
+
+def _chain_arrays(joints, links, r: float) -> tuple:
+    """The chain's capsules as arrays (starts, ends, bodies, turnings without the hinges), the
+    row of every capsule (for its labels) and the index of every joint's first capsule."""
+    starts, ends, bodies, turns = [], [], [], []
+    rows: list = []
+    first: list[int] = []
+    turning = 0.0
+    count = 0
+    for j, joint in enumerate(joints):
+        if j > 0:
+            (A, B, body, turn), link_rows, total = _link_arrays(links[j], j, r, 0.2)
+            starts.append(A)
+            ends.append(B)
+            bodies.append(body)
+            turns.append(turn + turning)
+            rows += link_rows
+            turning += total
+            count += len(link_rows)
+        first.append(count)
+        (A, B, body, turn), joint_rows = _joint_arrays(joint, j, r)
+        if len(joint_rows):
+            starts.append(A)
+            ends.append(B)
+            bodies.append(body)
+            turns.append(turn + turning)
+            rows += joint_rows
+            count += len(joint_rows)
+    if not rows:
+        empty = np.zeros((0, 3))
+        return empty, empty, np.zeros(0, dtype=np.int64), np.zeros(0), rows, first
+    return (np.concatenate(starts), np.concatenate(ends), np.concatenate(bodies),
+            np.concatenate(turns), rows, first)  # fmt: skip
+
+
 def _kink_prefix(joints) -> np.ndarray:
     """Turning added by the revolute hinges up to body b (index b + 1; b = -1: 0)."""
     kinks = [abs(j.state) if isinstance(j, RevoluteJoint) else 0.0 for j in joints]
@@ -455,6 +527,47 @@ class Overlap:
         return f"{self.first} and {self.second} overlap by {-self.clearance:.4g}"
 
 
+def _near_pairs(rows, tau, first, centre, half, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """Tested capsule pairs (i < j, j >= first[i]) whose segment balls come within ``reach``.
+
+    Two levels: a ball around each part (the rows of one element, which are contiguous) prunes
+    whole blocks of pairs before the segments' own balls are compared.
+    """
+    S = len(rows)
+    element = np.fromiter((row[5] for row in rows), dtype=np.int64, count=S)
+    starts = np.flatnonzero(np.r_[True, element[1:] != element[:-1]])
+    ends = np.r_[starts[1:], S]
+    sizes = ends - starts
+    E = starts.size
+    c = np.add.reduceat(centre, starts, axis=0) / sizes[:, None]
+    owner = np.repeat(np.arange(E), sizes)
+    spread = np.sqrt(((centre - c[owner]) ** 2).sum(axis=1)) + half
+    rho = np.maximum.reduceat(spread, starts)
+    # block pairs (e <= f) that contain a tested pair and whose balls come within reach
+    e, f = np.triu_indices(E)
+    last_first = np.minimum.reduceat(first, starts)  # smallest first[i] over the block's rows
+    tested = last_first[e] < ends[f]
+    d = c[e] - c[f]
+    near = np.sqrt(np.einsum("ij,ij->i", d, d)) - rho[e] - rho[f] < reach
+    keep = tested & near
+    e, f = e[keep], f[keep]
+    if e.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    ne, nf = sizes[e], sizes[f]
+    block = ne * nf
+    total = int(block.sum())
+    offset = np.repeat(np.cumsum(block) - block, block)
+    q = np.arange(total) - offset
+    nf_rep = np.repeat(nf, block)
+    i = np.repeat(starts[e], block) + q // nf_rep
+    j = np.repeat(starts[f], block) + q % nf_rep
+    ok = j >= first[i]
+    i, j = i[ok], j[ok]
+    d = centre[i] - centre[j]
+    ok = np.sqrt(np.einsum("ij,ij->i", d, d)) - half[i] - half[j] < reach
+    return i[ok], j[ok]
+
+
 def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overlap | None:
     """The deepest overlap of a chain at its current configuration (the pair rule of
     :mod:`kinegami.clearance`), or None when no tested capsules overlap.
@@ -464,8 +577,7 @@ def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overla
     the link into it) are measured: placement checks an extension without re-checking the
     chain it extends.
     """
-    rows, first_rows = _chain_rows(joints, links, r, None if names is None else tuple(names),
-                                   0.2)  # fmt: skip
+    a, b, body, tau, rows, first_rows = _chain_arrays(joints, links, r)
     S = len(rows)
     if S < 2:
         return None
@@ -473,28 +585,19 @@ def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overla
     start_new = 0
     if since > 0:
         start_new = first_rows[since - 1] + _joint_row_count(joints[since - 1], since - 1, r)
-    a = np.array([row[0] for row in rows])
-    b = np.array([row[1] for row in rows])
-    body = np.array([row[2] for row in rows], dtype=np.int64)
-    tau = np.array([row[4] for row in rows]) + _kink_prefix(joints)[body + 1]
+    tau = tau + _kink_prefix(joints)[body + 1]
     # turning is non-decreasing along the tube: the pairs (i, j >= first[i]) are the tested ones
     first = np.maximum(
         np.searchsorted(tau, tau + math.pi - TURN_TOLERANCE, side="left"), np.arange(S) + 1
     )
     first = np.maximum(first, start_new)
-    counts = np.maximum(S - first, 0)
-    total = int(counts.sum())
-    if total == 0:
+    if int(np.maximum(S - first, 0).sum()) == 0:
         return None
-    i = np.repeat(np.arange(S), counts)
-    j = np.repeat(first - np.cumsum(counts) + counts, counts) + np.arange(total)
     centre = 0.5 * (a + b)
     half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
-    d = centre[i] - centre[j]
-    near = np.sqrt(np.einsum("ij,ij->i", d, d)) - half[i] - half[j] < 2.0 * r
-    if not near.any():
+    i, j = _near_pairs(rows, tau, first, centre, half, 2.0 * r)
+    if i.size == 0:
         return None
-    i, j = i[near], j[near]
     dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
     k = int(np.argmin(dist))
     worst = float(dist[k]) - 2.0 * r
@@ -504,10 +607,18 @@ def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overla
     def label(row, param: float) -> str:
         breaks, labels = row[6], row[7]
         at = param * float(np.linalg.norm(row[1] - row[0]))
+        text = labels[-1]
         for n, x in enumerate(breaks):
             if at < x:
-                return labels[n]
-        return labels[-1]
+                text = labels[n]
+                break
+        element = int(row[5])
+        if names is not None and element % 2 == 0:  # a joint's part: add the joint's name
+            jj = element // 2
+            if jj < len(names) and names[jj] is not None:
+                plain = f"joint {jj}, {type(joints[jj]).__name__}"
+                text = text.replace(plain, f"{plain} '{names[jj]}'", 1)
+        return text
 
     first_row, second_row = rows[int(i[k])], rows[int(j[k])]
     return Overlap(worst, label(first_row, float(s[k])), label(second_row, float(t[k])),

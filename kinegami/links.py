@@ -353,6 +353,10 @@ class LinkCSC(ReadOnlyAttributes):
                 link.__dict__[name] = _readonly(T @ cache[name])
         if "twistAngle" in cache:
             link.__dict__["twistAngle"] = cache["twistAngle"]
+        # the link this one is a rigid copy of, and the transform from it (kinegami.bodies
+        # moves that link's cached capsules instead of rebuilding them)
+        origin, moved = cache.get("_moved_from", (self, None))
+        link.__dict__["_moved_from"] = (origin, T if moved is None else T @ moved)
         return link
 
     # --- pattern -----------------------------------------------------------------------------
