@@ -226,7 +226,7 @@ class _Run:
         placement = [str(w.message) for w in caught if issubclass(w.category, PlacementWarning)]
         clearance = [str(w.message) for w in caught if issubclass(w.category, ClearanceWarning)]
         if result is False or result is None:
-            _fail(_reason(placement[-1]) if placement else f"{what} failed")
+            _fail(f"{what}: {_reason(placement[-1])}" if placement else f"{what} failed")
         if clearance:
             self.warnings[:] = [clearance[-1]]
         return result
@@ -414,21 +414,31 @@ class AddJoint(Command):
             f"adding the {self.kind}",
             lambda: new.append(joint, relative=relative, **options),
         )
-        for k, later in enumerate(rest, start=after + 1):
-            run(
-                f"re-linking joint {k} ({type(later).__name__}) after the new joint",
-                lambda j=later: new.append(j, **_FIXED),
-            )
         added = index - after
-        names = (
-            document.names[: after + 1] + (None,) * (added - 1) + (name,)
-            + document.names[after + 1 :]
-        )  # fmt: skip
-        sources = (
-            tuple(range(after + 1)) + (None,) * added + tuple(range(after + 1, len(chain.Joints)))
-        )
-        return Outcome(document.replaced(chain=new, names=names), index,
-                       run.clear_warning(new), sources)  # fmt: skip
+        names = [*document.names[: after + 1], *(None,) * (added - 1), name]
+        sources: list = [*range(after + 1), *(None,) * added]
+        notes = []
+        for k, later in enumerate(rest, start=after + 1):
+            what = f"re-linking joint {k} ({type(later).__name__}) after the new joint"
+            try:
+                run(what, lambda j=later: new.append(j, **_FIXED))
+                source = k
+            except CommandError as fixed:
+                try:  # no link reaches it where it is: place it again on its axis
+                    run(what, lambda j=later: new.append(j, relative=False, safe=True))
+                except CommandError:
+                    raise fixed from None
+                source = None
+                notes.append(
+                    f"joint {len(new.Joints) - 1} ({type(later).__name__}, joint {k} before) "
+                    "could not be linked where it was and was placed again by safe placement "
+                    "(its axis of motion kept)"
+                )
+            count = len(new.Joints) - len(names)
+            names += [None] * (count - 1) + [document.names[k]]
+            sources += [None] * (count - 1) + [source]
+        return Outcome(document.replaced(chain=new, names=tuple(names)), index,
+                       (*notes, *run.clear_warning(new)), tuple(sources))  # fmt: skip
 
 
 @dataclass(frozen=True)

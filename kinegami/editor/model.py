@@ -21,7 +21,7 @@ import numpy as np
 from kinegami.chain import KinematicChain
 from kinegami.editor import commands as cmd
 from kinegami.editor.commands import Command, CommandError, Outcome
-from kinegami.editor.document import Document, JointRow
+from kinegami.editor.document import Document, JointRow, joint_parameters
 from kinegami.editor.patterns import PatternCache, link_shape_key
 from kinegami.errors import InvalidTypeError, KinegamiError
 
@@ -101,12 +101,18 @@ def _value_bits(value):
 
 
 def _joint_keys(joint) -> tuple[tuple, bytes]:
-    """(shape key, pose key) of a joint: the shape includes parameters and state."""
-    shape = [type(joint).__name__]
-    for key in sorted(vars(joint)):
-        if key != "_T":
-            shape.append((key, _value_bits(vars(joint)[key])))
-    return tuple(shape), joint.pose_matrix.tobytes()
+    """(shape key, pose key) of a joint: the shape is its type, parameters and state."""
+    parameters = tuple(
+        (key, _value_bits(value)) for key, value in sorted(joint_parameters(joint).items())
+    )
+    shape = (
+        type(joint).__name__,
+        parameters,
+        _value_bits(float(joint.r)),
+        _value_bits(float(joint.neutralLength)),
+        _value_bits(float(joint.state)),
+    )
+    return shape, joint.pose_matrix.tobytes()
 
 
 def _link_keys(link) -> tuple[tuple, bytes]:
