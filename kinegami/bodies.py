@@ -465,7 +465,13 @@ def _link_arrays(link, i: int, r: float, twistPortion: float) -> tuple:
 
 @functools.lru_cache(maxsize=16384)
 def _joint_arrays(joint, j: int, r: float) -> tuple:
-    """:func:`_arrays` of joint j's rows (labels without names) and the rows."""
+    """:func:`_arrays` of joint j's rows (labels without names) and the rows (those of the
+    joint it is a rigid copy of, when it is one: labels need only lengths along a segment)."""
+    moved = joint.__dict__.get("_moved_from")
+    if moved is not None:
+        (A, B, body, turn), rows = _joint_arrays(moved[0], j, r)
+        R, t = moved[1][:3, :3], moved[1][:3, 3]
+        return (A @ R.T + t, B @ R.T + t, body, turn), rows
     rows = _joint_rows(joint, j, r, f"joint {j}, {type(joint).__name__}")
     return _arrays(rows), rows
 

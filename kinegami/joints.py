@@ -226,6 +226,7 @@ class Joint(ReadOnlyAttributes):
     def _copy(self) -> Joint:
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
+        new.__dict__.pop("_moved_from", None)
         return new
 
     def with_pose(self, T: np.ndarray) -> Joint:
@@ -242,7 +243,12 @@ class Joint(ReadOnlyAttributes):
 
     def transformed(self, T: np.ndarray) -> Joint:
         """A copy whose Pose is moved by the world transform ``T`` (Pose <- T Pose)."""
-        return self.with_pose(T @ self._T)
+        new = self.with_pose(T @ self._T)
+        # the joint this one is a rigid copy of, and the transform from it (kinegami.bodies
+        # moves that joint's cached capsules instead of rebuilding them)
+        origin, moved = self.__dict__.get("_moved_from", (self, None))
+        new.__dict__["_moved_from"] = (origin, T if moved is None else T @ moved)
+        return new
 
     def with_reversed_path_direction(self) -> Joint:
         """A copy with the path direction reversed, axis-of-motion line kept (chain.md 1.4)."""
