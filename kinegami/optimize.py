@@ -26,20 +26,16 @@ from kinegami.bodies import worst_overlap
 from kinegami.chain import KinematicChain, PlacementWarning
 from kinegami.errors import (
     ClearanceWarning,
+    CompactionError,
     InvalidParameterError,
     InvalidTypeError,
-    KinegamiError,
 )
 from kinegami.geometry.csc import csc_lengths
 from kinegami.geometry.frames import rotation_about_line
 from kinegami.joints import Waypoint
-from kinegami.validation import check_int, check_positive
+from kinegami.validation import check_bool, check_int, check_positive
 
 __all__ = ["compact", "CompactionError", "shorten_by_axis_translations", "tube_length"]
-
-
-class CompactionError(KinegamiError, ValueError):
-    """No clear design was found (the input passes through itself and no move fixed it)."""
 
 
 def tube_length(chain: KinematicChain) -> float:
@@ -581,8 +577,7 @@ def compact(
     if not isinstance(chain, KinematicChain):
         raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
     seed = check_int("seed", seed)
-    if not isinstance(motion, bool):
-        raise InvalidTypeError(f"motion must be True or False, got {motion!r}")
+    motion = check_bool("motion", motion)
     _check_executor(executor)
     if time_limit is not None:
         time_limit = check_positive("time_limit", time_limit)
