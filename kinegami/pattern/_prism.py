@@ -7,7 +7,6 @@ the starting side and reduced to [0, W); y is the distance along the tube axis.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -17,9 +16,11 @@ from kinegami.validation import check_num_sides, check_radius
 EPS_FACTOR = 1e-4
 
 
-@dataclass(frozen=True)
 class Prism:
     """The regular n-gonal prism of circumradius ``r`` that every module is folded from.
+
+    Immutable, and shared: :func:`make_prism` returns one object per (numSides, r), whose
+    arrays are computed once and read-only.
 
     Attributes
     ----------
@@ -35,37 +36,88 @@ class Prism:
         Pattern width (perimeter) n b.
     eps : float
         Length tolerance 1e-4 b used to identify points.
+    columns : ndarray, shape (n,)
+        x of the n tube edges (polygon vertices), x_k = (k + 1/2) b.
+    vertex_angles : ndarray, shape (n,)
+        Angle beta_k = (k + 1/2) 2 pi / n of polygon vertex k about the axis, radians.
+    panel_centres : ndarray, shape (n,)
+        x of the panel centre lines, c_p = (p + 1) b mod W.
     """
 
-    numSides: int
-    r: float
-    b: float
-    a: float
-    W: float
-    eps: float
+    __slots__ = (
+        "numSides", "r", "b", "a", "W", "eps", "columns", "vertex_angles", "panel_centres",
+        "_cache",
+    )  # fmt: skip
 
-    @property
-    def columns(self) -> np.ndarray:
-        """x of the n tube edges (polygon vertices), x_k = (k + 1/2) b, shape (n,)."""
-        return (np.arange(self.numSides) + 0.5) * self.b
+    def __init__(self, numSides: int, r: float, b: float, a: float, W: float, eps: float):
+        s = object.__setattr__
+        for name, value in (("numSides", numSides), ("r", r), ("b", b), ("a", a), ("W", W),
+                            ("eps", eps)):  # fmt: skip
+            s(self, name, value)
+        k = np.arange(numSides)
+        s(self, "columns", _readonly((k + 0.5) * b))
+        s(self, "vertex_angles", _readonly((k + 0.5) * (2.0 * math.pi / numSides)))
+        s(self, "panel_centres", _readonly(wrap_x((k + 1.0) * b, W, eps)))
+        s(self, "_cache", {})
 
-    @property
-    def vertex_angles(self) -> np.ndarray:
-        """Angle beta_k = (k + 1/2) 2 pi / n of polygon vertex k about the axis, radians."""
-        return (np.arange(self.numSides) + 0.5) * (2.0 * math.pi / self.numSides)
+    def cached(self, key, make):
+        """``make()`` computed once per prism and ``key`` (for values derived from n and r
+        only; the value must be immutable)."""
+        try:
+            return self._cache[key]
+        except KeyError:
+            value = self._cache[key] = make()
+            return value
 
-    @property
-    def panel_centres(self) -> np.ndarray:
-        """x of the panel centre lines, c_p = (p + 1) b mod W, shape (n,)."""
-        return wrap_x((np.arange(self.numSides) + 1.0) * self.b, self.W, self.eps)
+    def __setattr__(self, name: str, value) -> None:
+        raise AttributeError(f"Prism is immutable (cannot set {name!r})")
+
+    def __eq__(self, other) -> bool:
+        if not isinstance(other, Prism):
+            return NotImplemented
+        return (self.numSides, self.r) == (other.numSides, other.r)
+
+    def __hash__(self) -> int:
+        return hash((self.numSides, self.r))
+
+    def __repr__(self) -> str:
+        return (
+            f"Prism(numSides={self.numSides}, r={self.r!r}, b={self.b!r}, a={self.a!r}, "
+            f"W={self.W!r}, eps={self.eps!r})"
+        )
+
+
+def _readonly(array: np.ndarray) -> np.ndarray:
+    array.flags.writeable = False
+    return array
 
 
 def make_prism(numSides, r) -> Prism:
-    """Validate ``numSides`` and ``r`` and return the :class:`Prism` (raises on bad input)."""
+    """Validate ``numSides`` and ``r`` and return the :class:`Prism` (raises on bad input).
+
+    Prisms are shared: the same (numSides, r) gives the same object.
+    """
+    try:
+        return _prism_cache[(type(numSides), numSides, type(r), r)]
+    except (KeyError, TypeError):
+        pass
     n = check_num_sides(numSides)
-    r = check_radius(r)
-    b = 2.0 * r * math.sin(math.pi / n)
-    return Prism(n, r, b, r * math.cos(math.pi / n), n * b, EPS_FACTOR * b)
+    r_checked = check_radius(r)
+    prism = _prism_cache.get((int, n, float, r_checked))
+    if prism is None:
+        b = 2.0 * r_checked * math.sin(math.pi / n)
+        prism = Prism(n, r_checked, b, r_checked * math.cos(math.pi / n), n * b, EPS_FACTOR * b)
+        if len(_prism_cache) > 1024:
+            _prism_cache.clear()
+        _prism_cache[(int, n, float, r_checked)] = prism
+    try:
+        _prism_cache[(type(numSides), numSides, type(r), r)] = prism
+    except TypeError:  # an unhashable (but valid) value: not cached
+        pass
+    return prism
+
+
+_prism_cache: dict = {}
 
 
 def wrap_x(x: np.ndarray, W: float, eps: float) -> np.ndarray:
@@ -76,6 +128,12 @@ def wrap_x(x: np.ndarray, W: float, eps: float) -> np.ndarray:
     """
     x = np.mod(x, W)
     return np.where((x < eps) | (x > W - eps), 0.0, x)
+
+
+def wrap_scalar(x: float, W: float, eps: float) -> float:
+    """:func:`wrap_x` of one Python float (the same arithmetic, without numpy's overhead)."""
+    x = x % W
+    return 0.0 if x < eps or x > W - eps else x
 
 
 def periodic_dx(dx: np.ndarray, W: float) -> np.ndarray:

@@ -20,9 +20,9 @@ from kinegami.pattern._fold import (
     rot_axis,
 )
 from kinegami.pattern._prism import Prism, make_prism, periodic_dx, wrap_x
+from kinegami.pattern.checks import real
 from kinegami.pattern.counts import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
-from kinegami.validation import check_real
 
 __all__ = ["ELBOW_ANGLE_TOL", "ElbowFittingPattern", "ElbowGeometry", "elbow_geometry"]
 
@@ -77,8 +77,8 @@ def normalise_elbow_angles(bendingAngle: float, rotationalAxisAngle: float) -> t
     InvalidParameterError
         If |theta| (after reduction to [-pi, pi]) is not in (ELBOW_ANGLE_TOL, pi - ELBOW_ANGLE_TOL).
     """
-    theta = check_real("bendingAngle", bendingAngle)
-    phi = check_real("rotationalAxisAngle", rotationalAxisAngle)
+    theta = real("bendingAngle", bendingAngle)
+    phi = real("rotationalAxisAngle", rotationalAxisAngle)
     theta_n = theta - 2.0 * math.pi * round(theta / (2.0 * math.pi))
     if not ELBOW_ANGLE_TOL < abs(theta_n) < math.pi - ELBOW_ANGLE_TOL:
         raise InvalidParameterError(
@@ -97,29 +97,49 @@ def elbow_geometry(prism: Prism, bendingAngle: float, rotationalAxisAngle: float
     """Column heights, tuck angles and collapsed columns of an elbow (section 3.3)."""
     theta, phi = normalise_elbow_angles(bendingAngle, rotationalAxisAngle)
     r, b, eps = prism.r, prism.b, prism.eps
-    beta = prism.vertex_angles
+    beta, prev, nxt, ring = prism.cached("elbow", lambda: _prism_arrays(prism))
     d_w = r * math.tan(theta / 2.0)
     h = d_w * (1.0 + np.sin(beta - phi))
-    H_m = float(h.max())
-    n = beta.shape[0]
-    prev, nxt = np.arange(-1, n - 1), np.arange(1, n + 1) % n
-    flat = math.pi - np.arctan((h[prev] - h) / b) - np.arctan((h[nxt] - h) / b)
-    q = np.empty((n, 3))
-    q[:, 0] = r * np.cos(beta)
-    q[:, 1] = r * np.sin(beta)
-    q[:, 2] = h
-    u = q[nxt] - q
-    w = q[prev] - q
-    cos_b = np.einsum("ij,ij->i", u, w) / np.sqrt(
-        np.einsum("ij,ij->i", u, u) * np.einsum("ij,ij->i", w, w)
-    )
-    polygon = np.arccos(np.clip(cos_b, -1.0, 1.0))
+    H_m = max(h.tolist())
+    dh_prev = h[prev] - h
+    dh_next = h[nxt] - h
+    flat = math.pi - np.arctan(dh_prev / b) - np.arctan(dh_next / b)
+    # the angle at corner k of the polygon q_k = (r cos beta_k, r sin beta_k, h_k) between
+    # u = q_{k+1} - q_k and w = q_{k-1} - q_k; the dot products are summed in the order
+    # (x + z) + y, the order numpy's einsum uses (the results are bit for bit the same)
+    uw = (ring.uw0 + dh_next * dh_prev) + ring.uw1
+    uu = (ring.uu0 + dh_next * dh_next) + ring.uu1
+    ww = (ring.ww0 + dh_prev * dh_prev) + ring.ww1
+    cos_b = uw / np.sqrt(uu * ww)
+    polygon = np.arccos(np.minimum(np.maximum(cos_b, -1.0), 1.0))
     tuck = 0.5 * (flat - polygon)
     # a column collapses when its tuck vertices L, M, O would lie within eps of each other:
     # h_k >= H_m - eps (spec), or the offset (H_m - h_k) tan(eps_k) of O_k below eps (fix B6)
     collapsed = (h >= H_m - eps) | ((H_m - h) * np.tan(tuck) < eps)
     low = (h < eps) & ~collapsed
     return ElbowGeometry(theta, phi, d_w, h, H_m, tuck, collapsed, low)
+
+
+class _Ring:
+    """Products of the ring's x and y differences to the next (u) and previous (w) corner."""
+
+    __slots__ = ("uw0", "uw1", "uu0", "uu1", "ww0", "ww1")
+
+
+def _prism_arrays(prism: Prism):
+    """beta_k, the previous and next column, and the :class:`_Ring` of the prism."""
+    n = prism.numSides
+    beta = prism.vertex_angles
+    prev, nxt = np.arange(-1, n - 1), np.arange(1, n + 1) % n
+    qx = prism.r * np.cos(beta)
+    qy = prism.r * np.sin(beta)
+    u0, u1 = qx[nxt] - qx, qy[nxt] - qy
+    w0, w1 = qx[prev] - qx, qy[prev] - qy
+    ring = _Ring()
+    ring.uw0, ring.uw1 = u0 * w0, u1 * w1
+    ring.uu0, ring.uu1 = u0 * u0, u1 * u1
+    ring.ww0, ring.ww1 = w0 * w0, w1 * w1
+    return beta, prev, nxt, ring
 
 
 def ElbowFittingPattern(
@@ -153,22 +173,99 @@ def ElbowFittingPattern(
     prism = make_prism(numSides, r)
     geo = elbow_geometry(prism, bendingAngle, rotationalAxisAngle)
     n = prism.numSides
-    c = int(np.count_nonzero(geo.collapsed))
-    adjacent = c == 1 or (c == 2 and np.any(geo.collapsed & np.roll(geo.collapsed, 1)))
-    if not adjacent:
+    layout = _layout(prism, geo)
+    if layout is None:
+        c = int(np.count_nonzero(geo.collapsed))
         raise InvalidParameterError(
             f"bendingAngle {bendingAngle!r} is too small to resolve for numSides={n}, "
             f"r={prism.r:g}: {c} columns lie within the tolerance {prism.eps:.3g} of the midline "
             "(at most two adjacent ones are allowed)"
         )
-    record = ModuleRecord(
+    record = ModuleRecord._of(
         "elbow",
         {"bendingAngle": float(bendingAngle), "rotationalAxisAngle": float(rotationalAxisAngle)},
     )
-    return _build_elbow(prism, geo, record)
+    return _build_elbow(prism, geo, layout, record)
 
 
-def _build_elbow(prism: Prism, geo: ElbowGeometry, record: ModuleRecord) -> TubularPattern:
+class _Layout:
+    """The elbow's vertex numbering and creases for one set of collapsed and low columns.
+
+    They depend on n and on which columns are collapsed or low only, so they are computed once
+    per prism and column set (:meth:`Prism.cached`) and shared, read-only, by every elbow with
+    that set; an elbow then only computes its vertex coordinates: x = x_source[x_index] and
+    y = y_source[y_index], with x_source = (x_k, O_k's wrapped x) and y_source = (0, H, H_m,
+    h_k, H - h_k).
+    """
+
+    __slots__ = ("P", "D", "total", "edges", "labels", "x_index", "y_index")
+
+    def __init__(self, prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> None:
+        n = prism.numSides
+        k = np.arange(n)
+        P, D = k, n + k
+        full = ~collapsed
+        # vertices: P, D, then per column Q (collapsed) or L, M, O (array Of), U (no L, U when
+        # low)
+        has_l = full & ~low
+        counts = np.where(collapsed, 1, 2 + 2 * has_l.astype(int))
+        start = 2 * n + np.concatenate([[0], np.cumsum(counts)[:-1]])
+        L = np.where(has_l, start, np.where(low, P, start))
+        M = np.where(has_l, start + 1, np.where(low, start, start))
+        Of = np.where(has_l, start + 2, np.where(low, start + 1, start))
+        U = np.where(has_l, start + 3, np.where(low, D, start))
+        total = 2 * n + int(counts.sum())
+        x_index = np.empty(total, dtype=np.intp)
+        y_index = np.empty(total, dtype=np.intp)
+        x_index[P], y_index[P] = k, 0
+        x_index[D], y_index[D] = k, 1
+        x_index[M], y_index[M] = k, 2
+        x_index[Of[full]], y_index[Of[full]] = n + k[full], 2
+        x_index[L[has_l]], y_index[L[has_l]] = k[has_l], 3 + k[has_l]
+        x_index[U[has_l]], y_index[U[has_l]] = k[has_l], 3 + n + k[has_l]
+        blocks = [crease_block(a, c, label) for a, c, label in _crease_table(P, D, L, M, Of, U)]
+        template = assemble(prism, np.zeros((total, 2)), blocks, P, D, 0.0, ModuleRecord("elbow"))
+        self.P, self.D, self.total = template.proximalBase, template.distalBase, total
+        self.edges, self.labels = template.edges_vertices, template.edges_assignment
+        x_index.flags.writeable = False
+        y_index.flags.writeable = False
+        self.x_index, self.y_index = x_index, y_index
+
+
+def _layout(prism: Prism, geo: ElbowGeometry) -> _Layout | None:
+    """The shared layout of an elbow's columns, or None when they cannot be resolved (more
+    than two collapsed columns, or two that are not adjacent)."""
+    collapsed, low = geo.collapsed, geo.low
+    key = ("elbow layout", collapsed.tobytes(), low.tobytes())
+
+    def make():
+        c = int(np.count_nonzero(collapsed))
+        adjacent = c == 1 or (c == 2 and np.any(collapsed & np.roll(collapsed, 1)))
+        return _Layout(prism, collapsed.copy(), low.copy()) if adjacent else None
+
+    return prism.cached(key, make)
+
+
+def _build_elbow(
+    prism: Prism, geo: ElbowGeometry, layout: _Layout, record: ModuleRecord
+) -> TubularPattern:
+    x = prism.columns
+    h, H_m = geo.h, geo.H_m
+    H = 2.0 * H_m
+    offset = (H_m - h) * np.tan(geo.tuck)
+    x_source = np.concatenate([x, wrap_x(x + offset, prism.W, prism.eps)])
+    y_source = np.concatenate([[0.0, H, H_m], h, H - h])
+    vertices = np.empty((layout.total, 2))
+    vertices[:, 0] = x_source[layout.x_index]
+    vertices[:, 1] = y_source[layout.y_index]
+    return TubularPattern._build(
+        prism.numSides, prism.r, vertices, layout.edges, layout.labels, layout.P, layout.D,
+        np.zeros(2), np.array([0.0, H]), float(H), (record,), 0, None, False,
+    )  # fmt: skip
+
+
+def _build_elbow_reference(prism: Prism, geo: ElbowGeometry, record: ModuleRecord):
+    """The elbow built column by column (the layout's definition; kept for the tests)."""
     n = prism.numSides
     x = prism.columns
     h, H_m = geo.h, geo.H_m

@@ -70,6 +70,7 @@ UVA_TO_DUBINS = np.array(
 #: Crease length errors above this many r trigger the Gauss-Newton repair.
 REPAIR_TOLERANCE = 1e-10
 
+
 @dataclass(frozen=True, eq=False)
 class FoldedModule:
     """One catalog module of a folded pattern.

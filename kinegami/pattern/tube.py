@@ -8,9 +8,9 @@ from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
 from kinegami.pattern._fold import polygon_point, translation
 from kinegami.pattern._prism import make_prism
+from kinegami.pattern.checks import nonnegative
 from kinegami.pattern.counts import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
-from kinegami.validation import check_nonnegative
 
 __all__ = ["TubeFittingPattern", "WaypointPattern"]
 
@@ -32,9 +32,19 @@ def WaypointPattern(numSides: int, r: float) -> TubularPattern:
 
 
 def _empty(prism, record: ModuleRecord) -> TubularPattern:
+    empty = prism.cached("empty", lambda: _empty_template(prism))
+    return TubularPattern._build(
+        prism.numSides, prism.r, empty.vertices_coords, empty.edges_vertices,
+        empty.edges_assignment, empty.proximalBase, empty.distalBase, np.zeros(2), np.zeros(2),
+        0.0, (record,), 0, None, False,
+    )  # fmt: skip
+
+
+def _empty_template(prism) -> TubularPattern:
     n = prism.numSides
     vertices = np.stack([prism.columns, np.zeros(n)], axis=1)
     base = np.arange(n)
+    record = ModuleRecord("waypoint")
     return assemble(prism, vertices, [(np.zeros((0, 2), int), "M")], base, base, 0.0, record)
 
 
@@ -57,20 +67,31 @@ def TubeFittingPattern(numSides: int, r: float, height: float) -> TubularPattern
         (fix B6: no coincident vertices or zero-length creases).
     """
     prism = make_prism(numSides, r)
-    h = check_nonnegative("height", height)
-    return _tube(prism, h, "M", ModuleRecord("tube", {"height": h}))
+    h = nonnegative("height", height)
+    return _tube(prism, h, "M", ModuleRecord._of("tube", {"height": h}))
 
 
 def _tube(prism, h: float, label: str, record: ModuleRecord) -> TubularPattern:
-    n = prism.numSides
     if h < prism.eps:
         return _empty(prism, record)
+    n = prism.numSides
+    tube = prism.cached(("tube", label), lambda: _tube_template(prism, label))
+    vertices = tube.vertices_coords.copy()
+    vertices[n:, 1] = h
+    return TubularPattern._build(
+        n, prism.r, vertices, tube.edges_vertices, tube.edges_assignment, tube.proximalBase,
+        tube.distalBase, np.zeros(2), np.array([0.0, h]), float(h), (record,), 0, None, False,
+    )  # fmt: skip
+
+
+def _tube_template(prism, label: str) -> TubularPattern:
+    """The tube of height 0 with creases ``label`` (shared arrays of every tube)."""
+    n = prism.numSides
     x = prism.columns
-    vertices = np.concatenate(
-        [np.stack([x, np.zeros(n)], axis=1), np.stack([x, np.full(n, h)], axis=1)]
-    )
+    vertices = np.concatenate([np.stack([x, np.zeros(n)], axis=1)] * 2)
     k = np.arange(n)
-    return assemble(prism, vertices, [crease_block(k, n + k, label)], k, n + k, h, record)
+    record = ModuleRecord("tube")
+    return assemble(prism, vertices, [crease_block(k, n + k, label)], k, n + k, 0.0, record)
 
 
 # --------------------------------------------------------------------------------------------

@@ -21,10 +21,11 @@ from typing import Any
 import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.pattern._prism import EPS_FACTOR, make_prism, periodic_dx, wrap_x
+from kinegami.pattern._prism import EPS_FACTOR, make_prism, periodic_dx, wrap_scalar, wrap_x
 from kinegami.validation import check_nonnegative
 
 _KEY_SHIFT = np.int64(1) << np.int64(32)
+_WIDTHS: dict = {}  # (n, r) -> W, as TubularPattern computes it
 _ASSIGNMENT_DTYPE = np.dtype("<U1")
 
 __all__ = ["FrozenParams", "ModuleRecord", "TubularPattern", "ValidationReport"]
@@ -108,6 +109,16 @@ class ModuleRecord:
     def __post_init__(self) -> None:
         if not isinstance(self.params, FrozenParams):
             object.__setattr__(self, "params", FrozenParams(self.params))
+
+    @classmethod
+    def _of(cls, kind: str, params: dict) -> ModuleRecord:
+        """A record taking ownership of the new dict ``params`` (the builders' fast path)."""
+        self = object.__new__(cls)
+        frozen = object.__new__(FrozenParams)
+        object.__setattr__(frozen, "_data", params)
+        object.__setattr__(self, "kind", kind)
+        object.__setattr__(self, "params", frozen)
+        return self
 
 
 @dataclass(frozen=True)
@@ -305,7 +316,10 @@ class TubularPattern:
         s = object.__setattr__
         s(self, "numSides", int(n))
         s(self, "r", float(r))
-        s(self, "width", float(n * 2.0 * r * np.sin(np.pi / n)))
+        width = _WIDTHS.get((n, r))
+        if width is None:
+            width = _WIDTHS[(n, r)] = float(n * 2.0 * r * np.sin(np.pi / n))
+        s(self, "width", width)
         s(self, "height", float(height))
         s(self, "vertices_coords", _readonly(vertices))
         s(self, "edges_vertices", _readonly(edges))
@@ -489,32 +503,7 @@ class TubularPattern:
             _check_composable(first, patterns[i], i, previous=patterns[i - 1])
         if len(patterns) == 1:
             return first
-        state = _ComposeState.after(first)
-        vertices = [first.vertices_coords]
-        edges = [first.edges_vertices]
-        assignment = [first.edges_assignment]
-        height = first.height
-        removed = first.removedDuplicates
-        modules = list(first.modules)
-        placements = first.module_vertices
-        for i, p in enumerate(patterns[1:], start=1):
-            step = _compose_step(state, p, i)
-            if step is None:
-                continue
-            vertices.append(step.vertices)
-            edges.append(step.edges)
-            assignment.append(step.assignment)
-            height += p.height
-            removed += p.removedDuplicates + step.removed
-            modules.extend(p.modules)
-            placements = _join_placements(placements, _placed(p, step.mapping))
-            state = step.state
-        return cls._build(
-            first.numSides, first.r, np.concatenate(vertices), np.concatenate(edges),
-            np.concatenate(assignment), first.proximalBase, state.distal_idx,
-            first.proximalMarker, state.marker, height, tuple(modules), removed,
-            state.distal_keys, first._has_internal_duplicates, placements,
-        )  # fmt: skip
+        return _compose_all(first, patterns)
 
     def reversed(self) -> TubularPattern:
         """The pattern read from the other end (spec section 2.4).
@@ -606,6 +595,136 @@ def _placed(pattern: TubularPattern, mapping: np.ndarray) -> tuple[np.ndarray, .
 
 def _join_placements(first, second):
     return None if first is None or second is None else first + second
+
+
+def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> TubularPattern:
+    """``patterns[0]`` followed by every other pattern (already checked to be composable).
+
+    The same result as applying :func:`_compose_step` to each pattern in turn, computed in a
+    few whole-array passes: the markers (a scalar recurrence) first, then every module's
+    translated and wrapped vertices at once, all cyclic shifts at once, the identification of
+    base vertices by following each proximal base vertex to the distal base vertex it lands on,
+    and the duplicate creases. A crease can only repeat an earlier one when both its ends are
+    base vertices shared with the module before, and then the earlier one is the first crease
+    on those two vertices, whichever module it came from: the first one wins.
+    """
+    n, W, eps = first.numSides, first.width, first.eps
+    items = [(i, p) for i, p in enumerate(patterns) if i > 0 and not p.isEmpty]
+    if not items:
+        return first
+    m = len(items)
+    # 1. the markers: module k is translated by offsets[k], the composite ends at (mx, my)
+    offsets = np.empty((m, 2))
+    mx, my = (float(v) for v in first.distalMarker)
+    height = first.height
+    removed = first.removedDuplicates
+    modules = list(first.modules)
+    sizes = np.empty(m, dtype=np.intp)
+    for k, (_, p) in enumerate(items):
+        px, py = p.proximalMarker.tolist()
+        dx, dy = p.distalMarker.tolist()
+        ox, oy = mx - px, my - py
+        offsets[k, 0], offsets[k, 1] = ox, oy
+        mx, my = wrap_scalar(dx + ox, W, eps), dy + oy
+        sizes[k] = p.numVertices
+        height += p.height
+        removed += p.removedDuplicates
+        modules.extend(p.modules)
+    pats = [p for _, p in items]
+    # 2. every module's vertices, translated and wrapped; slots are module vertices, numbered
+    #    after the first pattern's vertices (slot s < N0 is vertex s of the first pattern)
+    N0 = first.numVertices
+    starts = np.zeros(m, dtype=np.intp)
+    np.cumsum(sizes[:-1], out=starts[1:])
+    coords = np.concatenate([p.vertices_coords for p in pats])
+    coords += np.repeat(offsets, sizes, axis=0)
+    coords[:, 0] = wrap_x(coords[:, 0], W, eps)
+    proximal = np.concatenate([p.proximalBase for p in pats]) + np.repeat(starts, n)
+    last_distal = pats[-1].distalBase
+    distal = np.concatenate([p.distalBase for p in pats[:-1]] + [first.distalBase[:0]])
+    distal = distal + np.repeat(starts[:-1], n)
+    # 3. the cyclic shift of every module: first j with base k on previous distal k + j
+    target = np.concatenate([first.vertices_coords[first.distalBase], coords[distal]])
+    target = target.reshape(m, n, 2)
+    base = coords[proximal].reshape(m, n, 2)
+    roll = (np.arange(n)[:, None] + np.arange(n)[None, :]) % n  # roll[j, k] = k + j mod n
+    rolled = target[:, roll, :] - base[:, None, :, :]
+    good = (np.abs(periodic_dx(rolled[..., 0], W)) < eps) & (np.abs(rolled[..., 1]) < eps)
+    good = good.all(axis=2)
+    found = good.any(axis=1)
+    if not found.all():
+        k = int(np.flatnonzero(~found)[0])
+        state = _ComposeState(n, W, eps, None, None, target[k], None, 0)
+        _find_shift(state, base[k], items[k][0])  # raises with the module's index
+    shift = good.argmax(axis=1)
+    # 4. identify each proximal base vertex with the previous distal base vertex it lands on
+    #    (following degenerate modules whose distal base is their proximal base)
+    previous = np.empty((m, n), dtype=np.intp)
+    previous[0] = first.distalBase
+    previous[1:] = (N0 + distal).reshape(m - 1, n)
+    previous = np.take_along_axis(previous, (np.arange(n)[None, :] + shift[:, None]) % n, axis=1)
+    S = int(sizes.sum())
+    ref = np.arange(N0 + S)
+    ref[N0 + proximal] = previous.ravel()
+    while True:
+        followed = ref[ref]
+        if np.array_equal(followed, ref):
+            break
+        ref = followed
+    is_new = np.ones(S, dtype=bool)
+    is_new[proximal] = False
+    num_new = int(np.count_nonzero(is_new))
+    value = np.empty(N0 + S, dtype=np.intp)
+    value[:N0] = np.arange(N0)
+    value[N0:][is_new] = np.arange(N0, N0 + num_new)
+    index = value[ref]  # composite vertex of every slot
+    # 5. creases, and the duplicates among those joining two shared base vertices
+    local = [p.edges_vertices for p in pats]
+    counts = np.array([e.shape[0] for e in local], dtype=np.intp)
+    slot_edges = np.concatenate(local) + np.repeat(N0 + starts, counts)[:, None]
+    edges = index[slot_edges]
+    assignment = np.concatenate([p.edges_assignment for p in pats])
+    keep = np.ones(edges.shape[0], dtype=bool)
+    flagged = [k for k, p in enumerate(pats) if p._get_internal_duplicates()]
+    if flagged:
+        edge_starts = np.concatenate([[0], np.cumsum(counts)])
+        for k in flagged:
+            a, b = edge_starts[k], edge_starts[k + 1]
+            keep[a:b] &= _first_occurrence_mask(_edge_keys(edges[a:b]))
+    shared = np.zeros(N0 + num_new, dtype=bool)
+    shared[index[N0 + proximal]] = True
+    old_edges = first.edges_vertices
+    old_sub = old_edges[shared[old_edges[:, 0]] & shared[old_edges[:, 1]]]
+    sub = np.flatnonzero(shared[edges[:, 0]] & shared[edges[:, 1]])
+    if sub.shape[0]:
+        keys = _edge_keys(np.concatenate([old_sub, edges[sub]]))
+        _, first_index, inverse = np.unique(keys, return_index=True, return_inverse=True)
+        position = np.arange(keys.shape[0])
+        repeated = (first_index[inverse] != position)[old_sub.shape[0] :]
+        keep[sub[repeated]] = False
+    dropped = int(keep.shape[0] - np.count_nonzero(keep))
+    if dropped:
+        edges, assignment = edges[keep], assignment[keep]
+    removed += dropped
+    placements = first.module_vertices
+    if placements is not None:
+        placements = list(placements)
+        ends = (N0 + starts + sizes).tolist()
+        for p, a, b in zip(pats, (N0 + starts).tolist(), ends, strict=True):
+            own = _placed(p, index[a:b])
+            if own is None:
+                placements = None
+                break
+            placements.extend(own)
+        placements = None if placements is None else tuple(placements)
+    distal_idx = None if last_distal is None else index[N0 + starts[-1] + last_distal]
+    return TubularPattern._build(
+        n, first.r, np.concatenate([first.vertices_coords, coords[is_new]]),
+        np.concatenate([first.edges_vertices, edges]),
+        np.concatenate([first.edges_assignment, assignment]), first.proximalBase, distal_idx,
+        first.proximalMarker, np.array([mx, my]), height, tuple(modules), removed, None,
+        first._has_internal_duplicates, placements,
+    )  # fmt: skip
 
 
 def _copy_or_none(array: np.ndarray | None) -> np.ndarray | None:

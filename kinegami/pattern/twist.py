@@ -10,10 +10,10 @@ import numpy as np
 from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
 from kinegami.pattern._fold import corners, mod_w, moved_copy, polygon_point, rot_axis
-from kinegami.pattern._prism import Prism, make_prism, wrap_x
+from kinegami.pattern._prism import Prism, make_prism, wrap_scalar, wrap_x
+from kinegami.pattern.checks import nonnegative, real
 from kinegami.pattern.counts import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
-from kinegami.validation import check_nonnegative, check_real
 
 __all__ = ["TwistFittingPattern", "TwistGeometry", "twist_geometry"]
 
@@ -87,10 +87,10 @@ def TwistFittingPattern(
         distal marker shifted by the nearest whole number of columns.
     """
     prism = make_prism(numSides, r)
-    alpha = check_real("twistAngle", twistAngle)
-    h = check_nonnegative("moduleHeight", moduleHeight)
+    alpha = real("twistAngle", twistAngle)
+    h = nonnegative("moduleHeight", moduleHeight)
     geo = twist_geometry(prism, alpha, h)
-    record = ModuleRecord("twist", {"twistAngle": alpha, "moduleHeight": h})
+    record = ModuleRecord._of("twist", {"twistAngle": alpha, "moduleHeight": h})
     n, b = prism.numSides, prism.b
     k = np.arange(n)
     x = prism.columns
@@ -102,10 +102,24 @@ def TwistFittingPattern(
             distal_marker_x=float(wrap_x(np.array([columns * b]), prism.W, prism.eps)[0]),
         )  # fmt: skip
     H = geo.height
-    distal_x = wrap_x(x + geo.shift, prism.W, prism.eps)
-    vertices = np.concatenate(
-        [np.stack([x, np.zeros(n)], axis=1), np.stack([distal_x, np.full(n, H)], axis=1)]
-    )
+    band = prism.cached("twist", lambda: _band(prism))
+    vertices = band.vertices_coords.copy()
+    vertices[n:, 0] = wrap_x(x + geo.shift, prism.W, prism.eps)
+    vertices[n:, 1] = H
+    marker_x = wrap_scalar(geo.K * b + geo.shift, prism.W, prism.eps)
+    return TubularPattern._build(
+        n, prism.r, vertices, band.edges_vertices, band.edges_assignment, band.proximalBase,
+        band.distalBase, np.zeros(2), np.array([marker_x, H]), float(H), (record,), 0, None,
+        False,
+    )  # fmt: skip
+
+
+def _band(prism: Prism) -> TubularPattern:
+    """The twist's creases and bases (shared by every twist of the prism), at height 0."""
+    n = prism.numSides
+    k = np.arange(n)
+    x = prism.columns
+    vertices = np.concatenate([np.stack([x, np.zeros(n)], axis=1)] * 2)
     P, D = k, n + k
     prev = (k - 1) % n
     blocks = [
@@ -114,8 +128,7 @@ def TwistFittingPattern(
         crease_block(P[prev], P, "V"),  # proximal ring
         crease_block(D[prev], D, "V"),  # distal ring
     ]
-    marker_x = float(wrap_x(np.array([geo.K * b + geo.shift]), prism.W, prism.eps)[0])
-    return assemble(prism, vertices, blocks, P, D, H, record, distal_marker_x=marker_x)
+    return assemble(prism, vertices, blocks, P, D, 0.0, ModuleRecord("twist"))
 
 
 # --------------------------------------------------------------------------------------------
