@@ -3,7 +3,11 @@
 ``from kinegami import *`` gives the names the paper's listings use: ``KinematicChain``,
 the joints, ``LinkCSC``, ``TubularPattern``, ``SE3`` (spatialmath) and ``np`` (numpy), plus
 ``export(obj, path, **options)``, which writes a chain or a pattern in the format named by the
-file suffix (DXF, SVG, FOLD, PDF, STL, OBJ, URDF).
+file suffix (DXF, SVG, FOLD, PDF, STL, OBJ, URDF; docs/exports.md).
+
+Importing the package is cheap: the classes (and numpy, spatialmath) are imported when a name
+is first used (a module ``__getattr__``, which ``import *`` goes through for the names of
+``__all__``), so the ``kinegami`` command loads only what its command needs.
 """
 
 from kinegami import _startup
@@ -16,12 +20,11 @@ from kinegami import _mplconfig
 if _mplconfig.running_the_command():  # before spatialmath imports matplotlib
     _mplconfig.use_private_folder_if_needed()
 
-import numpy as np
-from spatialmath import SE3
+import importlib
 
-from kinegami import export
-from kinegami.chain import ClearanceWarning, KinematicChain, PlacementWarning
+from kinegami._version import __version__ as __version__
 from kinegami.errors import (
+    ClearanceWarning,
     IncompatibleJointError,
     InvalidParameterError,
     InvalidTypeError,
@@ -29,20 +32,10 @@ from kinegami.errors import (
     KinegamiError,
     NoPathError,
 )
-from kinegami.geometry.balls import Ball
-from kinegami.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
-    Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
-)
-from kinegami.links import LinkCSC
-from kinegami.pattern import TubularPattern
 
-__version__ = "0.1.0"
+# the function: it replaces the attribute the import gives the package kinegami.export, whose
+# modules are imported by name (from kinegami.export import dxf)
+from kinegami.export import export
 
 __all__ = [
     "KinematicChain",
@@ -68,3 +61,36 @@ __all__ = [
     "ClearanceWarning",
     "export",
 ]
+
+#: Names imported on first use: name -> (module, attribute; None for the module itself).
+_LAZY = {
+    "KinematicChain": ("kinegami.chain", "KinematicChain"),
+    "PlacementWarning": ("kinegami.chain", "PlacementWarning"),
+    "RevoluteJoint": ("kinegami.joints", "RevoluteJoint"),
+    "ExtendedRevoluteJoint": ("kinegami.joints", "ExtendedRevoluteJoint"),
+    "PrismaticJoint": ("kinegami.joints", "PrismaticJoint"),
+    "Waypoint": ("kinegami.joints", "Waypoint"),
+    "StartTip": ("kinegami.joints", "StartTip"),
+    "EndTip": ("kinegami.joints", "EndTip"),
+    "Joint": ("kinegami.joints", "Joint"),
+    "LinkCSC": ("kinegami.links", "LinkCSC"),
+    "TubularPattern": ("kinegami.pattern", "TubularPattern"),
+    "Ball": ("kinegami.geometry.balls", "Ball"),
+    "SE3": ("spatialmath", "SE3"),
+    "np": ("numpy", None),
+}
+
+
+def __getattr__(name: str):
+    try:
+        module_name, attribute = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module 'kinegami' has no attribute {name!r}") from None
+    module = importlib.import_module(module_name)
+    value = module if attribute is None else getattr(module, attribute)
+    globals()[name] = value  # once imported, an ordinary attribute
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

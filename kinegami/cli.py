@@ -74,12 +74,6 @@ class BuildJob:
         return self._clearance
 
 
-def _write_pattern_file(job: BuildJob, paths: list[Path]) -> None:
-    from kinegami.export import save_pattern
-
-    save_pattern(job.pattern, paths[0], units=job.info.units)
-
-
 def _write_pngs(job: BuildJob, paths: list[Path]) -> None:
     import matplotlib
 
@@ -99,38 +93,39 @@ def _write_pngs(job: BuildJob, paths: list[Path]) -> None:
 
 
 def _registry_writer(suffix: str) -> Callable[..., None]:
-    """A writer through :func:`kinegami.export.export`: pattern formats get the design's
-    pattern, chain formats the chain (with the design's twistPortion and units)."""
+    """A writer through the exporter registry (:func:`kinegami.export`): pattern formats get
+    the design's pattern, the others the chain (with the design's twistPortion); all get the
+    design's units."""
 
     def write(job: BuildJob, paths: list[Path]) -> None:
-        from kinegami.export.registry import FORMATS, export
+        from kinegami.export import registry
 
-        if FORMATS[suffix].accepts == "pattern":
-            export(job.pattern, paths[0], units=job.info.units)
+        if registry.FORMATS[suffix].accepts == "pattern":
+            registry.export(job.pattern, paths[0], units=job.info.units)
         else:
-            export(job.chain, paths[0], units=job.info.units, twistPortion=job.info.twistPortion)
+            registry.export(
+                job.chain, paths[0], units=job.info.units, twistPortion=job.info.twistPortion
+            )
 
     return write
 
 
 def output_formats() -> dict[str, OutputFormat]:
-    """The formats ``build --formats`` accepts, by name."""
-    formats = {
-        "dxf": OutputFormat("dxf", "crease pattern for a laser cutter", (".dxf",),
-                            _write_pattern_file),
-        "svg": OutputFormat("svg", "crease pattern (Origami Simulator, browsers)", (".svg",),
-                            _write_pattern_file),
-        "png": OutputFormat("png", "pictures of the 3D chain and of the pattern",
-                            ("_3d.png", "_pattern.png"), _write_pngs),
-    }  # fmt: skip
-    try:
-        from kinegami.export.registry import known_formats
-    except ImportError:  # pragma: no cover - exporters of issue 5 not installed
-        return formats
-    for suffix, description in known_formats().items():
-        name = suffix.lstrip(".")
-        if name not in formats:
-            formats[name] = OutputFormat(name, description, (suffix,), _registry_writer(suffix))
+    """The formats ``build --formats`` accepts, by name: every format of the exporter registry
+    (dxf and svg first) and ``png`` (pictures)."""
+    from kinegami.export import known_formats
+
+    known = known_formats()
+    png = OutputFormat("png", "pictures of the 3D chain and of the pattern",
+                       ("_3d.png", "_pattern.png"), _write_pngs)  # fmt: skip
+    order = [".dxf", ".svg", "png"] + [s for s in known if s not in (".dxf", ".svg")]
+    formats = {}
+    for suffix in order:
+        if suffix == "png":
+            formats["png"] = png
+        elif suffix in known:
+            name = suffix.lstrip(".")
+            formats[name] = OutputFormat(name, known[suffix], (suffix,), _registry_writer(suffix))
     return formats
 
 

@@ -492,17 +492,15 @@ def test_internal_errors_are_one_line(design, tmp_path, monkeypatch, capsys):
 def test_sigterm_during_a_build_leaves_nothing(design, tmp_path, monkeypatch):
     import signal
 
-    from kinegami import cli
+    from kinegami.export import registry
 
-    real = cli._write_pattern_file
+    real = registry.export
 
-    def killed(job, paths):
-        real(job, paths)
+    def killed(obj, path, **options):
+        real(obj, path, **options)
         os.kill(os.getpid(), signal.SIGTERM)
 
-    monkeypatch.setitem(
-        cli.output_formats.__globals__, "_write_pattern_file", killed
-    )  # used when the format table is made
+    monkeypatch.setattr(registry, "export", killed)  # what every --formats writer calls
     previous = signal.getsignal(signal.SIGTERM)
     with pytest.raises(SystemExit) as info:
         _main("build", design, "-o", tmp_path / "o", "--formats", "dxf")

@@ -17,12 +17,12 @@ import json
 import os
 from pathlib import Path
 
+from kinegami._atomic import write_atomic
 from kinegami.bodies import worst_overlap
 from kinegami.chain import KinematicChain
 from kinegami.design.errors import DesignError
 from kinegami.design.reader import FORMAT, UNITS, check_document, origin_of
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.export import write_atomic
 from kinegami.joints import (
     EndTip,
     ExtendedRevoluteJoint,
@@ -203,7 +203,8 @@ def save_design(
     """Write ``chain`` to the design file ``path`` (suffix .json) atomically; return the path.
 
     See :func:`design_to_dict` for the content. The document is checked against the format
-    before it is written, and a failed write leaves no file (kinegami.export.write_atomic).
+    before it is written, and a failed write leaves no file and an existing one as it was
+    (:func:`kinegami._atomic.write_atomic`).
 
     Examples
     --------

@@ -163,12 +163,18 @@ def dash_segments(segments: np.ndarray, dash: float, gap: float) -> tuple[np.nda
 def format_numbers(values: np.ndarray, extent: float) -> list[str]:
     """Shortest round-trip text of ``values`` rounded to 12 significant digits of ``extent``.
 
-    Rounding removes float noise such as 1e-17 (written as 0.0) so files stay readable.
+    Rounding removes float noise such as 1e-17 (written as 0.0) so files stay readable. The
+    coordinates of a sheet repeat (about 16 times each), so each distinct value is formatted
+    once: ``repr`` of a float is the slow part of writing a DXF or SVG.
     """
     values = np.asarray(values, dtype=float)
     digits = 12 - math.ceil(math.log10(extent)) if extent > 0 else 12
-    rounded = np.round(values, digits) + 0.0  # + 0.0 turns -0.0 into 0.0
-    return [repr(v) for v in rounded.ravel().tolist()]
+    rounded = np.round(values, digits).ravel() + 0.0  # + 0.0 turns -0.0 into 0.0
+    if rounded.size < 64:
+        return list(map(repr, rounded.tolist()))
+    distinct, index = np.unique(rounded, return_inverse=True)
+    texts = np.array(list(map(repr, distinct.tolist())), dtype=object)
+    return texts[index.ravel()].tolist()
 
 
 def sheet_lines(

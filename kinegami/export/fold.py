@@ -38,7 +38,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
+from kinegami.errors import FoldExportError, InvalidParameterError, InvalidTypeError
 from kinegami.export._options import UNITS_IN_MM, _positive
 from kinegami.pattern._prism import periodic_dx
 from kinegami.pattern.sheet import TOLERANCE_FACTOR
@@ -49,6 +49,7 @@ __all__ = [
     "FoldExportError",
     "sheet_graph",
     "fold_dict",
+    "fold_data",
     "write_fold",
     "fold_angles",
     "file_fold_angles",
@@ -59,11 +60,6 @@ __all__ = [
 FOLD_SPEC = 1.2
 
 _OPTIONS = ("units", "scale", "folded", "frame", "twistPortion", "title")
-
-
-class FoldExportError(KinegamiError, ValueError):
-    """The pattern's sheet is not a valid planar crease pattern (crossing or overlapping creases,
-    or a sheet of zero area)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -753,16 +749,18 @@ def fold_dict(pattern_or_chain, **options: Any) -> dict:
     return data
 
 
-def write_fold(pattern_or_chain, stream: TextIO, **options: Any) -> None:
-    """Write a pattern (or a chain's crease pattern) to a text stream as FOLD 1.2 JSON.
+def fold_data(pattern_or_chain, **options: Any) -> str:
+    """A pattern (or a chain's crease pattern) as FOLD 1.2 JSON text.
 
-    Takes the options of :func:`fold_dict`. Everything is computed before the first character
-    is written, so a failure writes nothing; use :func:`kinegami.export.save_pattern` (or
-    ``pattern.save("name.fold")``) for an atomic file.
+    Takes the options of :func:`fold_dict`; ``kinegami.export(obj, "name.fold")`` (or
+    ``pattern.save("name.fold")``) writes it to a file atomically.
     """
-    text = json.dumps(fold_dict(pattern_or_chain, **options), indent=1, allow_nan=False)
-    stream.write(text)
-    stream.write("\n")
+    return json.dumps(fold_dict(pattern_or_chain, **options), indent=1, allow_nan=False) + "\n"
+
+
+def write_fold(pattern_or_chain, stream: TextIO, **options: Any) -> None:
+    """Write :func:`fold_data` to a text stream (computed first: a failure writes nothing)."""
+    stream.write(fold_data(pattern_or_chain, **options))
 
 
 def save_fold(pattern_or_chain, path, **options: Any):
@@ -770,16 +768,14 @@ def save_fold(pattern_or_chain, path, **options: Any):
 
     Works for chains too (``save_pattern`` only accepts patterns).
     """
-    import io
     import os
     from pathlib import Path
 
-    from kinegami.export import write_atomic
+    from kinegami._atomic import write_atomic
 
     if not isinstance(path, str | os.PathLike) or not os.fspath(path).strip():
         raise InvalidParameterError(f"path must be a non-empty file name, got {path!r}")
-    buffer = io.StringIO()
-    write_fold(pattern_or_chain, buffer, **options)
+    text = fold_data(pattern_or_chain, **options)
     target = Path(os.fspath(path)).expanduser()
-    write_atomic(target, buffer.getvalue())
+    write_atomic(target, text)
     return target

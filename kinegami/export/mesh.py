@@ -86,6 +86,8 @@ __all__ = [
     "link_parts",
     "chain_mesh",
     "mesh_factor",
+    "stl_data",
+    "obj_data",
     "write_stl",
     "write_obj",
     "stl_bytes",
@@ -484,13 +486,12 @@ def stl_bytes(vertices: np.ndarray, faces: np.ndarray, header: bytes = _STL_HEAD
     return head + np.uint32(tri.shape[0]).astype("<u4").tobytes() + data.tobytes()
 
 
-def write_stl(chain: KinematicChain, stream: BinaryIO, **options: Any) -> None:
-    """Write the chain's model as one binary STL (millimetres, current configuration).
+def stl_data(chain: KinematicChain, **options: Any) -> bytes:
+    """The chain's model as one binary STL (millimetres, current configuration).
 
     Parameters
     ----------
     chain : KinematicChain
-    stream : binary stream
     units : {'mm', 'cm', 'm', 'in'}, optional
         Length of one chain unit (the unit of r); default ``'mm'``.
     scale : float, optional
@@ -506,13 +507,18 @@ def write_stl(chain: KinematicChain, stream: BinaryIO, **options: Any) -> None:
         For a bad option value.
     """
     parts = _scaled_parts(chain, options, "STL")
-    stream.write(stl_bytes(*_concatenate(parts)))
+    return stl_bytes(*_concatenate(parts))
 
 
-def write_obj(chain: KinematicChain, stream: TextIO, **options: Any) -> None:
-    """Write the chain's model as Wavefront OBJ, one object per part (millimetres).
+def write_stl(chain: KinematicChain, stream: BinaryIO, **options: Any) -> None:
+    """Write :func:`stl_data` of ``chain`` to a binary stream (options as there)."""
+    stream.write(stl_data(chain, **options))
 
-    Options as for :func:`write_stl`. Vertices are written with 12 significant digits.
+
+def obj_data(chain: KinematicChain, **options: Any) -> str:
+    """The chain's model as Wavefront OBJ text, one object per part (millimetres).
+
+    Options as for :func:`stl_data`. Vertices are written with 12 significant digits.
     """
     parts = _scaled_parts(chain, options, "OBJ")
     out = [
@@ -525,7 +531,12 @@ def write_obj(chain: KinematicChain, stream: TextIO, **options: Any) -> None:
         out.extend(f"v {x:.12g} {y:.12g} {z:.12g}\n" for x, y, z in part.vertices.tolist())
         out.extend(f"f {a} {b} {c}\n" for a, b, c in (part.faces + offset).tolist())
         offset += part.vertices.shape[0]
-    stream.write("".join(out))
+    return "".join(out)
+
+
+def write_obj(chain: KinematicChain, stream: TextIO, **options: Any) -> None:
+    """Write :func:`obj_data` of ``chain`` to a text stream (options as there)."""
+    stream.write(obj_data(chain, **options))
 
 
 def shell_mass_properties(

@@ -54,6 +54,7 @@ __all__ = [
     "PdfLayout",
     "pdf_layout",
     "draw_page",
+    "pdf_data",
     "write_pdf",
 ]
 
@@ -508,13 +509,12 @@ def _footer(ax, layout: PdfLayout, tile: Tile, text: dict) -> None:
             va="bottom", **text)  # fmt: skip
 
 
-def write_pdf(pattern: TubularPattern, stream: BinaryIO, **options: Any) -> None:
-    """Write the sheet of ``pattern`` at 1:1 as a PDF tiled over pages.
+def pdf_data(pattern: TubularPattern, **options: Any) -> bytes:
+    """The sheet of ``pattern`` at 1:1 as a PDF tiled over pages (needs matplotlib).
 
     Parameters
     ----------
     pattern : TubularPattern
-    stream : binary stream
     units, scale, perforate, dash, gap, skip_creases_on_cut
         As for :func:`kinegami.export.dxf.write_dxf` (units of the pattern; lengths in mm).
     paper : {'A4', 'Letter'}, optional
@@ -538,11 +538,20 @@ def write_pdf(pattern: TubularPattern, stream: BinaryIO, **options: Any) -> None
     InvalidTypeError, InvalidParameterError
         For an unknown option or a bad value (before anything is written).
     """
+    import io
+
     from matplotlib.backends.backend_pdf import PdfPages
 
     layout = pdf_layout(pattern, **options)
+    stream = io.BytesIO()
     metadata = {"Title": layout.title, "Creator": "kinegami", "CreationDate": None}
     with PdfPages(stream, metadata=metadata) as pdf:
         for index in range(layout.page_count):
             figure = draw_page(layout, index)
             pdf.savefig(figure)
+    return stream.getvalue()
+
+
+def write_pdf(pattern: TubularPattern, stream: BinaryIO, **options: Any) -> None:
+    """Write :func:`pdf_data` of ``pattern`` to a binary stream (options as there)."""
+    stream.write(pdf_data(pattern, **options))

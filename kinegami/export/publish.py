@@ -61,7 +61,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from kinegami.export import ExportError
+from kinegami.errors import ExportError, PublishError
 
 try:
     import fcntl
@@ -87,13 +87,6 @@ PAUSE_HOOK = "KINEGAMI_TEST_PAUSE_BEFORE_STEP"
 DEFERRED_SIGNALS = tuple(
     getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)
 )
-
-
-class PublishError(ExportError):
-    """A build could not be published, or an earlier interrupted one not recovered.
-
-    The message says what failed and where the earlier files are.
-    """
 
 
 # --- deferring signals -------------------------------------------------------------------------

@@ -1,28 +1,35 @@
-"""One entry point for every file format: ``export(obj, path, **options)``.
+"""The one exporter registry: ``export(obj, path, **options)`` for every file format.
 
-The format is chosen by the file suffix from a registry of exporter functions, one per suffix.
-Each works on a crease pattern or on a chain:
+The format is chosen by the file suffix. An exporter is a function that returns the file's
+data: ``func(obj, **options) -> str | bytes`` (text is written as UTF-8). A format that writes
+several files (``files=True``, the URDF and its meshes) is called as ``func(obj, path,
+**options)`` and returns ``{path relative to the folder: bytes}``. Built in:
 
-========  =======  ======  ===========================================================
-suffix    object   kind    exporter
-========  =======  ======  ===========================================================
-``.dxf``  pattern  text    :func:`kinegami.export.dxf.write_dxf` (via ``EXPORTERS``)
-``.svg``  pattern  text    :func:`kinegami.export.svg.write_svg` (via ``EXPORTERS``)
-``.fold`` any      text    ``kinegami.export.fold.write_fold``
-``.pdf``  pattern  binary  :func:`kinegami.export.pdf.write_pdf`
-``.stl``  chain    binary  :func:`kinegami.export.mesh.write_stl`
-``.obj``  chain    text    :func:`kinegami.export.mesh.write_obj`
-``.urdf`` chain    files   :func:`kinegami.export.urdf.urdf_files` (URDF + mesh folder)
-========  =======  ======  ===========================================================
+========  =======  ==============================================  =======================
+suffix    object   exporter                                        needs
+========  =======  ==============================================  =======================
+``.dxf``  pattern  :func:`kinegami.export.dxf.dxf_data`            -
+``.svg``  pattern  :func:`kinegami.export.svg.svg_data`            -
+``.fold`` any      :func:`kinegami.export.fold.fold_data`          -
+``.pdf``  pattern  :func:`kinegami.export.pdf.pdf_data`            matplotlib (``[pdf]``)
+``.stl``  chain    :func:`kinegami.export.mesh.stl_data`           trimesh (``[mesh]``)
+``.obj``  chain    :func:`kinegami.export.mesh.obj_data`           trimesh (``[mesh]``)
+``.urdf`` chain    :func:`kinegami.export.urdf.urdf_files`         trimesh (``[mesh]``)
+========  =======  ==============================================  =======================
 
-A :class:`~kinegami.chain.KinematicChain` given for a pattern format is exported as
-``chain.creasePattern(twistPortion)`` (the ``twistPortion`` option, default 0.2, is taken for
-that). Exporters are imported when first used, so a format whose module is missing only fails
-when a file of that format is written (:class:`ExporterUnavailableError`).
+Every entry point goes through here: :func:`export`, :func:`save_pattern` (what
+``TubularPattern.save`` calls), chain exports and ``kinegami build --formats``. A
+:class:`~kinegami.chain.KinematicChain` given for a pattern format is exported as
+``chain.creasePattern(twistPortion)`` (option ``twistPortion``, default 0.2).
 
-Every write is atomic: the file (or the set of files) is rendered in memory, written to
-temporary names in the target folder and moved into place with :func:`os.replace`; on any
-failure nothing is left behind and existing files are unchanged.
+Exporters are registered by name (``"package.module:function"``) and imported on first use, so
+importing kinegami imports none of them, and a format whose library is missing only fails
+when a file of that format is written: :class:`~kinegami.errors.ExporterUnavailableError`,
+whose message names the ``pip install 'kinegami[extra]'`` that adds it.
+
+Every write is atomic (:func:`kinegami._atomic.write_atomic`; :func:`write_atomic_files` for
+a set of files): on any failure nothing is left behind and existing files are unchanged.
+See docs/exports.md.
 """
 
 from __future__ import annotations
@@ -34,24 +41,31 @@ import os
 import secrets
 import shutil
 import signal
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-import kinegami.export as _base
-from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
-from kinegami.export import write_atomic_bytes  # re-exported: part of this module's API
-from kinegami.export.publish import deferred_signals
+from kinegami._atomic import create_temp, discard, export_error, prepare_folder, write_atomic
+from kinegami.errors import (
+    ExportError,
+    ExporterUnavailableError,
+    InvalidParameterError,
+    InvalidTypeError,
+    KinegamiError,
+)
 
 __all__ = [
+    "ACCEPTS",
+    "EXPORTERS",
     "ExportFormat",
     "ExporterUnavailableError",
     "FORMATS",
-    "ACCEPTS",
-    "register",
-    "known_formats",
     "export",
+    "known_formats",
+    "register",
+    "register_exporter",
+    "save_pattern",
     "write_atomic_bytes",
     "write_atomic_files",
 ]
@@ -59,11 +73,29 @@ __all__ = [
 #: What an exporter takes: a TubularPattern, a KinematicChain, or either as given.
 ACCEPTS = ("pattern", "chain", "any")
 
-_KINDS = ("text", "binary", "files")
+#: The same writer as :func:`kinegami._atomic.write_atomic` (bytes or text), by its old name.
+write_atomic_bytes = write_atomic
 
 
-class ExporterUnavailableError(KinegamiError, ImportError):
-    """The exporter of a registered format cannot be imported (its module is missing)."""
+def import_library(module: str, what: str, extra: str | None) -> Any:
+    """Import ``module`` for ``what``; a missing one is an :class:`ExporterUnavailableError`
+    naming the extra that installs it."""
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        raise _unavailable(what, module, extra, exc) from exc
+
+
+def _unavailable(what: str, module: str, extra: str | None, exc: ImportError):
+    missing = getattr(exc, "name", None) or module
+    if missing.partition(".")[0] == "kinegami" or extra is None:
+        hint = "reinstall kinegami" if missing.startswith("kinegami") else f"pip install {missing}"
+    else:
+        hint = f"pip install 'kinegami[{extra}]'"
+    return ExporterUnavailableError(
+        f"the {what} exporter is not available: cannot import {missing} ({exc}); to add it: "
+        f"{hint}"
+    )
 
 
 @dataclass(frozen=True)
@@ -79,11 +111,13 @@ class ExportFormat:
     accepts : str
         ``"pattern"``, ``"chain"`` or ``"any"``.
     kind : str
-        ``"text"``: ``func(obj, stream, **options)`` writes text; ``"binary"``: bytes;
+        ``"text"`` or ``"binary"``: ``func(obj, **options)`` returns the data (str or bytes);
         ``"files"``: ``func(obj, path, **options)`` returns ``{relative path: bytes}`` for the
         file itself and any files beside it.
     description : str
         One line for ``known_formats()`` and the CLI.
+    extra : str or None
+        The ``pip install 'kinegami[extra]'`` that installs the libraries it needs.
     """
 
     suffix: str
@@ -91,6 +125,7 @@ class ExportFormat:
     accepts: str
     kind: str
     description: str
+    extra: str | None = None
 
     @property
     def binary(self) -> bool:
@@ -98,22 +133,41 @@ class ExportFormat:
         return self.kind == "binary"
 
     def load(self) -> Callable[..., Any]:
-        """The exporter function, imported if registered by name."""
+        """The exporter function, imported if registered by name (ExporterUnavailableError if
+        that fails)."""
         if callable(self.func):
             return self.func
         module_name, _, attribute = self.func.partition(":")
-        try:
-            module = importlib.import_module(module_name)
-        except ImportError as exc:
-            raise ExporterUnavailableError(
-                f"the {self.suffix} exporter is not available: cannot import {module_name} ({exc})"
-            ) from exc
+        module = import_library(module_name, self.suffix, self.extra)
         try:
             return getattr(module, attribute)
         except AttributeError as exc:
             raise ExporterUnavailableError(
                 f"the {self.suffix} exporter is not available: {module_name} has no {attribute!r}"
             ) from exc
+
+    def render(self, obj: Any, path: Path, **options: Any) -> str | bytes | Mapping[str, bytes]:
+        """The file's data (for ``"files"``: every file's), checked; nothing is written."""
+        func = self.load()
+        try:
+            data = func(obj, path, **options) if self.kind == "files" else func(obj, **options)
+        except ModuleNotFoundError as exc:  # a library the exporter imports when it runs
+            raise _unavailable(self.suffix, exc.name or "?", self.extra, exc) from exc
+        except OSError as exc:  # e.g. a library cannot read its configuration
+            if isinstance(exc, KinegamiError):
+                raise
+            raise export_error(exc, path, "the exporter failed") from exc
+        if self.kind == "files":
+            if not isinstance(data, Mapping):
+                raise KinegamiError(
+                    f"the {self.suffix} exporter returned {type(data).__name__}, not a mapping "
+                    "of file names to bytes"
+                )
+        elif not isinstance(data, str | bytes | bytearray):
+            raise KinegamiError(
+                f"the {self.suffix} exporter returned {type(data).__name__}, not str or bytes"
+            )
+        return data
 
 
 #: Registered formats by lower-case suffix.
@@ -136,29 +190,41 @@ def register(
     description: str = "",
     *,
     files: bool = False,
+    extra: str | None = None,
 ) -> None:
     """Register the exporter of files ending in ``suffix`` (replacing any earlier one).
 
     Parameters
     ----------
     suffix : str
-        File suffix with the dot, e.g. ``".stl"`` (matched case-insensitively).
+        ``".ext"``, matched case-insensitively.
     func : callable or str
-        ``func(obj, stream, **options)`` writing text (or bytes if ``binary``) to ``stream``;
-        with ``files=True``, ``func(obj, path, **options) -> {relative path: bytes}``. A string
-        ``"package.module:function"`` is imported when the format is first used.
+        ``func(obj, **options) -> str | bytes`` returning the file's data (with ``files=True``:
+        ``func(obj, path, **options) -> {relative path: bytes}``), or its
+        ``"package.module:function"`` name, imported when first used.
     accepts : {'pattern', 'chain', 'any'}
-        What ``func`` takes. For ``'pattern'`` a chain is turned into its crease pattern.
+        What ``func`` takes. For ``'pattern'``, chains are given as their crease pattern.
     binary : bool
-        The stream is binary.
+        The file is binary (``func`` returns bytes).
     description : str
-        One line describing the format.
+        One line shown by :func:`known_formats` and ``kinegami build --help``.
     files : bool
-        The exporter returns a set of files (see ``func``).
+        ``func`` writes a main file and files beside it (see :func:`write_atomic_files`).
+    extra : str, optional
+        The ``pip install 'kinegami[extra]'`` named when ``func``'s libraries are missing.
+
+    Examples
+    --------
+    >>> def edge_count(pattern, **options):
+    ...     return f"{pattern.numEdges}\\n"
+    >>> register(".count", edge_count, description="number of creases")  # doctest: +SKIP
     """
     suffix = _check_suffix(suffix)
-    if not (callable(func) or (isinstance(func, str) and ":" in func)):
-        raise InvalidTypeError(f"func must be callable or 'package.module:function', got {func!r}")
+    if not callable(func):
+        if not isinstance(func, str) or ":" not in func:
+            raise InvalidTypeError(
+                f"func must be callable or 'package.module:function', got {func!r}"
+            )
     if accepts not in ACCEPTS:
         raise InvalidParameterError(f"accepts must be one of {ACCEPTS}, got {accepts!r}")
     if not isinstance(binary, bool) or not isinstance(files, bool):
@@ -167,35 +233,75 @@ def register(
         raise InvalidParameterError("give binary=True or files=True, not both")
     if not isinstance(description, str):
         raise InvalidTypeError(f"description must be a string, got {description!r}")
+    if extra is not None and not isinstance(extra, str):
+        raise InvalidTypeError(f"extra must be a string or None, got {extra!r}")
     kind = "files" if files else "binary" if binary else "text"
-    FORMATS[suffix] = ExportFormat(suffix, func, accepts, kind, description)
+    FORMATS[suffix] = ExportFormat(suffix, func, accepts, kind, description, extra)
 
 
-def _format(suffix: str) -> ExportFormat | None:
-    """The format of a suffix: registered here, or a pattern exporter of ``EXPORTERS``."""
-    found = FORMATS.get(suffix)
-    if found is not None:
-        return found
-    if suffix in _base.EXPORTERS:
-        return ExportFormat(
-            suffix, _base.EXPORTERS[suffix], "pattern", "text", "crease pattern (text)"
-        )
-    return None
+def register_exporter(suffix: str, exporter: Callable[..., None]) -> None:
+    """Register a pattern exporter written for a text stream: ``exporter(pattern, stream,
+    **options)`` (the older convention; :func:`register` takes functions returning the data).
+
+    Parameters
+    ----------
+    suffix : str
+        ``".ext"``, matched case-insensitively.
+    exporter : callable
+        Writes the pattern as text to the stream; raises a KinegamiError on bad options.
+    """
+    if not callable(exporter):
+        raise InvalidTypeError(f"exporter must be callable, got {exporter!r}")
+
+    def data(pattern: Any, **options: Any) -> str:
+        stream = io.StringIO()
+        exporter(pattern, stream, **options)
+        return stream.getvalue()
+
+    data.__name__ = getattr(exporter, "__name__", "exporter")
+    data.__wrapped__ = exporter
+    name = getattr(exporter, "__name__", "exporter")
+    register(suffix, data, "pattern", description=f"crease pattern ({name})")
+
+
+class _PatternExporters(Mapping):
+    """The registered formats that take a crease pattern, by suffix (a live, read-only view of
+    :data:`FORMATS`)."""
+
+    def __getitem__(self, suffix: str) -> ExportFormat:
+        fmt = FORMATS[suffix]
+        if fmt.accepts == "chain":
+            raise KeyError(suffix)
+        return fmt
+
+    def __iter__(self) -> Iterator[str]:
+        return iter([s for s, fmt in FORMATS.items() if fmt.accepts != "chain"])
+
+    def __len__(self) -> int:
+        return sum(fmt.accepts != "chain" for fmt in FORMATS.values())
+
+    def __repr__(self) -> str:
+        return f"EXPORTERS({', '.join(self)})"
+
+
+#: The formats ``pattern.save(path)`` can write, by suffix (read-only view of FORMATS).
+EXPORTERS: Mapping[str, ExportFormat] = _PatternExporters()
 
 
 def known_formats() -> dict[str, str]:
     """Description of every exportable suffix, sorted by suffix (for ``--formats`` help)."""
-    suffixes = set(FORMATS) | set(_base.EXPORTERS)
-    return {s: _format(s).description for s in sorted(suffixes)}
+    return {s: FORMATS[s].description for s in sorted(FORMATS)}
 
 
 def _known() -> str:
-    return ", ".join(known_formats())
+    return ", ".join(sorted(FORMATS))
 
 
-def _target(path: Any) -> Path:
+def _target(path: Any, verb: str = "export") -> Path:
     if path is None:
-        raise InvalidParameterError(f"a file name is required (known suffixes: {_known()})")
+        raise InvalidParameterError(
+            f"a file name is required, e.g. 'pattern.dxf' (known suffixes: {_known()})"
+        )
     if not isinstance(path, str | os.PathLike):
         raise InvalidTypeError(f"the file name must be a str or a path, got {path!r}")
     text = os.fspath(path)
@@ -209,12 +315,12 @@ def _target(path: Any) -> Path:
     suffix = target.suffix.lower()
     if target.name.lower() == suffix or not suffix:
         raise InvalidParameterError(
-            f"cannot export {text!r}: the file name needs a name and a suffix; known suffixes: "
+            f"cannot {verb} {text!r}: the file name needs a name and a suffix; known suffixes: "
             f"{_known()}"
         )
-    if _format(suffix) is None:
+    if suffix not in FORMATS:
         raise InvalidParameterError(
-            f"cannot export {text!r}: unknown file suffix {target.suffix!r}; known suffixes: "
+            f"cannot {verb} {text!r}: unknown file suffix {target.suffix!r}; known suffixes: "
             f"{_known()}"
         )
     return target
@@ -241,6 +347,18 @@ def _subject(obj: Any, fmt: ExportFormat, options: dict[str, Any]) -> Any:
     return obj
 
 
+def _write(obj: Any, target: Path, options: dict[str, Any]) -> Path:
+    fmt = FORMATS[target.suffix.lower()]
+    options = dict(options)
+    subject = _subject(obj, fmt, options)
+    data = fmt.render(subject, target, **options)
+    if fmt.kind == "files":
+        write_atomic_files(target, data)
+    else:
+        write_atomic(target, data)
+    return target
+
+
 def export(obj: Any, path: str | os.PathLike, **options: Any) -> Path:
     """Write ``obj`` (a KinematicChain or a TubularPattern) to ``path`` in the suffix's format.
 
@@ -248,7 +366,7 @@ def export(obj: Any, path: str | os.PathLike, **options: Any) -> Path:
     ----------
     obj : KinematicChain or TubularPattern
         Chains can be written in every format (pattern formats get
-        ``chain.creasePattern(twistPortion)``); patterns only in the pattern formats.
+        ``chain.creasePattern(twistPortion)``); patterns in the pattern formats.
     path : str or os.PathLike
         Target file; missing parent folders are created and an existing file is replaced.
     **options
@@ -269,44 +387,57 @@ def export(obj: Any, path: str | os.PathLike, **options: Any) -> Path:
     InvalidTypeError
         For an object the format cannot take, or an unknown option.
     ExporterUnavailableError
-        If the format's exporter module cannot be imported.
+        If a library the format needs is not installed (the message says what to install).
     ExportError
         If the files cannot be written; nothing is left behind.
 
     Examples
     --------
+    >>> from kinegami import export
     >>> export(chain, "out/robot.urdf", units="mm")  # doctest: +SKIP
     PosixPath('out/robot.urdf')
     >>> export(chain, "out/pattern.pdf", paper="Letter", scale=10)  # doctest: +SKIP
     PosixPath('out/pattern.pdf')
     """
-    target = _target(path)
-    fmt = _format(target.suffix.lower())
-    options = dict(options)
-    subject = _subject(obj, fmt, options)
-    func = fmt.load()
-    try:
-        if fmt.kind == "files":
-            files = func(subject, target, **options)
-        elif fmt.kind == "binary":
-            buffer = io.BytesIO()
-            func(subject, buffer, **options)
-            data = buffer.getvalue()
-        else:
-            stream = io.StringIO()
-            func(subject, stream, **options)
-            text = stream.getvalue()
-    except OSError as exc:
-        if isinstance(exc, KinegamiError):
-            raise
-        raise _base._export_error(exc, target, "the exporter failed") from exc
-    if fmt.kind == "files":
-        write_atomic_files(target, files)
-    elif fmt.kind == "binary":
-        write_atomic_bytes(target, data)
-    else:
-        _base.write_atomic(target, text)
-    return target
+    return _write(obj, _target(path), options)
+
+
+def save_pattern(pattern: Any, dxfName: str | os.PathLike | None, **options: Any) -> Path:
+    """Save a crease pattern in the format of the file suffix (what ``pattern.save`` calls).
+
+    Parameters
+    ----------
+    pattern : TubularPattern
+        The pattern to write (a module or a whole chain).
+    dxfName : str or os.PathLike
+        Target file name (the paper's keyword; every suffix of a format that takes a pattern:
+        ``.dxf``, ``.svg``, ``.fold``, ``.pdf``, ...). Missing parent folders are created; an
+        existing file is replaced.
+    **options
+        Passed to the exporter, e.g. ``units``, ``scale``, ``perforate`` for the sheet formats;
+        see docs/fabrication.md and docs/exports.md.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    InvalidParameterError, InvalidTypeError, ExporterUnavailableError, ExportError
+        As for :func:`export`; nothing is left behind.
+
+    Examples
+    --------
+    >>> from kinegami.pattern import TubeFittingPattern
+    >>> save_pattern(TubeFittingPattern(4, 10.0, 30.0), "out/tube.dxf")  # doctest: +SKIP
+    PosixPath('out/tube.dxf')
+    """
+    from kinegami.pattern.tubular import TubularPattern
+
+    if not isinstance(pattern, TubularPattern):
+        raise InvalidTypeError(f"pattern must be a TubularPattern, got {type(pattern).__name__}")
+    return _write(pattern, _target(dxfName, "save"), options)
 
 
 # --- atomic writing ------------------------------------------------------------------------
@@ -373,22 +504,24 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
     ExportError
         If anything cannot be written; nothing is left behind.
     """
+    from kinegami.export.publish import deferred_signals
+
     path = Path(path)
     groups = _split_files(path, files)
     parent = path.parent
     for head, content in groups.items():
         existing = parent / head
         if isinstance(content, dict) and existing.exists() and not existing.is_dir():
-            raise _base.ExportError(
+            raise ExportError(
                 errno.ENOTDIR,
                 f"cannot write the folder {head!r}: a file of that name exists",
                 str(existing),
             )
         if not isinstance(content, dict) and existing.is_dir():
-            raise _base.ExportError(
+            raise ExportError(
                 errno.EISDIR, f"cannot write {head!r}: a folder of that name exists", str(existing)
             )
-    _base.prepare_folder(path)
+    prepare_folder(path)
     temps: list[tuple[str, Path]] = []  # (name, temporary path), not yet moved
     moved: list[tuple[Path, Path | None]] = []  # folders moved into place, with their backup
     try:
@@ -402,7 +535,7 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
                         target.parent.mkdir(parents=True, exist_ok=True)
                         target.write_bytes(data)
                 else:
-                    fd, tmp = _base._create_temp(parent, head)
+                    fd, tmp = create_temp(parent, head)
                     temps.append((head, Path(tmp)))
                     with os.fdopen(fd, "wb") as stream:
                         stream.write(content)
@@ -412,7 +545,7 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
                 try:
                     for head, tmp in order:
                         if received:
-                            raise _base.ExportError(
+                            raise ExportError(
                                 errno.EINTR,
                                 f"cannot write the files: interrupted by "
                                 f"{signal.Signals(received[0]).name}; nothing was written",
@@ -446,11 +579,11 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
                 if tmp.is_dir():
                     shutil.rmtree(tmp, ignore_errors=True)
                 else:
-                    _base.discard(str(tmp))
+                    discard(str(tmp))
     except OSError as exc:
         if isinstance(exc, KinegamiError):
             raise
-        raise _base._export_error(exc, path, "write failed") from exc
+        raise export_error(exc, path, "write failed") from exc
     for _, backup in moved:
         if backup is not None:
             shutil.rmtree(backup, ignore_errors=True)
@@ -459,58 +592,50 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
 # --- built-in formats ----------------------------------------------------------------------
 
 
-def _pattern_exporter(suffix: str) -> Callable[..., None]:
-    """The text exporter registered in ``kinegami.export.EXPORTERS`` for ``suffix``, looked up
-    at call time (so ``register_exporter`` replacements apply)."""
-
-    def run(pattern, stream, **options):
-        return _base.EXPORTERS[suffix](pattern, stream, **options)
-
-    run.__name__ = f"pattern_exporter_{suffix[1:]}"
-    return run
-
-
 def _register_builtin() -> None:
     register(
         ".dxf",
-        _pattern_exporter(".dxf"),
+        "kinegami.export.dxf:dxf_data",
         "pattern",
         description="DXF R2013 of the flat sheet for laser cutters (mm; layers Mountain, "
         "Valley, Boundary, Cut)",
     )
     register(
         ".svg",
-        _pattern_exporter(".svg"),
+        "kinegami.export.svg:svg_data",
         "pattern",
         description="SVG of the flat sheet, true size in mm: for Origami Simulator (fold angles "
         "as opacity), or for cutting with flavour='laser'",
     )
     register(
         ".fold",
-        "kinegami.export.fold:write_fold",
+        "kinegami.export.fold:fold_data",
         "any",
         description="FOLD (JSON origami format) of the crease pattern",
     )
     register(
         ".pdf",
-        "kinegami.export.pdf:write_pdf",
+        "kinegami.export.pdf:pdf_data",
         "pattern",
         binary=True,
         description="PDF of the flat sheet at 1:1 tiled over A4 or Letter pages, with crop "
         "marks and a scale bar",
+        extra="pdf",
     )
     register(
         ".stl",
-        "kinegami.export.mesh:write_stl",
+        "kinegami.export.mesh:stl_data",
         "chain",
         binary=True,
         description="binary STL of the chain's 3D model in its current configuration (mm)",
+        extra="mesh",
     )
     register(
         ".obj",
-        "kinegami.export.mesh:write_obj",
+        "kinegami.export.mesh:obj_data",
         "chain",
         description="Wavefront OBJ of the chain's 3D model, one object per part (mm)",
+        extra="mesh",
     )
     register(
         ".urdf",
@@ -518,6 +643,7 @@ def _register_builtin() -> None:
         "chain",
         files=True,
         description="URDF robot model (metres) with STL meshes in <name>_meshes/",
+        extra="mesh",
     )
 
 

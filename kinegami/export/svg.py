@@ -29,6 +29,7 @@ Each line is a ``<line>`` in one group per kind and carries its own ``stroke``.
 
 from __future__ import annotations
 
+import io
 import math
 from typing import TYPE_CHECKING, Any, TextIO
 from xml.sax.saxutils import quoteattr
@@ -56,6 +57,7 @@ __all__ = [
     "SIMULATOR_GROUPS",
     "SIMULATOR_MERGE_TOLERANCE",
     "simulator_unit",
+    "svg_data",
     "write_svg",
 ]
 
@@ -110,6 +112,16 @@ def _stroke_width(value: Any) -> float:
     if not (np.isfinite(value) and value > 0):
         raise InvalidParameterError(f"stroke_width must be finite and > 0, got {value!r}")
     return float(value)
+
+
+def svg_data(pattern: TubularPattern, **options: Any) -> str:
+    """The sheet of ``pattern`` as SVG text (true size in mm); options as for :func:`write_svg`.
+
+    Raises as :func:`write_svg` does.
+    """
+    stream = io.StringIO()
+    write_svg(pattern, stream, **options)
+    return stream.getvalue()
 
 
 def write_svg(pattern: TubularPattern, stream: TextIO, **options: Any) -> None:

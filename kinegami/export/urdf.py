@@ -393,7 +393,7 @@ def write_urdf(chain: KinematicChain, stream: TextIO, **options: Any) -> None:
     """Write the URDF text of ``chain`` to ``stream`` (options as for :func:`urdf_model`).
 
     Mesh files cannot go to a stream, so ``meshes`` defaults to False here; use
-    ``kinegami.export.export(chain, "robot.urdf")`` (or :func:`urdf_model`) to get them too.
+    ``kinegami.export(chain, "robot.urdf")`` (or :func:`urdf_model`) to get them too.
     """
     options = dict(options)
     options.setdefault("meshes", False)

@@ -196,3 +196,82 @@ def test_long_pattern_round_trip(tmp_path, long_pattern):
     sheet = flatten(long_pattern)
     for layer, kind in LAYER_KIND.items():
         assert lines[layer].shape[0] == sheet.count(kind)
+
+
+# --- the stored template: the file ezdxf writes, without importing ezdxf ---------------------
+
+
+def _normalised(text: str) -> list[str]:
+    """DXF text with what differs between two writes (GUIDs, times) blanked, and the CLASSES
+    entries (which ezdxf writes in set order) sorted."""
+    import re
+
+    text = re.sub(r"\{[0-9A-F]{8}-[0-9A-F-]{27}\}", "{GUID}", text)
+    text = re.sub(r"\n\d+\.\d+\.\d+ @ [^\n]+\n", "\nVERSION @ TIME\n", text)
+    text = re.sub(r"(\$TD(?:CREATE|UPDATE)\n 40\n)[^\n]+", r"\1JULIAN", text)
+    start = text.index("  2\nCLASSES\n")
+    end = text.index("  0\nENDSEC\n", start)
+    classes = sorted(text[start:end].split("  0\nCLASS\n"))
+    return [text[:start], *classes, text[end:]]
+
+
+@pytest.mark.parametrize("options", [{}, {"units": "cm", "perforate": True}, {"scale": 1e-3}])
+def test_template_output_is_what_ezdxf_writes(composite6, options):
+    from kinegami.export import _dxf_template, dxf
+    from kinegami.export._options import resolve_sheet_options, sheet_lines
+
+    if ezdxf.__version__ != _dxf_template.EZDXF_VERSION:
+        pytest.skip("template made with another ezdxf; run python -m kinegami.export.dxf")
+    segments, kinds, bounds = sheet_lines(composite6, resolve_sheet_options(options, {}, "DXF"))
+    skeleton, first, owner = dxf._ezdxf_skeleton(bounds, segments.shape[0])
+    cut = skeleton.index("  2\nENTITIES\n") + len("  2\nENTITIES\n")
+    lines = dxf._line_entities(segments, kinds, first, owner, bounds)
+    by_ezdxf = skeleton[:cut] + lines + skeleton[cut:]
+    assert _normalised(dxf.dxf_data(composite6, **options)) == _normalised(by_ezdxf)
+
+
+def test_stored_template_is_up_to_date():
+    from kinegami.export import _dxf_template, dxf
+
+    if ezdxf.__version__ != _dxf_template.EZDXF_VERSION:
+        pytest.skip("template made with another ezdxf; run python -m kinegami.export.dxf")
+    namespace: dict = {}
+    exec(dxf.make_template(), namespace)
+    assert (namespace["FIRST_HANDLE"], namespace["OWNER"]) == (
+        _dxf_template.FIRST_HANDLE, _dxf_template.OWNER
+    )
+    assert _normalised("".join(namespace["PARTS"])) == _normalised("".join(_dxf_template.PARTS))
+
+
+def test_every_file_gets_new_guids(revolute6):
+    import re
+
+    from kinegami.export.dxf import dxf_data
+
+    guids = [re.findall(r"\{[0-9A-F-]{36}\}", dxf_data(revolute6)) for _ in range(2)]
+    assert len(guids[0]) == 2 and not set(guids[0]) & set(guids[1])
+
+
+def test_empty_sheet_of_creases_still_opens(tmp_path):
+    """A zero-length tube: only the outlines."""
+    from kinegami.pattern import TubeFittingPattern
+
+    path = save_pattern(TubeFittingPattern(4, 1.0, 0.0), tmp_path / "flat.dxf")
+    lines, doc = read_lines(path)
+    assert not doc.audit().has_errors
+    assert sum(len(v) for v in lines.values()) >= 2
+
+
+def test_saving_a_dxf_does_not_import_ezdxf(tmp_path):
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\nfrom kinegami.pattern import TubeFittingPattern\n"
+        f"TubeFittingPattern(4, 10.0, 30.0).save({str(tmp_path / 't.dxf')!r})\n"
+        "print('ezdxf' in sys.modules)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "False"
+    lines, doc = read_lines(tmp_path / "t.dxf")
+    assert doc.units == DXF_INSUNITS_MM and set(lines) <= set(LAYER_KIND)

@@ -9,10 +9,8 @@ import types
 
 import pytest
 
-import kinegami.export as base
-import kinegami.export.registry as registry
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
-from kinegami.export import ExportError, save_pattern
+from kinegami.export import ExportError, register_exporter, registry, save_pattern
 from kinegami.export.registry import (
     FORMATS,
     ExporterUnavailableError,
@@ -37,9 +35,8 @@ def listing(folder) -> list[str]:
 
 @pytest.fixture
 def formats(monkeypatch):
-    """FORMATS and EXPORTERS restored after the test."""
+    """The registry (FORMATS) restored after the test."""
     monkeypatch.setattr(registry, "FORMATS", dict(FORMATS))
-    monkeypatch.setattr(base, "EXPORTERS", dict(base.EXPORTERS))
     return registry.FORMATS
 
 
@@ -71,7 +68,7 @@ def test_every_format_from_a_chain(tmp_path, example_1a, suffix):
 def test_fold_is_registered_lazily(tmp_path, example_1a, monkeypatch):
     """.fold is imported on first use; without kinegami/export/fold.py only .fold (and the
     Origami Simulator SVG, drawn from the FOLD export's graph) fails."""
-    assert FORMATS[".fold"].func == "kinegami.export.fold:write_fold"
+    assert FORMATS[".fold"].func == "kinegami.export.fold:fold_data"
     monkeypatch.setitem(sys.modules, "kinegami.export.fold", None)  # as if the file were missing
     with pytest.raises(ExporterUnavailableError, match="kinegami.export.fold"):
         export(example_1a, tmp_path / "chain.fold")
@@ -81,15 +78,15 @@ def test_fold_is_registered_lazily(tmp_path, example_1a, monkeypatch):
 
 
 def test_fold_gets_the_chain_and_its_options(tmp_path, example_1a, monkeypatch):
-    """write_fold takes a pattern or a chain: the chain and all options are passed on."""
+    """fold_data takes a pattern or a chain: the chain and all options are passed on."""
     calls = []
 
-    def write_fold(obj, stream, **options):
+    def fold_data(obj, **options):
         calls.append((obj, options))
-        stream.write('{"file_spec": 1.1}\n')
+        return '{"file_spec": 1.1}\n'
 
     module = types.ModuleType("kinegami.export.fold")
-    module.write_fold = write_fold
+    module.fold_data = fold_data
     monkeypatch.setitem(sys.modules, "kinegami.export.fold", module)
     path = export(example_1a, tmp_path / "chain.fold", twistPortion=0.3, units="cm")
     assert path.read_text() == '{"file_spec": 1.1}\n'
@@ -135,20 +132,20 @@ def test_exporters_registered_with_register_exporter_are_used(tmp_path, example_
     def write_count(pattern, stream, **options):
         stream.write(f"{pattern.numEdges}\n")
 
-    base.register_exporter(".count", write_count)
+    register_exporter(".count", write_count)
     assert ".count" in known_formats()
     path = export(example_1a, tmp_path / "p.count")
     assert path.read_text() == f"{example_1a.creasePattern().numEdges}\n"
     # replacing the DXF writer through register_exporter changes what export() writes
-    base.register_exporter(".dxf", write_count)
+    register_exporter(".dxf", write_count)
     assert export(example_1a, tmp_path / "p.dxf").read_text() == path.read_text()
 
 
 def test_register_a_binary_chain_format(tmp_path, example_1a, formats):
-    def write_joints(chain, stream, **options):
-        stream.write(bytes([len(chain.Joints)]) * options.get("repeat", 1))
+    def joints_data(chain, **options):
+        return bytes([len(chain.Joints)]) * options.get("repeat", 1)
 
-    register(".jnt", write_joints, accepts="chain", binary=True, description="joint count")
+    register(".jnt", joints_data, accepts="chain", binary=True, description="joint count")
     assert formats[".jnt"].binary
     assert export(example_1a, tmp_path / "c.jnt", repeat=3).read_bytes() == b"\x07\x07\x07"
     with pytest.raises(InvalidTypeError, match="KinematicChain"):
@@ -241,8 +238,7 @@ def test_bad_option_writes_nothing(tmp_path, example_1a):
 
 
 def test_exporter_failing_midway_leaves_nothing(tmp_path, example_1a, formats):
-    def half_then_fail(chain, stream, **options):
-        stream.write(b"half a file")
+    def half_then_fail(chain, **options):
         raise OSError(5, "Input/output error")
 
     register(".half", half_then_fail, "chain", binary=True)
@@ -346,3 +342,77 @@ def test_obj_through_export_is_the_writer_output(tmp_path, example_1a):
     write_obj(example_1a, stream, units="cm")
     path = export(example_1a, tmp_path / "c.obj", units="cm")
     assert path.read_text(encoding="utf-8") == stream.getvalue()
+
+
+# --- one registry: every format from every entry point -------------------------------------
+
+
+def test_one_registry_behind_every_name():
+    import kinegami
+    from kinegami import export as from_package
+    from kinegami.export import EXPORTERS
+    from kinegami.export import export as from_subpackage
+
+    assert from_package is kinegami.export is from_subpackage is export is registry.export
+    assert sys.modules["kinegami.export.registry"] is registry
+    assert set(EXPORTERS) == {s for s, fmt in FORMATS.items() if fmt.accepts != "chain"}
+    assert all(EXPORTERS[s] is FORMATS[s] for s in EXPORTERS)
+    with pytest.raises(TypeError):
+        EXPORTERS[".dxf"] = None  # a read-only view: register() changes the registry
+
+
+@pytest.mark.parametrize("suffix", sorted(FORMATS))
+def test_every_registered_suffix_from_export_and_save(tmp_path, example_1a, suffix):
+    """export(chain, path) writes every format; pattern.save(path) and save_pattern every
+    format that takes a pattern (the others name the KinematicChain they need)."""
+    pattern = example_1a.creasePattern()
+    assert export(example_1a, tmp_path / "chain" / f"c{suffix}").stat().st_size > 0
+    if FORMATS[suffix].accepts == "chain":
+        with pytest.raises(InvalidTypeError, match="KinematicChain"):
+            pattern.save(tmp_path / "pattern" / f"p{suffix}")
+        return
+    saved = pattern.save(tmp_path / "pattern" / f"p{suffix}")
+    exported = export(pattern, tmp_path / "pattern" / f"q{suffix}")
+    assert saved == tmp_path / "pattern" / f"p{suffix}"
+    if suffix in (".svg", ".fold"):  # no creation time or GUID in the file
+        assert saved.read_bytes() == exported.read_bytes()
+    if suffix == ".svg":  # a chain's FOLD keeps the chain's frame; its SVG is its pattern's
+        assert saved.read_bytes() == (tmp_path / "chain" / f"c{suffix}").read_bytes()
+
+
+def test_pattern_save_writes_a_pdf(tmp_path, example_1a):
+    path = example_1a.creasePattern().save(tmp_path / "x.pdf")
+    assert path.read_bytes().startswith(b"%PDF")
+
+
+def test_missing_library_names_the_extra_to_install(tmp_path, example_1a, monkeypatch):
+    """A library an exporter imports when it runs (matplotlib for PDF) is missing: an
+    ExporterUnavailableError (a KinegamiError and an ImportError) saying what to install."""
+    monkeypatch.setitem(sys.modules, "matplotlib.backends.backend_pdf", None)
+    with pytest.raises(ExporterUnavailableError, match=r"pip install 'kinegami\[pdf\]'") as info:
+        example_1a.creasePattern().save(tmp_path / "x.pdf")
+    assert isinstance(info.value, ImportError) and isinstance(info.value, KinegamiError)
+    assert "matplotlib" in str(info.value)
+    assert listing(tmp_path) == []
+
+
+def test_exporter_returning_the_wrong_type_writes_nothing(tmp_path, example_1a, formats):
+    register(".bad", lambda chain, **options: 42, "chain")
+    with pytest.raises(KinegamiError, match="returned int"):
+        export(example_1a, tmp_path / "x.bad")
+    assert listing(tmp_path) == []
+
+
+def test_text_exporters_return_the_file(example_1a):
+    """The exporters behind the registry return the data; the stream writers write it."""
+    from kinegami.export import dxf, fold, mesh, svg
+
+    pattern = example_1a.creasePattern()
+    for data, writer in ((svg.svg_data, svg.write_svg), (fold.fold_data, fold.write_fold),
+                         (mesh.obj_data, mesh.write_obj)):  # fmt: skip
+        subject = example_1a if data is mesh.obj_data else pattern
+        stream = io.StringIO()
+        writer(subject, stream)
+        assert stream.getvalue() == data(subject)
+    assert isinstance(dxf.dxf_data(pattern), str)
+    assert isinstance(mesh.stl_data(example_1a), bytes)

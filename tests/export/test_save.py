@@ -6,9 +6,8 @@ from pathlib import Path
 
 import pytest
 
-import kinegami.export as export
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
-from kinegami.export import EXPORTERS, ExportError, register_exporter, save_pattern
+from kinegami.export import ExportError, register_exporter, registry, save_pattern
 
 
 def _files(folder: Path) -> list[str]:
@@ -31,7 +30,7 @@ def test_accepts_str_paths(tmp_path, revolute6):
     assert save_pattern(revolute6, str(tmp_path / "p.dxf")).exists()
 
 
-@pytest.mark.parametrize("name", ["p.pdf", "p", "p.dxf.bak"])
+@pytest.mark.parametrize("name", ["p.step", "p", "p.dxf.bak"])
 def test_unknown_suffix_names_the_known_ones(tmp_path, revolute6, name):
     with pytest.raises(InvalidParameterError) as info:
         save_pattern(revolute6, tmp_path / name)
@@ -116,7 +115,8 @@ def test_exporter_failing_mid_write_leaves_nothing(tmp_path, revolute6, monkeypa
         stream.write("0\nSECTION\n")
         raise KinegamiError("exporter broke half way")
 
-    monkeypatch.setitem(EXPORTERS, ".dxf", broken)
+    monkeypatch.setattr(registry, "FORMATS", dict(registry.FORMATS))
+    register_exporter(".dxf", broken)
     path = tmp_path / "p.dxf"
     path.write_text("previous")
     with pytest.raises(KinegamiError, match="half way"):
@@ -141,7 +141,7 @@ def test_disk_write_failure_leaves_no_file_or_temp(tmp_path, revolute6, monkeypa
             self.stream.write(text[: len(text) // 2])
             raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(export.os, "fdopen", lambda *a, **k: Full(real_fdopen(*a, **k)))
+    monkeypatch.setattr(os, "fdopen", lambda *a, **k: Full(real_fdopen(*a, **k)))
     with pytest.raises(ExportError) as info:
         save_pattern(revolute6, tmp_path / "p.dxf")
     assert info.value.errno == errno.ENOSPC
@@ -153,7 +153,7 @@ def test_replace_failure_leaves_no_temp(tmp_path, revolute6, monkeypatch):
     def refuse(src, dst):
         raise PermissionError(errno.EACCES, "Permission denied")
 
-    monkeypatch.setattr(export.os, "replace", refuse)
+    monkeypatch.setattr(os, "replace", refuse)
     with pytest.raises(ExportError):
         save_pattern(revolute6, tmp_path / "p.svg")
     assert _files(tmp_path) == []
@@ -172,14 +172,14 @@ def test_interrupt_is_reraised_and_cleaned_up(tmp_path, revolute6, monkeypatch):
     def interrupt(src, dst):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(export.os, "replace", interrupt)
+    monkeypatch.setattr(os, "replace", interrupt)
     with pytest.raises(KeyboardInterrupt):
         save_pattern(revolute6, tmp_path / "p.dxf")
     assert _files(tmp_path) == []
 
 
 def test_register_exporter(tmp_path, revolute6, monkeypatch):
-    monkeypatch.setattr(export, "EXPORTERS", dict(EXPORTERS))
+    monkeypatch.setattr(registry, "FORMATS", dict(registry.FORMATS))
 
     def write_count(pattern, stream, **options):
         stream.write(f"{pattern.numEdges} {options}\n")

@@ -418,7 +418,7 @@ def test_export_replaces_the_mesh_folder(tmp_path, example_1a):
 
 
 def test_exporter_failure_leaves_nothing(tmp_path, example_1a, monkeypatch):
-    import kinegami.export.urdf as urdf
+    from kinegami.export import urdf
 
     def broken(*args, **kwargs):
         raise MemoryError("out of memory while meshing")
