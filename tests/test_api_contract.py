@@ -80,3 +80,55 @@ def test_command_without_arguments_prints_help():
         check=True,
     )
     assert done.stdout.startswith("kinegami ")
+
+
+def _fresh(code: str) -> str:
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return done.stdout.strip()
+
+
+def test_export_is_a_function_and_kinegami_export_a_plain_package():
+    import inspect
+
+    import kinegami
+    from kinegami import export
+
+    assert inspect.isfunction(export) and kinegami.export is export
+    package = sys.modules["kinegami.export"]
+    assert not callable(package)  # no callable module
+    from kinegami.export import (  # the public names of the package stay importable
+        EXPORTERS,
+        ExportError,
+        known_formats,
+        register_exporter,
+        save_pattern,
+        write_atomic,
+        write_atomic_bytes,
+    )
+
+    assert package.export is export
+    assert all((EXPORTERS, ExportError, known_formats, register_exporter, save_pattern,
+                write_atomic, write_atomic_bytes))  # fmt: skip
+
+
+def test_importing_kinegami_imports_no_heavy_library():
+    heavy = ("numpy", "spatialmath", "scipy", "matplotlib", "ezdxf", "trimesh", "jsonschema")
+    code = f"import sys, kinegami\nprint([m for m in {heavy!r} if m in sys.modules])"
+    assert _fresh(code) == "[]"
+
+
+def test_star_import_gives_every_name_of_the_paper():
+    code = (
+        "from kinegami import *\nimport kinegami, spatialmath, numpy\n"
+        "missing = [n for n in kinegami.__all__ if n not in globals()]\n"
+        "print(missing, SE3 is spatialmath.SE3, np is numpy, callable(export))"
+    )
+    assert _fresh(code) == "[] True True True"
+
+
+def test_unknown_attribute_of_the_package_is_an_attribute_error():
+    import kinegami
+
+    with pytest.raises(AttributeError, match="no_such_name"):
+        kinegami.no_such_name  # noqa: B018
+    assert "KinematicChain" in dir(kinegami)

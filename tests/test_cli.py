@@ -535,3 +535,26 @@ def test_formats_all(design, tmp_path):
          "arm.stl", "arm.obj", "arm.urdf", "arm_meshes"]
     )  # fmt: skip
     assert set(output_formats()) == {"dxf", "svg", "png", "fold", "pdf", "stl", "obj", "urdf"}
+
+
+def test_every_registered_suffix_is_a_build_format(design, tmp_path):
+    """build --formats takes each format of the exporter registry by its suffix's name."""
+    from kinegami.export import known_formats
+
+    for suffix in known_formats():
+        out = tmp_path / suffix.lstrip(".")
+        assert _main("build", design, "-o", out, "--formats", suffix.lstrip(".")) == 0
+        assert (out / f"arm{suffix}").is_file()
+
+
+def test_missing_exporter_library_is_one_line(design, tmp_path, monkeypatch, capsys):
+    """ExporterUnavailableError: one line naming the extra to install, exit 1, no files."""
+    import sys
+
+    monkeypatch.setitem(sys.modules, "matplotlib.backends.backend_pdf", None)
+    assert _main("build", design, "-o", tmp_path / "o", "--formats", "dxf,pdf") == 1
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert "pdf export" in err and "pip install 'kinegami[pdf]'" in err
+    assert "internal error" not in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
