@@ -354,8 +354,8 @@ class AddJoint(Command):
 
     Parameters
     ----------
-    kind : the joint type, one of :data:`JOINT_TYPES` (a StartTip only as a new root... never:
-        a chain has one root).
+    kind : the joint type, one of :data:`JOINT_TYPES` (not a StartTip: only the root is one, and
+        an EndTip only at the end).
     parameters : its parameters (defaults: totalBendingAngle pi, numSinkLayers 1, tubeLength 2r,
         neutralLength 3r, numLayers 3, coneAngle pi/4, pathIndex 2, length 1.5r).
     pose : its Pose, a 4x4 rigid transform (default the identity); relative to joint
