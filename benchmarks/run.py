@@ -312,6 +312,7 @@ def main(argv: list[str] | None = None) -> None:
     rows.append(("  path length per joint (max)", f"{max(paths):.2f} r", "<= 60 r"))
 
     rows += clearance_rows(args.compact_seeds)
+    rows += __import__("startup").rows()  # benchmarks/startup.py: fresh processes
 
     width = max(len(r[0]) for r in rows)
     print(f"{'measurement':<{width}}  {'result':>12}  goal")
