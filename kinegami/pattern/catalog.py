@@ -11,6 +11,7 @@ and calls :func:`register` with its entry; import that file in ``kinegami/patter
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -27,6 +28,7 @@ if TYPE_CHECKING:
 __all__ = [
     "ModuleKind",
     "UnknownModuleKindError",
+    "cached_build",
     "find_kind",
     "kinds",
     "module_kind",
@@ -90,6 +92,27 @@ class ModuleKind:
     def rebuild(self, numSides: int, r: float, params: Mapping[str, Any]) -> TubularPattern:
         """The catalog pattern of a record of this kind (``build`` with the record's values)."""
         return self.build(numSides, r, *(params[name] for name in self.params))
+
+
+def cached_build(build: Callable[..., TubularPattern]) -> Callable[..., TubularPattern]:
+    """Cache a module constructor per argument values (and types): patterns are immutable
+    values, so equal arguments may share one pattern. Errors are not cached; unhashable
+    arguments bypass the cache. ``cache_clear()`` empties it."""
+    cached = functools.lru_cache(maxsize=1024, typed=True)(build)
+
+    @functools.wraps(build)
+    def wrapper(*args, **kwargs):
+        try:
+            hash(args)
+            if kwargs:
+                hash(tuple(kwargs.items()))
+        except TypeError:
+            return build(*args, **kwargs)
+        return cached(*args, **kwargs)
+
+    wrapper.cache_clear = cached.cache_clear
+    wrapper.cache_info = cached.cache_info
+    return wrapper
 
 
 _REGISTRY: dict[str, ModuleKind] = {}

@@ -142,6 +142,7 @@ def _prism_arrays(prism: Prism):
     return beta, prev, nxt, ring
 
 
+@catalog.cached_build
 def ElbowFittingPattern(
     numSides: int, r: float, bendingAngle: float, rotationalAxisAngle: float
 ) -> TubularPattern:

@@ -92,6 +92,7 @@ def _check_rebo(numSides, r, neutralLength, numLayers, coneAngle, low: float):
     return prism, d, N, beta, geo
 
 
+@catalog.cached_build
 def REBOPattern(
     numSides: int,
     r: float,
@@ -173,6 +174,7 @@ def _build_rebo(
     return assemble(prism, vertices, blocks, B[0], B[N], geo.height, record)
 
 
+@catalog.cached_build
 def PrismaticJointPattern(
     numSides: int, r: float, neutralLength: float, numLayers: int, coneAngle: float
 ) -> TubularPattern:

@@ -82,6 +82,7 @@ def _check_resolvable(prism: Prism, geo: RevoluteGeometry, name: str, value: flo
         )
 
 
+@catalog.cached_build
 def RevoluteJointPattern(
     numSides: int, r: float, totalBendingAngle: float, numSinkLayers: int = 1
 ) -> TubularPattern:
@@ -122,6 +123,7 @@ def RevoluteJointPattern(
     return _build_revolute(prism, geo, layers, record)
 
 
+@catalog.cached_build
 def EndTipPattern(numSides: int, r: float, length: float) -> TubularPattern:
     """The end tip: closes the tube on a segment of length b along e_v at ``length`` (3.6).
 
@@ -146,6 +148,7 @@ def EndTipPattern(numSides: int, r: float, length: float) -> TubularPattern:
     return _build_end_tip(prism, geo, ModuleRecord("end_tip", {"length": ell}))
 
 
+@catalog.cached_build
 def StartTipPattern(numSides: int, r: float, length: float) -> TubularPattern:
     """The start tip: the end tip reversed (section 2.4); its base is the distal base at y = H.
 

@@ -15,6 +15,7 @@ from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 __all__ = ["TubeFittingPattern", "WaypointPattern"]
 
 
+@catalog.cached_build
 def WaypointPattern(numSides: int, r: float) -> TubularPattern:
     """The empty pattern: the n base vertices at y = 0, no creases, height 0 (section 3.9).
 
@@ -48,6 +49,7 @@ def _empty_template(prism) -> TubularPattern:
     return assemble(prism, vertices, [(np.zeros((0, 2), int), "M")], base, base, 0.0, record)
 
 
+@catalog.cached_build
 def TubeFittingPattern(numSides: int, r: float, height: float) -> TubularPattern:
     """A straight tube of axial length ``height`` (section 3.1).
 

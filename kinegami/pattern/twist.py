@@ -61,6 +61,7 @@ def twist_geometry(prism: Prism, twistAngle: float, moduleHeight: float) -> Twis
     return TwistGeometry(K, residual, shift, excess, height, height < prism.eps)
 
 
+@catalog.cached_build
 def TwistFittingPattern(
     numSides: int, r: float, twistAngle: float, moduleHeight: float
 ) -> TubularPattern:
