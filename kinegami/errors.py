@@ -14,6 +14,7 @@ inherit the matching builtin, so ``except ValueError`` keeps working (as ezdxf d
     +-- NoPathError(ValueError)              no CSC link joins two frames
     +-- IncompatibleJointError(ValueError)   another numSides or r than the chain's
     +-- CompactionError(ValueError)          compaction found no clear design
+    +-- EditorCommandError(ValueError)       an editor command that cannot be applied
     +-- DesignError(ValueError)              a design file is unreadable or invalid
     +-- DesignFileExistsError(FileExistsError)
     +-- FoldExportError(ValueError)          a pattern FOLD export cannot write
@@ -42,6 +43,7 @@ __all__ = [
     "NoPathError",
     "IncompatibleJointError",
     "CompactionError",
+    "EditorCommandError",
     "FoldedFormError",
     "UnknownModuleKindError",
     "DesignError",
@@ -91,6 +93,11 @@ class IncompatibleJointError(KinegamiError, ValueError):
 
 class CompactionError(KinegamiError, ValueError):
     """No clear design was found (the input passes through itself and no move fixed it)."""
+
+
+class EditorCommandError(KinegamiError, ValueError):
+    """An editor command that cannot be applied; the message says why (parameter, value,
+    range). Also ``kinegami.editor.CommandError``."""
 
 
 # --- patterns ------------------------------------------------------------------------------

@@ -60,6 +60,7 @@ HIERARCHY = {
     "NoPathError": (ValueError,),
     "IncompatibleJointError": (ValueError,),
     "CompactionError": (ValueError,),
+    "EditorCommandError": (ValueError,),
     "FoldedFormError": (ValueError,),
     "UnknownModuleKindError": (ValueError, KeyError),
     "DesignError": (ValueError,),
@@ -649,3 +650,10 @@ def test_edit_flags_must_be_booleans(chain_and_snapshot, call, name):
         call(chain_and_snapshot[0])
     check_error(excinfo, TypeError, name)
     assert_unchanged(chain_and_snapshot)
+
+
+def test_the_editors_command_error_is_the_one_in_errors():
+    from kinegami.editor.commands import CommandError
+    from kinegami.errors import EditorCommandError
+
+    assert CommandError is EditorCommandError

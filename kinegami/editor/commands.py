@@ -21,7 +21,12 @@ from kinegami.chain import KinematicChain
 from kinegami.design import limits
 from kinegami.design.reader import UNITS
 from kinegami.editor.document import Document, fork_chain, joint_parameters
-from kinegami.errors import ClearanceWarning, KinegamiError, PlacementWarning
+from kinegami.errors import (
+    ClearanceWarning,
+    EditorCommandError,
+    KinegamiError,
+    PlacementWarning,
+)
 from kinegami.joints import (
     EndTip,
     ExtendedRevoluteJoint,
@@ -55,8 +60,7 @@ __all__ = [
 ]
 
 
-class CommandError(KinegamiError, ValueError):
-    """A command that cannot be applied; the message says why (parameter, value, range)."""
+CommandError = EditorCommandError  # the editor's name for it
 
 
 class _Keep:
