@@ -1,4 +1,6 @@
-"""Parameters of the regular prism and the wrapping of pattern coordinates (spec sections 1, 2.1).
+"""Parameters of the regular prism and the wrapping of pattern coordinates.
+
+See docs/theory/patterns.md, sections 1 and 2.
 
 Pattern coordinates (x, y): x is the arc length around the polygon, measured from the midpoint of
 the starting side and reduced to [0, W); y is the distance along the tube axis.
@@ -12,7 +14,7 @@ import numpy as np
 
 from kinegami.validation import check_num_sides, check_radius
 
-#: Relative length tolerance of the reference: eps = EPS_FACTOR * b (spec section 1.1).
+#: Relative length tolerance of the reference: eps = EPS_FACTOR * b (docs/theory/patterns.md 1.1).
 EPS_FACTOR = 1e-4
 
 

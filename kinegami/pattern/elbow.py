@@ -1,4 +1,7 @@
-"""Elbow fitting: a bend of the tube by a tucked, flat-folded strip (spec section 3.3)."""
+"""Elbow fitting: a bend of the tube by a tucked, flat-folded strip.
+
+See docs/theory/patterns.md 3.3.
+"""
 
 from __future__ import annotations
 
@@ -350,7 +353,7 @@ def _exact_elbow(prism: Prism, theta: float, phi: float, records) -> TubularPatt
 
     Vertices closer than ``MERGE_TOLERANCE`` r are merged (exactly collapsed columns, h_k = 0),
     the creases between merged vertices dropped and repeated creases kept once, the first in
-    the spec's order (so two adjacent collapsed columns share one M crease, as in step 5).
+    the catalog's order (so two adjacent collapsed columns share one M crease, as in step 5).
     """
     geo = elbow_geometry(prism, theta, phi)
     n, W = prism.numSides, prism.W
@@ -450,9 +453,6 @@ def _fold(prism: Prism, pattern: TubularPattern, params):
     T[:3, :3] = R
     T[:3, 3] = shift
     return X, T
-
-
-# --- revolute joint and tips (spec 3.4-3.6) ------------------------------------------------
 
 
 catalog.register(

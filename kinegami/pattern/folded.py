@@ -1,18 +1,19 @@
 """The folded form: 3D positions of every vertex of a crease pattern at joint state 0.
 
 A :class:`~kinegami.pattern.TubularPattern` made of catalog modules remembers which modules it
-is made of (``pattern.modules``). :func:`folded_form` rebuilds every module from its record,
-replays the composition of spec/patterns.md section 2.2 to learn which global vertex each module
-vertex became, folds every module in its own proximal frame (section 3 and docs/fold.md) and
-chains the module transforms, so the result is an isometric 3D realisation of the whole pattern.
+is made of (``pattern.modules``) and where each module's vertices went
+(``pattern.module_vertices``, recorded by composition). :func:`folded_form` rebuilds every
+module from its record, folds it with its catalog entry's fold in its own proximal frame
+(docs/theory/patterns.md section 4 and docs/fold.md) and chains the module transforms, so
+the result is an isometric 3D realisation of the whole pattern.
 
-Frames. Inside a module, positions are computed in its proximal frame (e_u, e_v, e_a) of spec
-section 1.3. In world coordinates a module's end is described by its Dubins frame (x = e_a, the
-path direction; y = e_u, the reference point; z = e_v), the convention of the chain code
-(``joint.proximal_dubins_frame()``). For a chain, the first module's proximal Dubins frame is the
-first joint's proximal Dubins frame, so the folded form lies on the chain's 3D model at state 0:
-every module end coincides with the chain's joint and link frames. Two exceptions follow the
-pattern rather than the kinematic model, because the pattern cannot fold otherwise:
+Frames. Inside a module, positions are computed in its proximal frame (e_u, e_v, e_a) of
+docs/theory/patterns.md section 1. In world coordinates a module's end is described by its Dubins
+frame (x = e_a, the path direction; y = e_u, the reference point; z = e_v), the convention of the
+chain code (``joint.proximal_dubins_frame()``). For a chain, the first module's proximal Dubins
+frame is the first joint's proximal Dubins frame, so the folded form lies on the chain's 3D model
+at state 0: every module end coincides with the chain's joint and link frames. Two exceptions
+follow the pattern rather than the kinematic model, because the pattern cannot fold otherwise:
 
 * a prismatic joint's pattern folds to length d' + L instead of the kinematic d: the sleeve adds
   L = d / sin(coneAngle) (spec B7) and the bellows, folded with rigid faces, is
@@ -21,7 +22,7 @@ pattern rather than the kinematic model, because the pattern cannot fold otherwi
 * turns and twists of at most 0.01 rad that the link builder leaves out of the pattern, and tubes
   shorter than eps = 1e-4 b, are missing from the folded form too (patterns.md 4.2).
 
-Where the spec gives no positions (the REBO bellows, the nested sink layers of the revolute
+Where the pattern gives no positions (the REBO bellows, the nested sink layers of the revolute
 joint, the free crimp flaps of the revolute joint and tips) docs/fold.md says which isometric
 realisation is used; every face is then a rigid, planar copy of its flat polygon.
 
@@ -62,7 +63,7 @@ __all__ = [
 ]
 
 #: Q such that a frame's Dubins form is ``G @ Q.T`` when ``G`` has the columns (e_u, e_v, e_a):
-#: (x_D, y_D, z_D) = (e_a, e_u, e_v) (spec section 1.3).
+#: (x_D, y_D, z_D) = (e_a, e_u, e_v) (docs/theory/patterns.md 1.3).
 UVA_TO_DUBINS = np.array(
     [[0.0, 0.0, 1.0, 0.0], [1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
 )
@@ -142,10 +143,10 @@ class UnsnappedForm:
 
     The catalog moves some vertices a little (elbow columns merged with their base or collapsed onto
     the midline by fix B6: less than eps = 1e-4 b, or up to about 2e-4 r for a column collapsed by
-    its tuck offset; points snapped onto the seam, spec 2.1: less than eps); no folded form of those
-    vertices keeps every crease length. The unsnapped pattern puts every vertex where the module
-    formulas put it (a few more vertices and short creases where B6 merged points), so its fold is
-    piecewise isometric: every face is a planar rigid copy of its flat polygon.
+    its tuck offset; points snapped onto the seam by composition: less than eps); no folded form
+    of those vertices keeps every crease length. The unsnapped pattern puts every vertex where
+    the module formulas put it (a few more vertices and short creases where B6 merged points),
+    so its fold is piecewise isometric: every face is a planar rigid copy of its flat polygon.
 
     Attributes
     ----------
@@ -247,7 +248,8 @@ def unsnapped_form(pattern_or_chain, frame=None, twistPortion: float = 0.2) -> U
 
     Takes the arguments of :func:`folded_vertices`. Every module is rebuilt from its record
     without the catalog's eps rules (see :class:`UnsnappedForm`) and the modules are composed as
-    in spec 2.2 but with x reduced modulo W only. The FOLD exporter writes this sheet.
+    in composition (docs/theory/patterns.md 2) but with x reduced modulo W only. The FOLD
+    exporter writes this sheet.
 
     Raises
     ------
@@ -421,7 +423,8 @@ def _fold(pattern: TubularPattern, G0: np.ndarray) -> FoldedForm:
 def _fold_unsnapped(pattern: TubularPattern, G0: np.ndarray) -> UnsnappedForm:
     """Compose the unsnapped modules (:func:`unsnapped_form`) and fold them.
 
-    The composition is that of spec 2.2 without the eps rules: x is reduced modulo W only (no
+    The composition is that of docs/theory/patterns.md 2, without the eps rules: x is reduced
+    modulo W only (no
     snapping onto the seam, also for the markers), and every module is placed with the exact
     marker. Vertex i < N of the result is vertex i of ``pattern`` (the correspondence comes
     from the replay of the catalog composition); the vertices that only the unsnapped modules
@@ -480,7 +483,7 @@ def _fold_unsnapped(pattern: TubularPattern, G0: np.ndarray) -> UnsnappedForm:
     X = np.concatenate(X)
     edges = np.concatenate(edges)
     labels = np.concatenate(labels)
-    # spec 2.2 step 5: a crease joining the same two vertices as an earlier one is dropped
+    # composition step 4: a crease joining the same two vertices as an earlier one is dropped
     lo = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64)
     hi = np.maximum(edges[:, 0], edges[:, 1]).astype(np.int64)
     first = np.unique(lo * coords.shape[0] + hi, return_index=True)[1]

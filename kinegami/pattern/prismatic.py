@@ -1,4 +1,4 @@
-"""REBO bellows and the prismatic joint built around it (spec sections 3.7, 3.8)."""
+"""REBO bellows and the prismatic joint built around it (docs/theory/patterns.md 3.7, 3.8)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,7 @@
-"""Revolute joint with sink layers, and the tips made from its half (spec sections 3.4-3.6)."""
+"""Revolute joint with sink layers, and the tips made from its half.
+
+See docs/theory/patterns.md 3.4-3.6.
+"""
 
 from __future__ import annotations
 
@@ -288,7 +291,7 @@ def _build_revolute(
             raise InvalidParameterError(
                 f"numSinkLayers={layers} cannot be folded with totalBendingAngle={theta!r} for "
                 f"numSides={prism.numSides}: the crimp is so low that a projected sink chain "
-                "(spec 3.5) leaves its panel and the creases would overlap; use "
+                "(docs/theory/patterns.md 3.5) leaves its panel and the creases would overlap; use "
                 "numSinkLayers=1 or a larger totalBendingAngle"
             ) from None
         blocks += sink_blocks
@@ -551,9 +554,6 @@ def _fold_sink_chains(prism, xy, X, matched, centre, H):
         best = np.flatnonzero(candidate)[np.argmin(span[candidate])]
         X[i] = centre + (along / span[best]) * (outer_X[best] - centre)
     return X
-
-
-# --- REBO (spec 3.7) and prismatic joint (3.8) ---------------------------------------------
 
 
 def _fold_joint(prism: Prism, pattern: TubularPattern, params):

@@ -1,4 +1,4 @@
-"""The flat sheet a tubular pattern is cut from (spec/patterns.md section 5).
+"""The flat sheet a tubular pattern is cut from (docs/fabrication.md).
 
 The tube is cut open along the seam x = 0 = W, which bisects the starting panel. The sheet is
 the rectangle x in [-b/2, W + b/2], y in [y0, y0 + H]: the n panels of the tube plus a second
@@ -62,7 +62,7 @@ _KIND_DTYPE = np.dtype("<U1")
 
 @dataclass(frozen=True, eq=False)
 class Sheet:
-    """The lines drawn on the flat sheet of a tubular pattern (spec section 5).
+    """The lines drawn on the flat sheet of a tubular pattern (docs/fabrication.md).
 
     Attributes
     ----------
@@ -84,7 +84,7 @@ class Sheet:
         Length tolerance used to clip and de-duplicate (1e-9 r).
     snapTolerance : float
         End points closer than this to a clip line (x = -b/2, W + b/2) are put on it: the
-        pattern's tolerance eps = 1e-4 b (spec section 1.1).
+        pattern's tolerance eps = 1e-4 b (docs/theory/patterns.md 1.1).
     """
 
     segments: np.ndarray
@@ -164,7 +164,7 @@ def _rectangle(xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray
 
 
 def flatten(pattern: TubularPattern, *, skip_creases_on_cut: bool = False) -> Sheet:
-    """The lines drawn on the flat sheet of ``pattern`` (spec section 5, clipped as in B8).
+    """The lines drawn on the flat sheet of ``pattern`` (docs/fabrication.md, clipped as in B8).
 
     Parameters
     ----------

@@ -1,4 +1,7 @@
-"""Tube fitting (a straight tube) and the empty waypoint pattern (spec sections 3.1, 3.9)."""
+"""Tube fitting (a straight tube) and the empty waypoint pattern.
+
+See docs/theory/patterns.md 3.1, 3.9.
+"""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """The tubular crease pattern: plain data in the spirit of FOLD, and its composition.
 
 A :class:`TubularPattern` is a graph drawn on the surface of a regular n-gonal prism, unrolled
-into the strip 0 <= x < W (spec/patterns.md section 1.4). It is immutable: every operation
+into the strip 0 <= x < W (docs/theory/patterns.md section 1.4). It is immutable: every operation
 returns a new pattern and the stored arrays are read-only.
 
 Composition (section 2.2) is implemented once, in :func:`_compose_step`, which works on the
@@ -159,7 +159,7 @@ def _first_occurrence_mask(keys: np.ndarray) -> np.ndarray:
 
 
 class TubularPattern:
-    """A crease pattern on the surface of a regular n-gonal tube (spec section 1.4).
+    """A crease pattern on the surface of a regular n-gonal tube (docs/theory/patterns.md 1.4).
 
     Parameters
     ----------
@@ -364,7 +364,7 @@ class TubularPattern:
 
     @property
     def eps(self) -> float:
-        """Length tolerance 1e-4 b used to identify points (spec section 1.1)."""
+        """Length tolerance 1e-4 b used to identify points (docs/theory/patterns.md 1.1)."""
         return EPS_FACTOR * self.sideLength
 
     @property
@@ -449,7 +449,7 @@ class TubularPattern:
     # Operations
 
     def append(self, other: TubularPattern) -> TubularPattern:
-        """Return this pattern followed by ``other`` (spec section 2.2).
+        """Return this pattern followed by ``other`` (docs/theory/patterns.md 2.2).
 
         ``other`` is translated so that its proximal marker lands on this pattern's distal
         marker, its proximal base is identified with this pattern's distal base (for the cyclic
@@ -506,7 +506,7 @@ class TubularPattern:
         return _compose_all(first, patterns)
 
     def reversed(self) -> TubularPattern:
-        """The pattern read from the other end (spec section 2.4).
+        """The pattern read from the other end (docs/theory/patterns.md 2.4).
 
         y is mapped to 2 y0 + H - y (y0 = proximal marker y), the two bases are swapped, the x
         coordinates of the two markers are swapped and labels are kept. The mirror image of the
@@ -828,7 +828,7 @@ def _find_shift(state: _ComposeState, base_xy: np.ndarray, index: int) -> int:
 
 
 def _compose_step(state: _ComposeState, other: TubularPattern, index: int) -> _Step | None:
-    """Append ``other`` to the composite described by ``state`` (spec section 2.2, steps 1-6).
+    """Append ``other`` to the composite described by ``state`` (docs/theory/patterns.md 2).
 
     Returns the new vertices, the re-indexed creases that survive duplicate removal and the new
     state, or None when ``other`` is empty (a waypoint: nothing changes). The work is

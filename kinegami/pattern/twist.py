@@ -1,4 +1,7 @@
-"""Twist fitting: a band of triangles that rotates the tube about its axis (spec section 3.2)."""
+"""Twist fitting: a band of triangles that rotates the tube about its axis.
+
+See docs/theory/patterns.md 3.2.
+"""
 
 from __future__ import annotations
 
