@@ -426,6 +426,31 @@ def cmd_new(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_edit(args: argparse.Namespace) -> int:
+    import time
+
+    try:
+        port = int(args.port)
+    except ValueError:
+        port = -1
+    if not 0 <= port <= 65535:
+        raise CommandError(f"--port must be an integer in [0, 65535], got {_printable(args.port)}")
+    from kinegami.editor.server import LOCAL_HOSTS, EditorServer
+
+    server = EditorServer(args.design, host=args.host, port=port)
+    try:
+        what = _printable(str(args.design)) if args.design else "the starter design"
+        print(f"kinegami edit: editing {what} at {server.url} (each tab edits its own copy; "
+              "Ctrl-C stops)", flush=True)  # fmt: skip
+        if args.host not in LOCAL_HOSTS:
+            _warn("edit", f"listening on {args.host}: anyone who can reach this machine on the "
+                          "network can open the editor and edit designs")  # fmt: skip
+        while True:
+            time.sleep(3600)
+    finally:
+        server.stop()
+
+
 def cmd_validate(args: argparse.Namespace) -> int:
     from kinegami.design import read_design, validate_design
 
@@ -856,6 +881,21 @@ def make_parser() -> argparse.ArgumentParser:
         "--force", action="store_true", help="allow OUT to be DESIGN itself (replaced atomically)"
     )
     compact.set_defaults(run=cmd_compact)
+
+    edit = commands.add_parser(
+        "edit",
+        help="edit a design in the browser",
+        description="Serve the browser editor (needs pip install 'kinegami[gui]') and print its "
+        "address. Each browser tab edits its own copy of DESIGN (default: the starter design); "
+        "designs are saved by downloading them. Listens on 127.0.0.1 unless --host says "
+        "otherwise. Runs until Ctrl-C.",
+    )
+    edit.add_argument("design", metavar="DESIGN", nargs="?", help="design file (.json)")
+    edit.add_argument("--port", metavar="P", default="8080", help="port (default: %(default)s; "
+                      "0: a free one)")  # fmt: skip
+    edit.add_argument("--host", metavar="H", default="127.0.0.1", help="address to listen on "
+                      "(default: %(default)s, this machine only)")  # fmt: skip
+    edit.set_defaults(run=cmd_edit)
     return parser
 
 

@@ -1,0 +1,119 @@
+"""The ``kinegami edit`` server: a viser server where each browser tab edits its own document.
+
+>>> from kinegami.editor.server import EditorServer
+>>> server = EditorServer(port=0)  # doctest: +SKIP
+>>> server.url  # doctest: +SKIP
+'http://127.0.0.1:8080'
+
+Every tab (viser client) gets an :class:`~kinegami.editor.view.EditorView` over a new
+:class:`~kinegami.editor.model.EditorModel` of the starting design; the design is read once,
+on the server, from the path given on the command line. Browsers can only upload design
+files' contents, never name server paths. See docs/editor.md.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import threading
+from pathlib import Path
+
+from kinegami.editor.document import Document
+from kinegami.editor.model import EditorModel
+from kinegami.editor.view import EditorView, gallery
+from kinegami.errors import ExporterUnavailableError
+
+__all__ = ["EditorServer", "LOCAL_HOSTS", "starting_document"]
+
+#: Hosts that only this machine can reach (any other --host gets a warning).
+LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
+
+
+def starting_document(design: str | os.PathLike | None = None) -> Document:
+    """The document each new tab starts from: the design file, else the starter design of
+    ``kinegami new`` (a start tip and a few joints). Raises DesignError for a bad file."""
+    if design is None:
+        return EditorModel().document
+    return Document.load(design)
+
+
+def _viser():
+    try:
+        import viser
+    except ImportError as exc:
+        raise ExporterUnavailableError(
+            "the browser editor needs viser: pip install 'kinegami[gui]'"
+        ) from exc
+    return viser
+
+
+class EditorServer:
+    """A viser server with one editor per connected tab.
+
+    Parameters
+    ----------
+    design : the design file every tab starts from (None: the starter design).
+    host, port : where to listen (port 0: a free port).
+    """
+
+    def __init__(self, design: str | os.PathLike | None = None, host: str = "127.0.0.1",
+                 port: int = 8080):  # fmt: skip
+        viser = _viser()
+        self.document = starting_document(design)
+        self.path = None if design is None else Path(os.fspath(design))
+        self.views: dict[int, EditorView] = {}
+        self._lock = threading.Lock()
+        if port == 0:
+            port = _free_port(host)
+        with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the CLI prints its own
+            self.server = viser.ViserServer(host=host, port=port, label="kinegami edit",
+                                            verbose=False)  # fmt: skip
+        self.server.on_client_connect(self._connect)
+        self.server.on_client_disconnect(self._disconnect)
+
+    @property
+    def port(self) -> int:
+        return self.server.get_port()
+
+    @property
+    def url(self) -> str:
+        host = self.server.get_host()
+        if ":" in host:
+            host = f"[{host}]"
+        return f"http://{host}:{self.port}"
+
+    def new_view(self, target) -> EditorView:
+        """An editor over a new model of the starting document, drawn on ``target`` (a viser
+        client, or the server itself in tests)."""
+        return EditorView(target, EditorModel(self.document))
+
+    def _connect(self, client) -> None:
+        view = self.new_view(client)
+        with self._lock:
+            self.views[client.client_id] = view
+
+    def _disconnect(self, client) -> None:
+        with self._lock:
+            view = self.views.pop(client.client_id, None)
+        if view is not None:
+            view.close()
+
+    def stop(self) -> None:
+        """Stop serving."""
+        with contextlib.redirect_stdout(io.StringIO()):
+            self.server.stop()
+
+
+def _free_port(host: str) -> int:
+    import socket
+
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    with socket.socket(family, socket.SOCK_STREAM) as sock:
+        sock.bind((host, 0))
+        return sock.getsockname()[1]
+
+
+def examples() -> tuple[str, ...]:
+    """The gallery designs a tab can open."""
+    return tuple(gallery())

@@ -1,0 +1,591 @@
+"""The browser view of the editor: one :class:`EditorView` binds an EditorModel to a viser
+scene and side panel (``kinegami edit``, :mod:`kinegami.editor.server`; docs/editor.md).
+
+The view holds no design state: every widget calls a model command, and the view redraws what
+the model's :class:`~kinegami.editor.model.Change` says changed. Meshes are built in their
+own frame (a joint's Pose, a link's start frame), so a part that only moved rigidly gets a new
+pose and no new mesh. viser is imported by the caller (the server); this module only uses the
+handles it is given, so tests can drive it with a server and no browser.
+"""
+
+from __future__ import annotations
+
+import functools
+import io
+import math
+import threading
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from kinegami.editor.document import Document
+from kinegami.editor.model import Change, CommandResult, EditorModel
+
+__all__ = ["EditorView", "DOWNLOADS", "MAX_UPLOAD_BYTES", "gallery", "download_data"]
+
+#: The largest design file a browser may upload (bytes).
+MAX_UPLOAD_BYTES = 16 * 1024 * 1024
+#: Download buttons: label -> file suffix (through the export registry).
+DOWNLOADS = {"DXF": ".dxf", "SVG": ".svg", "FOLD": ".fold", "PDF": ".pdf", "STL": ".stl",
+             "URDF": ".urdf"}  # fmt: skip
+GALLERY_DIR = Path(__file__).resolve().parents[2] / "examples" / "designs"
+
+JOINT_COLOR = (70, 140, 220)
+LINK_COLOR = (200, 200, 190)
+SELECTED_COLOR = (250, 180, 40)
+COLLIDING_COLOR = (220, 40, 40)
+JOINT_KINDS = ("RevoluteJoint", "PrismaticJoint", "ExtendedRevoluteJoint", "Waypoint", "EndTip")
+
+
+def gallery(folder: Path = GALLERY_DIR) -> dict[str, Path]:
+    """The gallery's design files by stem (examples/designs; empty when not installed)."""
+    if not folder.is_dir():
+        return {}
+    return {p.stem: p for p in sorted(folder.glob("*.json"))}
+
+
+def download_data(model: EditorModel, suffix: str) -> tuple[str, bytes]:
+    """(file name, bytes) of the current design in the format of ``suffix`` (``.json``: the
+    design file; ``.urdf``: a zip of the URDF and its meshes). Raises the registry's errors."""
+    from kinegami.export.registry import FORMATS
+
+    stem = _file_stem(model)
+    if suffix == ".json":
+        return f"{stem}.json", model.to_design_text().encode()
+    fmt = FORMATS[suffix]
+    name = f"{stem}{suffix}"
+    subject = model.chain if fmt.accepts == "chain" else model.pattern()
+    data = fmt.render(subject, Path(name))
+    if fmt.kind == "files":
+        buffer = io.BytesIO()
+        with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+            for path, content in sorted(data.items()):
+                archive.writestr(str(path), content)
+        return f"{stem}_urdf.zip", buffer.getvalue()
+    return name, data.encode() if isinstance(data, str) else bytes(data)
+
+
+def _file_stem(model: EditorModel) -> str:
+    name = model.document.name or (model.path.stem if model.path else "") or "design"
+    stem = "".join(c if c.isalnum() or c in "-_" else "_" for c in str(name)).strip("_")
+    return stem[:64] or "design"
+
+
+def _locked(method):
+    """Run a view method under the view's lock."""
+
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        with self.lock:
+            return method(self, *args, **kwargs)
+
+    return wrapper
+
+
+def _wxyz(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) of a rotation matrix."""
+    from scipy.spatial.transform import Rotation
+
+    x, y, z, w = Rotation.from_matrix(R).as_quat()
+    return np.array([w, x, y, z])
+
+
+def _matrix(wxyz) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    w, x, y, z = wxyz
+    return Rotation.from_quat([x, y, z, w]).as_matrix()
+
+
+@dataclass
+class _Node:
+    """The scene nodes of one joint or link: its meshes in its own frame."""
+
+    uid: int
+    obj: Any  # the joint or link drawn (an immutable value)
+    handles: list = field(default_factory=list)
+    frame: Any = None
+    sent: int = 0  # how many times its meshes were sent
+
+
+class EditorView:
+    """One document in one browser tab: an EditorModel drawn with a viser client's ``scene``
+    and ``gui`` (or a server's, in tests).
+
+    Parameters
+    ----------
+    target : a viser ClientHandle (or ViserServer): its ``scene``, ``gui``,
+        ``send_file_download`` and ``add_notification`` are used.
+    model : the model to edit (default: the starter design).
+    """
+
+    def __init__(self, target: Any, model: EditorModel | None = None):
+        self.target = target
+        self.scene = target.scene
+        self.gui = target.gui
+        self.model = model if model is not None else EditorModel()
+        self.message = ""  # the last reason or warning shown
+        self.meshes_sent = 0  # meshes sent since the view started (tests read it)
+        self._uids = 0
+        self._joints: list[_Node] = []
+        self._links: list[_Node] = []
+        self._colliding: set[tuple[str, int]] = set()
+        self._syncing = False
+        #: Held while a callback edits the model (viser runs callbacks in a thread pool).
+        self.lock = threading.RLock()
+        self._sliders: list = []
+        self._gizmo = None
+        self._gizmo_pose: np.ndarray | None = None
+        self._build_panel()
+        self.scene.add_frame("/world", axes_length=2.0 * self._r, axes_radius=0.04 * self._r)
+        self._unsubscribe = self.model.subscribe(self._on_change)
+        self._redraw_all()
+
+    # --- model binding ------------------------------------------------------------------------
+    @property
+    def _r(self) -> float:
+        return float(self.model.chain.Joints[0].r)
+
+    @_locked
+    def set_model(self, model: EditorModel) -> None:
+        """Edit another model (a loaded example or upload): everything is drawn again."""
+        self._unsubscribe()
+        self.model = model
+        self.model.propagate = bool(self._propagate.value)
+        self._unsubscribe = model.subscribe(self._on_change)
+        self._clear_scene()
+        self._redraw_all()
+
+    def close(self) -> None:
+        """Stop listening to the model (the tab closed)."""
+        self._unsubscribe()
+
+    def act(self, action) -> CommandResult:
+        """Run ``action()`` (a model call returning a CommandResult) under the view's lock and
+        show its outcome (widget callbacks run in viser's thread pool)."""
+        with self.lock:
+            return self.run(action())
+
+    def run(self, result: CommandResult) -> CommandResult:
+        """Show a command's outcome: the reason when refused, else its warnings."""
+        if not result.ok:
+            self._say(f"**Refused:** {result.reason}")
+        elif result.warnings:
+            self._say("**Warning:** " + "; ".join(result.warnings))
+        else:
+            self._say(f"{result.action}: done")
+        return result
+
+    def _say(self, text: str) -> None:
+        self.message = text
+        self._message.content = text
+
+    def _on_change(self, change: Change) -> None:
+        if change.kind == "select":
+            self._recolour()
+            self._update_gizmo()
+            self._update_panel()
+            return
+        self._update_scene(change)
+        self._update_panel(structure=change.structure)
+
+    # --- scene --------------------------------------------------------------------------------
+    def _new_uid(self) -> int:
+        self._uids += 1
+        return self._uids
+
+    def _clear_scene(self) -> None:
+        for node in self._joints + self._links:
+            if node is not None:
+                self._remove(node)
+        self._joints, self._links = [], []
+
+    def _remove(self, node: _Node) -> None:
+        for handle in node.handles:
+            handle.remove()
+        if node.frame is not None:
+            node.frame.remove()
+        node.handles = []
+
+    def _redraw_all(self) -> None:
+        chain = self.model.chain
+        self._joints = [self._joint_node(j, i) for i, j in enumerate(chain.Joints)]
+        self._links = [self._link_node(chain.Links[i], i) if i else None
+                       for i in range(len(chain.Joints))]  # fmt: skip
+        self._refresh_clearance()
+        self._recolour()
+        self._update_gizmo()
+        self._update_panel(structure=True)
+
+    def _joint_node(self, joint, i: int) -> _Node:
+        from kinegami.export.mesh import joint_parts
+
+        node = _Node(self._new_uid(), joint)
+        pose = np.asarray(joint.pose_matrix, dtype=float)
+        for part in joint_parts(joint, i):
+            name = f"/chain/joint{node.uid}/{part.side or 'body'}"
+            node.handles.append(self._add_mesh(name, part, pose, JOINT_COLOR, ("joint", node)))
+        node.frame = self.scene.add_frame(
+            f"/frames/joint{node.uid}", axes_length=1.5 * joint.r, axes_radius=0.03 * joint.r,
+            wxyz=_wxyz(pose[:3, :3]), position=pose[:3, 3],
+        )  # fmt: skip
+        node.sent += 1
+        return node
+
+    def _link_node(self, link, i: int) -> _Node:
+        from kinegami.export.mesh import link_parts
+
+        node = _Node(self._new_uid(), link)
+        frame = np.asarray(link.start_frame, dtype=float)
+        chain = self.model.chain
+        for part in link_parts(link, i, chain.numSides, self.model.document.twist_portion):
+            node.handles.append(self._add_mesh(f"/chain/link{node.uid}/{part.side}", part, frame,
+                                               LINK_COLOR, ("link", node)))  # fmt: skip
+        node.sent += 1
+        return node
+
+    def _add_mesh(self, name: str, part, frame: np.ndarray, color, owner):
+        R, t = frame[:3, :3], frame[:3, 3]
+        local = (part.vertices - t) @ R
+        handle = self.scene.add_mesh_simple(
+            name, local, part.faces, color=color, flat_shading=True,
+            wxyz=_wxyz(R), position=t,
+        )  # fmt: skip
+        self.meshes_sent += 1
+        if owner[0] == "joint":
+            node = owner[1]
+            handle.on_click(lambda event, node=node: self._click(node))
+        return handle
+
+    @_locked
+    def _click(self, node: _Node) -> None:
+        if node in self._joints:
+            self.model.select(self._joints.index(node))
+
+    def _move(self, node: _Node, frame: np.ndarray) -> None:
+        wxyz, t = _wxyz(frame[:3, :3]), frame[:3, 3]
+        for handle in node.handles:
+            handle.wxyz, handle.position = wxyz, t
+        if node.frame is not None:
+            node.frame.wxyz, node.frame.position = wxyz, t
+
+    def _update_scene(self, change: Change) -> None:
+        chain = self.model.chain
+        joints, links = chain.Joints, chain.Links
+        old_joints, old_links = self._joints, self._links
+        if change.structure or len(joints) != len(old_joints):
+            sources = change.joint_sources or (None,) * len(joints)
+            used = set()
+            new_joints, new_links = [], []
+            for i, joint in enumerate(joints):
+                s = sources[i] if i < len(sources) else None
+                if s is not None and s < len(old_joints) and old_joints[s].obj is joint:
+                    new_joints.append(old_joints[s])
+                    used.add(("j", s))
+                else:
+                    new_joints.append(self._joint_node(joint, i))
+                if i == 0:
+                    new_links.append(None)
+                    continue
+                old = next((k for k, n in enumerate(old_links)
+                            if n is not None and n.obj is links[i] and ("l", k) not in used),
+                           None)  # fmt: skip
+                if old is not None:
+                    new_links.append(old_links[old])
+                    used.add(("l", old))
+                else:
+                    new_links.append(self._link_node(links[i], i))
+            for k, node in enumerate(old_joints):
+                if ("j", k) not in used:
+                    self._remove(node)
+            for k, node in enumerate(old_links):
+                if node is not None and ("l", k) not in used:
+                    self._remove(node)
+            self._joints, self._links = new_joints, new_links
+        else:
+            reshaped = set(change.reshaped_joints)
+            for i in change.joints:
+                if i in reshaped:
+                    self._remove(old_joints[i])
+                    self._joints[i] = self._joint_node(joints[i], i)
+                else:
+                    self._joints[i].obj = joints[i]
+                    self._move(self._joints[i], np.asarray(joints[i].pose_matrix, dtype=float))
+            reshaped = set(change.reshaped_links)
+            for i in change.links:
+                if i == 0:
+                    continue
+                if i in reshaped or self._links[i] is None:
+                    if self._links[i] is not None:
+                        self._remove(self._links[i])
+                    self._links[i] = self._link_node(links[i], i)
+                else:
+                    self._links[i].obj = links[i]
+                    self._move(self._links[i], np.asarray(links[i].start_frame, dtype=float))
+        self._refresh_clearance()
+        self._recolour()
+        self._update_gizmo()
+
+    def _refresh_clearance(self) -> None:
+        report = self.model.clearance()
+        self._colliding = set()
+        for pair in report.pairs:
+            for element in pair.elements:
+                if element < 0:
+                    continue
+                kind = "joint" if element % 2 == 0 else "link"
+                self._colliding.add((kind, (element + 1) // 2))
+        self._clearance_text = self._clearance_words(report)
+
+    @staticmethod
+    def _clearance_words(report) -> str:
+        if report.closest is None:
+            return "clear (no parts far enough apart along the tube to collide)"
+        if report.ok:
+            return f"clear: minimum clearance {report.min_clearance:.4g}"
+        lines = [f"**self-intersecting**: {len(report.pairs)} pair(s), deepest overlap "
+                 f"{-report.min_clearance:.4g}"]  # fmt: skip
+        lines += [f"- {pair}" for pair in report.pairs[:8]]
+        return "\n".join(lines)
+
+    def colour_of(self, kind: str, index: int) -> tuple[int, int, int]:
+        """The colour a joint or link is drawn in (selected, colliding or plain)."""
+        if kind == "joint" and index == self.model.selected:
+            return SELECTED_COLOR
+        if (kind, index) in self._colliding:
+            return COLLIDING_COLOR
+        return JOINT_COLOR if kind == "joint" else LINK_COLOR
+
+    def _recolour(self) -> None:
+        for kind, nodes in (("joint", self._joints), ("link", self._links)):
+            for i, node in enumerate(nodes):
+                if node is None:
+                    continue
+                color = self.colour_of(kind, i)
+                for handle in node.handles:
+                    if tuple(handle.color) != color:
+                        handle.color = color
+
+    # --- handles ------------------------------------------------------------------------------
+    def _update_gizmo(self) -> None:
+        index = self.model.selected
+        if index is None or index >= len(self.model.chain.Joints):
+            if self._gizmo is not None:
+                self._gizmo.visible = False
+            self._gizmo_pose = None
+            return
+        pose = np.asarray(self.model.chain.Joints[index].pose_matrix, dtype=float)
+        self._gizmo_pose = pose
+        if self._gizmo is None:
+            self._gizmo = self.scene.add_transform_controls(
+                "/gizmo", scale=3.0 * self._r, active_axes=(False, False, True),
+                disable_sliders=True, depth_test=False,
+            )  # fmt: skip
+            self._gizmo.on_update(self._on_gizmo)
+        self._gizmo.visible = True
+        self._gizmo.wxyz, self._gizmo.position = _wxyz(pose[:3, :3]), pose[:3, 3]
+
+    def _on_gizmo(self, event) -> None:
+        if getattr(event, "phase", "end") != "end":
+            return
+        self.drag_to(np.asarray(self._gizmo.position, dtype=float), self._gizmo.wxyz)
+
+    @_locked
+    def drag_to(self, position, wxyz) -> CommandResult | None:
+        """Apply a finished handle drag: the slide along the selected joint's axis and the
+        roll about it that take its Pose to ``position``/``wxyz`` (other motion is ignored).
+        A refused move snaps the handle back and shows the reason."""
+        pose = self._gizmo_pose
+        if pose is None or self.model.selected is None:
+            return None
+        R0, p0 = pose[:3, :3], pose[:3, 3]
+        distance = float(np.dot(np.asarray(position, dtype=float) - p0, R0[:, 2]))
+        relative = R0.T @ _matrix(wxyz)
+        angle = math.atan2(relative[1, 0], relative[0, 0])
+        result = None
+        if abs(distance) > 1e-9 * self._r:
+            result = self.run(self.model.slide(None, distance))
+        if (result is None or result.ok) and abs(angle) > 1e-9:
+            result = self.run(self.model.roll(None, angle))
+        self._update_gizmo()  # snaps back when refused
+        return result
+
+    # --- side panel ---------------------------------------------------------------------------
+    def _build_panel(self) -> None:
+        gui = self.gui
+        self._message = gui.add_markdown("")
+        with gui.add_folder("Edit"):
+            undo_redo = gui.add_button_group("History", ("Undo", "Redo"))
+            undo_redo.on_click(lambda e: self.act(self._undo if e.target.value == "Undo"
+                                                  else self._redo))  # fmt: skip
+            self._propagate = gui.add_checkbox(
+                "Propagate",
+                initial_value=self.model.propagate,
+                hint="moves carry the later joints along",
+            )
+            self._propagate.on_update(
+                lambda _: setattr(self.model, "propagate", bool(self._propagate.value))
+            )
+            self._joint_list = gui.add_dropdown("Joint", ("(none)",))
+            self._joint_list.on_update(self._on_joint_list)
+            self._joint_info = gui.add_markdown("")
+            self._step = gui.add_number("Slide by", initial_value=0.5, step=0.1)
+            slide = gui.add_button_group("Slide", ("- slide", "+ slide"))
+            slide.on_click(
+                lambda e: self.act(
+                    lambda: self.model.slide(
+                        None, (1 if e.target.value == "+ slide" else -1) * float(self._step.value)
+                    )
+                )
+            )
+            self._angle = gui.add_number("Roll by (deg)", initial_value=15.0, step=5.0)
+            roll = gui.add_button_group("Roll", ("- roll", "+ roll"))
+            roll.on_click(lambda e: self.act(lambda: self.model.roll(
+                None, (1 if e.target.value == "+ roll" else -1)
+                * math.radians(float(self._angle.value)))))  # fmt: skip
+            self._kind = gui.add_dropdown("New joint", JOINT_KINDS)
+            add = gui.add_button("Add joint after selected")
+            add.on_click(lambda _: self.act(lambda: self.model.add_joint(str(self._kind.value))))
+            delete = gui.add_button("Delete selected joint", color="red")
+            delete.on_click(lambda _: self.act(self.model.delete))
+        self._config = gui.add_folder("Configuration")
+        with gui.add_folder("Clearance"):
+            self._clearance = gui.add_markdown("")
+            compact = gui.add_button("Compact")
+            compact.on_click(lambda _: self.act(lambda: self.model.compact(time_limit=30.0)))
+        with gui.add_folder("File"):
+            save = gui.add_button("Save design (download)")
+            save.on_click(lambda _: self.download(".json"))
+            for label, suffix in DOWNLOADS.items():
+                button = gui.add_button(f"Download {label}")
+                button.on_click(lambda _, s=suffix: self.download(s))
+            names = tuple(gallery()) or ("(none)",)
+            self._example = gui.add_dropdown("Example", names)
+            open_example = gui.add_button("Open example")
+            open_example.on_click(lambda _: self.open_example(str(self._example.value)))
+            upload = gui.add_upload_button("Upload design", mime_type="application/json")
+            upload.on_upload(lambda e: self.upload(e.target.value.name, e.target.value.content))
+
+    def _undo(self) -> CommandResult:
+        return self.model.undo()
+
+    def _redo(self) -> CommandResult:
+        return self.model.redo()
+
+    def _labels(self) -> tuple[str, ...]:
+        return tuple(f"{row.index}: {row.type}" + (f" '{row.name}'" if row.name else "")
+                     for row in self.model.joint_table())  # fmt: skip
+
+    @_locked
+    def _on_joint_list(self, _event) -> None:
+        if self._syncing:
+            return
+        value = str(self._joint_list.value)
+        if value == "(none)":
+            self.model.select(None)
+        else:
+            self.model.select(int(value.split(":", 1)[0]))
+
+    def _update_panel(self, structure: bool = False) -> None:
+        self._syncing = True
+        try:
+            labels = ("(none)",) + self._labels()
+            if tuple(self._joint_list.options) != labels:
+                self._joint_list.options = labels
+            selected = self.model.selected
+            self._joint_list.value = labels[selected + 1] if selected is not None else "(none)"
+            self._joint_info.content = self._joint_text()
+            self._clearance.content = self._clearance_text
+            self._update_sliders(structure)
+        finally:
+            self._syncing = False
+
+    def _joint_text(self) -> str:
+        selected = self.model.selected
+        if selected is None:
+            return "No joint selected: click one."
+        row = self.model.joint_table()[selected]
+        lines = [f"**{row.type}** {row.name or ''}", f"state {row.state:.4g} in "
+                 f"[{row.state_range[0]:.4g}, {row.state_range[1]:.4g}]"]  # fmt: skip
+        lines += [f"- {k}: {v:.4g}" if isinstance(v, float) else f"- {k}: {v}"
+                  for k, v in row.parameters.items()]  # fmt: skip
+        return "\n".join(lines)
+
+    def _update_sliders(self, structure: bool) -> None:
+        rows = [row for row in self.model.joint_table() if row.movable]
+        keys = [(row.index, row.state_range) for row in rows]
+        if structure or [s[0] for s in self._sliders] != keys:
+            for _, handle in self._sliders:
+                handle.remove()
+            self._sliders = []
+            with self._config:
+                for row in rows:
+                    lo, hi = (float(v) for v in row.state_range)
+                    handle = self.gui.add_slider(
+                        f"{row.index}: {row.name or row.type}", min=lo, max=hi,
+                        step=(hi - lo) / 200.0, initial_value=float(row.state),
+                    )  # fmt: skip
+                    handle.on_update(lambda _, i=row.index, h=handle: self._on_slider(i, h))
+                    self._sliders.append(((row.index, row.state_range), handle))
+            return
+        for (index, _), handle in self._sliders:
+            state = float(self.model.joint_table()[index].state)
+            if abs(float(handle.value) - state) > 1e-12:
+                handle.value = state
+
+    @_locked
+    def _on_slider(self, index: int, handle) -> None:
+        if self._syncing:
+            return
+        state = float(handle.value)
+        if abs(state - float(self.model.joint_table()[index].state)) > 1e-12:
+            self.set_state(index, state)
+
+    @_locked
+    def set_state(self, index: int, state: float) -> CommandResult:
+        """Set a joint's state (what its Configuration slider does)."""
+        return self.run(self.model.set_state(index, state))
+
+    # --- files --------------------------------------------------------------------------------
+    @_locked
+    def download(self, suffix: str) -> tuple[str, bytes] | None:
+        """Send the design (``.json``) or an export to the browser; returns (name, data)."""
+        try:
+            name, data = download_data(self.model, suffix)
+        except Exception as error:  # noqa: BLE001 - any exporter failure is shown, not raised
+            self._say(f"**Download failed:** {error}")
+            return None
+        self.target.send_file_download(name, data, save_immediately=True)
+        self._say(f"downloaded {name} ({len(data)} bytes)")
+        return name, data
+
+    @_locked
+    def open_example(self, stem: str) -> bool:
+        """Edit a gallery design (by its stem; only files of the gallery can be opened)."""
+        path = gallery().get(stem)
+        if path is None:
+            self._say(f"**Refused:** no gallery design named {stem!r}")
+            return False
+        return self._open(Document.load(path), f"opened example {stem}")
+
+    @_locked
+    def upload(self, name: str, content: bytes) -> bool:
+        """Edit an uploaded design file (parsed as a design only; at most MAX_UPLOAD_BYTES)."""
+        if len(content) > MAX_UPLOAD_BYTES:
+            self._say(f"**Refused:** {name!r} is {len(content)} bytes; the limit is "
+                      f"{MAX_UPLOAD_BYTES} (16 MiB)")  # fmt: skip
+            return False
+        try:
+            document = Document.loads(content.decode("utf-8"))
+        except Exception as error:  # noqa: BLE001 - a bad upload is a message, not a crash
+            self._say(f"**Refused:** {name!r} is not a design file: {error}")
+            return False
+        return self._open(document, f"opened {name}")
+
+    def _open(self, document: Document, text: str) -> bool:
+        self.set_model(EditorModel(document))
+        self._say(text)
+        return True
