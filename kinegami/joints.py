@@ -20,9 +20,10 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
-from spatialmath import SE3
 
 from kinegami.errors import IncompatibleJointError, InvalidParameterError, InvalidTypeError
 from kinegami.geometry.balls import Ball
@@ -58,13 +59,32 @@ __all__ = [
 ]
 
 
+if TYPE_CHECKING:
+    from spatialmath import SE3
+
+
+def as_se3(T: np.ndarray) -> SE3:
+    """``T`` as a spatialmath SE3 (imported on first use: importing spatialmath costs most of
+    a second, which commands that never hand out an SE3 should not pay)."""
+    from spatialmath import SE3
+
+    return SE3(T, check=False)
+
+
+def _is_se3(value) -> bool:
+    """Whether ``value`` is a spatialmath SE3 (without importing spatialmath: an SE3 can only
+    exist once spatialmath is imported)."""
+    spatialmath = sys.modules.get("spatialmath")
+    return spatialmath is not None and isinstance(value, spatialmath.SE3)
+
+
 def pose_array(Pose, name: str = "Pose", r: float | None = None) -> np.ndarray:
     """A validated 4x4 float array from an SE3 or a 4x4 array-like (proper rigid, finite).
 
     With the tube radius ``r``, the translation must also lie within +-1e6 r in each
     coordinate (:data:`kinegami.validation.LENGTH_FACTOR`).
     """
-    if isinstance(Pose, SE3):
+    if _is_se3(Pose):
         if len(Pose) != 1:
             raise InvalidParameterError(f"{name} must be a single SE3, got {len(Pose)} poses")
         T = np.array(Pose.A, dtype=float)
@@ -150,7 +170,7 @@ class Joint(ReadOnlyAttributes):
 
         A new SE3 each time: changing it does not change the joint (edit through the chain).
         """
-        return SE3(np.array(self._T), check=False)
+        return as_se3(np.array(self._T))
 
     @property
     def pose_matrix(self) -> np.ndarray:
@@ -199,19 +219,19 @@ class Joint(ReadOnlyAttributes):
     # --- published frame accessors (SE3) ----------------------------------------------------
     def ProximalFrame(self) -> SE3:
         """Proximal frame (where the incoming link ends) as an SE3."""
-        return SE3(self.proximal_frame(), check=False)
+        return as_se3(self.proximal_frame())
 
     def DistalFrame(self) -> SE3:
         """Distal frame (where the outgoing link starts) at the current state, as an SE3."""
-        return SE3(self.distal_frame(), check=False)
+        return as_se3(self.distal_frame())
 
     def ProximalDubinsFrame(self) -> SE3:
         """Proximal Dubins frame (x = path direction) as an SE3."""
-        return SE3(self.proximal_dubins_frame(), check=False)
+        return as_se3(self.proximal_dubins_frame())
 
     def DistalDubinsFrame(self) -> SE3:
         """Distal Dubins frame (x = path direction) at the current state, as an SE3."""
-        return SE3(self.distal_dubins_frame(), check=False)
+        return as_se3(self.distal_dubins_frame())
 
     # --- bounding ball --------------------------------------------------------------------
     def boundingBall(self) -> Ball:

@@ -12,15 +12,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-from spatialmath import SE3
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
 from kinegami.geometry.balls import Ball, merge_balls
 from kinegami.geometry.csc import CSCPath, solve_csc
 from kinegami.geometry.frames import rotation_matrix, signed_angle
-from kinegami.joints import pose_array
+from kinegami.joints import as_se3, pose_array
 from kinegami.validation import (
     ReadOnlyAttributes,
     check_max_angle_per_elbow,
@@ -28,6 +28,9 @@ from kinegami.validation import (
     check_radius,
     check_twist_portion,
 )
+
+if TYPE_CHECKING:
+    from spatialmath import SE3
 
 __all__ = ["LinkCSC", "ElbowArc", "ELBOW_MIN_ANGLE", "TWIST_MIN_ANGLE"]
 
@@ -236,12 +239,12 @@ class LinkCSC(ReadOnlyAttributes):
     @property
     def StartDubinsPose(self) -> SE3:
         """The start frame (x = tangent) as an SE3."""
-        return SE3(np.array(self._start), check=False)
+        return as_se3(np.array(self._start))
 
     @property
     def EndDubinsPose(self) -> SE3:
         """The end frame (x = tangent) as an SE3."""
-        return SE3(np.array(self._end), check=False)
+        return as_se3(np.array(self._end))
 
     @property
     def start_frame(self) -> np.ndarray:

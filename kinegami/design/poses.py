@@ -4,7 +4,9 @@
    it must be rigid to within :data:`RIGID_TOL`.
 2. A list of steps composed left to right like spatialmath products:
    ``[{"Trans": [5, 5, 0]}, {"Ry": 45}]`` is ``SE3.Trans(5, 5, 0) * SE3.Ry(pi/4)``, computed with
-   the same spatialmath calls, so a design reproduces the Python listing bit for bit.
+   spatialmath's arithmetic (the same cos/sin and matrix products, without importing it:
+   tests/design/test_poses.py checks it bit for bit), so a design reproduces the Python listing
+   exactly.
 3. An axis ``{"point": p, "axis": z, "xhat": x}``: origin p, z = axis / |axis|, x = xhat made
    perpendicular to z (Gram-Schmidt; default :func:`default_xhat`), y = z cross x.
 
@@ -17,7 +19,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from spatialmath import SE3
 
 from kinegami.design.errors import DesignError, json_path, numeric_errors
 
@@ -28,14 +29,34 @@ RIGID_TOL = 1e-9
 #: ``xhat`` is parallel to ``axis`` when its perpendicular part is below this times |xhat|.
 PARALLEL_TOL = 1e-9
 
+def _rotation(axis: int, angle: float) -> np.ndarray:
+    """spatialmath's ``SE3.Rx/Ry/Rz(angle)`` (math.cos and math.sin, the same matrix)."""
+    c, s = math.cos(angle), math.sin(angle)
+    T = np.eye(4)
+    if axis == 0:
+        T[:3, :3] = [[1, 0, 0], [0, c, -s], [0, s, c]]
+    elif axis == 1:
+        T[:3, :3] = [[c, 0, s], [0, 1, 0], [-s, 0, c]]
+    else:
+        T[:3, :3] = [[c, -s, 0], [s, c, 0], [0, 0, 1]]
+    return T
+
+
+def _translation(x: float, y: float, z: float) -> np.ndarray:
+    """spatialmath's ``SE3.Trans(x, y, z)``."""
+    T = np.eye(4)
+    T[:3, 3] = (x, y, z)
+    return T
+
+
 _STEPS = {
-    "Trans": lambda v: SE3.Trans(float(v[0]), float(v[1]), float(v[2])),
-    "Tx": lambda v: SE3.Tx(float(v)),
-    "Ty": lambda v: SE3.Ty(float(v)),
-    "Tz": lambda v: SE3.Tz(float(v)),
-    "Rx": lambda a: SE3.Rx(a),
-    "Ry": lambda a: SE3.Ry(a),
-    "Rz": lambda a: SE3.Rz(a),
+    "Trans": lambda v: _translation(float(v[0]), float(v[1]), float(v[2])),
+    "Tx": lambda v: _translation(float(v), 0.0, 0.0),
+    "Ty": lambda v: _translation(0.0, float(v), 0.0),
+    "Tz": lambda v: _translation(0.0, 0.0, float(v)),
+    "Rx": lambda a: _rotation(0, a),
+    "Ry": lambda a: _rotation(1, a),
+    "Rz": lambda a: _rotation(2, a),
 }
 _ROTATIONS = ("Rx", "Ry", "Rz")
 
@@ -99,10 +120,10 @@ def _steps_pose(steps, angle_units: str) -> np.ndarray:
         if key in _ROTATIONS:
             value = to_radians(value, angle_units)
         factor = _STEPS[key](value)
-        pose = factor if pose is None else pose * factor
+        pose = factor if pose is None else pose @ factor
     if pose is None:
         return np.eye(4)
-    return np.array(pose.A, dtype=float)
+    return pose
 
 
 def _scaled(vector) -> np.ndarray | None:

@@ -225,3 +225,28 @@ def test_degrees_build_the_same_chain_as_radians():
     np.testing.assert_allclose(
         [j.pose_matrix for j in b.Joints], [j.pose_matrix for j in a.Joints], rtol=0, atol=1e-12
     )
+
+
+_STEP_KINDS = ["Trans", "Tx", "Ty", "Tz", "Rx", "Ry", "Rz"]
+
+
+@given(st.lists(st.tuples(st.sampled_from(_STEP_KINDS), st.tuples(lengths, lengths, lengths)),
+                min_size=1, max_size=6))  # fmt: skip
+def test_any_steps_equal_spatialmath_to_the_bit_without_importing_it(steps):
+    """Design poses use spatialmath's arithmetic without importing spatialmath (which costs
+    most of a second): equal bits, signs of zeros included, for any sequence of steps."""
+    json_steps, expected = [], None
+    for kind, v in steps:
+        if kind == "Trans":
+            json_steps.append({kind: list(v)})
+            factor = SE3.Trans(*v)
+        elif kind in ("Tx", "Ty", "Tz"):
+            json_steps.append({kind: v[0]})
+            factor = getattr(SE3, kind)(v[0])
+        else:
+            json_steps.append({kind: v[0]})
+            factor = getattr(SE3, kind)(v[0])
+        expected = factor if expected is None else expected * factor
+    got = pose_from_json(json_steps)
+    want = np.array(expected.A, dtype=float)
+    assert got.tobytes() == want.tobytes()
