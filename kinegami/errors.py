@@ -159,7 +159,7 @@ class DesignError(KinegamiError, ValueError):
         return DesignError(self.reason, field=self.field, value=value, file=file)
 
     def __str__(self) -> str:
-        from kinegami.validation import format_value  # validation imports this module
+        from kinegami._format import format_value  # a leaf module, imported when needed
 
         text = f"{self.field}: {self.reason}"
         if self.has_value:

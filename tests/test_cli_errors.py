@@ -151,7 +151,7 @@ INTERRUPT_AT = textwrap.dedent(
     "trigger, message",
     [
         ("numpy", "kinegami: interrupted"),  # importing the package, before main()
-        ("spatialmath", "kinegami validate: interrupted"),  # the command imports it
+        ("jsonschema", "kinegami validate: interrupted"),  # the command imports it
         ("kinegami.design", "kinegami validate: interrupted"),  # in the command
     ],
 )

@@ -16,8 +16,8 @@ import secrets
 from importlib import resources
 from pathlib import Path
 
+from kinegami._atomic import discard, write_atomic
 from kinegami.errors import DesignFileExistsError, InvalidParameterError
-from kinegami.export import discard, write_atomic
 from kinegami.validation import check_bool
 
 __all__ = [
