@@ -1,4 +1,4 @@
-"""Joints of a tubular chain: revolute, prismatic, waypoints and tips (chain.md section 1).
+"""Joints of a tubular chain: revolute, prismatic, waypoints and tips (docs/theory/chain.md §1).
 
 Every joint has a ``Pose`` (an SE3: origin at the joint centre in the state-0 configuration,
 z axis = axis of motion), a tube radius ``r``, a polygon side count ``numSides``, a
@@ -235,7 +235,7 @@ class Joint(ReadOnlyAttributes):
 
     # --- bounding ball --------------------------------------------------------------------
     def boundingBall(self) -> Ball:
-        """A ball containing the joint at its current state (chain.md 1.3)."""
+        """A ball containing the joint at its current state (docs/theory/chain.md §2)."""
         return Ball(self._T[:3, 3], math.hypot(self._r, self._neutralLength / 2.0))
 
     def bounding_radius(self) -> float:
@@ -271,7 +271,10 @@ class Joint(ReadOnlyAttributes):
         return new
 
     def with_reversed_path_direction(self) -> Joint:
-        """A copy with the path direction reversed, axis-of-motion line kept (chain.md 1.4)."""
+        """A copy with the path direction reversed, axis-of-motion line kept.
+
+        See docs/theory/chain.md §1.
+        """
         flip = rot_x(math.pi) if self.pathIndex() == 2 else rot_z(math.pi)
         return self.with_pose(_exact_flip(self._T, flip))
 

@@ -1,4 +1,4 @@
-"""Links: CSC Dubins paths turned into elbow, twist and tube fittings (chain.md section 2).
+"""Links: CSC Dubins paths turned into elbow, twist and tube fittings (docs/theory/chain.md §3).
 
 A link joins a start Dubins frame (the parent joint's distal Dubins frame) to an end Dubins
 frame (the child's proximal Dubins frame). Frames are 4x4 arrays in world coordinates whose x
@@ -34,11 +34,11 @@ if TYPE_CHECKING:
 
 __all__ = ["LinkCSC", "ElbowArc", "ELBOW_MIN_ANGLE", "TWIST_MIN_ANGLE"]
 
-#: Arcs turning more than this get elbows (chain.md 2.3 [FIX]: no skipped small turns).
+#: Arcs turning more than this get elbows (docs/theory/chain.md §3: no skipped small turns).
 ELBOW_MIN_ANGLE = 1e-9
-#: A straight part gets a twist fitting when |twist| exceeds this (chain.md 2.5, patterns 4.2).
+#: A straight part gets a twist fitting when |twist| exceeds this (docs/theory/chain.md §3).
 TWIST_MIN_ANGLE = 0.01
-#: Arcs and twists up to this angle are left out of the crease pattern (patterns.md 4.2).
+#: Arcs and twists up to this angle are left out of the crease pattern (docs/theory/patterns.md §3).
 PATTERN_MIN_ANGLE = 0.01
 
 
@@ -76,7 +76,10 @@ class ElbowArc:
         return self.frames[:-1, :3, 3] + delta * self.frames[:-1, :3, 0]
 
     def bounding_ball(self) -> Ball | None:
-        """Fold-merge of the elbow balls (chain.md 3.2), or None if the arc has no elbow."""
+        """Fold-merge of the elbow balls, or None if the arc has no elbow.
+
+        See docs/theory/chain.md §2.
+        """
         if self.count == 0:
             return None
         radius = self.r * math.hypot(math.tan(self.elbowAngle / 2.0), 1.0)
@@ -317,7 +320,10 @@ class LinkCSC(ReadOnlyAttributes):
         return ball if ball is not None else Ball(self._end[:3, 3], self.r)
 
     def branchingParameters(self) -> list[float]:
-        """[phi_w1, theta1, r, tMag, phi_y2, theta2, r] in degrees/lengths (chain.md 2.6)."""
+        """[phi_w1, theta1, r, tMag, phi_y2, theta2, r] in degrees/lengths.
+
+        See docs/theory/chain.md §3.
+        """
         p = self.path
         a_s, b_s = self._start[:3, 0], self._start[:3, 1]
         first = math.degrees(signed_angle(b_s, p.w1, a_s))
@@ -336,7 +342,10 @@ class LinkCSC(ReadOnlyAttributes):
 
     # --- rigid motion ------------------------------------------------------------------------
     def transformed(self, T: np.ndarray) -> LinkCSC:
-        """The link moved rigidly by the world transform T (no re-solve; chain.md 2.6)."""
+        """The link moved rigidly by the world transform T (no re-solve).
+
+        See docs/theory/chain.md §3.
+        """
         start = T @ self._start
         end = T @ self._end
         start.setflags(write=False)
@@ -364,12 +373,12 @@ class LinkCSC(ReadOnlyAttributes):
 
     # --- pattern -----------------------------------------------------------------------------
     def creasePattern(self, numSides: int, twistPortion: float = 0.2):
-        """The link's crease pattern (patterns.md 4.2): elbows, twist, tube, elbows.
+        """The link's crease pattern (docs/theory/patterns.md §3): elbows, twist, tube, elbows.
 
         Arcs turning more than 0.01 rad get ``count`` elbow modules; the straight part gets a
         twist of height ``twistPortion * tMag`` when |twistAngle| > 0.01, and a tube for the
         rest. Smaller turns are exact in the chain's frames but below what the pattern
-        resolves, and are left out of the pattern as in the reference (patterns.md 4.2).
+        resolves, and are left out of the pattern as in the reference (docs/theory/patterns.md §3).
         """
         from kinegami.pattern import TubularPattern, WaypointPattern
 

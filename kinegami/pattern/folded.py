@@ -20,7 +20,7 @@ follow the pattern rather than the kinematic model, because the pattern cannot f
   d' = :func:`rebo_folded_length` >= d long; everything after a prismatic joint is translated by
   d' + L - d along its axis;
 * turns and twists of at most 0.01 rad that the link builder leaves out of the pattern, and tubes
-  shorter than eps = 1e-4 b, are missing from the folded form too (patterns.md 4.2).
+  shorter than eps = 1e-4 b, are missing from the folded form too (docs/theory/patterns.md §4).
 
 Where the pattern gives no positions (the REBO bellows, the nested sink layers of the revolute
 joint, the free crimp flaps of the revolute joint and tips) docs/fold.md says which isometric
