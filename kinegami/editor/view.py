@@ -85,12 +85,25 @@ def _locked(method):
     return wrapper
 
 
-def _wxyz(R: np.ndarray) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) of a rotation matrix."""
-    from scipy.spatial.transform import Rotation
-
-    x, y, z, w = Rotation.from_matrix(R).as_quat()
-    return np.array([w, x, y, z])
+def _wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
+    """Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method; called for every
+    moved part of a drag step, so plain floats rather than scipy)."""
+    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = np.asarray(R, dtype=float).tolist()
+    trace = m00 + m11 + m22
+    if trace > 0.0:
+        s = 2.0 * math.sqrt(trace + 1.0)
+        q = (0.25 * s, (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s)
+    elif m00 > m11 and m00 > m22:
+        s = 2.0 * math.sqrt(1.0 + m00 - m11 - m22)
+        q = ((m21 - m12) / s, 0.25 * s, (m01 + m10) / s, (m02 + m20) / s)
+    elif m11 > m22:
+        s = 2.0 * math.sqrt(1.0 + m11 - m00 - m22)
+        q = ((m02 - m20) / s, (m01 + m10) / s, 0.25 * s, (m12 + m21) / s)
+    else:
+        s = 2.0 * math.sqrt(1.0 + m22 - m00 - m11)
+        q = ((m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s)
+    n = math.sqrt(sum(v * v for v in q))
+    return tuple(v / n for v in q)
 
 
 def _matrix(wxyz) -> np.ndarray:
@@ -143,6 +156,7 @@ class EditorView:
         self.scene.add_frame("/world", axes_length=2.0 * self._r, axes_radius=0.04 * self._r)
         self._unsubscribe = self.model.subscribe(self._on_change)
         self._redraw_all()
+        self.frame_camera()
 
     # --- model binding ------------------------------------------------------------------------
     @property
@@ -158,6 +172,19 @@ class EditorView:
         self._unsubscribe = model.subscribe(self._on_change)
         self._clear_scene()
         self._redraw_all()
+        self.frame_camera()
+
+    def frame_camera(self) -> None:
+        """Point a browser tab's camera at the whole chain (a server target has none)."""
+        camera = getattr(self.target, "camera", None)
+        if camera is None:
+            return
+        ball = self.model.chain.boundingBall
+        centre, radius = np.asarray(ball.c, dtype=float), float(ball.r) + self._r
+        direction = np.array([1.0, -1.2, 0.8]) / np.linalg.norm([1.0, -1.2, 0.8])
+        camera.up_direction = (0.0, 0.0, 1.0)
+        camera.position = centre + 2.6 * radius * direction
+        camera.look_at = centre
 
     def close(self) -> None:
         """Stop listening to the model (the tab closed)."""
@@ -225,13 +252,10 @@ class EditorView:
 
         node = _Node(self._new_uid(), joint)
         pose = np.asarray(joint.pose_matrix, dtype=float)
+        node.frame = self._add_frame(f"/chain/joint{node.uid}", pose, axes=joint.r)
         for part in joint_parts(joint, i):
             name = f"/chain/joint{node.uid}/{part.side or 'body'}"
-            node.handles.append(self._add_mesh(name, part, pose, JOINT_COLOR, ("joint", node)))
-        node.frame = self.scene.add_frame(
-            f"/frames/joint{node.uid}", axes_length=1.5 * joint.r, axes_radius=0.03 * joint.r,
-            wxyz=_wxyz(pose[:3, :3]), position=pose[:3, 3],
-        )  # fmt: skip
+            node.handles.append(self._add_mesh(name, part, pose, JOINT_COLOR, node))
         node.sent += 1
         return node
 
@@ -240,24 +264,31 @@ class EditorView:
 
         node = _Node(self._new_uid(), link)
         frame = np.asarray(link.start_frame, dtype=float)
+        node.frame = self._add_frame(f"/chain/link{node.uid}", frame, axes=None)
         chain = self.model.chain
         for part in link_parts(link, i, chain.numSides, self.model.document.twist_portion):
-            node.handles.append(self._add_mesh(f"/chain/link{node.uid}/{part.side}", part, frame,
-                                               LINK_COLOR, ("link", node)))  # fmt: skip
+            name = f"/chain/link{node.uid}/{part.side}"
+            node.handles.append(self._add_mesh(name, part, frame, LINK_COLOR, None))
         node.sent += 1
         return node
 
-    def _add_mesh(self, name: str, part, frame: np.ndarray, color, owner):
+    def _add_frame(self, name: str, frame: np.ndarray, axes: float | None):
+        """The node a part's meshes hang from, at ``frame`` (a joint's shows its axes): a
+        rigid move sets its pose only."""
+        return self.scene.add_frame(
+            name, show_axes=axes is not None, axes_length=1.5 * (axes or 1.0),
+            axes_radius=0.03 * (axes or 1.0), wxyz=_wxyz(frame[:3, :3]), position=frame[:3, 3],
+        )  # fmt: skip
+
+    def _add_mesh(self, name: str, part, frame: np.ndarray, color, joint_node):
+        """A part's mesh under its node, in the node's frame."""
         R, t = frame[:3, :3], frame[:3, 3]
         local = (part.vertices - t) @ R
-        handle = self.scene.add_mesh_simple(
-            name, local, part.faces, color=color, flat_shading=True,
-            wxyz=_wxyz(R), position=t,
-        )  # fmt: skip
+        handle = self.scene.add_mesh_simple(name, local, part.faces, color=color,
+                                            flat_shading=True)  # fmt: skip
         self.meshes_sent += 1
-        if owner[0] == "joint":
-            node = owner[1]
-            handle.on_click(lambda event, node=node: self._click(node))
+        if joint_node is not None:
+            handle.on_click(lambda event, node=joint_node: self._click(node))
         return handle
 
     @_locked
@@ -266,11 +297,7 @@ class EditorView:
             self.model.select(self._joints.index(node))
 
     def _move(self, node: _Node, frame: np.ndarray) -> None:
-        wxyz, t = _wxyz(frame[:3, :3]), frame[:3, 3]
-        for handle in node.handles:
-            handle.wxyz, handle.position = wxyz, t
-        if node.frame is not None:
-            node.frame.wxyz, node.frame.position = wxyz, t
+        node.frame.wxyz, node.frame.position = _wxyz(frame[:3, :3]), frame[:3, 3]
 
     def _update_scene(self, change: Change) -> None:
         chain = self.model.chain
@@ -348,7 +375,7 @@ class EditorView:
             return f"clear: minimum clearance {report.min_clearance:.4g}"
         lines = [f"**self-intersecting**: {len(report.pairs)} pair(s), deepest overlap "
                  f"{-report.min_clearance:.4g}"]  # fmt: skip
-        lines += [f"- {pair}" for pair in report.pairs[:8]]
+        lines += [""] + [f"- {pair}" for pair in report.pairs[:8]]
         return "\n".join(lines)
 
     def colour_of(self, kind: str, index: int) -> tuple[int, int, int]:
@@ -508,8 +535,8 @@ class EditorView:
         if selected is None:
             return "No joint selected: click one."
         row = self.model.joint_table()[selected]
-        lines = [f"**{row.type}** {row.name or ''}", f"state {row.state:.4g} in "
-                 f"[{row.state_range[0]:.4g}, {row.state_range[1]:.4g}]"]  # fmt: skip
+        lines = [f"**{selected}: {row.type}** {row.name or ''}", "", f"state {row.state:.4g} in "
+                 f"[{row.state_range[0]:.4g}, {row.state_range[1]:.4g}]", ""]  # fmt: skip
         lines += [f"- {k}: {v:.4g}" if isinstance(v, float) else f"- {k}: {v}"
                   for k, v in row.parameters.items()]  # fmt: skip
         return "\n".join(lines)

@@ -68,8 +68,7 @@ def test_state_change_resends_only_the_joint(view):
 def test_moved_meshes_get_the_new_pose(view):
     assert view.act(lambda: view.model.slide(2, 1.0, propagate=True)).ok
     pose = view.model.chain.Joints[-1].pose_matrix
-    for handle in [*view._joints[-1].handles, view._joints[-1].frame]:
-        assert_allclose(handle.position, pose[:3, 3], atol=1e-6)
+    assert_allclose(view._joints[-1].frame.position, pose[:3, 3], atol=1e-6)
 
 
 def test_drag_along_the_axis_slides_the_joint(view):
@@ -189,3 +188,14 @@ def test_cli_edit_refuses_a_bad_port(capsys):
 def test_cli_edit_refuses_a_missing_design(capsys, tmp_path):
     assert main(["edit", str(tmp_path / "missing.json"), "--port", "0"]) == 1
     assert capsys.readouterr().err.startswith("kinegami edit: error:")
+
+
+def test_quaternions_of_rotations():
+    from scipy.spatial.transform import Rotation
+
+    from kinegami.editor.view import _matrix, _wxyz
+
+    flips = [np.diag(d) for d in ([1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0])]
+    rotations = [np.eye(3), *flips, *Rotation.random(50, random_state=1).as_matrix()]
+    for R in rotations:
+        assert_allclose(_matrix(_wxyz(R)), R, atol=1e-12)
