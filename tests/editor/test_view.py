@@ -199,3 +199,11 @@ def test_quaternions_of_rotations():
     rotations = [np.eye(3), *flips, *Rotation.random(50, random_state=1).as_matrix()]
     for R in rotations:
         assert_allclose(_matrix(_wxyz(R)), R, atol=1e-12)
+
+
+def test_clicking_a_joint_mesh_selects_it(view):
+    node = view._joints[4]
+    view._click(node)
+    assert view.model.selected == 4
+    assert view._gizmo.visible
+    assert_allclose(view._gizmo.position, view.model.chain.Joints[4].pose_matrix[:3, 3], atol=1e-6)
