@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from kinegami.errors import InvalidParameterError
+from kinegami.errors import UnknownModuleKindError
 
 if TYPE_CHECKING:
     from kinegami.pattern._prism import Prism
@@ -44,11 +44,6 @@ Unsnapped = Callable[["Prism", "TubularPattern", Mapping[str, Any]], tuple["Tubu
 Fold = Callable[["Prism", "TubularPattern", Mapping[str, Any]], tuple[Any, Any]]
 
 
-class UnknownModuleKindError(InvalidParameterError, KeyError):
-    """No catalog entry is registered under a module kind."""
-
-    def __str__(self) -> str:  # KeyError would quote the message
-        return str(self.args[0]) if self.args else ""
 
 
 def identity_unsnapped(prism: Prism, catalog: TubularPattern, params: Mapping[str, Any]):
