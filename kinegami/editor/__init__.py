@@ -1,7 +1,7 @@
 """The design editor's model: a design as a document, commands with undo, and change events.
 
-Plain Python, no web code: the browser view (``kinegami edit``, to come) binds its widgets to
-these calls. See docs/editor.md.
+Plain Python, no web code: the browser view (``kinegami edit``: kinegami.editor.view and
+kinegami.editor.server, on viser) binds its widgets to these calls. See docs/editor.md.
 
 >>> from kinegami.editor import EditorModel
 >>> model = EditorModel()                      # the starter design of `kinegami new`
