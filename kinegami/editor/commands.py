@@ -9,6 +9,7 @@ runs commands, keeps the undo history and tells views what changed. See docs/edi
 
 from __future__ import annotations
 
+import abc
 import math
 import warnings
 from collections.abc import Mapping, Sequence
@@ -337,15 +338,15 @@ def _check_name(document: Document, name, j: int | None = None):
 
 
 # --- commands ------------------------------------------------------------------------------------
-class Command:
+class Command(abc.ABC):
     """Base class of the editor's commands (frozen dataclasses; see docs/editor.md)."""
 
     #: Short text for menus and the undo history.
     label: ClassVar[str] = "command"
 
+    @abc.abstractmethod
     def apply(self, document: Document) -> Outcome:
         """The document this command makes of ``document`` (raises CommandError)."""
-        raise NotImplementedError
 
     def describe(self) -> str:
         """One line for the undo history, e.g. ``slide joint 3 by 0.5``."""
@@ -471,7 +472,7 @@ class DeleteJoint(Command):
 
 
 @dataclass(frozen=True)
-class _AxisMove(Command):
+class _AxisMove(Command, abc.ABC):
     joint: int | str
     amount: float
     propagate: bool = True
@@ -483,8 +484,9 @@ class _AxisMove(Command):
     def describe(self) -> str:
         return f"{self.label} {self.joint!r} by {self.amount!r}"
 
+    @abc.abstractmethod
     def _check_amount(self, r: float) -> float:
-        raise NotImplementedError
+        """The move's amount, checked (raises CommandError)."""
 
     def apply(self, document: Document) -> Outcome:
         j = resolve_joint(document, self.joint)
