@@ -215,12 +215,21 @@ def flatten(pattern: TubularPattern, *, skip_creases_on_cut: bool = False) -> Sh
         flat = np.abs(ys[:, 1] - ys[:, 0]) <= tol
         on_edge = (np.abs(ys - y0) <= tol).all(axis=1) | (np.abs(ys - (y0 + H)) <= tol).all(axis=1)
         base, labels = base[~(flat & on_edge)], labels[~(flat & on_edge)]
-    # its copies shifted by -W, 0, +W (no other copy can reach the sheet: |dx| < W/2, b <= W/4)
-    shifts = np.array([0.0, W, -W])
-    copies = np.repeat(base[None], 3, axis=0)
-    copies[..., 0] += shifts[:, None, None]
-    copies = copies.reshape(-1, 2, 2)
-    labels = np.tile(labels, 3)
+    # its copies shifted by -W, 0, +W (no other copy can reach the sheet: |dx| < W/2, b <= W/4);
+    # a shifted copy lying wholly beyond the strip (past the snap distance) cannot keep a piece,
+    # so only the copies near the seam are clipped (same result, in the same order)
+    xs = base[:, :, 0]
+    reach = snap + tol
+    right = base[xs.min(axis=1) + W <= xmax + reach].copy()
+    right[..., 0] += W
+    left = base[xs.max(axis=1) - W >= xmin - reach].copy()
+    left[..., 0] -= W
+    copies = np.concatenate([base, right, left])
+    labels = np.concatenate([
+        labels,
+        labels[xs.min(axis=1) + W <= xmax + reach],
+        labels[xs.max(axis=1) - W >= xmin - reach],
+    ])
 
     keep, clipped = clip_segments(copies, xmin, xmax, tol, snap)
     creases, labels = clipped[keep], labels[keep]
