@@ -1,5 +1,5 @@
 """``python -m kinegami``: the ``kinegami`` command, run from the package that Python imports
-(the source tree when it is on the path; tests/test_cli.py runs the command this way)."""
+(the source tree when it is on the path; tests/cli/helpers.py runs the command this way)."""
 
 from kinegami.cli import main
 

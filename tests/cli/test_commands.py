@@ -11,74 +11,22 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-EXAMPLE1 = ROOT / "examples" / "designs" / "example1.json"
-
-DESIGN = {
-    "format": "kinegami-design",
-    "version": 1,
-    "name": "Example 1A",
-    "units": "mm",
-    "numSides": 4,
-    "r": 1,
-    "joints": [
-        {"type": "StartTip", "length": 1.5, "pose": [{"Trans": [3, 3, 0]}]},
-        {"type": "PrismaticJoint", "neutralLength": 3, "numLayers": 3,
-         "coneAngle": 0.7853981633974483, "pose": [{"Trans": [5, 5, 0]}]},
-        {"type": "RevoluteJoint", "totalBendingAngle": 3.141592653589793,
-         "pose": [{"Ry": 0.7853981633974483}]},
-        {"type": "EndTip", "length": 1.5, "pose": [{"Ry": 1.5707963267948966}]},
-    ],
-    "edits": [
-        {"op": "rotateJointAboutAxisOfMotion", "joint": 4, "angle": 0.5},
-    ],
-}  # fmt: skip
-
-
-def command() -> list[str]:
-    """The command as the tests run it: ``python -m kinegami`` from this source tree (see
-    :func:`source_env`), never an installed copy that may predate the last edit."""
-    return [sys.executable, "-m", "kinegami"]
-
-
-def source_env(**changes) -> dict[str, str]:
-    """The environment of a subprocess that imports kinegami from this checkout: the repository
-    first on PYTHONPATH, no display, the Agg backend; ``changes`` on top (None removes)."""
-    env = dict(os.environ, MPLBACKEND="Agg")
-    env.pop("DISPLAY", None)
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
-    for name, value in changes.items():
-        if value is None:
-            env.pop(name, None)
-        else:
-            env[name] = value
-    return env
-
-
-def run(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [*command(), *map(str, args)], capture_output=True, text=True, cwd=cwd,
-        env=env or source_env(), timeout=300,
-    )  # fmt: skip
-
-
-def write(path: Path, data) -> Path:
-    path.write_text(data if isinstance(data, str) else json.dumps(data, indent=2))
-    return path
+from .helpers import (
+    DESIGN,
+    EXAMPLE1,
+    GALLERY,
+    ROOT,
+    assert_clean_failure,
+    main_in_process,
+    run,
+    source_env,
+    write,
+)
 
 
 @pytest.fixture
 def design(tmp_path) -> Path:
     return write(tmp_path / "arm.json", DESIGN)
-
-
-def assert_clean_failure(result, *words):
-    assert result.returncode == 1, result
-    assert "Traceback" not in result.stderr + result.stdout
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1, result.stderr
-    for word in words:
-        assert word in lines[0], (word, lines[0])
 
 
 # --- help and version ----------------------------------------------------------------------
@@ -380,9 +328,6 @@ def test_chain_formats_through_the_export_registry(design, tmp_path):
     assert not [p for p in tmp_path.rglob(".kinegami-build-*")]
 
 
-GALLERY = sorted((ROOT / "examples" / "designs").glob("*.json"))
-
-
 @pytest.mark.parametrize("path", GALLERY, ids=[p.stem for p in GALLERY])
 def test_every_gallery_design_builds_from_the_command_line(path, tmp_path, capsys):
     """In-process (the subprocess path is covered above): exit 0 and the four files."""
@@ -404,18 +349,9 @@ def test_gallery_is_not_empty():
 
 
 # --- all or nothing, in-process (failures injected) ----------------------------------------
-def _main(*args) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from kinegami.cli import main
-
-    return main([str(a) for a in args])
-
-
 def test_failed_publish_restores_the_previous_build(design, tmp_path, monkeypatch, capsys):
     out = tmp_path / "o"
-    assert _main("build", design, "-o", out, "--formats", "dxf,svg") == 0
+    assert main_in_process("build", design, "-o", out, "--formats", "dxf,svg") == 0
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     (out / "keep.txt").write_text("user file")
     real_replace = os.replace
@@ -428,7 +364,7 @@ def test_failed_publish_restores_the_previous_build(design, tmp_path, monkeypatc
         return real_replace(src, dst)
 
     monkeypatch.setattr(os, "replace", failing_replace)
-    assert _main("build", design, "-o", out, "--formats", "dxf,svg") == 1
+    assert main_in_process("build", design, "-o", out, "--formats", "dxf,svg") == 1
     monkeypatch.setattr(os, "replace", real_replace)
     err = capsys.readouterr().err
     assert "Permission denied" in err and "Traceback" not in err
@@ -441,7 +377,7 @@ def test_failed_publish_restores_the_previous_build(design, tmp_path, monkeypatc
 def test_build_replaces_a_folder_in_the_way(design, tmp_path):
     out = tmp_path / "o"
     (out / "arm.dxf").mkdir(parents=True)
-    assert _main("build", design, "-o", out, "--formats", "dxf") == 0
+    assert main_in_process("build", design, "-o", out, "--formats", "dxf") == 0
     assert (out / "arm.dxf").is_file()
 
 
@@ -453,7 +389,7 @@ def test_exporter_errors_name_the_design_and_format(design, tmp_path, monkeypatc
         raise InvalidParameterError("needs 761 A4 pages, more than max_pages=200")
 
     monkeypatch.setattr(registry, "export", refuse)
-    assert _main("build", design, "-o", tmp_path / "o", "--formats", "pdf") == 1
+    assert main_in_process("build", design, "-o", tmp_path / "o", "--formats", "pdf") == 1
     err = capsys.readouterr().err.strip()
     assert "arm.json: pdf export: needs 761 A4 pages" in err
     assert not (tmp_path / "o").exists()
@@ -467,8 +403,8 @@ def test_pattern_errors_are_design_errors(design, tmp_path, monkeypatch, capsys)
         raise InvalidParameterError("bendingAngle too small to resolve")
 
     monkeypatch.setattr(KinematicChain, "creasePattern", broken)
-    assert _main("validate", design, "--build") == 1
-    assert _main("build", design, "-o", tmp_path / "o") == 1
+    assert main_in_process("validate", design, "--build") == 1
+    assert main_in_process("build", design, "-o", tmp_path / "o") == 1
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 2
     assert all("arm.json" in line and "bendingAngle too small" in line for line in lines)
@@ -482,7 +418,7 @@ def test_internal_errors_are_one_line(design, tmp_path, monkeypatch, capsys):
         raise ZeroDivisionError("oops\nsecond line")
 
     monkeypatch.setattr(cli, "_summary", bug)
-    assert _main("build", design, "-o", tmp_path / "o") == 1
+    assert main_in_process("build", design, "-o", tmp_path / "o") == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert "internal error" in err and "ZeroDivisionError: oops second line" in err
@@ -503,7 +439,7 @@ def test_sigterm_during_a_build_leaves_nothing(design, tmp_path, monkeypatch):
     monkeypatch.setattr(registry, "export", killed)  # what every --formats writer calls
     previous = signal.getsignal(signal.SIGTERM)
     with pytest.raises(SystemExit) as info:
-        _main("build", design, "-o", tmp_path / "o", "--formats", "dxf")
+        main_in_process("build", design, "-o", tmp_path / "o", "--formats", "dxf")
     assert info.value.code == 128 + signal.SIGTERM
     assert sorted(p.name for p in tmp_path.iterdir()) == ["arm.json"]
     assert signal.getsignal(signal.SIGTERM) is previous
@@ -511,14 +447,14 @@ def test_sigterm_during_a_build_leaves_nothing(design, tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("name", [".", "..", ".hidden", "a/b", "tab\tname"])
 def test_bad_output_names(design, tmp_path, name, capsys):
-    assert _main("build", design, "-o", tmp_path / "o", "--name", name) == 1
+    assert main_in_process("build", design, "-o", tmp_path / "o", "--name", name) == 1
     assert "--name" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
 
 
 def test_control_characters_in_the_design_name_are_escaped(tmp_path, capsys):
     path = write(tmp_path / "n.json", dict(DESIGN, name="a\nb\x1b[31mRED"))
-    assert _main("build", path, "-o", tmp_path / "o", "--formats", "dxf") == 0
+    assert main_in_process("build", path, "-o", tmp_path / "o", "--formats", "dxf") == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out
     assert out.splitlines()[0].startswith("a\\nb\\x1b[31mRED")
@@ -528,7 +464,7 @@ def test_formats_all(design, tmp_path):
     """Every registered format builds (the README's --formats all)."""
     from kinegami.cli import output_formats
 
-    assert _main("build", design, "-o", tmp_path / "o", "--formats", "all") == 0
+    assert main_in_process("build", design, "-o", tmp_path / "o", "--formats", "all") == 0
     names = sorted(p.name for p in (tmp_path / "o").iterdir())
     assert names == sorted(
         ["arm.dxf", "arm.svg", "arm_3d.png", "arm_pattern.png", "arm.fold", "arm.pdf",
@@ -543,7 +479,7 @@ def test_every_registered_suffix_is_a_build_format(design, tmp_path):
 
     for suffix in known_formats():
         out = tmp_path / suffix.lstrip(".")
-        assert _main("build", design, "-o", out, "--formats", suffix.lstrip(".")) == 0
+        assert main_in_process("build", design, "-o", out, "--formats", suffix.lstrip(".")) == 0
         assert (out / f"arm{suffix}").is_file()
 
 
@@ -552,7 +488,7 @@ def test_missing_exporter_library_is_one_line(design, tmp_path, monkeypatch, cap
     import sys
 
     monkeypatch.setitem(sys.modules, "matplotlib.backends.backend_pdf", None)
-    assert _main("build", design, "-o", tmp_path / "o", "--formats", "dxf,pdf") == 1
+    assert main_in_process("build", design, "-o", tmp_path / "o", "--formats", "dxf,pdf") == 1
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1
     assert "pdf export" in err and "pip install 'kinegami[pdf]'" in err

@@ -9,13 +9,13 @@ import shutil
 
 import numpy as np
 import pytest
-from test_cli import ROOT, assert_clean_failure, run, write
-from test_cli_check import fold_back
 
 from kinegami import ClearanceWarning, cli
 from kinegami.design import load_design, load_design_with_info
 from kinegami.joints import Waypoint
 from kinegami.optimize import CompactionError, tube_length
+
+from .helpers import ROOT, assert_clean_failure, fold_back, run, write
 
 EXAMPLE1 = ROOT / "examples" / "designs" / "example1.json"  # 6 joints and 3 waypoints, cm
 #: Seconds each start of the search may take in these tests (the search itself is not tested).

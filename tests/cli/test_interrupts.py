@@ -16,9 +16,10 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from test_cli import DESIGN, command, source_env
 
 from kinegami.export import publish
+
+from .helpers import DESIGN, command, main_in_process, source_env
 
 pytestmark = pytest.mark.skipif(publish.fcntl is None, reason="needs POSIX flock")
 
@@ -55,15 +56,6 @@ def out(tmp_path) -> Path:
     for name, data in OLD.items():
         (folder / name).write_bytes(data)
     return folder
-
-
-def _main(*args) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from kinegami.cli import main
-
-    return main([str(a) for a in args])
 
 
 def is_new_build(folder: Path, also: tuple[str, ...] = ()) -> bool:
@@ -113,7 +105,7 @@ def test_sigkill_while_publishing_is_recovered_by_the_next_build(design, out, st
     assert process.returncode == -signal.SIGKILL
     assert any(name.startswith(publish.PREFIX) for name in os.listdir(out))
     # a later build of another format: puts the old files back, and says so in one line
-    assert _main("build", design, "-o", out, "--formats", "fold") == 0
+    assert main_in_process("build", design, "-o", out, "--formats", "fold") == 0
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("kinegami build: note: ") and "interrupted" in err[0]
     if step >= 2:  # arm.dxf had been moved aside
@@ -122,7 +114,7 @@ def test_sigkill_while_publishing_is_recovered_by_the_next_build(design, out, st
     assert here.pop("arm.fold").startswith(b"{")
     assert here == OLD
     # and the next build of the same formats publishes normally, with nothing to recover
-    assert _main("build", design, "-o", out, "--formats", "dxf,svg") == 0
+    assert main_in_process("build", design, "-o", out, "--formats", "dxf,svg") == 0
     assert "note:" not in capsys.readouterr().err
     assert is_new_build(out, also=("arm.fold",))
 
@@ -139,9 +131,9 @@ def test_an_interrupt_at_any_move_in_process(design, out, monkeypatch, index, ca
         real(src, dst)
 
     monkeypatch.setattr(publish, "_move", interrupted)
-    assert _main("build", design, "-o", out, "--formats", "dxf,svg") == 130
+    assert main_in_process("build", design, "-o", out, "--formats", "dxf,svg") == 130
     assert snapshot(out) == OLD
     monkeypatch.setattr(publish, "_move", real)
-    assert _main("build", design, "-o", out, "--formats", "dxf,svg") == 0
+    assert main_in_process("build", design, "-o", out, "--formats", "dxf,svg") == 0
     assert "note:" not in capsys.readouterr().err  # nothing was left to recover
     assert is_new_build(out)

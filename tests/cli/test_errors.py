@@ -13,36 +13,25 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-EXAMPLE1 = ROOT / "examples" / "designs" / "example1.json"
+from .helpers import EXAMPLE1, assert_clean_failure, command, source_env
+
 NAME = "Bras \u00e0 3 axes \u2014 \u00fc"
 
 
-def _env(**changes) -> dict[str, str]:
-    """Runs the source tree (as tests/test_cli.py does), Agg backend, no display."""
-    env = dict(os.environ, MPLBACKEND="Agg")
-    env.pop("DISPLAY", None)
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
-    env.update(changes)
-    return env
-
-
 def run(*args, cwd=None, **env) -> subprocess.CompletedProcess:
+    """``kinegami args`` as a subprocess of this source tree, ``env`` added to its environment;
+    undecodable output replaced rather than raising (the tests pick the terminal's encoding)."""
     return subprocess.run(
-        [sys.executable, "-m", "kinegami", *map(str, args)], capture_output=True, text=True,
-        cwd=cwd, env=_env(**env), timeout=300, errors="replace",
+        [*command(), *map(str, args)], capture_output=True, text=True,
+        cwd=cwd, env=source_env(**env), timeout=300, errors="replace",
     )  # fmt: skip
 
 
 def one_line_failure(result, *words) -> str:
-    assert result.returncode == 1, result
-    assert "Traceback" not in result.stderr + result.stdout
+    """A clean failure (helpers.assert_clean_failure) that is no internal error; its line."""
+    assert_clean_failure(result, *words)
     assert "internal error" not in result.stderr
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1, result.stderr
-    for word in words:
-        assert word in lines[0], (word, lines[0])
-    return lines[0]
+    return result.stderr.strip()
 
 
 @pytest.fixture
@@ -158,7 +147,7 @@ INTERRUPT_AT = textwrap.dedent(
 def test_ctrl_c_during_start_up_is_one_line_and_exit_130(trigger, message):
     result = subprocess.run(
         [sys.executable, "-c", INTERRUPT_AT, trigger, "validate", "--build", EXAMPLE1],
-        capture_output=True, text=True, env=_env(), timeout=300,
+        capture_output=True, text=True, env=source_env(), timeout=300,
     )  # fmt: skip
     assert result.returncode == 130, result
     assert result.stderr == message + "\n"
@@ -170,5 +159,5 @@ def test_importing_the_library_keeps_ctrl_c_as_keyboard_interrupt():
         "import signal, kinegami, kinegami.cli; "
         "assert signal.getsignal(signal.SIGINT) is signal.default_int_handler"
     )
-    result = subprocess.run([sys.executable, "-c", code], env=_env(), capture_output=True)
+    result = subprocess.run([sys.executable, "-c", code], env=source_env(), capture_output=True)
     assert result.returncode == 0, result.stderr

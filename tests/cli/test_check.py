@@ -11,19 +11,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_cli import ROOT, assert_clean_failure, run, write
 
 from kinegami.clearance import chain_clearance, sweep
 from kinegami.design import load_design, load_design_with_info, read_design
 from kinegami.design.reader import origin_of
 from kinegami.joints import RevoluteJoint
 
-GALLERY = sorted((ROOT / "examples" / "designs").glob("*.json"))
-EXAMPLE1 = ROOT / "examples" / "designs" / "example1.json"  # in cm, r = 1 cm
+from .helpers import EXAMPLE1, GALLERY, ROOT, assert_clean_failure, fold_back, run, write
+
 DOUBLING_BACK = ROOT / "examples" / "designs" / "doubling_back.json"
 PLANAR = ROOT / "examples" / "designs" / "planar_joint.json"  # no pair is ever tested
 
-FIXED = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
 
 #: Reference output of the fold-back design 1.9 r apart (tests/clearance: parallel_return(1.9)).
 FOLD_BACK_PAIRS = [
@@ -38,33 +36,6 @@ MOTION_KEYS = {"samples", "seed", "colliding", "colliding_fraction", "worst_pair
                "free_intervals"}  # fmt: skip
 INTERVAL_KEYS = {"joint", "type", "name", "kind", "state", "range", "free"}
 PAIR_KEYS = {"first", "second", "clearance", "points"}
-
-
-def fold_back(d: float) -> dict:
-    """A design whose tube goes out along +x, over the top and back along -x, ``d`` r to the
-    side of its way out and past its start tip (every joint exactly where it is put)."""
-
-    def waypoint(point, xhat):
-        pose = {"point": point, "axis": [0, 0, 1], "xhat": xhat}
-        return {"type": "Waypoint", "pathIndex": 0, "pose": pose, **FIXED}
-
-    return {
-        "format": "kinegami-design",
-        "version": 1,
-        "name": "Fold back",
-        "units": "mm",
-        "numSides": 4,
-        "r": 1,
-        "joints": [
-            {"type": "StartTip", "name": "base", "length": 1.5,
-             "pose": {"point": [-10, 0, 0], "axis": [1, 0, 0]}},
-            waypoint([0, 0, 0], [1, 0, 0]),
-            waypoint([0, d, 6], [-1, 0, 0]),
-            waypoint([-10, d, 0], [-1, 0, 0]),
-            {"type": "EndTip", "name": "tool", "length": 1.5,
-             "pose": {"point": [-15.75, d, 0], "axis": [-1, 0, 0]}, **FIXED},
-        ],
-    }  # fmt: skip
 
 
 @pytest.fixture
