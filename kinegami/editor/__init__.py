@@ -11,26 +11,8 @@ kinegami.editor.server, on viser) binds its widgets to these calls. See docs/edi
 (True, True)
 """
 
-from kinegami.editor.commands import (
-    JOINT_TYPES,
-    KEEP,
-    PLACEMENTS,
-    AddJoint,
-    Command,
-    CommandError,
-    Compact,
-    DeleteJoint,
-    Outcome,
-    RenameJoint,
-    RollJoint,
-    SetJointParameters,
-    SetJointState,
-    SetJointStates,
-    SetOptions,
-    SlideJoint,
-    TransformAll,
-    TransformJoint,
-)
+from kinegami.editor import commands
+from kinegami.editor.commands import *  # noqa: F403 - the names of commands.__all__
 from kinegami.editor.document import Document, JointRow, joint_parameters
 from kinegami.editor.model import Change, CommandResult, EditorModel
 from kinegami.editor.patterns import PatternCache
@@ -43,22 +25,5 @@ __all__ = [
     "JointRow",
     "joint_parameters",
     "PatternCache",
-    "Command",
-    "CommandError",
-    "Outcome",
-    "AddJoint",
-    "DeleteJoint",
-    "SlideJoint",
-    "RollJoint",
-    "TransformJoint",
-    "TransformAll",
-    "SetJointParameters",
-    "RenameJoint",
-    "SetJointState",
-    "SetJointStates",
-    "Compact",
-    "SetOptions",
-    "JOINT_TYPES",
-    "PLACEMENTS",
-    "KEEP",
+    *commands.__all__,
 ]

@@ -11,7 +11,6 @@ from __future__ import annotations
 import copy
 import json
 import os
-import tempfile
 import warnings
 from dataclasses import dataclass
 from functools import cached_property
@@ -19,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from kinegami._atomic import write_atomic
 from kinegami.chain import KinematicChain
 from kinegami.design import DesignInfo, design_to_dict, dumps_design
 from kinegami.design.reader import (
@@ -41,7 +41,7 @@ from kinegami.joints import (
     Waypoint,
 )
 
-__all__ = ["Document", "JointRow", "joint_parameters", "fork_chain", "write_text_atomic"]
+__all__ = ["Document", "JointRow", "joint_parameters", "fork_chain"]
 
 
 def fork_chain(chain: KinematicChain) -> KinematicChain:
@@ -106,31 +106,6 @@ class JointRow:
     def movable(self) -> bool:
         """Whether the joint has a range of motion (revolute and prismatic joints)."""
         return self.state_range[0] != self.state_range[1]
-
-
-def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically: a temporary file in the same folder,
-    flushed to disk, then ``os.replace``; a failure leaves no temporary file and ``path`` as
-    it was."""
-    target = Path(os.fspath(path)).expanduser()
-    folder = target.parent if str(target.parent) else Path(".")
-    fd, temporary = tempfile.mkstemp(dir=folder, prefix=f".{target.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)
-        os.replace(temporary, target)
-    except BaseException:
-        try:
-            os.unlink(temporary)
-        except FileNotFoundError:
-            pass
-        raise
-    return target
 
 
 def _check_text(key: str, value) -> str | None:
@@ -307,7 +282,9 @@ class Document:
         return text
 
     def save(self, path: str | os.PathLike) -> Path:
-        """Write the design file ``path`` (suffix .json) atomically and return its path."""
+        """Write the design file ``path`` (suffix .json) atomically (:func:`kinegami._atomic.
+        write_atomic`: an interrupted or failed write leaves the old file and no temporary
+        file) and return its path."""
         if not isinstance(path, str | os.PathLike) or isinstance(os.fspath(path), bytes):
             raise InvalidTypeError(f"path must be a str or a path, got {path!r}")
         target = Path(os.fspath(path)).expanduser()
@@ -317,4 +294,4 @@ class Document:
             )
         if target.is_dir():
             raise InvalidParameterError(f"{os.fspath(path)!r} is a directory, not a file name")
-        return write_text_atomic(target, self.design_text)
+        return write_atomic(target, self.design_text)

@@ -1,70 +1,30 @@
-"""``kinegami edit`` end to end: the viser editor in headless Chromium (Debian's
-/usr/bin/chromium through Playwright, software WebGL), as tests/export/test_origami_simulator.py
-runs it. Marked ``browser``; they skip when playwright or chromium is missing, and fail then
+"""``kinegami edit`` end to end: the viser editor in headless Chromium (Debian's chromium
+through Playwright, software WebGL: tests/headless_chromium.py, shared with the Origami Simulator
+tests). Marked ``browser``; they skip when playwright or chromium is missing, and fail then
 instead when KINEGAMI_REQUIRE_BROWSER is set (CI). Each step saves a screenshot in the test's
 tmp folder.
 """
 
 from __future__ import annotations
 
-import os
 import time
 from pathlib import Path
 
+import headless_chromium
 import pytest
 
 from .helpers import EXAMPLE1
 
 pytestmark = pytest.mark.browser
 
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
 TIMEOUT = 60.0  # seconds for the page or the server to react (software rendering is slow)
-
-
-def chromium_path() -> Path:
-    return Path(os.environ.get("KINEGAMI_CHROMIUM", "/usr/bin/chromium"))
-
-
-def _missing() -> str | None:
-    try:
-        import playwright.sync_api  # noqa: F401
-    except ImportError:
-        return "playwright is not installed (pip install '.[dev]')"
-    try:
-        import viser  # noqa: F401
-    except ImportError:
-        return "viser is not installed (pip install '.[gui]')"
-    if not chromium_path().is_file():
-        return f"no chromium at {chromium_path()} (apt-get install chromium, or KINEGAMI_CHROMIUM)"
-    return None
 
 
 @pytest.fixture(scope="module")
 def browser():
-    missing = _missing()
-    if missing is not None:
-        if os.environ.get("KINEGAMI_REQUIRE_BROWSER"):
-            pytest.fail(f"browser tests required but {missing}")
-        pytest.skip(missing)
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(
-            executable_path=str(chromium_path()), args=CHROMIUM_ARGS
-        )
-        try:
-            yield browser
-        finally:
-            browser.close()
+    headless_chromium.require(headless_chromium.missing("viser"))
+    with headless_chromium.browser() as chromium:
+        yield chromium
 
 
 @pytest.fixture(scope="module")

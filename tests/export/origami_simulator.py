@@ -10,8 +10,8 @@ run is repeatable. The results are read from the page: the average vertex error 
 scaled to a unit bounding sphere), the nodes' flat positions and the creases' target angles.
 
 Where the simulator comes from: ``KINEGAMI_ORIGAMI_SIMULATOR`` or ``../shared/tools/
-OrigamiSimulator`` beside the repository; the browser: ``KINEGAMI_CHROMIUM`` or
-``/usr/bin/chromium`` (Debian's package; Playwright's own browser download is not used).
+OrigamiSimulator`` beside the repository; the browser: tests/headless_chromium.py (Debian's
+chromium, shared with the editor's browser tests).
 """
 
 from __future__ import annotations
@@ -26,28 +26,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from headless_chromium import chromium_path, launch
 
 REPO = Path(__file__).resolve().parents[2]
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
 
 
 def simulator_folder() -> Path:
     return Path(
         os.environ.get("KINEGAMI_ORIGAMI_SIMULATOR", REPO.parent / "shared/tools/OrigamiSimulator")
     )
-
-
-def chromium_path() -> Path:
-    return Path(os.environ.get("KINEGAMI_CHROMIUM", "/usr/bin/chromium"))
 
 
 @dataclass
@@ -153,9 +140,7 @@ class OrigamiSimulator:
         self.url = f"http://127.0.0.1:{self._server.server_address[1]}/index.html?model=none"
         self._playwright = sync_playwright().start()
         try:
-            self._browser = self._playwright.chromium.launch(
-                executable_path=str(self.chromium), args=CHROMIUM_ARGS
-            )
+            self._browser = launch(self._playwright, self.chromium)
         except BaseException:
             self._playwright.stop()
             self._server.shutdown()

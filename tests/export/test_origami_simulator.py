@@ -24,6 +24,7 @@ import math
 import os
 from pathlib import Path
 
+import headless_chromium
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -34,7 +35,6 @@ from kinegami.export.registry import export
 
 from .origami_simulator import (
     OrigamiSimulator,
-    chromium_path,
     handedness_agreement,
     match_nodes,
     shape_distance,
@@ -54,24 +54,14 @@ GALLERY = sorted(p.stem for p in DESIGN_DIR.glob("*.json"))
 
 def _missing() -> str | None:
     """Why the browser tests cannot run here, or None."""
-    try:
-        import playwright.sync_api  # noqa: F401
-    except ImportError:
-        return "playwright is not installed (pip install '.[dev]')"
     if not (simulator_folder() / "index.html").is_file():
         return f"no Origami Simulator at {simulator_folder()} (set KINEGAMI_ORIGAMI_SIMULATOR)"
-    if not chromium_path().is_file():
-        return f"no chromium at {chromium_path()} (apt-get install chromium, or KINEGAMI_CHROMIUM)"
-    return None
+    return headless_chromium.missing()
 
 
 @pytest.fixture(scope="module")
 def simulator():
-    missing = _missing()
-    if missing is not None:
-        if os.environ.get("KINEGAMI_REQUIRE_BROWSER"):
-            pytest.fail(f"browser tests required but {missing}")
-        pytest.skip(missing)
+    headless_chromium.require(_missing())
     with OrigamiSimulator() as sim:
         yield sim
 
