@@ -1,0 +1,658 @@
+"""The printed junction connector of a branch node (docs/junctions.md).
+
+A branch node B of a kinematic tree has a distal Dubins frame D and child links L_c, all
+starting at D. Near D the sibling tubes overlap; a 3D-printed connector holds them there. Its
+inputs are plain: the tube radius r, ``numSides`` n, D (4x4, world), the child links
+(:class:`~kinegami.links.LinkCSC`, each starting at D; children reached through zero-length
+waypoints are given by their own links), which child is the trunk (optional) and the options.
+Lengths are in the units of r; frames are 4x4 world arrays whose first axis is the tangent.
+
+* :func:`sibling_overlap_lengths`: the overlap length l_ov(c), the largest arc length sigma on
+  L_c at which the centreline is still within 2r of a sibling's centreline.
+* :func:`link_frame_at`: the frame on a link at arc length sigma (the transported Dubins frame).
+* :func:`junction_sockets`: where each child's socket ends (sigma_c = l_ov(c) + d_s) and where
+  its sheet starts (the frame at sigma_c - d_s), with the feasibility check sigma_c <= l(L_c).
+* :func:`junction_connector`: the watertight mesh (trimesh), built with manifold3d booleans
+  (the optional ``print`` extra).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+
+from kinegami.errors import ExporterUnavailableError, InvalidParameterError, InvalidTypeError
+from kinegami.geometry.csc_centreline import (
+    csc_distances,
+    csc_points,
+    csc_tangents,
+    csc_transported_frame,
+)
+from kinegami.links import LinkCSC
+from kinegami.validation import (
+    check_in_range,
+    check_int,
+    check_num_sides,
+    check_radius,
+)
+
+if TYPE_CHECKING:  # pragma: no cover
+    import trimesh
+
+__all__ = [
+    "ConnectorOptions",
+    "JunctionSocket",
+    "ParentSide",
+    "sibling_overlap_lengths",
+    "link_frame_at",
+    "junction_sockets",
+    "junction_connector",
+    "trunk_split_plane",
+    "split_connector",
+    "section_polygon",
+]
+
+#: What the connector does on the parent's side of D (docs/junctions.md).
+ParentSide = Literal["socket", "flange", "base", "none"]
+PARENT_SIDES: tuple[str, ...] = ("socket", "flange", "base", "none")
+
+#: Centreline points closer than this many r to a sibling's centreline overlap it.
+OVERLAP_FACTOR = 2.0
+#: Largest sampling step of the overlap search, in units of r.
+MAX_OVERLAP_STEP = 0.01
+
+
+# --- overlap lengths and frames -----------------------------------------------------------
+def _check_links(links, r: float | None = None) -> list[LinkCSC]:
+    if isinstance(links, LinkCSC) or not isinstance(links, Sequence):
+        raise InvalidTypeError(f"links must be a sequence of LinkCSC, got {type(links).__name__}")
+    links = list(links)
+    for k, link in enumerate(links):
+        if not isinstance(link, LinkCSC):
+            raise InvalidTypeError(f"links[{k}] must be a LinkCSC, got {type(link).__name__}")
+        if r is not None and abs(link.r - r) > 1e-12 * r:
+            raise InvalidParameterError(
+                f"links[{k}] has r = {link.r!r}, the junction's r = {r!r}; every child link "
+                "must have the junction's tube radius"
+            )
+    if len(links) < 2:
+        raise InvalidParameterError(
+            f"links must hold at least 2 child links (a junction has siblings), got {len(links)}"
+        )
+    return links
+
+
+def _check_step(step, r: float) -> float:
+    if step is None:
+        return MAX_OVERLAP_STEP * r
+    return check_in_range(
+        "step",
+        step,
+        0.0,
+        MAX_OVERLAP_STEP * r,
+        high_inclusive=True,
+        range_text=f"(0, 0.01 r] = (0, {MAX_OVERLAP_STEP * r:g}] (r = {r:g})",
+    )
+
+
+def sibling_overlap_lengths(
+    links: Sequence[LinkCSC], r: float, step: float | None = None
+) -> np.ndarray:
+    """The overlap length of each child link with its siblings (units of r).
+
+    l_ov(c) = sup{sigma <= l(L_c) : the centreline point gamma_c(sigma) is within 2r of the
+    centreline of some sibling}: sampled every ``step`` <= 0.01 r (default 0.01 r), with
+    exact point-to-centreline distances, and the last crossing of 2r refined by bisection to
+    1e-12 r. All links start at the same point, so l_ov(c) >= min(2r, l(L_c)).
+
+    Parameters
+    ----------
+    links : the child links (at least 2), all starting at the branch node's distal frame.
+    r : tube radius.
+    step : sampling step along each link, in (0, 0.01 r].
+
+    Returns
+    -------
+    (k,) array, one overlap length per link, in link order.
+
+    Examples
+    --------
+    >>> a = LinkCSC(1, SE3(), SE3.Trans(10, 6, 0))
+    >>> b = LinkCSC(1, SE3(), SE3.Trans(10, -6, 0))
+    >>> sibling_overlap_lengths([a, b], 1.0).round(3).tolist()
+    [1.977, 1.977]
+    """
+    r = check_radius(r)
+    links = _check_links(links, r)
+    step = _check_step(step, r)
+    limit = OVERLAP_FACTOR * r
+    out = np.zeros(len(links))
+    for k, link in enumerate(links):
+        others = [other.path for j, other in enumerate(links) if j != k]
+        length = link.length
+
+        def gap(sigma, path=link.path, others=others):
+            P = csc_points(path, sigma)
+            return np.min([csc_distances(q, P) for q in others], axis=0) - limit
+
+        count = max(1, math.ceil(length / step))
+        sigma = np.linspace(0.0, length, count + 1)
+        inside = np.nonzero(gap(sigma) < 0.0)[0]
+        if inside.size == 0:  # cannot happen for links that start at one point
+            continue
+        i = int(inside[-1])
+        if i == count:
+            out[k] = length
+            continue
+        lo, hi = float(sigma[i]), float(sigma[i + 1])
+        while hi - lo > 1e-12 * r:
+            mid = 0.5 * (lo + hi)
+            if gap(np.array([mid]))[0] < 0.0:
+                lo = mid
+            else:
+                hi = mid
+        out[k] = hi
+    return out
+
+
+def link_frame_at(link: LinkCSC, sigma: float) -> np.ndarray:
+    """The frame on ``link`` at arc length ``sigma`` (4x4 world array, first axis = tangent).
+
+    The link's start Dubins frame transported along its centreline: for sigma <= r theta1 the
+    frame after one elbow of angle sigma / r (same rotation-axis angle phi1 as arc 1); on the
+    straight part F1 Trans(sigma - r theta1, 0, 0) with F1 the frame after arc 1 (the roll
+    before the link's twist fitting); on arc 2 that frame turned about arc 2's axis.
+    ``sigma`` must lie in [0, l(L)].
+
+    Examples
+    --------
+    >>> link = LinkCSC(1, SE3(), SE3.Trans(10, 4, 0))
+    >>> F = link_frame_at(link, link.length)
+    >>> bool(np.allclose(F[:3, 3], (10, 4, 0)))
+    True
+    """
+    if not isinstance(link, LinkCSC):
+        raise InvalidTypeError(f"link must be a LinkCSC, got {type(link).__name__}")
+    length = link.length
+    sigma = check_in_range(
+        "sigma",
+        sigma,
+        0.0,
+        length,
+        low_inclusive=True,
+        high_inclusive=True,
+        range_text=f"[0, {length:.6g}] (the link's length)",
+    )
+    return csc_transported_frame(link.path, link.start_frame, sigma)
+
+
+# --- options -------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ConnectorOptions:
+    """Dimensions of a printed junction connector (lengths in the units of r).
+
+    ``None`` means the default for the tube radius r (``resolved(r)`` fills them in).
+
+    Attributes
+    ----------
+    thickness : sheet thickness t, in [0, 0.5 r] (default 0.01 r).
+    clearance : gap delta between the paper and the socket, in [0, 0.5 r] (default 0.02 r).
+    wall : wall thickness w of the connector, in (0, 2 r] (default 0.2 r).
+    socket_depth : how far each paper tube reaches into its socket, d_s, in (0, 100 r]
+        (default r).
+    extension : how far the voids reach past the open ends, epsilon, in (0, r]
+        (default 0.01 r).
+    plate : thickness of the flange and of the base plate, in (0, 10 r] (default = wall).
+    mitre_angle : largest turn of one mitred prism where a channel follows an arc, in
+        (0, pi/2] (default pi/16).
+    """
+
+    thickness: float | None = None
+    clearance: float | None = None
+    wall: float | None = None
+    socket_depth: float | None = None
+    extension: float | None = None
+    plate: float | None = None
+    mitre_angle: float = math.pi / 16
+
+    def resolved(self, r: float) -> ConnectorOptions:
+        """The options with every default filled in for the tube radius ``r``, checked."""
+        r = check_radius(r)
+
+        def length(name, value, default, low, high, low_inclusive):
+            if value is None:
+                value = default
+            low_text = "[" if low_inclusive else "("
+            return check_in_range(
+                name,
+                value,
+                low * r,
+                high * r,
+                low_inclusive=low_inclusive,
+                high_inclusive=True,
+                range_text=(
+                    f"{low_text}{low:g} r, {high:g} r] = {low_text}{low * r:g}, {high * r:g}] "
+                    f"(r = {r:g})"
+                ),
+            )
+
+        wall = length("wall", self.wall, 0.2 * r, 0.0, 2.0, False)
+        return ConnectorOptions(
+            thickness=length("thickness", self.thickness, 0.01 * r, 0.0, 0.5, True),
+            clearance=length("clearance", self.clearance, 0.02 * r, 0.0, 0.5, True),
+            wall=wall,
+            socket_depth=length("socket_depth", self.socket_depth, r, 0.0, 100.0, False),
+            extension=length("extension", self.extension, 0.01 * r, 0.0, 1.0, False),
+            plate=length("plate", self.plate, wall, 0.0, 10.0, False),
+            mitre_angle=check_in_range(
+                "mitre_angle",
+                self.mitre_angle,
+                0.0,
+                math.pi / 2,
+                high_inclusive=True,
+                range_text="(0, pi/2]",
+            ),
+        )
+
+    def inner_radius(self, r: float, numSides: int) -> float:
+        """Circumradius R_in = r + (t + delta) / cos(pi/n) of the voids (offsets normal to the
+        faces). Call on resolved options."""
+        return r + (self.thickness + self.clearance) / math.cos(math.pi / numSides)
+
+    def outer_radius(self, r: float, numSides: int) -> float:
+        """Circumradius R_out = R_in + w / cos(pi/n) of the channels. Call on resolved options."""
+        return self.inner_radius(r, numSides) + self.wall / math.cos(math.pi / numSides)
+
+    def paper_radius(self, r: float, numSides: int) -> float:
+        """Circumradius r + t / cos(pi/n) of the outside of a paper tube of thickness t."""
+        return r + self.thickness / math.cos(math.pi / numSides)
+
+
+def _options(options: ConnectorOptions | None, r: float) -> ConnectorOptions:
+    if options is None:
+        options = ConnectorOptions()
+    elif not isinstance(options, ConnectorOptions):
+        raise InvalidTypeError(
+            f"options must be a ConnectorOptions or None, got {type(options).__name__}"
+        )
+    return options.resolved(r)
+
+
+# --- sockets -------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class JunctionSocket:
+    """Where one child's tube meets the connector (lengths in units of r, along the link).
+
+    Attributes
+    ----------
+    child : index of the child in the links given.
+    trunk : True for the trunk (a sleeve over [-d_s, overlap] around the continuous tube).
+    overlap : l_ov(c).
+    socket_end : sigma_c = l_ov(c) + d_s, where the connector ends (trunk: l_ov(t)).
+    sheet_start : sigma_c - d_s = l_ov(c), where the child's paper tube (its sheet) starts
+        (trunk: None, its sheet runs through).
+    frame : read-only 4x4 frame on the link at ``sheet_start`` (trunk: at ``socket_end``).
+    link_length : l(L_c).
+    """
+
+    child: int
+    trunk: bool
+    overlap: float
+    socket_end: float
+    sheet_start: float | None
+    frame: np.ndarray
+    link_length: float
+
+
+def _check_frame(D, r: float) -> np.ndarray:
+    try:
+        D = np.array(getattr(D, "A", D), dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidTypeError(f"D must be a 4x4 array or SE3, got {type(D).__name__}") from None
+    if D.shape != (4, 4) or not np.all(np.isfinite(D)):
+        raise InvalidParameterError(f"D must be a finite 4x4 frame, got shape {D.shape}")
+    R = D[:3, :3]
+    if (
+        np.abs(R.T @ R - np.eye(3)).max() > 1e-9
+        or np.linalg.det(R) < 0
+        or np.abs(D[3] - (0, 0, 0, 1)).max() > 1e-12
+    ):
+        raise InvalidParameterError("D must be a rigid transform (rotation and translation)")
+    return D
+
+
+def _check_starts(links: list[LinkCSC], D: np.ndarray, r: float) -> None:
+    for k, link in enumerate(links):
+        S = link.start_frame
+        scale = max(1.0, float(np.abs(D[:3, 3]).max()) / r)
+        if (
+            float(np.abs(S[:3, 3] - D[:3, 3]).max()) > 1e-9 * r * scale
+            or float(np.abs(S[:3, :3] - D[:3, :3]).max()) > 1e-9
+        ):
+            raise InvalidParameterError(
+                f"links[{k}] must start at the branch node's distal frame D: it starts at "
+                f"{np.round(S[:3, 3], 6).tolist()} with axes {np.round(S[:3, :3], 6).tolist()}, "
+                f"D is at {np.round(D[:3, 3], 6).tolist()} with axes "
+                f"{np.round(D[:3, :3], 6).tolist()}"
+            )
+
+
+def _check_trunk(trunk, count: int) -> int | None:
+    if trunk is None:
+        return None
+    trunk = check_int("trunk", trunk, 0)
+    if trunk >= count:
+        raise InvalidParameterError(
+            f"trunk must be None or a child index in [0, {count - 1}], got {trunk}"
+        )
+    return trunk
+
+
+def junction_sockets(
+    links: Sequence[LinkCSC],
+    r: float,
+    *,
+    trunk: int | None = None,
+    options: ConnectorOptions | None = None,
+    step: float | None = None,
+) -> tuple[JunctionSocket, ...]:
+    """The socket of each child: overlap, socket end, sheet start and its frame.
+
+    sigma_c = l_ov(c) + d_s for every child but the trunk; the child's sheet starts at
+    sigma_c - d_s, at the frame :func:`link_frame_at` gives there. Feasible only if
+    sigma_c <= l(L_c): otherwise InvalidParameterError (naming the child, sigma_c and the link
+    length); slide the child along its axis or re-place it first. The trunk's sleeve ends at
+    l_ov(t) and is always feasible.
+    """
+    r = check_radius(r)
+    links = _check_links(links, r)
+    trunk = _check_trunk(trunk, len(links))
+    opts = _options(options, r)
+    overlaps = sibling_overlap_lengths(links, r, step)
+    sockets = []
+    for k, (link, ov) in enumerate(zip(links, overlaps, strict=True)):
+        length = link.length
+        if k == trunk:
+            frame = link_frame_at(link, float(ov))
+            frame.setflags(write=False)
+            sockets.append(JunctionSocket(k, True, float(ov), float(ov), None, frame, length))
+            continue
+        end = float(ov) + opts.socket_depth
+        if end > length + 1e-12 * r:
+            raise InvalidParameterError(
+                f"junction child {k} is infeasible: its socket would end at sigma_c = l_ov + d_s "
+                f"= {ov:.6g} + {opts.socket_depth:.6g} = {end:.6g}, past the end of its link "
+                f"(length {length:.6g}); sigma_c must lie in [l_ov + d_s, l(L_c)] = "
+                f"[{end:.6g}, {length:.6g}], which is empty. Slide the child along its axis (or "
+                "re-place it) so that its link is longer, or reduce socket_depth"
+            )
+        end = min(end, length)
+        start = end - opts.socket_depth
+        frame = link_frame_at(link, start)
+        frame.setflags(write=False)
+        sockets.append(JunctionSocket(k, False, float(ov), end, start, frame, length))
+    return tuple(sockets)
+
+
+# --- geometry of the channels -----------------------------------------------------------------
+def section_polygon(frame: np.ndarray, radius: float, numSides: int) -> np.ndarray:
+    """(n, 3) vertices of the n-gon of circumradius ``radius`` in the (b, c) plane of
+    ``frame``, vertex k at angle (k + 1/2) 2 pi / n from b (docs/theory/patterns.md §1)."""
+    psi = (np.arange(numSides) + 0.5) * 2.0 * math.pi / numSides
+    F = np.asarray(frame, dtype=float)
+    return (
+        F[:3, 3]
+        + radius * np.cos(psi)[:, None] * F[:3, 1]
+        + radius * np.sin(psi)[:, None] * F[:3, 2]
+    )
+
+
+@dataclass(frozen=True)
+class _Sweep:
+    """A polyline centreline with a frame per leg: leg i runs from points[i] to points[i+1]
+    along frames[i][:3, 0]; consecutive legs meet in their bisector plane."""
+
+    points: np.ndarray  # (m + 1, 3)
+    frames: np.ndarray  # (m, 4, 4)
+
+
+def _link_sweep(link: LinkCSC, s0: float, s1: float, max_angle: float) -> _Sweep:
+    """The link's centreline over [s0, s1] as mitred legs (arcs split into sub-elbows of at
+    most ``max_angle``, each from the arc to the crossing of its tangents and back), extended
+    straight along the tangent before 0 and past the link's end."""
+    path = link.path
+    r = link.r
+    length = link.length
+    l1 = r * path.theta1
+    l2 = l1 + path.tMag
+    a0, a1 = max(s0, 0.0), min(s1, length)
+    points = [csc_points(path, [a0])[0] + min(s0, 0.0) * csc_tangents(path, [0.0])[0]]
+    frames = [csc_transported_frame(path, link.start_frame, a0)]
+    for lo, hi in ((0.0, l1), (l2, length)):
+        lo, hi = max(lo, a0), min(hi, a1)
+        if hi - lo <= 1e-12 * r:
+            continue
+        count = max(1, math.ceil((hi - lo) / r / max_angle - 1e-12))
+        beta = (hi - lo) / r / count
+        half = r * math.tan(beta / 2.0)
+        for j in range(count):
+            F = csc_transported_frame(path, link.start_frame, lo + j * r * beta)
+            points.append(F[:3, 3] + half * F[:3, 0])
+            frames.append(csc_transported_frame(path, link.start_frame, lo + (j + 1) * r * beta))
+    end = csc_points(path, [a1])[0] + max(s1 - length, 0.0) * csc_tangents(path, [length])[0]
+    points.append(end)
+    return _Sweep(np.array(points), np.array(frames))
+
+
+def _straight_sweep(frame: np.ndarray, s0: float, s1: float) -> _Sweep:
+    """A straight leg along the frame's first axis over [s0, s1] (frame origin at 0)."""
+    F = np.asarray(frame, dtype=float)
+    a = F[:3, 0]
+    pts = np.array([F[:3, 3] + s0 * a, F[:3, 3] + s1 * a])
+    G = F.copy()
+    G[:3, 3] = pts[0]
+    return _Sweep(pts, G[None])
+
+
+def _leg_point_sets(sweep: _Sweep, radius: float, n: int, overlap: float = 0.0) -> list[np.ndarray]:
+    """The 2n vertices of each leg's mitred prism (its section projected along the leg onto
+    the planes at both ends), pushed ``overlap`` past each mitre plane so that neighbouring
+    legs overlap instead of touching (a union of solids that only touch is fragile)."""
+    P, F = sweep.points, sweep.frames
+    m = len(F)
+    A = F[:, :3, 0]
+    out = []
+    for i in range(m):
+        a = A[i]
+        # neighbouring legs differ in radius by ``overlap``: no coplanar side faces either
+        R = radius + (i % 2) * overlap
+        n0 = a if i == 0 else A[i - 1] + A[i]
+        n1 = a if i == m - 1 else A[i] + A[i + 1]
+        G = F[i].copy()
+        G[:3, 3] = P[i]
+        poly = section_polygon(G, R, n)
+        ends = []
+        for q, normal, push in (
+            (P[i], n0, -overlap if i > 0 else 0.0),
+            (P[i + 1], n1, overlap if i < m - 1 else 0.0),
+        ):
+            lam = ((q - poly) @ normal) / float(a @ normal) + push
+            ends.append(poly + lam[:, None] * a)
+        out.append(np.vstack(ends))
+    return out
+
+
+def _manifold():
+    try:
+        import manifold3d
+    except ImportError as exc:
+        missing = getattr(exc, "name", None) or "manifold3d"
+        raise ExporterUnavailableError(
+            f"the junction connector mesh is not available: cannot import {missing} ({exc}); "
+            "to add it: pip install 'kinegami[print]'"
+        ) from exc
+    return manifold3d
+
+
+def _solid(mf, point_sets: list[np.ndarray]):
+    """Union of the convex hulls of the point sets (empty hulls of flat legs dropped)."""
+    hulls = [mf.Manifold.hull_points(np.ascontiguousarray(p, dtype=float)) for p in point_sets]
+    hulls = [h for h in hulls if not h.is_empty()]
+    if not hulls:
+        return mf.Manifold()
+    return mf.Manifold.batch_boolean(hulls, mf.OpType.Add)
+
+
+def _to_trimesh(solid):
+    import trimesh
+
+    mesh = solid.to_mesh64()
+    vertices = np.asarray(mesh.vert_properties, dtype=float)[:, :3]
+    faces = np.asarray(mesh.tri_verts, dtype=np.int64)
+    return trimesh.Trimesh(vertices=vertices, faces=faces, process=True)
+
+
+def _check_parent_side(parent_side) -> str:
+    if parent_side not in PARENT_SIDES:
+        raise InvalidParameterError(
+            f"parent_side must be one of {', '.join(map(repr, PARENT_SIDES))}, got {parent_side!r}"
+        )
+    return parent_side
+
+
+def junction_connector(
+    r: float,
+    numSides: int,
+    D,
+    links: Sequence[LinkCSC],
+    *,
+    parent_side: ParentSide,
+    trunk: int | None = None,
+    options: ConnectorOptions | None = None,
+    step: float | None = None,
+) -> trimesh.Trimesh:
+    """The printed junction connector of a branch node as one watertight mesh (world frame).
+
+    Each child c gets a channel: the n-gon section of the transported Dubins frame swept along
+    its centreline over [0, sigma_c] (straight parts as prisms, arcs as mitred prisms of at
+    most ``options.mitre_angle``), outer circumradius R_out, void R_in (see
+    :class:`ConnectorOptions`); the body is the union of the outer channels minus the union
+    of the voids, which reach ``options.extension`` past every open end. The trunk (if given)
+    gets a sleeve over [-d_s, l_ov(t)] open at both ends instead of a socket.
+
+    ``parent_side`` (docs/junctions.md) says what the connector does behind D, along -a_D:
+    ``"socket"``: a socket over [-d_s, 0] for a parent that ends in a plain tube at least d_s
+    long; ``"flange"``: an annular plate (R_in to R_out, thickness ``options.plate``) just
+    behind D, glued to the parent's distal end; ``"base"``: a closed plate of that thickness
+    (a root waypoint); ``"none"``: the hub stays open at D. With a trunk, ``"socket"`` is the
+    sleeve's lower part.
+
+    Parameters
+    ----------
+    r : tube radius. numSides : n, even >= 4.
+    D : the branch node's distal Dubins frame (4x4 array or SE3, world).
+    links : the child links (at least 2), each starting at D.
+    parent_side : "socket", "flange", "base" or "none" (keyword, no default: the caller knows
+        how the parent ends).
+    trunk : index in ``links`` of the child whose tube runs through the hub, or None.
+    options : :class:`ConnectorOptions` (defaults: t = 0.01 r, delta = 0.02 r, w = 0.2 r,
+        d_s = r).
+    step : sampling step of the overlap search (:func:`sibling_overlap_lengths`).
+
+    Raises
+    ------
+    InvalidParameterError : a child whose socket would end past its link (sigma_c > l(L_c)),
+        links that do not start at D, bad options.
+    ExporterUnavailableError : manifold3d is not installed (``pip install 'kinegami[print]'``).
+    """
+    r = check_radius(r)
+    n = check_num_sides(numSides)
+    D = _check_frame(D, r)
+    links = _check_links(links, r)
+    _check_starts(links, D, r)
+    parent_side = _check_parent_side(parent_side)
+    opts = _options(options, r)
+    sockets = junction_sockets(links, r, trunk=trunk, options=opts, step=step)
+    mf = _manifold()
+    return _to_trimesh(_connector_solid(mf, n, D, links, sockets, parent_side, opts, r))
+
+
+#: Size of the deliberate offsets that keep the boolean kernel away from coincident faces
+#: (units of r): neighbouring legs of a channel overlap by this and alternate their radius by
+#: it, and child k's channel is 2 (k + 1) times this larger than the nominal one.
+_SEPARATION = 2e-5
+
+
+def _connector_solid(mf, n, D, links, sockets, parent_side, opts, r):
+    R_in = opts.inner_radius(r, n)
+    R_out = opts.outer_radius(r, n)
+    eps = opts.extension
+    d_s = opts.socket_depth
+    eta = _SEPARATION * r
+    # how far the parts reach behind D (outer) and whether the voids open there
+    if parent_side == "socket":
+        back, open_back = d_s, True
+    elif parent_side == "flange":
+        back, open_back = opts.plate, True
+    elif parent_side == "base":
+        back, open_back = opts.plate, False
+    else:
+        back, open_back = 0.0, True
+    outer_sets: list[np.ndarray] = []
+    inner_sets: list[np.ndarray] = []
+    # children start along a_D: a short overlap behind D joins them to the parent side
+    join = min(eps, back) if back > 0 else 0.0
+    for k, (link, sock) in enumerate(zip(links, sockets, strict=True)):
+        end = sock.socket_end
+        # channels that start in one frame would have coincident faces: a tiny radius step
+        # per child keeps the boolean kernel from leaving surfaces that touch along an edge
+        grow = 2 * (k + 1) * eta
+        outer = _link_sweep(link, -join, end, opts.mitre_angle)
+        inner = _link_sweep(link, -eps if open_back else 0.0, end + eps, opts.mitre_angle)
+        outer_sets += _leg_point_sets(outer, R_out + grow, n, eta)
+        inner_sets += _leg_point_sets(inner, R_in + grow, n, eta)
+    if back > 0.0:
+        outer_sets += _leg_point_sets(_straight_sweep(D, -back, 0.0), R_out, n, eta)
+        if open_back:
+            inner_sets += _leg_point_sets(_straight_sweep(D, -back - eps, eps), R_in, n, eta)
+    return _solid(mf, outer_sets) - _solid(mf, inner_sets)
+
+
+# --- the trunk sleeve in two halves ------------------------------------------------------------
+def trunk_split_plane(D, trunk_link: LinkCSC) -> tuple[np.ndarray, np.ndarray]:
+    """(point, unit normal) of the plane that splits a trunk sleeve into two halves.
+
+    The plane contains a_D and the trunk's first turn (the trunk's centreline over arc 1 and
+    the straight part lies in it), so each half comes off the continuous trunk tube sideways;
+    for a trunk that does not turn first, the plane (a_D, b_D).
+    """
+    D = _check_frame(D, trunk_link.r if isinstance(trunk_link, LinkCSC) else 1.0)
+    if not isinstance(trunk_link, LinkCSC):
+        raise InvalidTypeError(f"trunk_link must be a LinkCSC, got {type(trunk_link).__name__}")
+    path = trunk_link.path
+    normal = path.k1 if path.theta1 > 1e-9 else D[:3, 2]
+    normal = np.asarray(normal, dtype=float)
+    return D[:3, 3].copy(), normal / np.linalg.norm(normal)
+
+
+def split_connector(
+    mesh: trimesh.Trimesh, point, normal
+) -> tuple[trimesh.Trimesh, trimesh.Trimesh]:
+    """The two halves of a connector mesh cut by the plane through ``point`` with ``normal``
+    (first the half on the normal's side); each half is watertight."""
+    mf = _manifold()
+    point = np.asarray(point, dtype=float)
+    normal = np.asarray(normal, dtype=float)
+    normal = normal / np.linalg.norm(normal)
+    solid = mf.Manifold(
+        mf.Mesh64(
+            vert_properties=np.ascontiguousarray(mesh.vertices, dtype=np.float64),
+            tri_verts=np.ascontiguousarray(mesh.faces, dtype=np.uint64),
+        )
+    )
+    a, b = solid.split_by_plane(normal, float(point @ normal))
+    return _to_trimesh(a), _to_trimesh(b)
