@@ -92,19 +92,14 @@ def _propagate_flag(propogate, propagate) -> bool:
     return propagate
 
 
-class KinematicChain:
-    """A serial chain of tubular origami joints joined by CSC links.
+class _JointAssembly:
+    """What a chain and a tree share: the root, joints and links in world coordinates, one
+    bounding ball, placement of new joints and the all-or-nothing commit of every change.
 
-    Parameters
-    ----------
-    startJoint : the root joint (copied; world coordinates).
-    maxAnglePerElbow : largest turn of a single elbow fitting, in (0, pi] (default pi/2).
-
-    Examples
-    --------
-    >>> chain = KinematicChain(StartTip(4, 1, Pose=SE3.Trans(3, 3, 0), length=1.5))
-    >>> chain.append(PrismaticJoint(4, 1, 3, 3, np.pi / 4, SE3.Trans(5, 5, 0)))
-    2
+    ``Links[i]`` runs from the distal Dubins frame of joint i's parent to joint i's proximal
+    Dubins frame (``Links[0]`` is the empty path at the root). Subclasses say who the parent is
+    (:class:`KinematicChain`: joint i - 1; :class:`kinegami.tree.KinematicTree`: any earlier
+    joint) and how clearance is measured.
     """
 
     def __init__(
@@ -128,6 +123,355 @@ class KinematicChain:
         if ball.r < self.r:
             ball = Ball(root.pose_matrix[:3, 3], self.r)
         self._ball = ball
+
+    @property
+    def requireClearance(self) -> bool:
+        """Reject appends, edits and state changes that would make the chain pass through
+        itself (False: apply them and emit a ClearanceWarning naming the parts)."""
+        return self._require_clearance
+
+    @requireClearance.setter
+    def requireClearance(self, value: bool) -> None:
+        self._require_clearance = check_bool("requireClearance", value)
+
+    # --- published read-only views -----------------------------------------------------------
+    @property
+    def Joints(self) -> tuple[Joint, ...]:
+        """The joints, in order (world coordinates)."""
+        return tuple(self._joints)
+
+    @property
+    def Links(self) -> tuple[LinkCSC, ...]:
+        """``Links[i]`` joins joint i-1's distal frame to joint i's proximal frame."""
+        return tuple(self._links)
+
+    @property
+    def boundingBall(self) -> Ball:
+        """A ball (centre ``c``, radius ``r``) containing every joint and link."""
+        return self._ball
+
+    def __len__(self) -> int:
+        return len(self._joints)
+
+    def totalPathLength(self) -> float:
+        """Sum of the centreline lengths of all links."""
+        return float(sum(link.path.length for link in self._links))
+
+    # --- helpers -----------------------------------------------------------------------------
+    def _root_link(self, root: Joint) -> LinkCSC:
+        frame = root.proximal_dubins_frame()
+        return LinkCSC._between(self.r, self.maxAnglePerElbow, frame, frame)
+
+    def _link(self, parent: Joint, child: Joint) -> LinkCSC:
+        return LinkCSC._between(
+            self.r,
+            self.maxAnglePerElbow,
+            parent.distal_dubins_frame(),
+            child.proximal_dubins_frame(),
+        )
+
+    def _index(self, jointIndex) -> int:
+        if isinstance(jointIndex, bool) or not isinstance(jointIndex, int | np.integer):
+            raise InvalidTypeError(f"jointIndex must be an integer, got {shown(jointIndex)}")
+        n = len(self._joints)
+        j = int(jointIndex)
+        if not -n <= j < n:
+            raise JointIndexError(
+                f"jointIndex must be in [{-n}, {n - 1}] for a chain of {n} joints, got {shown(j)}"
+            )
+        return j % n
+
+    @staticmethod
+    def _merge_link_and_joint(ball: Ball, link: LinkCSC, joint: Joint) -> Ball:
+        ball = merge_balls(ball, link.arc2Ball)
+        ball = merge_balls(ball, link.arc1Ball)
+        return merge_balls(ball, joint.boundingBall())
+
+    @staticmethod
+    def _ball_of(joints: Sequence[Joint], links: Sequence[LinkCSC]) -> Ball:
+        """The chain ball in the reference's recompute order (docs/theory/chain.md §2)."""
+        ball = joints[0].boundingBall()
+        for joint in joints[1:]:
+            ball = merge_balls(ball, joint.boundingBall())
+        for link in links:
+            ball = merge_balls(ball, link.arc1Ball)
+            ball = merge_balls(ball, link.arc2Ball)
+        return ball
+
+    def _overlap(self, joints, links, parents, since: int = 0):
+        """The deepest overlap of the given lists (an Overlap) or None; with ``since`` = k only
+        pairs with a part of joint k or later (docs/clearance.md). ``parents`` as
+        :meth:`_extended` returns them (a chain ignores them)."""
+        return worst_overlap(joints, links, self.r, since=since)
+
+    def _accept(self, what: str, joints, links, ball: Ball | None = None, parents=None) -> bool:
+        """Commit the new lists unless they pass through themselves and the chain requires
+        clearance (then warn PlacementWarning, keep the chain, return False); a commit that
+        leaves the chain self-intersecting emits a ClearanceWarning."""
+        found = self._overlap(joints, links, parents)
+        if found is not None and self._require_clearance:
+            self._reject(f"{what} failed: the {self._noun} would pass through itself ({found})")
+            return False
+        self._commit(joints, links, ball, parents)
+        if found is not None:
+            warnings.warn(
+                ClearanceWarning(
+                    f"{what}: the {self._noun} passes through itself ({found})",
+                    found.clearance, found.first, found.second,
+                ),
+                stacklevel=_caller_level(),
+            )  # fmt: skip
+        return True
+
+    def _commit(self, joints: list[Joint], links: list[LinkCSC], ball: Ball | None = None,
+                parents=None):  # fmt: skip
+        """Swap in new lists (``parents``: a tree's new parent list; a chain ignores it)."""
+        if ball is None:
+            ball = self._ball_of(joints, links)
+        self._joints, self._links, self._ball = joints, links, ball
+
+    def recomputeBoundingBall(self) -> Ball:
+        """Recompute the ball from every joint and link (docs/theory/chain.md §2) and return it."""
+        self._ball = self._ball_of(self._joints, self._links)
+        return self._ball
+
+    #: What the messages call the assembly.
+    _noun = "chain"
+
+    def _reject(self, message: str) -> None:
+        warnings.warn(
+            f"{message}; the {self._noun} is unchanged", PlacementWarning,
+            stacklevel=_caller_level(),
+        )  # fmt: skip
+
+    def _parent_list(self) -> list[int]:
+        """The parent of every joint (-1 for the root)."""
+        return list(range(-1, len(self._joints) - 1))
+
+    # --- placement ----------------------------------------------------------------------------
+    def _place(
+        self, what: str, p: int, newJoint: Joint, relative, safe, fixedPosition, fixedOrientation
+    ) -> int | None:
+        """Add ``newJoint`` as a child of joint ``p`` (append / addJoint; docs/placement.md):
+        the new joint's index, or None with a PlacementWarning (nothing changed)."""
+        relative = check_bool("relative", relative)
+        safe = check_bool("safe", safe)
+        fixedPosition = check_bool("fixedPosition", fixedPosition)
+        fixedOrientation = check_bool("fixedOrientation", fixedOrientation)
+        if safe and fixedPosition:
+            raise InvalidParameterError(
+                "safe=True and fixedPosition=True cannot be combined: safe placement moves the "
+                "joint along its axis; pass safe=False to keep the given position"
+            )
+        if safe and fixedOrientation:
+            raise InvalidParameterError(
+                "safe=True and fixedOrientation=True cannot be combined; pass safe=False to "
+                "keep the given orientation"
+            )
+        check_same_tube(newJoint, self.numSides, self.r)
+        if isinstance(newJoint, StartTip):
+            raise InvalidParameterError(f"a StartTip can only be the first joint of a {self._noun}")
+        parent = self._joints[p]
+        if isinstance(parent, EndTip):
+            raise InvalidParameterError(
+                "nothing can be appended after an EndTip" if self._noun == "chain"
+                else f"joint {p} is an EndTip: nothing can follow it"
+            )  # fmt: skip
+
+        joint = newJoint._copy()
+        if relative:
+            joint = joint.with_pose(parent.pose_matrix @ joint.pose_matrix)
+
+        try:
+            if safe:
+                joints, links, ball, parents = self._safe_extension(p, joint)
+            elif fixedPosition:
+                if not fixedOrientation:
+                    joint = orient_by_common_normal(joint, parent.pose_matrix)
+                joints, links, ball, parents = self._extended([joint], p)
+            else:
+                joints, links, ball, parents = self._compact_extension(p, joint, fixedOrientation)
+        except KinegamiError as error:
+            self._reject(f"{what} failed: {error}")
+            return None
+        if not self._accept(what, joints, links, ball, parents):
+            return None
+        return len(joints) - 1
+
+    def _compact_extension(self, p: int, joint: Joint, fixedOrientation: bool):
+        """Compact placement (docs/placement.md): the extended lists and ball; raises on failure.
+
+        The joint slides along its axis to the point the published rule picks. If no link
+        reaches it there, or its link passes through the chain, the clearance boundary on the
+        other side of the ball is tried (the rule's side choice is arbitrary in the tie case);
+        a self-intersecting result is kept only when neither side is clear.
+        """
+        parent = self._joints[p]
+        at = joint.pose_matrix[:3, 3]
+        z = joint.pose_matrix[:3, 2]
+        clearance = 4.0 * self.r + self._ball.r + joint.bounding_radius()
+        lam = compact_lambda(parent.pose_matrix[:3, 3], at, z, self._ball, clearance, self.r)
+        other = compact_lambda_other_side(at, z, self._ball, clearance, self.r)
+        error = None
+        first = None
+        for slide in (lam, other):
+            if slide is None:
+                continue
+            placed = joint.translated_along_z(slide)
+            if not fixedOrientation:
+                placed = orient_by_common_normal(placed, parent.pose_matrix)
+            try:
+                extended = self._extended([placed], p)
+            except KinegamiError as failure:
+                error = error or failure
+                continue
+            # the rule's choice if it is clear of the chain, else the other side if that is
+            if self._overlap(extended[0], extended[1], extended[3], len(self._joints)) is None:
+                return extended
+            first = first or extended
+        if first is not None:
+            return first  # nothing clear: kept, and append warns (ClearanceWarning)
+        raise error
+
+    def _extended(self, new_joints: list[Joint], p: int):
+        """Lists, ball and parents with ``new_joints`` appended as a sub-chain from joint ``p``
+        (links solved); raises on failure."""
+        joints = list(self._joints)
+        links = list(self._links)
+        parents = self._parent_list()
+        ball = self._ball
+        previous = p
+        for joint in new_joints:
+            link = self._link(joints[previous], joint)
+            ball = self._merge_link_and_joint(ball, link, joint)
+            parents.append(previous)
+            previous = len(joints)
+            joints.append(joint)
+            links.append(link)
+        return joints, links, ball, parents
+
+    def _safe_extension(self, p: int, joint: Joint):
+        """Safe placement: the extended lists and ball (docs/placement.md).
+
+        Candidates, in order: the published rule with the joint's path direction as given, then
+        reversed (docs/placement.md). The first that succeeds, stays close (ball growth at
+        most SAFE_GROWTH_LIMIT r, new links at most SAFE_PATH_LIMIT r long) and does not pass
+        through the chain (its new parts clear of every part before them, docs/clearance.md)
+        is kept, so the published results are reproduced wherever the published rule works.
+        Otherwise the radial construction, which always succeeds and grows the ball by a
+        bounded amount, is used (its first variant that is clear, see RADIAL_VARIANTS) unless
+        a clear published candidate is no worse on both counts.
+        """
+        parent = self._joints[p]
+        distal = parent.distal_frame()
+        k = parent.pathIndex()
+        limits = (SAFE_GROWTH_LIMIT * self.r, SAFE_PATH_LIMIT * self.r)
+        first_new = len(self._joints)
+
+        def clear(extended) -> bool:
+            joints, links, _, parents = extended
+            return self._overlap(joints, links, parents, first_new) is None
+
+        fallbacks = []
+        for reverse in (False, True):
+            try:
+                extended = self._extended(
+                    published_safe_placement(distal, k, joint, self._ball, reverse=reverse), p
+                )
+            except KinegamiError:
+                continue
+            cost = self._cost(extended)
+            ok = clear(extended)
+            if ok and cost[0] <= limits[0] and cost[1] <= limits[1]:
+                return extended
+            fallbacks.append((cost, ok, extended))
+        radial = None
+        error = None
+        for variant in self._radial_variants(distal, k, p):
+            try:
+                candidate = self._extended(
+                    radial_safe_placement(distal, k, joint, self._ball, **variant), p
+                )
+            except KinegamiError as failure:
+                error = error or failure
+                continue
+            radial = radial or candidate
+            if clear(candidate):
+                radial = candidate
+                break
+        else:
+            # no radial variant is clear: a clear published candidate, if any, else the first
+            for _, ok, extended in fallbacks:
+                if ok:
+                    return extended
+            if radial is None:
+                if fallbacks:
+                    return fallbacks[0][2]
+                raise error
+            return radial
+        growth_r, path_r = self._cost(radial)
+        for (growth, path), ok, extended in fallbacks:
+            if ok and growth <= max(growth_r, limits[0]) and path <= max(path_r, limits[1]):
+                return extended
+        return radial
+
+    def _radial_variants(self, distal: np.ndarray, k: int, p: int):
+        """RADIAL_VARIANTS, then the same escaping sideways first: away from the tube that
+        arrived at the parent (for a parent reached by a U-turn), then out of the plane of
+        that U-turn on either side."""
+        yield from RADIAL_VARIANTS
+        A, d1 = distal[:3, 3], distal[:3, k]
+        path = self._links[p].path
+        if path.length <= 0.0:
+            return
+        away = A - 0.5 * (np.asarray(path.q1) + np.asarray(path.q2))
+        away = away - float(away @ d1) * d1
+        if float(np.linalg.norm(away)) < 1e-9 * self.r:
+            return
+        side = np.cross(d1, away)
+        for escape in (away, side, -side):
+            for variant in RADIAL_VARIANTS:
+                yield {**variant, "escape": escape}
+
+    def _cost(self, extended) -> tuple[float, float]:
+        """(growth of the ball radius, length of the new links) of an extension."""
+        links, ball = extended[1], extended[2]
+        added = links[len(self._links) :]
+        return ball.r - self._ball.r, sum(link.path.length for link in added)
+
+    # --- edits ---------------------------------------------------------------------------------
+    def _try_edit(self, what: str, build) -> bool:
+        try:
+            joints, links = build()
+            ball = self._ball_of(joints, links)
+        except KinegamiError as error:
+            self._reject(f"{what} failed: {error}")
+            return False
+        return self._accept(what, joints, links, ball)
+
+    def transformAll(self, Transformation) -> bool:
+        """Move the whole chain rigidly by ``Transformation`` (no link is re-solved)."""
+        T = pose_array(Transformation, "Transformation", r=self.r)
+        joints = [joint.transformed(T) for joint in self._joints]
+        links = [link.transformed(T) for link in self._links]
+        self._commit(joints, links, self._ball.transformed(T))
+        return True
+
+
+class KinematicChain(_JointAssembly):
+    """A serial chain of tubular origami joints joined by CSC links.
+
+    Parameters
+    ----------
+    startJoint : the root joint (copied; world coordinates).
+    maxAnglePerElbow : largest turn of a single elbow fitting, in (0, pi] (default pi/2).
+
+    Examples
+    --------
+    >>> chain = KinematicChain(StartTip(4, 1, Pose=SE3.Trans(3, 3, 0), length=1.5))
+    >>> chain.append(PrismaticJoint(4, 1, 3, 3, np.pi / 4, SE3.Trans(5, 5, 0)))
+    2
+    """
 
     @classmethod
     def from_dh(
@@ -191,124 +535,15 @@ class KinematicChain:
         )  # fmt: skip
 
     @property
-    def requireClearance(self) -> bool:
-        """Reject appends, edits and state changes that would make the chain pass through
-        itself (False: apply them and emit a ClearanceWarning naming the parts)."""
-        return self._require_clearance
-
-    @requireClearance.setter
-    def requireClearance(self, value: bool) -> None:
-        self._require_clearance = check_bool("requireClearance", value)
-
-    # --- published read-only views -----------------------------------------------------------
-    @property
-    def Joints(self) -> tuple[Joint, ...]:
-        """The joints, in order (world coordinates)."""
-        return tuple(self._joints)
-
-    @property
-    def Links(self) -> tuple[LinkCSC, ...]:
-        """``Links[i]`` joins joint i-1's distal frame to joint i's proximal frame."""
-        return tuple(self._links)
-
-    @property
     def Parents(self) -> tuple[int, ...]:
         """Parent index of every joint (-1 for the root)."""
         return tuple(range(-1, len(self._joints) - 1))
-
-    @property
-    def boundingBall(self) -> Ball:
-        """A ball (centre ``c``, radius ``r``) containing every joint and link."""
-        return self._ball
-
-    def __len__(self) -> int:
-        return len(self._joints)
 
     def __repr__(self) -> str:
         kinds = ", ".join(type(j).__name__ for j in self._joints)
         return (
             f"KinematicChain({len(self._joints)} joints: {kinds}; "
             f"path length {self.totalPathLength():.6g})"
-        )
-
-    def totalPathLength(self) -> float:
-        """Sum of the centreline lengths of all links."""
-        return float(sum(link.path.length for link in self._links))
-
-    # --- helpers -----------------------------------------------------------------------------
-    def _root_link(self, root: Joint) -> LinkCSC:
-        frame = root.proximal_dubins_frame()
-        return LinkCSC._between(self.r, self.maxAnglePerElbow, frame, frame)
-
-    def _link(self, parent: Joint, child: Joint) -> LinkCSC:
-        return LinkCSC._between(
-            self.r,
-            self.maxAnglePerElbow,
-            parent.distal_dubins_frame(),
-            child.proximal_dubins_frame(),
-        )
-
-    def _index(self, jointIndex) -> int:
-        if isinstance(jointIndex, bool) or not isinstance(jointIndex, int | np.integer):
-            raise InvalidTypeError(f"jointIndex must be an integer, got {shown(jointIndex)}")
-        n = len(self._joints)
-        j = int(jointIndex)
-        if not -n <= j < n:
-            raise JointIndexError(
-                f"jointIndex must be in [{-n}, {n - 1}] for a chain of {n} joints, got {shown(j)}"
-            )
-        return j % n
-
-    @staticmethod
-    def _merge_link_and_joint(ball: Ball, link: LinkCSC, joint: Joint) -> Ball:
-        ball = merge_balls(ball, link.arc2Ball)
-        ball = merge_balls(ball, link.arc1Ball)
-        return merge_balls(ball, joint.boundingBall())
-
-    @staticmethod
-    def _ball_of(joints: Sequence[Joint], links: Sequence[LinkCSC]) -> Ball:
-        """The chain ball in the reference's recompute order (docs/theory/chain.md §2)."""
-        ball = joints[0].boundingBall()
-        for joint in joints[1:]:
-            ball = merge_balls(ball, joint.boundingBall())
-        for link in links:
-            ball = merge_balls(ball, link.arc1Ball)
-            ball = merge_balls(ball, link.arc2Ball)
-        return ball
-
-    def _accept(self, what: str, joints, links, ball: Ball | None = None) -> bool:
-        """Commit the new lists unless they pass through themselves and the chain requires
-        clearance (then warn PlacementWarning, keep the chain, return False); a commit that
-        leaves the chain self-intersecting emits a ClearanceWarning."""
-        found = worst_overlap(joints, links, self.r)
-        if found is not None and self._require_clearance:
-            self._reject(f"{what} failed: the chain would pass through itself ({found})")
-            return False
-        self._commit(joints, links, ball)
-        if found is not None:
-            warnings.warn(
-                ClearanceWarning(
-                    f"{what}: the chain passes through itself ({found})",
-                    found.clearance, found.first, found.second,
-                ),
-                stacklevel=_caller_level(),
-            )  # fmt: skip
-        return True
-
-    def _commit(self, joints: list[Joint], links: list[LinkCSC], ball: Ball | None = None):
-        if ball is None:
-            ball = self._ball_of(joints, links)
-        self._joints, self._links, self._ball = joints, links, ball
-
-    def recomputeBoundingBall(self) -> Ball:
-        """Recompute the ball from every joint and link (docs/theory/chain.md §2) and return it."""
-        self._ball = self._ball_of(self._joints, self._links)
-        return self._ball
-
-    @staticmethod
-    def _reject(message: str) -> None:
-        warnings.warn(
-            message + "; the chain is unchanged", PlacementWarning, stacklevel=_caller_level()
         )
 
     # --- building ----------------------------------------------------------------------------
@@ -333,180 +568,10 @@ class KinematicChain:
         Returns the new joint's index, or None (with a PlacementWarning, chain unchanged) when
         no link with turns < pi reaches it.
         """
-        relative = check_bool("relative", relative)
-        safe = check_bool("safe", safe)
-        fixedPosition = check_bool("fixedPosition", fixedPosition)
-        fixedOrientation = check_bool("fixedOrientation", fixedOrientation)
-        if safe and fixedPosition:
-            raise InvalidParameterError(
-                "safe=True and fixedPosition=True cannot be combined: safe placement moves the "
-                "joint along its axis; pass safe=False to keep the given position"
-            )
-        if safe and fixedOrientation:
-            raise InvalidParameterError(
-                "safe=True and fixedOrientation=True cannot be combined; pass safe=False to "
-                "keep the given orientation"
-            )
-        check_same_tube(newJoint, self.numSides, self.r)
-        if isinstance(newJoint, StartTip):
-            raise InvalidParameterError("a StartTip can only be the first joint of a chain")
-        parent = self._joints[-1]
-        if isinstance(parent, EndTip):
-            raise InvalidParameterError("nothing can be appended after an EndTip")
-
-        joint = newJoint._copy()
-        if relative:
-            joint = joint.with_pose(parent.pose_matrix @ joint.pose_matrix)
-
-        try:
-            if safe:
-                joints, links, ball = self._safe_extension(parent, joint)
-            elif fixedPosition:
-                if not fixedOrientation:
-                    joint = orient_by_common_normal(joint, parent.pose_matrix)
-                joints, links, ball = self._extended([joint])
-            else:
-                joints, links, ball = self._compact_extension(parent, joint, fixedOrientation)
-        except KinegamiError as error:
-            self._reject(f"append failed: {error}")
-            return None
-        if not self._accept("append", joints, links, ball):
-            return None
-        return len(joints) - 1
-
-    def _compact_extension(self, parent: Joint, joint: Joint, fixedOrientation: bool):
-        """Compact placement (docs/placement.md): the extended lists and ball; raises on failure.
-
-        The joint slides along its axis to the point the published rule picks. If no link
-        reaches it there, or its link passes through the chain, the clearance boundary on the
-        other side of the ball is tried (the rule's side choice is arbitrary in the tie case);
-        a self-intersecting result is kept only when neither side is clear.
-        """
-        p = joint.pose_matrix[:3, 3]
-        z = joint.pose_matrix[:3, 2]
-        clearance = 4.0 * self.r + self._ball.r + joint.bounding_radius()
-        lam = compact_lambda(parent.pose_matrix[:3, 3], p, z, self._ball, clearance, self.r)
-        other = compact_lambda_other_side(p, z, self._ball, clearance, self.r)
-        error = None
-        first = None
-        for slide in (lam, other):
-            if slide is None:
-                continue
-            placed = joint.translated_along_z(slide)
-            if not fixedOrientation:
-                placed = orient_by_common_normal(placed, parent.pose_matrix)
-            try:
-                extended = self._extended([placed])
-            except KinegamiError as failure:
-                error = error or failure
-                continue
-            # the rule's choice if it is clear of the chain, else the other side if that is
-            if worst_overlap(extended[0], extended[1], self.r, since=len(self._joints)) is None:
-                return extended
-            first = first or extended
-        if first is not None:
-            return first  # nothing clear: kept, and append warns (ClearanceWarning)
-        raise error
-
-    def _extended(self, new_joints: list[Joint]):
-        """Lists and ball with ``new_joints`` appended (links solved); raises on failure."""
-        joints = list(self._joints)
-        links = list(self._links)
-        ball = self._ball
-        for joint in new_joints:
-            link = self._link(joints[-1], joint)
-            ball = self._merge_link_and_joint(ball, link, joint)
-            joints.append(joint)
-            links.append(link)
-        return joints, links, ball
-
-    def _safe_extension(self, parent: Joint, joint: Joint):
-        """Safe placement: the extended lists and ball (docs/placement.md).
-
-        Candidates, in order: the published rule with the joint's path direction as given, then
-        reversed (docs/placement.md). The first that succeeds, stays close (ball growth at
-        most SAFE_GROWTH_LIMIT r, new links at most SAFE_PATH_LIMIT r long) and does not pass
-        through the chain (its new parts clear of every part before them, docs/clearance.md)
-        is kept, so the published results are reproduced wherever the published rule works.
-        Otherwise the radial construction, which always succeeds and grows the ball by a
-        bounded amount, is used (its first variant that is clear, see RADIAL_VARIANTS) unless
-        a clear published candidate is no worse on both counts.
-        """
-        distal = parent.distal_frame()
-        k = parent.pathIndex()
-        limits = (SAFE_GROWTH_LIMIT * self.r, SAFE_PATH_LIMIT * self.r)
-        first_new = len(self._joints)
-
-        def clear(extended) -> bool:
-            joints, links, _ = extended
-            return worst_overlap(joints, links, self.r, since=first_new) is None
-
-        fallbacks = []
-        for reverse in (False, True):
-            try:
-                extended = self._extended(
-                    published_safe_placement(distal, k, joint, self._ball, reverse=reverse)
-                )
-            except KinegamiError:
-                continue
-            cost = self._cost(extended)
-            ok = clear(extended)
-            if ok and cost[0] <= limits[0] and cost[1] <= limits[1]:
-                return extended
-            fallbacks.append((cost, ok, extended))
-        radial = None
-        error = None
-        for variant in self._radial_variants(distal, k):
-            try:
-                candidate = self._extended(
-                    radial_safe_placement(distal, k, joint, self._ball, **variant)
-                )
-            except KinegamiError as failure:
-                error = error or failure
-                continue
-            radial = radial or candidate
-            if clear(candidate):
-                radial = candidate
-                break
-        else:
-            # no radial variant is clear: a clear published candidate, if any, else the first
-            for _, ok, extended in fallbacks:
-                if ok:
-                    return extended
-            if radial is None:
-                if fallbacks:
-                    return fallbacks[0][2]
-                raise error
-            return radial
-        growth_r, path_r = self._cost(radial)
-        for (growth, path), ok, extended in fallbacks:
-            if ok and growth <= max(growth_r, limits[0]) and path <= max(path_r, limits[1]):
-                return extended
-        return radial
-
-    def _radial_variants(self, distal: np.ndarray, k: int):
-        """RADIAL_VARIANTS, then the same escaping sideways first: away from the tube that
-        arrived at the parent (for a parent reached by a U-turn), then out of the plane of
-        that U-turn on either side."""
-        yield from RADIAL_VARIANTS
-        A, d1 = distal[:3, 3], distal[:3, k]
-        path = self._links[-1].path
-        if path.length <= 0.0:
-            return
-        away = A - 0.5 * (np.asarray(path.q1) + np.asarray(path.q2))
-        away = away - float(away @ d1) * d1
-        if float(np.linalg.norm(away)) < 1e-9 * self.r:
-            return
-        side = np.cross(d1, away)
-        for escape in (away, side, -side):
-            for variant in RADIAL_VARIANTS:
-                yield {**variant, "escape": escape}
-
-    def _cost(self, extended) -> tuple[float, float]:
-        """(growth of the ball radius, length of the new links) of an extension."""
-        _, links, ball = extended
-        added = links[len(self._links) :]
-        return ball.r - self._ball.r, sum(link.path.length for link in added)
+        return self._place(
+            "append", len(self._joints) - 1, newJoint, relative, safe, fixedPosition,
+            fixedOrientation,
+        )  # fmt: skip
 
     # --- edits ---------------------------------------------------------------------------------
     def _moved(self, j: int, T: np.ndarray, propagate: bool):
@@ -529,15 +594,6 @@ class KinematicChain:
             links[0] = links[0].transformed(T)
         return joints, links
 
-    def _try_edit(self, what: str, build) -> bool:
-        try:
-            joints, links = build()
-            ball = self._ball_of(joints, links)
-        except KinegamiError as error:
-            self._reject(f"{what} failed: {error}")
-            return False
-        return self._accept(what, joints, links, ball)
-
     def transformJoint(
         self,
         jointIndex: int,
@@ -557,14 +613,6 @@ class KinematicChain:
         T = pose_array(Transformation, "Transformation", r=self.r)
         prop = _propagate_flag(propogate, propagate)
         return self._try_edit("transformJoint", lambda: self._moved(j, T, prop))
-
-    def transformAll(self, Transformation) -> bool:
-        """Move the whole chain rigidly by ``Transformation`` (no link is re-solved)."""
-        T = pose_array(Transformation, "Transformation", r=self.r)
-        joints = [joint.transformed(T) for joint in self._joints]
-        links = [link.transformed(T) for link in self._links]
-        self._commit(joints, links, self._ball.transformed(T))
-        return True
 
     def _axis_edit(
         self, what: str, jointIndex, T_of_joint, propogate, propagate, applyToPreviousWaypoint
