@@ -57,7 +57,7 @@ def test_radial_placement_links_always_exist(
     ball = Ball(np.zeros(3), R)
     chain._ball = ball  # the placement only reads the ball
     new = radial_safe_placement(parent.distal_frame(), parent.pathIndex(), joint, ball)
-    joints, links, _, _ = chain._extended(new, len(chain.Joints) - 1)  # NoPathError if a link is missing
+    joints, links, _, _ = chain._extended(new, len(chain.Joints) - 1)  # NoPathError: no link
     placed = new[-1]
     # the joint keeps its axis line and lies at least 4r + rho beyond the ball
     z_old, z_new = T[:3, 2], placed.pose_matrix[:3, 2]
