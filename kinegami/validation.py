@@ -42,13 +42,17 @@ R_MAX = 1e6
 #: file) satisfies ``|value| <= LENGTH_FACTOR * r``. With r <= R_MAX, squares and products of
 #: such values stay far from the float range, and r stays well above their rounding error.
 LENGTH_FACTOR = 1e6
-def check_bool(name: str, value) -> bool:
+def check_bool(name: str, value, none: bool = False) -> bool | None:
     """``value`` as a bool, or InvalidTypeError unless it is True or False (numpy's too).
 
-    Integers are refused: ``endTip=1`` is more likely a mistake than a choice.
+    Integers are refused: ``endTip=1`` is more likely a mistake than a choice. With
+    ``none=True``, None is accepted too (and returned), e.g. ``block`` of ``show()``.
     """
+    if none and value is None:
+        return None
     if not isinstance(value, bool | np.bool_):
-        raise InvalidTypeError(f"{name} must be True or False, got {shown(value)}")
+        allowed = "None, True or False" if none else "True or False"
+        raise InvalidTypeError(f"{name} must be {allowed}, got {shown(value)}")
     return bool(value)
 
 

@@ -4,18 +4,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from numbers import Real
 from typing import Any
 
 import numpy as np
 
-from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami._format import shown
+from kinegami.errors import InvalidParameterError
+from kinegami.validation import check_bool, check_options, check_positive
 
 __all__ = [
     "UNITS_IN_MM",
     "DEFAULT_DASH",
     "DEFAULT_GAP",
     "SheetOptions",
+    "unit_factor",
     "resolve_sheet_options",
     "dash_segments",
     "format_numbers",
@@ -57,19 +59,22 @@ class SheetOptions:
     extra: dict
 
 
-def _positive(name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer):
-        raise InvalidTypeError(f"{name} must be a number, got {value!r}")
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
-    return value
+def unit_factor(units: Any = "mm", scale: Any = 1.0, unit: str = "pattern unit") -> float:
+    """Millimetres per ``unit`` for the ``units`` and ``scale`` options (checked).
 
-
-def _flag(name: str, value: Any) -> bool:
-    if not isinstance(value, bool | np.bool_):
-        raise InvalidTypeError(f"{name} must be True or False, got {value!r}")
-    return bool(value)
+    Raises
+    ------
+    InvalidParameterError
+        For a ``units`` not in :data:`UNITS_IN_MM`, or a ``scale`` that is not > 0.
+    InvalidTypeError
+        For a ``scale`` that is not a real number.
+    """
+    if not isinstance(units, str) or units not in UNITS_IN_MM:
+        raise InvalidParameterError(
+            f"units must be one of {', '.join(map(repr, UNITS_IN_MM))} (the length of one "
+            f"{unit}), got {shown(units)}"
+        )
+    return UNITS_IN_MM[units] * check_positive("scale", scale)
 
 
 def resolve_sheet_options(options: dict[str, Any], extra: dict[str, Any], fmt: str) -> SheetOptions:
@@ -91,35 +96,23 @@ def resolve_sheet_options(options: dict[str, Any], extra: dict[str, Any], fmt: s
     InvalidParameterError
         For a value out of range, an unknown unit, or ``dash``/``gap`` with ``perforate=False``.
     """
-    valid = _COMMON + tuple(extra)
-    unknown = sorted(set(options) - set(valid))
-    if unknown:
-        raise InvalidTypeError(
-            f"{fmt} export got unknown option{'s' if len(unknown) > 1 else ''} "
-            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(valid)}"
-        )
-    units = options.get("units", "mm")
-    if units not in UNITS_IN_MM:
-        raise InvalidParameterError(
-            f"units must be one of {', '.join(map(repr, UNITS_IN_MM))} (the length of one "
-            f"pattern unit), got {units!r}"
-        )
-    scale = _positive("scale", options.get("scale", 1.0))
+    check_options(options, _COMMON + tuple(extra), f"{fmt} export")
+    factor = unit_factor(options.get("units", "mm"), options.get("scale", 1.0))
     dash, gap = options.get("dash"), options.get("gap")
     perforate = options.get("perforate")
     if perforate is None:
         perforate = dash is not None or gap is not None
-    perforate = _flag("perforate", perforate)
+    perforate = check_bool("perforate", perforate)
     if not perforate and (dash is not None or gap is not None):
         raise InvalidParameterError(
             f"dash={dash!r} and gap={gap!r} only apply with perforate=True, got perforate=False"
         )
-    dash = DEFAULT_DASH if dash is None else _positive("dash", dash)
-    gap = DEFAULT_GAP if gap is None else _positive("gap", gap)
-    skip = _flag("skip_creases_on_cut", options.get("skip_creases_on_cut", False))
+    dash = DEFAULT_DASH if dash is None else check_positive("dash", dash)
+    gap = DEFAULT_GAP if gap is None else check_positive("gap", gap)
+    skip = check_bool("skip_creases_on_cut", options.get("skip_creases_on_cut", False))
     values = dict(extra)
     values.update({k: v for k, v in options.items() if k in extra})
-    return SheetOptions(UNITS_IN_MM[units] * scale, perforate, dash, gap, skip, values)
+    return SheetOptions(factor, perforate, dash, gap, skip, values)
 
 
 def dash_segments(segments: np.ndarray, dash: float, gap: float) -> tuple[np.ndarray, np.ndarray]:

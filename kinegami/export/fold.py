@@ -39,9 +39,10 @@ from typing import Any, TextIO
 import numpy as np
 
 from kinegami.errors import FoldExportError, InvalidParameterError, InvalidTypeError
-from kinegami.export._options import UNITS_IN_MM, _positive
+from kinegami.export._options import unit_factor
 from kinegami.pattern._prism import periodic_dx
 from kinegami.pattern.sheet import TOLERANCE_FACTOR
+from kinegami.validation import check_bool, check_options
 
 __all__ = [
     "FOLD_SPEC",
@@ -633,26 +634,14 @@ def file_fold_angles(graph: SheetGraph) -> np.ndarray:
 
 
 def _resolve_options(options: dict[str, Any]) -> dict[str, Any]:
-    unknown = sorted(set(options) - set(_OPTIONS))
-    if unknown:
-        raise InvalidTypeError(
-            f"FOLD export got unknown option{'s' if len(unknown) > 1 else ''} "
-            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(_OPTIONS)}"
-        )
-    units = options.get("units", "mm")
-    if units not in UNITS_IN_MM:
-        raise InvalidParameterError(
-            f"units must be one of {', '.join(map(repr, UNITS_IN_MM))} (the length of one "
-            f"pattern unit), got {units!r}"
-        )
-    folded = options.get("folded", True)
-    if not isinstance(folded, bool | np.bool_):
-        raise InvalidTypeError(f"folded must be True or False, got {folded!r}")
+    check_options(options, _OPTIONS, "FOLD export")
+    factor = unit_factor(options.get("units", "mm"), options.get("scale", 1.0))
+    folded = check_bool("folded", options.get("folded", True))
     title = options.get("title")
     if title is not None and not isinstance(title, str):
         raise InvalidTypeError(f"title must be a string, got {title!r}")
     return {
-        "factor": UNITS_IN_MM[units] * _positive("scale", options.get("scale", 1.0)),
+        "factor": factor,
         "folded": bool(folded),
         "frame": options.get("frame"),
         "twistPortion": options.get("twistPortion", 0.2),

@@ -57,8 +57,8 @@ from kinegami.bodies import (
     revolute_hull_points,
     tip_hull_points,
 )
-from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.export._options import UNITS_IN_MM
+from kinegami.errors import InvalidTypeError
+from kinegami.export._options import unit_factor
 from kinegami.joints import (
     EndTip,
     ExtendedRevoluteJoint,
@@ -68,7 +68,7 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
-from kinegami.validation import check_positive, check_twist_portion
+from kinegami.validation import check_twist_portion, resolve_options
 
 if TYPE_CHECKING:  # pragma: no cover
     import trimesh
@@ -419,25 +419,7 @@ def chain_parts(
 
 def mesh_factor(units: Any = "mm", scale: Any = 1.0) -> float:
     """Millimetres per chain unit for the ``units`` and ``scale`` options (checked)."""
-    if not isinstance(units, str) or units not in UNITS_IN_MM:
-        raise InvalidParameterError(
-            f"units must be one of {', '.join(map(repr, UNITS_IN_MM))} (the length of one "
-            f"chain unit), got {units!r}"
-        )
-    return UNITS_IN_MM[units] * check_positive("scale", scale)
-
-
-def check_options(options: dict[str, Any], defaults: dict[str, Any], fmt: str) -> dict[str, Any]:
-    """``defaults`` updated by ``options``; unknown option names raise InvalidTypeError."""
-    unknown = sorted(set(options) - set(defaults))
-    if unknown:
-        raise InvalidTypeError(
-            f"{fmt} export got unknown option{'s' if len(unknown) > 1 else ''} "
-            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(defaults)}"
-        )
-    values = dict(defaults)
-    values.update(options)
-    return values
+    return unit_factor(units, scale, "chain unit")
 
 
 _MESH_DEFAULTS = {"units": "mm", "scale": 1.0, "twistPortion": 0.2}
@@ -445,7 +427,7 @@ _MESH_DEFAULTS = {"units": "mm", "scale": 1.0, "twistPortion": 0.2}
 
 def _scaled_parts(chain: Any, options: dict[str, Any], fmt: str) -> list[MeshPart]:
     chain = _check_chain(chain, fmt)
-    opts = check_options(options, _MESH_DEFAULTS, fmt)
+    opts = resolve_options(options, _MESH_DEFAULTS, f"{fmt} export")
     factor = mesh_factor(opts["units"], opts["scale"])
     parts = chain_parts(chain, twistPortion=opts["twistPortion"])
     return [p.transformed(np.eye(4), factor) for p in parts]

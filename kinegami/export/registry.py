@@ -54,6 +54,7 @@ from kinegami.errors import (
     InvalidTypeError,
     KinegamiError,
 )
+from kinegami.validation import check_bool
 
 __all__ = [
     "ACCEPTS",
@@ -227,8 +228,7 @@ def register(
             )
     if accepts not in ACCEPTS:
         raise InvalidParameterError(f"accepts must be one of {ACCEPTS}, got {accepts!r}")
-    if not isinstance(binary, bool) or not isinstance(files, bool):
-        raise InvalidTypeError(f"binary and files must be True or False, got {binary!r}, {files!r}")
+    binary, files = check_bool("binary", binary), check_bool("files", files)
     if binary and files:
         raise InvalidParameterError("give binary=True or files=True, not both")
     if not isinstance(description, str):

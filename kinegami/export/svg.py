@@ -38,13 +38,13 @@ import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export._options import (
-    UNITS_IN_MM,
-    _positive,
     format_numbers,
     resolve_sheet_options,
     sheet_lines,
+    unit_factor,
 )
 from kinegami.pattern.sheet import SHEET_KINDS
+from kinegami.validation import check_options, check_positive
 
 if TYPE_CHECKING:  # pragma: no cover
     from kinegami.pattern.tubular import TubularPattern
@@ -107,11 +107,7 @@ def _check_colors(colors: Any) -> dict[str, str]:
 
 
 def _stroke_width(value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
-        raise InvalidTypeError(f"stroke_width must be a number, got {value!r}")
-    if not (np.isfinite(value) and value > 0):
-        raise InvalidParameterError(f"stroke_width must be finite and > 0, got {value!r}")
-    return float(value)
+    return check_positive("stroke_width", value)
 
 
 def svg_data(pattern: TubularPattern, **options: Any) -> str:
@@ -215,20 +211,8 @@ def _simulator_options(options: dict[str, Any]) -> tuple[float, float]:
             "flavour draws whole fold lines in the simulator's colours), got flavour="
             f"{options.get('flavour', 'simulator')!r}"
         )
-    unknown = sorted(set(options) - set(_SIMULATOR_OPTIONS))
-    if unknown:
-        valid = _SIMULATOR_OPTIONS + _LASER_ONLY
-        raise InvalidTypeError(
-            f"SVG export got unknown option{'s' if len(unknown) > 1 else ''} "
-            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(valid)}"
-        )
-    units = options.get("units", "mm")
-    if units not in UNITS_IN_MM:
-        raise InvalidParameterError(
-            f"units must be one of {', '.join(map(repr, UNITS_IN_MM))} (the length of one "
-            f"pattern unit), got {units!r}"
-        )
-    factor = UNITS_IN_MM[units] * _positive("scale", options.get("scale", 1.0))
+    check_options(options, _SIMULATOR_OPTIONS + _LASER_ONLY, "SVG export")  # laser ones: above
+    factor = unit_factor(options.get("units", "mm"), options.get("scale", 1.0))
     return factor, _stroke_width(options.get("stroke_width", _DEFAULT_STROKE_WIDTH))
 
 

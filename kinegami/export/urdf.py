@@ -54,18 +54,23 @@ from typing import TYPE_CHECKING, Any, TextIO
 
 import numpy as np
 
-from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.errors import InvalidParameterError
 from kinegami.export.mesh import (
     _check_chain,
     chain_parts,
-    check_options,
     mesh_factor,
     shell_mass_properties,
     stl_bytes,
 )
 from kinegami.geometry.frames import inverse
 from kinegami.joints import PrismaticJoint, RevoluteJoint
-from kinegami.validation import check_nonnegative, check_positive, check_twist_portion
+from kinegami.validation import (
+    check_bool,
+    check_nonnegative,
+    check_positive,
+    check_twist_portion,
+    resolve_options,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from kinegami.chain import KinematicChain
@@ -204,12 +209,6 @@ def _check_name(name: Any, what: str) -> str:
     return name
 
 
-def _check_flag(name: str, value: Any) -> bool:
-    if not isinstance(value, bool | np.bool_):
-        raise InvalidTypeError(f"{name} must be True or False, got {value!r}")
-    return bool(value)
-
-
 def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
     """The URDF of ``chain`` and its mesh files, in memory.
 
@@ -247,12 +246,12 @@ def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
         For a bad option value.
     """
     chain = _check_chain(chain, "URDF")
-    opts = check_options(options, URDF_DEFAULTS, "URDF")
+    opts = resolve_options(options, URDF_DEFAULTS, "URDF export")
     name = _check_name("kinegami_chain" if opts["name"] is None else opts["name"], "name")
     metres = mesh_factor(opts["units"], opts["scale"]) / 1000.0
     effort = check_positive("effort", opts["effort"])
     velocity = check_positive("velocity", opts["velocity"])
-    with_meshes = _check_flag("meshes", opts["meshes"])
+    with_meshes = check_bool("meshes", opts["meshes"])
     folder = opts["mesh_folder"]
     folder = _check_name(f"{name}_meshes" if folder is None else folder, "mesh_folder")
     folder = folder.strip("/")

@@ -8,15 +8,19 @@ from :mod:`kinegami.style`. matplotlib is imported only when a chain is drawn.
 
 from __future__ import annotations
 
-import math
 import re
-from numbers import Real
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from kinegami import style
 from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.validation import (
+    check_bool,
+    check_in_range,
+    check_positive,
+    resolve_options,
+)
 from kinegami.viz import chain_geometry as geo
 from kinegami.viz._backend import show_if_interactive
 
@@ -99,36 +103,18 @@ def resolve_chain_options(options: dict[str, Any]) -> dict[str, Any]:
     Raises InvalidTypeError for an unknown option name or a value of the wrong type, and
     InvalidParameterError for a value out of range.
     """
-    unknown = sorted(set(options) - set(CHAIN_PLOT_OPTIONS))
-    if unknown:
-        raise InvalidTypeError(
-            f"show() got unknown option{'s' if len(unknown) > 1 else ''} "
-            f"{', '.join(map(repr, unknown))}; valid options are: {', '.join(CHAIN_PLOT_OPTIONS)}"
-        )
-    opts = dict(style.CHAIN_PLOT_DEFAULTS)
-    opts.update(options)
+    opts = resolve_options(options, style.CHAIN_PLOT_DEFAULTS, "show()")
     for name in _BOOL_OPTIONS:
-        if not isinstance(opts[name], bool | np.bool_):
-            raise InvalidTypeError(f"{name} must be True or False, got {opts[name]!r}")
-        opts[name] = bool(opts[name])
-    if opts["block"] is not None and not isinstance(opts["block"], bool | np.bool_):
-        raise InvalidTypeError(f"block must be None, True or False, got {opts['block']!r}")
+        opts[name] = check_bool(name, opts[name])
+    opts["block"] = check_bool("block", opts["block"], none=True)
     from matplotlib.colors import is_color_like
 
     for name in _COLOR_OPTIONS:
         if not is_color_like(opts[name]):
             raise InvalidParameterError(f"{name} must be a matplotlib colour, got {opts[name]!r}")
     for name in _SCALE_OPTIONS:
-        value = opts[name]
-        if isinstance(value, bool) or not isinstance(value, Real):
-            raise InvalidTypeError(f"{name} must be a number, got {value!r}")
-        if not (math.isfinite(value) and value > 0):
-            raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
-    alpha = opts["surfaceOpacity"]
-    if isinstance(alpha, bool) or not isinstance(alpha, Real):
-        raise InvalidTypeError(f"surfaceOpacity must be a number, got {alpha!r}")
-    if not 0.0 <= alpha <= 1.0:
-        raise InvalidParameterError(f"surfaceOpacity must be in [0, 1], got {alpha!r}")
+        check_positive(name, opts[name])
+    check_in_range("surfaceOpacity", opts["surfaceOpacity"], 0.0, 1.0, True, True)
     ax = opts["ax"]
     if ax is not None and getattr(ax, "name", None) != "3d":
         raise InvalidTypeError(

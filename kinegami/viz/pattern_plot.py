@@ -9,14 +9,16 @@ copies of the starting panel (the glue tab, lightly shaded) and the cut outline 
 
 from __future__ import annotations
 
-import math
-from numbers import Real
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.validation import (
+    check_bool,
+    check_in_range,
+    check_positive,
+    resolve_options,
+)
 from kinegami.viz._backend import show_if_interactive
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -61,35 +63,17 @@ _BOOL_OPTIONS = ("showGlueTab", "showBoundary", "showCut", "showCreasesOnCut")
 
 
 def _resolve_options(options: dict[str, Any]) -> dict[str, Any]:
-    unknown = sorted(set(options) - set(PATTERN_PLOT_DEFAULTS))
-    if unknown:
-        raise InvalidTypeError(
-            f"show() got unknown option{'s' if len(unknown) > 1 else ''} "
-            f"{', '.join(map(repr, unknown))}; valid options are: "
-            f"{', '.join(PATTERN_PLOT_DEFAULTS)}"
-        )
-    opts = dict(PATTERN_PLOT_DEFAULTS)
-    opts.update(options)
+    opts = resolve_options(options, PATTERN_PLOT_DEFAULTS, "show()")
     from matplotlib.colors import is_color_like
 
     for name in _COLOR_OPTIONS:
         if not is_color_like(opts[name]):
             raise InvalidParameterError(f"{name} must be a matplotlib colour, got {opts[name]!r}")
     for name in _BOOL_OPTIONS:
-        if not isinstance(opts[name], bool | np.bool_):
-            raise InvalidTypeError(f"{name} must be True or False, got {opts[name]!r}")
-        opts[name] = bool(opts[name])
-    for name in ("linewidth", "glueTabOpacity"):
-        if isinstance(opts[name], bool) or not isinstance(opts[name], Real):
-            raise InvalidTypeError(f"{name} must be a number, got {opts[name]!r}")
-    if not (0.0 < opts["linewidth"] < math.inf):
-        raise InvalidParameterError(f"linewidth must be finite and > 0, got {opts['linewidth']!r}")
-    if not (0.0 <= opts["glueTabOpacity"] <= 1.0):
-        raise InvalidParameterError(
-            f"glueTabOpacity must be in [0, 1], got {opts['glueTabOpacity']!r}"
-        )
-    if opts["block"] is not None and not isinstance(opts["block"], bool | np.bool_):
-        raise InvalidTypeError(f"block must be None, True or False, got {opts['block']!r}")
+        opts[name] = check_bool(name, opts[name])
+    check_positive("linewidth", opts["linewidth"])
+    check_in_range("glueTabOpacity", opts["glueTabOpacity"], 0.0, 1.0, True, True)
+    opts["block"] = check_bool("block", opts["block"], none=True)
     if opts["title"] is not None and not isinstance(opts["title"], str):
         raise InvalidTypeError(f"title must be None or a string, got {opts['title']!r}")
     ax = opts["ax"]
