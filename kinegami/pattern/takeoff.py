@@ -359,11 +359,12 @@ class TakeoffJunction:
         return T
 
     def skirt_frame(self, trunk_frame) -> np.ndarray:
-        """The proximal frame of :meth:`skirt_pattern` (a straight-tube frame (s, e_a, m) at
-        O + skirt_base m): folding the skirt from here ends at the take-off frame's tube frame."""
-        B = self.branch_frame(trunk_frame)
-        B[:3, 3] += self.skirt_base * B[:3, 2]
-        return B
+        """The proximal Dubins frame of :meth:`skirt_pattern`, as a 4x4: the take-off frame's
+        axes (m, s, e_a) at O + skirt_base m. Folding the skirt (a straight tube) from here ends
+        at the take-off frame; it is the ``frame`` to give the folded form of a branch sheet."""
+        T = self.takeoff_frame(trunk_frame)
+        T[:3, 3] -= (self.max_depth + self.stub_length) * T[:3, 0]
+        return T
 
     # --- fold maps ---------------------------------------------------------------------------
 

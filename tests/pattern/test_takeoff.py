@@ -472,20 +472,40 @@ def test_skirt_pattern(n, h0):
     # net puts it, and the distal frame is the take-off frame
     F = random_frame(np.random.default_rng(n))
     X, T_local = SKIRT_KIND.fold(j.prism, skirt, skirt.modules[0].params)
-    S = j.skirt_frame(F)
-    world = X @ S[:3, :3].T + S[:3, 3]
+    D = j.skirt_frame(F)  # Dubins axes (m, s, e_a): the tube frame is (s, e_a, m)
+    S = np.column_stack([D[:3, 1], D[:3, 2], D[:3, 0]])
+    world = X @ S.T + D[:3, 3]
     V = j.numVertices
     assert_allclose(world[:V], j.fold_branch(j.fish_mouth, F), atol=1e-12)
-    end = S @ T_local
-    assert_allclose(end[:3, 3], j.takeoff_frame(F)[:3, 3], atol=1e-12)
+    assert_allclose(D[:3, 3] + S @ T_local[:3, 3], j.takeoff_frame(F)[:3, 3], atol=1e-12)
     # a branch chain appends after it
     chain = skirt.append(TubeFittingPattern(n, 1.0, 1.0))
     assert chain.height == pytest.approx(skirt.height + 1.0)
     assert chain.validate().ok
 
 
-def test_skirt_kind_is_not_registered_on_import():
-    assert "takeoff_skirt" not in catalog.kinds()
+def test_registered_skirt_folds_with_the_branch_chain():
+    """Once SKIRT_KIND is in the catalog, the folded form of skirt + chain starts at the
+    fish-mouth of the branch net and the chain starts at the take-off frame."""
+    from kinegami.pattern.folded import folded_vertices
+
+    n = 8
+    j = takeoff_junction(n, 1.0, 3, 0.5, stub_length=0.3)
+    F = random_frame(np.random.default_rng(11))
+    sheet = j.skirt_pattern().append(TubeFittingPattern(n, 1.0, 2.0))
+    registered = "takeoff_skirt" in catalog.kinds()
+    catalog.register(SKIRT_KIND)
+    try:
+        X = folded_vertices(sheet, frame=j.skirt_frame(F))
+    finally:
+        if not registered:
+            catalog.unregister("takeoff_skirt")
+    assert_allclose(X[: j.numVertices], j.fold_branch(j.fish_mouth, F), atol=1e-12)
+    _, a, _ = prism_numbers(n, 1.0)
+    top = sheet.vertices_coords[sheet.distalBase]
+    branch_xy = top + [0.0, j.skirt_base]  # the skirt's y is y' - skirt_base
+    assert_allclose(X[sheet.distalBase], j.fold_branch(branch_xy, F), atol=1e-12)
+    assert branch_xy[0, 1] == pytest.approx(a + 0.3 + 2.0)
 
 
 # --- values and bad input ------------------------------------------------------------------
