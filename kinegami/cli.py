@@ -437,11 +437,23 @@ def cmd_edit(args: argparse.Namespace) -> int:
         raise CommandError(f"--port must be an integer in [0, 65535], got {_printable(args.port)}")
     from kinegami.editor.server import LOCAL_HOSTS, EditorServer
 
-    server = EditorServer(args.design, host=args.host, port=port)
+    server = EditorServer(args.design, host=args.host, port=port, recover=args.recover)
     try:
         what = _printable(str(args.design)) if args.design else "the starter design"
         print(f"kinegami edit: editing {what} at {server.url} (each tab edits its own copy; "
               "Ctrl-C stops)", flush=True)  # fmt: skip
+        recovery = server.recovery
+        if recovery is not None:
+            where = _printable(str(recovery.path))
+            if args.recover:
+                print(f"kinegami edit: each tab starts from the autosave {where} "
+                      f"({recovery.describe()})", flush=True)  # fmt: skip
+            else:
+                print(f"kinegami edit: found the autosave {where} ({recovery.describe()}); "
+                      "the editor offers it back (or start with --recover)", flush=True)
+        elif args.recover:
+            _note("edit", "--recover: there is no autosave newer than the design; starting "
+                          "from the design")  # fmt: skip
         if args.host not in LOCAL_HOSTS:
             _warn("edit", f"listening on {args.host}: anyone who can reach this machine on the "
                           "network can open the editor and edit designs")  # fmt: skip
@@ -887,14 +899,18 @@ def make_parser() -> argparse.ArgumentParser:
         help="edit a design in the browser",
         description="Serve the browser editor (needs pip install 'kinegami[gui]') and print its "
         "address. Each browser tab edits its own copy of DESIGN (default: the starter design); "
-        "designs are saved by downloading them. Listens on 127.0.0.1 unless --host says "
-        "otherwise. Runs until Ctrl-C.",
+        "designs are saved to DESIGN or downloaded, and unsaved changes are autosaved beside "
+        "DESIGN (or in the user's data folder) and offered back on the next start. Listens on "
+        "127.0.0.1 unless --host says otherwise. Runs until Ctrl-C.",
     )
     edit.add_argument("design", metavar="DESIGN", nargs="?", help="design file (.json)")
     edit.add_argument("--port", metavar="P", default="8080", help="port (default: %(default)s; "
                       "0: a free one)")  # fmt: skip
     edit.add_argument("--host", metavar="H", default="127.0.0.1", help="address to listen on "
                       "(default: %(default)s, this machine only)")  # fmt: skip
+    edit.add_argument("--recover", action="store_true", help="start from the autosave of "
+                      "DESIGN (.DESIGN.autosave beside it; without DESIGN, in the user's data "
+                      "folder) when it is newer than DESIGN, instead of asking in the browser")
     edit.set_defaults(run=cmd_edit)
     return parser
 

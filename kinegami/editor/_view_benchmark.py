@@ -19,7 +19,7 @@ from kinegami.editor.model import EditorModel
 def main() -> None:
     from kinegami.editor.server import EditorServer
 
-    server = EditorServer(port=0)
+    server = EditorServer(port=0, autosave=False)
     try:
         view = server.new_view(server.server)
         view.set_model(EditorModel(compact_chain()))

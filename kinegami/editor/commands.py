@@ -55,6 +55,7 @@ __all__ = [
     "SetJointStates",
     "Compact",
     "SetOptions",
+    "ReplaceDocument",
     "JOINT_TYPES",
     "PLACEMENTS",
     "KEEP",
@@ -824,3 +825,22 @@ class SetOptions(Command):
             changes["chain"] = new
         return Outcome(document.replaced(**changes), None, run.clear_warning(new),
                        tuple(range(len(new.Joints))))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class ReplaceDocument(Command):
+    """Replace the whole document by ``document`` (e.g. an autosave offered back after a
+    crash); undo gives the one before back. ``what`` is its line in the undo history."""
+
+    document: Document
+    what: str = "replace the document"
+
+    label: ClassVar[str] = "replace the document"
+
+    def apply(self, document: Document) -> Outcome:
+        if not isinstance(self.document, Document):
+            _fail(f"document must be an editor Document, got {shown(self.document)}")
+        return Outcome(self.document)
+
+    def describe(self) -> str:
+        return str(self.what)

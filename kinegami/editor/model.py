@@ -34,8 +34,8 @@ class Change:
 
     Attributes
     ----------
-    kind : ``"command"``, ``"undo"``, ``"redo"``, ``"load"``, ``"save"``, ``"select"`` or
-        ``"new"``.
+    kind : ``"command"``, ``"undo"``, ``"redo"``, ``"load"``, ``"save"``, ``"select"``,
+        ``"new"`` or ``"preview"`` (a preview shown or ended; see :meth:`EditorModel.preview`).
     joints : indices (in the new document) of the joints whose pose, state or parameters
         changed, or that are new.
     links : indices of the links that changed (``Links[i]`` leads into joint i).
@@ -249,6 +249,7 @@ class EditorModel:
         self._selected: int | None = None
         self._listeners: list[Callable[[Change], None]] = []
         self._patterns = PatternCache()
+        self._preview_base: Document | None = None  # the document under a preview
         #: Default of ``propagate`` for the move helpers (:meth:`slide`, :meth:`roll`,
         #: :meth:`transform`): move the later joints too. A view's toggle sets it.
         self.propagate = True
@@ -279,7 +280,17 @@ class EditorModel:
     def dirty(self) -> bool:
         """Whether the document differs from the last one saved or loaded (or the one the
         model was made with)."""
-        return self._document is not self._saved
+        return self.base_document is not self._saved
+
+    @property
+    def base_document(self) -> Document:
+        """The document commands act on: :attr:`document`, or the one under a preview."""
+        return self._document if self._preview_base is None else self._preview_base
+
+    @property
+    def previewing(self) -> bool:
+        """Whether :attr:`document` is a preview (see :meth:`preview`)."""
+        return self._preview_base is not None
 
     @property
     def selected(self) -> int | None:
@@ -320,6 +331,17 @@ class EditorModel:
         if cached is None:
             cached = self._patterns.pattern(document.chain, document.twist_portion)
             document.__dict__["_pattern"] = cached
+        return cached
+
+    def joint_modules(self) -> tuple[range, ...]:
+        """Per joint, which records of ``pattern().modules`` (and of its ``module_vertices``)
+        are the joint's own modules: a range of indices, empty for a joint without a pattern
+        of its own (a waypoint). Computed once per document."""
+        document = self._document
+        cached = document.__dict__.get("_joint_modules")
+        if cached is None:
+            cached = self._patterns.joint_records(document.chain, document.twist_portion)
+            document.__dict__["_joint_modules"] = cached
         return cached
 
     def joint_table(self) -> tuple[JointRow, ...]:
@@ -374,6 +396,7 @@ class EditorModel:
             return CommandResult(
                 False, "command", f"command must be an editor Command, got {command!r}"
             )
+        self.end_preview()
         before = self._document
         try:
             outcome = command.apply(before)
@@ -412,6 +435,7 @@ class EditorModel:
 
     def undo(self) -> CommandResult:
         """Undo the last command (the document and selection before it come back exactly)."""
+        self.end_preview()
         if not self._undo:
             return CommandResult(False, "undo", "there is nothing to undo")
         step = self._undo.pop()
@@ -420,16 +444,52 @@ class EditorModel:
 
     def redo(self) -> CommandResult:
         """Redo the last undone command (its document comes back exactly)."""
+        self.end_preview()
         if not self._redo:
             return CommandResult(False, "redo", "there is nothing to redo")
         step = self._redo.pop()
         self._undo.append(step)
         return self._switch(step.after, step.selected_after, "redo", "redo")
 
+    # --- previews -----------------------------------------------------------------------------
+    def preview(self, command: Command) -> CommandResult:
+        """Show what ``command`` would make of the document, without recording it.
+
+        :attr:`document` becomes the command's result (listeners get a ``"preview"`` change)
+        while :attr:`base_document` stays the document before the first preview: the history,
+        :attr:`dirty` and what :meth:`save` writes do not change. Each preview applies to the
+        base document (previews do not pile up); :meth:`end_preview` gives the base back, and
+        so does any command, undo, redo, save or load before it runs. An animation is a stream
+        of previews.
+        """
+        if not isinstance(command, Command):
+            return CommandResult(
+                False, "preview", f"command must be an editor Command, got {command!r}"
+            )
+        base = self.base_document
+        try:
+            outcome = command.apply(base)
+        except CommandError as error:
+            return CommandResult(False, command.label, str(error))
+        except (KinegamiError, ValueError, TypeError, IndexError, ArithmeticError) as error:
+            return CommandResult(False, command.label, f"{command.label}: {error}")
+        self._preview_base = base
+        return self._switch(outcome.document, self._selected, "preview", command.label,
+                            outcome.warnings, outcome.sources)  # fmt: skip
+
+    def end_preview(self) -> CommandResult:
+        """Give back the document under the preview (nothing happens when not previewing)."""
+        base = self._preview_base
+        if base is None:
+            return CommandResult(False, "end preview", "there is no preview to end")
+        self._preview_base = None
+        return self._switch(base, self._selected, "preview", "end preview")
+
     # --- files --------------------------------------------------------------------------------
     def save(self, path: str | os.PathLike | None = None) -> CommandResult:
         """Write the design file (default: the model's path) atomically; the model is then
         clean and belongs to that file."""
+        self.end_preview()
         target = self._path if path is None else path
         if target is None:
             return CommandResult(False, "save", "path: the document has no file yet; give one")
@@ -453,6 +513,7 @@ class EditorModel:
             document = Document.load(path)
         except (KinegamiError, ValueError, TypeError, OSError) as error:
             return CommandResult(False, "load", f"load: {error}")
+        self.end_preview()
         self._undo.clear()
         self._redo.clear()
         self._path = Path(os.fspath(path))

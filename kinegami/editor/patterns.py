@@ -22,7 +22,7 @@ from kinegami.chain import KinematicChain
 from kinegami.links import LinkCSC
 from kinegami.pattern import TubularPattern
 
-__all__ = ["PatternCache", "link_shape_key"]
+__all__ = ["PatternCache", "link_shape_key", "joint_records"]
 
 
 def _arc_key(arc) -> tuple:
@@ -39,6 +39,24 @@ def link_shape_key(link: LinkCSC) -> tuple:
         float(link.twistAngle),
         _arc_key(link.elbows2),
     )
+
+
+def joint_records(parts) -> tuple[range, ...]:
+    """Per joint, the indices in the composite's ``modules`` of the joint's own module records.
+
+    ``parts[i]`` is what joint i adds, in order: the modules of the link into it, then the
+    joint's pattern (only the joint's pattern for joint 0). Composition keeps every record of
+    the first pattern and of every later one that is not empty (a waypoint's pattern is only
+    its base polygon and adds none), so the records of the composite follow the parts.
+    """
+    records, k = [], 0
+    for i, part in enumerate(parts):
+        for m, module in enumerate(part):
+            count = len(module.modules) if (i == 0 and m == 0) or not module.isEmpty else 0
+            if m == len(part) - 1:
+                records.append(range(k, k + count))
+            k += count
+    return tuple(records)
 
 
 class PatternCache:
@@ -75,6 +93,11 @@ class PatternCache:
         for link, joint in zip(links[1:], joints[1:], strict=True):
             parts.append(self.link_modules(link, chain.numSides, twistPortion) + (joint.pattern,))
         return parts
+
+    def joint_records(self, chain: KinematicChain, twistPortion: float = 0.2) -> tuple[range, ...]:
+        """Per joint of ``chain``, the indices of its own records in the ``modules`` of
+        :meth:`pattern` (see :func:`joint_records`)."""
+        return joint_records(self._parts_of(chain, twistPortion))
 
     def pattern(self, chain: KinematicChain, twistPortion: float = 0.2) -> TubularPattern:
         """The crease pattern of ``chain`` (equal to ``chain.creasePattern(twistPortion)``)."""

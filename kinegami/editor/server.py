@@ -8,7 +8,8 @@
 Every tab (viser client) gets an :class:`~kinegami.editor.view.EditorView` over a new
 :class:`~kinegami.editor.model.EditorModel` of the starting design; the design is read once,
 on the server, from the path given on the command line. Browsers can only upload design
-files' contents, never name server paths. See docs/editor.md.
+files' contents, never name server paths: the only files the server writes are that design
+(the Save button) and its autosave (:mod:`kinegami.editor.autosave`). See docs/editor.md.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ import os
 import threading
 from pathlib import Path
 
+from kinegami.editor.autosave import Autosaver, Recovery, autosave_path, find_recovery
+from kinegami.editor.commands import ReplaceDocument
 from kinegami.editor.document import Document
 from kinegami.editor.model import EditorModel
 from kinegami.editor.view import EditorView, gallery
@@ -55,15 +58,26 @@ class EditorServer:
     ----------
     design : the design file every tab starts from (None: the starter design).
     host, port : where to listen (port 0: a free port).
+    autosave : keep an autosave of every tab's unsaved changes (see
+        :mod:`kinegami.editor.autosave`).
+    recover : start every tab from the autosave found on start (when there is one) instead
+        of asking.
     """
 
     def __init__(self, design: str | os.PathLike | None = None, host: str = "127.0.0.1",
-                 port: int = 8080):  # fmt: skip
+                 port: int = 8080, *, autosave: bool = True,
+                 recover: bool = False):  # fmt: skip
         viser = _viser()
         self.document = starting_document(design)
         self.path = None if design is None else Path(os.fspath(design))
         self.views: dict[int, EditorView] = {}
         self._lock = threading.Lock()
+        self.autosave = bool(autosave)
+        self._autosavers: dict[Path, Autosaver] = {}
+        #: The autosave found on start that is newer than the design (offered to each new
+        #: tab until one recovers or discards it), or None.
+        self.recovery: Recovery | None = find_recovery(self.path) if self.autosave else None
+        self.recover = bool(recover)
         if port == 0:
             port = _free_port(host)
         with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the CLI prints its own
@@ -83,10 +97,33 @@ class EditorServer:
             host = f"[{host}]"
         return f"http://{host}:{self.port}"
 
+    def autosaver(self, design: Path | None) -> Autosaver:
+        """The one autosaver of a design file (None: of designs with no file), shared by the
+        tabs."""
+        path = autosave_path(design)
+        with self._lock:
+            saver = self._autosavers.get(path)
+            if saver is None:
+                saver = self._autosavers[path] = Autosaver(path)
+            return saver
+
     def new_view(self, target) -> EditorView:
         """An editor over a new model of the starting document, drawn on ``target`` (a viser
-        client, or the server itself in tests)."""
-        return EditorView(target, EditorModel(self.document))
+        client, or the server itself in tests). With an autosave found on start, the tab
+        starts from it (``recover``) or offers it back."""
+        model = EditorModel(self.document, self.path)
+        recovery = self.recovery
+        if recovery is not None and self.recover:
+            model.apply(ReplaceDocument(recovery.document, f"recover the autosave "
+                                                           f"({recovery.describe()})"))  # fmt: skip
+            recovery = None
+        return EditorView(
+            target, model, autosave_for=self.autosaver if self.autosave else None,
+            recovery=recovery, on_recovery=self._recovered,
+        )  # fmt: skip
+
+    def _recovered(self, choice: str) -> None:
+        self.recovery = None  # offered once: recovered or discarded in one tab
 
     def _connect(self, client) -> None:
         view = self.new_view(client)
@@ -100,7 +137,15 @@ class EditorServer:
             view.close()
 
     def stop(self) -> None:
-        """Stop serving."""
+        """Stop serving; pending autosaves are written."""
+        with self._lock:
+            views = list(self.views.values())
+            self.views.clear()
+            savers = list(self._autosavers.values())
+        for view in views:
+            view.close()
+        for saver in savers:
+            saver.close()
         with contextlib.redirect_stdout(io.StringIO()):
             self.server.stop()
 

@@ -14,15 +14,21 @@ import functools
 import io
 import math
 import threading
+import time
 import zipfile
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from kinegami.editor import sheet_drawing
+from kinegami.editor.background import Debounced
+from kinegami.editor.commands import ReplaceDocument, SetJointStates
 from kinegami.editor.document import Document
 from kinegami.editor.model import Change, CommandResult, EditorModel
+from kinegami.errors import KinegamiError
 
 __all__ = ["EditorView", "DOWNLOADS", "MAX_UPLOAD_BYTES", "gallery", "download_data"]
 
@@ -38,6 +44,13 @@ LINK_COLOR = (200, 200, 190)
 SELECTED_COLOR = (250, 180, 40)
 COLLIDING_COLOR = (220, 40, 40)
 JOINT_KINDS = ("RevoluteJoint", "PrismaticJoint", "ExtendedRevoluteJoint", "Waypoint", "EndTip")
+#: Seconds without a change before the crease-pattern panel is drawn again.
+PATTERN_DELAY = 0.2
+#: Width of the crease-pattern panel (pixels).
+PATTERN_PANEL_WIDTH = 460
+#: The animation: seconds of one back-and-forth sweep, and the most frames a second.
+ANIMATION_PERIOD = 4.0
+ANIMATION_FPS = 20.0
 
 
 def gallery(folder: Path = GALLERY_DIR) -> dict[str, Path]:
@@ -133,9 +146,19 @@ class EditorView:
     target : a viser ClientHandle (or ViserServer): its ``scene``, ``gui``,
         ``send_file_download`` and ``add_notification`` are used.
     model : the model to edit (default: the starter design).
+    autosave_for : ``autosave_for(path)`` gives the
+        :class:`~kinegami.editor.autosave.Autosaver` of a design file (None: a design with no
+        file); None: no autosave.
+    recovery : an autosave found on start (:class:`~kinegami.editor.autosave.Recovery`) to
+        offer back in a dialog; ``on_recovery(choice)`` is called with ``"recover"`` or
+        ``"discard"`` once the user chose.
+    pattern_delay : seconds without a change before the crease-pattern panel is drawn again.
     """
 
-    def __init__(self, target: Any, model: EditorModel | None = None):
+    def __init__(self, target: Any, model: EditorModel | None = None, *,
+                 autosave_for: Callable | None = None, recovery=None,
+                 on_recovery: Callable[[str], None] | None = None,
+                 pattern_delay: float = PATTERN_DELAY):  # fmt: skip
         self.target = target
         self.scene = target.scene
         self.gui = target.gui
@@ -152,11 +175,26 @@ class EditorView:
         self._sliders: list = []
         self._gizmo = None
         self._gizmo_pose: np.ndarray | None = None
+        self._autosave_for = autosave_for
+        self.autosave = None if autosave_for is None else autosave_for(self.model.path)
+        self._animation: threading.Event | None = None
+        #: How many times the crease-pattern panel was sent (tests read it).
+        self.pattern_draws = 0
+        self.animation_frames = 0  # frames the running or last animation showed
+        self._closed = False
+        self._pattern_lines = None  # (pattern, units, SheetLines) last drawn
+        self._pattern_key = None
+        self._pattern_redraw = Debounced(self.redraw_pattern, pattern_delay,
+                                         name="kinegami-pattern")  # fmt: skip
         self._build_panel()
+        self._build_pattern_panel()
         self.scene.add_frame("/world", axes_length=2.0 * self._r, axes_radius=0.04 * self._r)
         self._unsubscribe = self.model.subscribe(self._on_change)
         self._redraw_all()
         self.frame_camera()
+        self._recovery_modal = None
+        if recovery is not None:
+            self.offer_recovery(recovery, on_recovery)
 
     # --- model binding ------------------------------------------------------------------------
     @property
@@ -166,10 +204,14 @@ class EditorView:
     @_locked
     def set_model(self, model: EditorModel) -> None:
         """Edit another model (a loaded example or upload): everything is drawn again."""
+        self.stop_animation()
         self._unsubscribe()
         self.model = model
         self.model.propagate = bool(self._propagate.value)
         self._unsubscribe = model.subscribe(self._on_change)
+        if self._autosave_for is not None:
+            self.autosave = self._autosave_for(model.path)
+        self._save_file.visible = model.path is not None
         self._clear_scene()
         self._redraw_all()
         self.frame_camera()
@@ -187,13 +229,25 @@ class EditorView:
         camera.look_at = centre
 
     def close(self) -> None:
-        """Stop listening to the model (the tab closed)."""
-        self._unsubscribe()
+        """Stop listening to the model (the tab closed); a pending autosave is written."""
+        with self.lock:
+            self.stop_animation()
+            self._unsubscribe()
+            self._closed = True
+        self._pattern_redraw.close()
+        if self.autosave is not None:
+            self.autosave.flush()
+
+    def flush(self) -> None:
+        """Do now what waits for a pause: draw the crease-pattern panel if it is due."""
+        self._pattern_redraw.flush()
 
     def act(self, action) -> CommandResult:
         """Run ``action()`` (a model call returning a CommandResult) under the view's lock and
-        show its outcome (widget callbacks run in viser's thread pool)."""
+        show its outcome (widget callbacks run in viser's thread pool). A running animation
+        stops first."""
         with self.lock:
+            self.stop_animation()
             return self.run(action())
 
     def run(self, result: CommandResult) -> CommandResult:
@@ -211,6 +265,7 @@ class EditorView:
         self._message.content = text
 
     def _on_change(self, change: Change) -> None:
+        self._pattern_redraw.trigger()
         if change.kind == "select":
             self._recolour()
             self._update_gizmo()
@@ -218,6 +273,11 @@ class EditorView:
             return
         self._update_scene(change)
         self._update_panel(structure=change.structure)
+        if self.autosave is not None:
+            if change.kind == "save":
+                self.autosave.discard()
+            elif change.kind != "preview":
+                self.autosave.record(self.model.base_document, self.model.dirty, self)
 
     # --- scene --------------------------------------------------------------------------------
     def _new_uid(self) -> int:
@@ -295,6 +355,10 @@ class EditorView:
     def _click(self, node: _Node) -> None:
         if node in self._joints:
             self.model.select(self._joints.index(node))
+
+    def click_joint(self, index: int) -> None:
+        """What a click on joint ``index``'s mesh does (select it)."""
+        self._click(self._joints[index])
 
     def _move(self, node: _Node, frame: np.ndarray) -> None:
         node.frame.wxyz, node.frame.position = _wxyz(frame[:3, :3]), frame[:3, 3]
@@ -425,6 +489,7 @@ class EditorView:
         """Apply a finished handle drag: the slide along the selected joint's axis and the
         roll about it that take its Pose to ``position``/``wxyz`` (other motion is ignored).
         A refused move snaps the handle back and shows the reason."""
+        self.stop_animation()
         pose = self._gizmo_pose
         if pose is None or self.model.selected is None:
             return None
@@ -479,11 +544,23 @@ class EditorView:
             delete = gui.add_button("Delete selected joint", color="red")
             delete.on_click(lambda _: self.act(self.model.delete))
         self._config = gui.add_folder("Configuration")
+        with self._config:
+            self._animate = gui.add_button(
+                "Animate", hint="sweep every joint through its range and back; click again to "
+                "stop (the states come back as they were)",
+            )  # fmt: skip
+            self._animate.on_click(lambda _: self.toggle_animation())
         with gui.add_folder("Clearance"):
             self._clearance = gui.add_markdown("")
             compact = gui.add_button("Compact")
             compact.on_click(lambda _: self.act(lambda: self.model.compact(time_limit=30.0)))
         with gui.add_folder("File"):
+            self._save_file = gui.add_button(
+                "Save to " + (self.model.path.name if self.model.path else "file"),
+                visible=self.model.path is not None,
+                hint="write the design file this editor was started with",
+            )  # fmt: skip
+            self._save_file.on_click(lambda _: self.save_file())
             save = gui.add_button("Save design (download)")
             save.on_click(lambda _: self.download(".json"))
             for label, suffix in DOWNLOADS.items():
@@ -565,7 +642,7 @@ class EditorView:
 
     @_locked
     def _on_slider(self, index: int, handle) -> None:
-        if self._syncing:
+        if self._syncing or self._animation is not None:
             return
         state = float(handle.value)
         if abs(state - float(self.model.joint_table()[index].state)) > 1e-12:
@@ -574,12 +651,14 @@ class EditorView:
     @_locked
     def set_state(self, index: int, state: float) -> CommandResult:
         """Set a joint's state (what its Configuration slider does)."""
+        self.stop_animation()
         return self.run(self.model.set_state(index, state))
 
     # --- files --------------------------------------------------------------------------------
     @_locked
     def download(self, suffix: str) -> tuple[str, bytes] | None:
         """Send the design (``.json``) or an export to the browser; returns (name, data)."""
+        self.stop_animation()
         try:
             name, data = download_data(self.model, suffix)
         except Exception as error:  # noqa: BLE001 - any exporter failure is shown, not raised
@@ -587,6 +666,8 @@ class EditorView:
             return None
         self.target.send_file_download(name, data, save_immediately=True)
         self._say(f"downloaded {name} ({len(data)} bytes)")
+        if suffix == ".json" and self.model.path is None and self.autosave is not None:
+            self.autosave.discard()  # with no file on the server, the download is the save
         return name, data
 
     @_locked
@@ -616,3 +697,185 @@ class EditorView:
         self.set_model(EditorModel(document))
         self._say(text)
         return True
+
+    @_locked
+    def save_file(self) -> CommandResult:
+        """Write the design file the editor was started with (atomically); the autosave is
+        removed. Only that file: a design opened in the browser has no file on the server."""
+        self.stop_animation()
+        if self.model.path is None:
+            return self.run(CommandResult(False, "save", "this design has no file on the "
+                                          "server: use Save design (download)"))  # fmt: skip
+        return self.run(self.model.save())
+
+    # --- crease pattern -----------------------------------------------------------------------
+    def _build_pattern_panel(self) -> None:
+        self._pattern_panel = self.gui.add_panel()
+        with self._pattern_panel.add_tab("Crease pattern"):
+            self._pattern_html = self.gui.add_html("<div>drawing the crease pattern...</div>")
+        self._pattern_panel.dock_left()
+        self._pattern_panel.set_width(PATTERN_PANEL_WIDTH)
+
+    @property
+    def pattern_html(self) -> str:
+        """The crease-pattern panel's HTML (an inline SVG of the sheet)."""
+        return self._pattern_html.content
+
+    @_locked
+    def redraw_pattern(self) -> bool:
+        """Draw the crease-pattern panel if the pattern, its units or the selection changed
+        since it was last drawn (the view calls it after a pause; see :meth:`flush`).
+        Returns whether it sent a new drawing."""
+        if self._closed:
+            return False
+        model = self.model
+        units = model.document.units
+        try:
+            pattern = model.pattern()
+        except (KinegamiError, ValueError) as error:
+            key = ("error", str(error))
+            if key != self._pattern_key:
+                self._pattern_key = key
+                self._pattern_html.content = (
+                    f"<div><b>No crease pattern:</b> {sheet_drawing.html.escape(str(error))}</div>"
+                )
+                self.pattern_draws += 1
+                return True
+            return False
+        cached = self._pattern_lines
+        if cached is None or cached[0] is not pattern or cached[1] != units:
+            cached = (pattern, units, sheet_drawing.sheet_lines(pattern, units))
+            self._pattern_lines = cached
+        lines = cached[2]
+        selected = model.selected
+        span = label = None
+        if selected is not None:
+            records = model.joint_modules()[selected]
+            span = sheet_drawing.joint_span(pattern, records)
+            row = model.joint_table()[selected]
+            label = f"joint {selected} ({row.type}" + (f" '{row.name}'" if row.name else "") + ")"
+            if not len(records):
+                label += ": no modules of its own; the line marks where its links meet"
+        key = (id(lines), span, label)
+        if key == self._pattern_key:
+            return False
+        self._pattern_key = key
+        self._pattern_html.content = sheet_drawing.sheet_html(lines, span, label)
+        self.pattern_draws += 1
+        return True
+
+    # --- animation ----------------------------------------------------------------------------
+    @property
+    def animating(self) -> bool:
+        """Whether the animation runs."""
+        return self._animation is not None
+
+    @_locked
+    def toggle_animation(self) -> bool:
+        """Start the animation, or stop it when it runs; returns whether it runs now."""
+        if self._animation is not None:
+            self.stop_animation()
+            return False
+        return self.animate()
+
+    @_locked
+    def animate(self, period: float = ANIMATION_PERIOD, fps: float = ANIMATION_FPS) -> bool:
+        """Sweep every movable joint through its state range and back, smoothly, every
+        ``period`` seconds, until :meth:`stop_animation` (or any edit) stops it.
+
+        Each frame is a preview (``EditorModel.preview``), not a command: nothing enters the
+        undo history, the design does not become dirty, and stopping gives back the states the
+        joints had. Each joint starts where it is. Frames that the chain refuses (e.g. it would
+        pass through itself with requireClearance) are skipped.
+        """
+        rows = [row for row in self.model.joint_table() if row.movable]
+        if not rows or self._animation is not None:
+            return self._animation is not None
+        states = [float(row.state) for row in self.model.joint_table()]
+        sweeps = []
+        for row in rows:
+            lo, hi = (float(v) for v in row.state_range)
+            mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+            start = math.asin(min(1.0, max(-1.0, (float(row.state) - mid) / half)))
+            sweeps.append((row.index, mid, half, start))
+        stop = threading.Event()
+        self._animation = stop
+        self._animate.label = "Stop animation"
+        self.animation_frames = 0
+        thread = threading.Thread(
+            target=self._animation_loop, args=(stop, states, sweeps, float(period), float(fps)),
+            name="kinegami-animation", daemon=True,
+        )  # fmt: skip
+        thread.start()
+        self._say("animating: every joint sweeps its range (click Stop animation to stop)")
+        return True
+
+    def _animation_loop(self, stop: threading.Event, states: list, sweeps: list,
+                        period: float, fps: float) -> None:  # fmt: skip
+        begin = time.monotonic()
+        while not stop.is_set():
+            frame_start = time.monotonic()
+            phase = 2.0 * math.pi * (frame_start - begin) / period
+            values = list(states)
+            for index, mid, half, start in sweeps:
+                values[index] = min(max(mid + half * math.sin(start + phase), mid - half),
+                                    mid + half)  # fmt: skip
+            with self.lock:
+                if stop.is_set():
+                    return
+                if self.model.preview(SetJointStates(values)).ok:
+                    self.animation_frames += 1
+            stop.wait(max(0.0, 1.0 / fps - (time.monotonic() - frame_start)))
+
+    @_locked
+    def stop_animation(self) -> bool:
+        """Stop the animation: the joints get back the states they had. False when none ran."""
+        stop = self._animation
+        if stop is None:
+            return False
+        stop.set()
+        self._animation = None
+        self._animate.label = "Animate"
+        self.model.end_preview()
+        self._say("animation stopped: the states are back as they were")
+        return True
+
+    # --- recovery -----------------------------------------------------------------------------
+    def offer_recovery(self, recovery, on_choice: Callable[[str], None] | None = None) -> None:
+        """Ask, in a dialog, whether to edit the autosave ``recovery`` (newer than the file)
+        instead of the file; ``on_choice("recover" | "discard")`` after the user chose."""
+        gui = self.gui
+        with gui.add_modal("Recover unsaved changes?") as modal:
+            gui.add_markdown(
+                f"An autosave with {recovery.describe()} was found (`{recovery.path.name}`), "
+                "newer than the file. **Recover** edits it (undo gives the file back); "
+                "**Discard** removes it."
+            )  # fmt: skip
+            buttons = gui.add_button_group("Autosave", ("Recover", "Discard"))
+        self._recovery_modal = modal
+
+        def chosen(event) -> None:
+            choice = "recover" if event.target.value == "Recover" else "discard"
+            self.choose_recovery(recovery, choice)
+            if on_choice is not None:
+                on_choice(choice)
+
+        buttons.on_click(chosen)
+
+    @_locked
+    def choose_recovery(self, recovery, choice: str) -> CommandResult | None:
+        """``"recover"``: edit the autosave's document (one undoable step from the file);
+        ``"discard"``: remove the autosave file. Closes the dialog."""
+        if self._recovery_modal is not None:
+            self._recovery_modal.close()
+            self._recovery_modal = None
+        if choice == "recover":
+            command = ReplaceDocument(recovery.document, f"recover the autosave "
+                                                         f"({recovery.describe()})")  # fmt: skip
+            return self.act(lambda: self.model.apply(command))
+        try:
+            recovery.path.unlink()
+        except FileNotFoundError:
+            pass
+        self._say(f"discarded the autosave {recovery.path.name}")
+        return None

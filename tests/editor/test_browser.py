@@ -31,7 +31,7 @@ def browser():
 def server(browser):
     from kinegami.editor.server import EditorServer
 
-    server = EditorServer(EXAMPLE1, port=0)
+    server = EditorServer(EXAMPLE1, port=0, autosave=False)
     yield server
     server.stop()
 

@@ -28,7 +28,7 @@ from .helpers import EXAMPLE1  # noqa: E402
 
 @pytest.fixture
 def server():
-    server = EditorServer(EXAMPLE1, port=0)
+    server = EditorServer(EXAMPLE1, port=0, autosave=False)
     yield server
     server.stop()
 
@@ -108,7 +108,7 @@ def test_configuration_sliders_span_the_state_ranges(view):
 
 
 def test_colliding_parts_are_red():
-    server = EditorServer(port=0)
+    server = EditorServer(port=0, autosave=False)
     try:
         view = server.new_view(server.server)
         view.act(lambda: view.model.select(2))
@@ -169,7 +169,7 @@ def test_examples_open_only_gallery_designs(view):
 
 
 def test_tabs_edit_their_own_documents(server):
-    other = EditorServer(EXAMPLE1, port=0)
+    other = EditorServer(EXAMPLE1, port=0, autosave=False)
     try:
         a, b = server.new_view(server.server), other.new_view(other.server)
         assert a.act(lambda: a.model.slide(4, 0.5)).ok

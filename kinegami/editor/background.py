@@ -1,0 +1,86 @@
+"""Work the editor does after a pause rather than on every change: :class:`Debounced`.
+
+A drag or an animation changes the document many times a second. What is not needed for each
+step (the crease-pattern drawing, the autosave) is triggered on every change and runs once, in
+a background thread, when no change came for ``delay`` seconds. See docs/editor.md.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+
+__all__ = ["Debounced"]
+
+
+class Debounced:
+    """Call ``func()`` in a background thread ``delay`` seconds after the last :meth:`trigger`.
+
+    ``func`` takes its own locks. An exception it raises is kept in :attr:`error` (the thread
+    goes on). :meth:`flush` runs a pending call at once in the caller's thread.
+    """
+
+    def __init__(self, func: Callable[[], object], delay: float, name: str = "debounced"):
+        self._func = func
+        self.delay = float(delay)
+        self._name = name
+        self._cond = threading.Condition()
+        self._due: float | None = None  # when the pending call runs; None: none pending
+        self._closed = False
+        self._thread: threading.Thread | None = None
+        #: The last exception ``func`` raised in the background thread, or None.
+        self.error: BaseException | None = None
+
+    @property
+    def pending(self) -> bool:
+        """Whether a call is waiting to run."""
+        return self._due is not None
+
+    def trigger(self) -> None:
+        """Ask for a call ``delay`` seconds from now (a later trigger moves it later)."""
+        with self._cond:
+            if self._closed:
+                return
+            self._due = time.monotonic() + self.delay
+            if self._thread is None:
+                self._thread = threading.Thread(target=self._loop, name=self._name, daemon=True)
+                self._thread.start()
+            self._cond.notify()
+
+    def flush(self) -> bool:
+        """Run the pending call now, in this thread; False when none was pending."""
+        with self._cond:
+            if self._due is None:
+                return False
+            self._due = None
+        self._func()
+        return True
+
+    def close(self, flush: bool = False) -> None:
+        """Stop the thread (after running a pending call when ``flush``)."""
+        if flush:
+            self.flush()
+        with self._cond:
+            self._closed = True
+            self._due = None
+            self._cond.notify()
+
+    def _loop(self) -> None:
+        while True:
+            with self._cond:
+                while not self._closed:
+                    if self._due is None:
+                        self._cond.wait()
+                        continue
+                    left = self._due - time.monotonic()
+                    if left <= 0.0:
+                        break
+                    self._cond.wait(left)
+                if self._closed:
+                    return
+                self._due = None
+            try:
+                self._func()
+            except Exception as error:  # noqa: BLE001 - kept for the owner; the thread goes on
+                self.error = error
