@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinegami.geometry.segments import segment_distances
+from kinegami.geometry.segments import point_segment_parameters, segment_distances
 from kinegami.joints import (
     EndTip,
     ExtendedRevoluteJoint,
@@ -65,6 +65,11 @@ __all__ = [
     "joint_label",
     "deepest_overlap",
     "worst_overlap",
+    "tree_worst_overlap",
+    "tree_pair_distances",
+    "part_label",
+    "junction_extent",
+    "link_polyline",
     "Overlap",
     "CONTACT_TOLERANCE",
     "TURN_TOLERANCE",
@@ -610,24 +615,9 @@ def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overla
     if worst >= -CONTACT_TOLERANCE * r:
         return None
 
-    def label(row, param: float) -> str:
-        breaks, labels = row[6], row[7]
-        at = param * float(np.linalg.norm(row[1] - row[0]))
-        text = labels[-1]
-        for n, x in enumerate(breaks):
-            if at < x:
-                text = labels[n]
-                break
-        element = int(row[5])
-        if names is not None and element % 2 == 0:  # a joint's part: add the joint's name
-            jj = element // 2
-            if jj < len(names) and names[jj] is not None:
-                plain = f"joint {jj}, {type(joints[jj]).__name__}"
-                text = text.replace(plain, f"{plain} '{names[jj]}'", 1)
-        return text
-
     first_row, second_row = rows[int(i[k])], rows[int(j[k])]
-    return Overlap(worst, label(first_row, float(s[k])), label(second_row, float(t[k])),
+    return Overlap(worst, part_label(first_row, float(s[k]), joints, names),
+                   part_label(second_row, float(t[k]), joints, names),
                    (int(first_row[5]), int(second_row[5])))  # fmt: skip
 
 
@@ -688,3 +678,258 @@ def capsule_model(chain, names=None, twistPortion: float = 0.2) -> CapsuleModel:
         if isinstance(array, np.ndarray):
             array.setflags(write=False)
     return model
+
+
+# --- trees -----------------------------------------------------------------------------------
+def link_polyline(link) -> np.ndarray:
+    """The link's centreline polyline (units of r, world): its start, every elbow vertex of
+    both arcs, its end; shape (k, 3). The tube lies within r of it except at mitred corners."""
+    start = np.asarray(link.start_frame[:3, 3], dtype=float)
+    end = np.asarray(link.end_frame[:3, 3], dtype=float)
+    return np.concatenate([start[None], link.elbows1.vertices(), link.elbows2.vertices(),
+                           end[None]])  # fmt: skip
+
+
+def _polyline_samples(points: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points every ``step`` (or closer) along a polyline and their distances from its start."""
+    d = np.diff(points, axis=0)
+    lengths = np.sqrt((d**2).sum(axis=1))
+    cumulative = np.concatenate([[0.0], np.cumsum(lengths)])
+    total = float(cumulative[-1])
+    if total <= 0.0:
+        return points[:1], np.zeros(1)
+    count = max(2, int(math.ceil(total / step)) + 1)
+    s = np.linspace(0.0, total, count)
+    k = np.clip(np.searchsorted(cumulative, s, side="right") - 1, 0, len(lengths) - 1)
+    safe = np.where(lengths[k] > 0.0, lengths[k], 1.0)
+    t = np.where(lengths[k] > 0.0, (s - cumulative[k]) / safe, 0.0)
+    return points[k] + t[:, None] * d[k], s
+
+
+def junction_extent(polyline: np.ndarray, siblings: tuple[np.ndarray, ...], r: float) -> float:
+    """How far (along ``polyline``, from its start) a tube leaving a branching joint runs
+    within 2r of a sibling tube leaving the same frame before it first separates from all of
+    them: the part a junction body covers (docs/trees.md). 0 without siblings."""
+    if not siblings:
+        return 0.0
+    points, s = _polyline_samples(polyline, 0.02 * r)
+    a = np.concatenate([p[:-1] for p in siblings if len(p) > 1])
+    b = np.concatenate([p[1:] for p in siblings if len(p) > 1])
+    if a.size == 0:
+        return 0.0
+    t = _point_params(points[:, None, :], a[None], b[None])
+    nearest = a[None] + t[..., None] * (b - a)[None]
+    distance = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)
+    apart = np.flatnonzero(distance >= 2.0 * r * (1.0 - CONTACT_TOLERANCE))
+    if apart.size == 0:
+        return float(s[-1])
+    return float(s[apart[0]])
+
+
+def _point_params(points, a, b) -> np.ndarray:
+    return point_segment_parameters(points, a, b)
+
+
+def _polyline_distance(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
+    """Distance along ``polyline`` (from its start) of the point of it nearest each point."""
+    a, b = polyline[:-1], polyline[1:]
+    lengths = np.sqrt(((b - a) ** 2).sum(axis=1))
+    cumulative = np.concatenate([[0.0], np.cumsum(lengths)])
+    t = _point_params(points[:, None, :], a[None], b[None])
+    nearest = a[None] + t[..., None] * (b - a)[None]
+    k = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).argmin(axis=1)
+    rows = np.arange(points.shape[0])
+    return cumulative[k] + t[rows, k] * lengths[k]
+
+
+def tree_pair_distances(
+    joints, links, parents, r: float, since: int = 0, reach: float | None = None
+) -> tuple | None:
+    """The tested capsule pairs of a tree that come within ``reach`` (default 2r) and their
+    distances (docs/trees.md): ``(i, j, distance, s, t, rows, a, b)`` with ``i``, ``j`` row
+    indices, ``s``, ``t`` the closest points' parameters, ``rows`` the capsule rows (labels)
+    and ``a``, ``b`` their end points; None when nothing is tested.
+
+    Parts on one path from the root are tested as in a chain (when the centreline between
+    them turns by at least pi, hinges included). Parts on different branches are always tested,
+    except where two tubes leaving the same branching joint still run together within the
+    junction that joins them (:func:`junction_extent` of each); on a chain the tested pairs
+    are the chain's.
+    """
+    parents = [int(p) for p in parents]
+    reach = 2.0 * r if reach is None else reach
+    n = len(joints)
+    children: list[list[int]] = [[] for _ in range(n)]
+    for k in range(1, n):
+        children[parents[k]].append(k)
+    # turning along the path from the root: links, and revolute hinges by their states
+    link_total = np.zeros(n)
+    rows: list = []
+    pieces_a, pieces_b, owner_node, base_turn = [], [], [], []
+    for j in range(n):
+        if j > 0:
+            (A, B, body, turn), link_rows, total = _link_arrays(links[j], j, r, 0.2)
+            link_total[j] = total
+            if len(link_rows):
+                pieces_a.append(A)
+                pieces_b.append(B)
+                owner_node.append(np.full(len(link_rows), j))
+                base_turn.append(turn)
+                rows += link_rows
+        (A, B, body, turn), joint_rows = _joint_arrays(joints[j], j, r)
+        if len(joint_rows):
+            pieces_a.append(A)
+            pieces_b.append(B)
+            owner_node.append(np.full(len(joint_rows), j))
+            base_turn.append(turn)
+            rows += joint_rows
+    S = len(rows)
+    if S < 2:
+        return None
+    a = np.concatenate(pieces_a)
+    b = np.concatenate(pieces_b)
+    node = np.concatenate(owner_node)
+    own = np.concatenate(base_turn)
+    element = np.fromiter((row[5] for row in rows), dtype=np.int64, count=S)
+    body_a = np.fromiter((row[2] for row in rows), dtype=np.int64, count=S)
+    is_link = element % 2 == 1
+    path_links = np.zeros(n)  # link turning from the root to the end of joint j's link
+    kinks = np.zeros(n)  # hinge turning from the root to joint j's distal side
+    for j in range(n):
+        p = parents[j]
+        path_links[j] = link_total[j] + (path_links[p] if p >= 0 else 0.0)
+        kink = abs(joints[j].state) if isinstance(joints[j], RevoluteJoint) else 0.0
+        kinks[j] = kink + (kinks[p] if p >= 0 else 0.0)
+    parent_of = np.array(parents)
+    before = np.where(is_link, path_links[np.maximum(parent_of[node], 0)], path_links[node])
+    before = np.where(is_link & (parent_of[node] < 0), 0.0, before)
+    tau = own + before + np.where(body_a >= 0, kinks[np.maximum(body_a, 0)], 0.0)
+
+    # junctions: how far each child link of a branching joint runs with its siblings
+    extent = np.zeros(n)
+    polylines = {}
+    for kids in children:
+        if len(kids) < 2:
+            continue
+        for k in kids:
+            polylines[k] = link_polyline(links[k])
+        for k in kids:
+            others = tuple(polylines[o] for o in kids if o != k)
+            extent[k] = junction_extent(polylines[k], others, r)
+
+    centre = 0.5 * (a + b)
+    half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
+    first = np.arange(S) + 1
+    i, j = _near_pairs(rows, tau, first, centre, half, reach)
+    if since > 0 and i.size:
+        keep = (node[i] >= since) | (node[j] >= since)
+        i, j = i[keep], j[keep]
+    if i.size == 0:
+        return None
+
+    def ancestors(k: int) -> list[int]:
+        path = []
+        while k >= 0:
+            path.append(k)
+            k = parents[k]
+        return path
+
+    lineage = {}
+
+    def lca(x: int, y: int) -> int:
+        if x not in lineage:
+            lineage[x] = ancestors(x)
+        if y not in lineage:
+            lineage[y] = ancestors(y)
+        ys = set(lineage[y])
+        for z in lineage[x]:
+            if z in ys:
+                return z
+        return -1  # pragma: no cover - every node descends from the root
+
+    tested = np.zeros(i.size, dtype=bool)
+    clip_i = np.zeros(i.size)  # distance along a junction link from which a part counts
+    clip_j = np.zeros(i.size)
+    junction_pair = np.zeros(i.size, dtype=bool)
+    for q in range(i.size):
+        x, y = int(node[i[q]]), int(node[j[q]])
+        c = lca(x, y)
+        if c == x or c == y:  # one path from the root: the chain rule
+            lo, hi = (i[q], j[q]) if tau[i[q]] <= tau[j[q]] else (j[q], i[q])
+            tested[q] = tau[hi] - tau[lo] >= math.pi - TURN_TOLERANCE
+            continue
+        tested[q] = True
+        # the two children of c the parts descend from
+        cx = lineage[x][lineage[x].index(c) - 1]
+        cy = lineage[y][lineage[y].index(c) - 1]
+        if cx == x and cy == y and is_link[i[q]] and is_link[j[q]]:
+            junction_pair[q] = True
+            clip_i[q], clip_j[q] = extent[x], extent[y]
+    i, j = i[tested], j[tested]
+    junction_pair, clip_i, clip_j = junction_pair[tested], clip_i[tested], clip_j[tested]
+    if i.size == 0:
+        return None
+    dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
+    for q in np.flatnonzero(junction_pair):
+        # both parts inside the junction do not count: the distance of the rest
+        x, y = int(node[i[q]]), int(node[j[q]])
+        best = (math.inf, 0.0, 0.0)
+        for (p0, p1, e0, line), (o0, o1) in (
+            ((a[i[q]], b[i[q]], clip_i[q], polylines[x]), (a[j[q]], b[j[q]])),
+            ((a[j[q]], b[j[q]], clip_j[q], polylines[y]), (a[i[q]], b[i[q]])),
+        ):
+            d0, d1 = _polyline_distance(np.array([p0, p1]), line)
+            if max(d0, d1) <= e0:
+                continue
+            u = 0.0 if d1 == d0 else min(max((e0 - d0) / (d1 - d0), 0.0), 1.0)
+            if d1 < d0:
+                q0, q1 = p0, p0 + u * (p1 - p0)
+            else:
+                q0, q1 = p0 + u * (p1 - p0), p1
+            dd, _, _ = segment_distances(q0[None], q1[None], o0[None], o1[None])
+            best = min(best, (float(dd[0]), 0.0, 0.0))
+        dist[q] = best[0]
+    return i, j, dist, s, t, rows, a, b
+
+
+def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int = 0):
+    """:func:`worst_overlap` for a tree (docs/trees.md): the deepest overlap, or None.
+
+    Parts on one path from the root are tested as in a chain; parts on different branches are
+    always tested, except where two tubes leaving the same branching joint still run together
+    within the junction that joins them. On a chain it is :func:`worst_overlap`.
+    """
+    parents = [int(p) for p in parents]
+    if parents == list(range(-1, len(joints) - 1)):
+        return worst_overlap(joints, links, r, names=names, since=since)
+    found = tree_pair_distances(joints, links, parents, r, since)
+    if found is None:
+        return None
+    i, j, dist, s, t, rows, _, _ = found
+    k = int(np.argmin(dist))
+    worst = float(dist[k]) - 2.0 * r
+    if worst >= -CONTACT_TOLERANCE * r:
+        return None
+    first_row, second_row = rows[int(i[k])], rows[int(j[k])]
+    return Overlap(worst, part_label(first_row, float(s[k]), joints, names),
+                   part_label(second_row, float(t[k]), joints, names),
+                   (int(first_row[5]), int(second_row[5])))  # fmt: skip
+
+
+def part_label(row, param: float, joints, names=None) -> str:
+    """The part at parameter ``param`` in [0, 1] of a capsule row, in words (with the joint's
+    name from ``names``, if given)."""
+    breaks, labels = row[6], row[7]
+    at = param * float(np.linalg.norm(row[1] - row[0]))
+    text = labels[-1]
+    for n, x in enumerate(breaks):
+        if at < x:
+            text = labels[n]
+            break
+    element = int(row[5])
+    if names is not None and element % 2 == 0:
+        jj = element // 2
+        if jj < len(names) and names[jj] is not None:
+            plain = f"joint {jj}, {type(joints[jj]).__name__}"
+            text = text.replace(plain, f"{plain} '{names[jj]}'", 1)
+    return text

@@ -170,14 +170,15 @@ class _JointAssembly:
             child.proximal_dubins_frame(),
         )
 
-    def _index(self, jointIndex) -> int:
+    def _index(self, jointIndex, name: str = "jointIndex") -> int:
         if isinstance(jointIndex, bool) or not isinstance(jointIndex, int | np.integer):
-            raise InvalidTypeError(f"jointIndex must be an integer, got {shown(jointIndex)}")
+            raise InvalidTypeError(f"{name} must be an integer, got {shown(jointIndex)}")
         n = len(self._joints)
         j = int(jointIndex)
         if not -n <= j < n:
             raise JointIndexError(
-                f"jointIndex must be in [{-n}, {n - 1}] for a chain of {n} joints, got {shown(j)}"
+                f"{name} must be in [{-n}, {n - 1}] for a {self._noun} of {n} joints, "
+                f"got {shown(j)}"
             )
         return j % n
 

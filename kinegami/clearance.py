@@ -34,6 +34,8 @@ from kinegami.bodies import (
     TURN_TOLERANCE,
     CapsuleModel,
     capsule_model,
+    part_label,
+    tree_pair_distances,
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.segments import segment_distances
@@ -46,6 +48,7 @@ __all__ = [
     "ClearanceReport",
     "SweepReport",
     "chain_clearance",
+    "tree_clearance",
     "sweep",
     "ClearanceEngine",
     "engine_for",
@@ -675,3 +678,72 @@ def sweep(
         free_intervals=engine.free_intervals(current, int(resolution)),
         states=tuple(float(x) for x in current),
     )
+
+
+def tree_clearance(tree, states=None, names=None) -> ClearanceReport:
+    """The clearance of a :class:`~kinegami.tree.KinematicTree` at its current states or at
+    ``states`` (one per joint, in index order); the tree is not changed.
+
+    The pair rule of trees (docs/trees.md): parts on one path from the root are tested as in a
+    chain; parts on different branches always, except where two tubes leaving the same
+    branching joint run together inside the junction that joins them. A tree that is a chain
+    gets the chain's report.
+
+    Raises
+    ------
+    InvalidParameterError, InvalidTypeError
+        For ``states`` of the wrong length or type, or outside a joint's range.
+    """
+    joints = tree.Joints
+    if states is None:
+        values = tuple(float(joint.state) for joint in joints)
+        links = tree.Links
+    else:
+        if isinstance(states, str | bytes) or not isinstance(states, Sequence | np.ndarray):
+            raise InvalidTypeError(
+                f"states must be a list of {len(joints)} joint states, got {type(states).__name__}"
+            )
+        if len(states) != len(joints):
+            raise InvalidParameterError(
+                f"states must have one state per joint ({len(joints)}), got {len(states)}"
+            )
+        checked = [check_real(f"states[{k}]", s) for k, s in enumerate(states)]
+        for k, (s, joint) in enumerate(zip(checked, joints, strict=True)):
+            lo, hi = joint.stateRange()
+            if not lo - 1e-12 <= s <= hi + 1e-12:
+                raise InvalidParameterError(
+                    f"states[{k}] = {s!r} is outside joint {k}'s state range [{lo:.6g}, {hi:.6g}]"
+                )
+        values = tuple(min(max(s, j.stateRange()[0]), j.stateRange()[1])
+                       for s, j in zip(checked, joints, strict=True))  # fmt: skip
+        joints, links = tree._configured(values)
+    r = float(tree.r)
+    found = tree_pair_distances(joints, links, tree.Parents, r, reach=math.inf)
+    if found is None:
+        return ClearanceReport(True, math.inf, (), None, values)
+    i, j, dist, s, t, rows, a, b = found
+    clearance = dist - 2.0 * r
+    order = np.argsort(clearance, kind="stable")
+    limit = -CONTACT_TOLERANCE * r
+
+    def make(q: int) -> CollidingPair:
+        ii, jj = int(i[q]), int(j[q])
+        p = a[ii] + s[q] * (b[ii] - a[ii])
+        o = a[jj] + t[q] * (b[jj] - a[jj])
+        return CollidingPair(
+            part_label(rows[ii], float(s[q]), joints, names),
+            part_label(rows[jj], float(t[q]), joints, names),
+            float(clearance[q]),
+            (tuple(map(float, p)), tuple(map(float, o))),
+            (int(rows[ii][5]), int(rows[jj][5])),
+        )
+
+    closest = make(int(order[0]))
+    pairs: dict[tuple[str, str], CollidingPair] = {}
+    for q in order:
+        if clearance[q] >= limit:
+            break
+        pair = make(int(q))
+        pairs.setdefault((pair.first, pair.second), pair)
+    best = float(clearance[order[0]])
+    return ClearanceReport(best >= limit, best, tuple(pairs.values()), closest, values)

@@ -1,0 +1,388 @@
+"""KinematicTree: joints with any number of children, joined by CSC links (docs/trees.md).
+
+A tree holds its joints in world coordinates, in the order they were added (a parent's index is
+always smaller than its children's, so index order is a topological order), the parent of every
+joint (``Parents``; -1 for the root) and, for every joint i >= 1, the link ``Links[i]`` from its
+parent's distal Dubins frame to its own proximal Dubins frame. One bounding ball covers the whole
+tree, so a safe or compact placement puts a new joint beyond everything built so far.
+
+Everything a chain does, a tree does on subtrees: a moved joint takes its descendants along, a
+state change moves the subtrees beyond the joint. Every operation computes the new lists first
+and swaps them in only when all exist, so a refused one leaves the tree bit-identical. A
+:class:`~kinegami.chain.KinematicChain` is the tree in which joint i's parent is joint i - 1:
+the same calls on both give the same joints, links and ball, bit for bit (tested).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from kinegami.bodies import tree_worst_overlap
+from kinegami.chain import _PROPAGATE_DEFAULT, _JointAssembly, _propagate_flag
+from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
+from kinegami.geometry.frames import rotation_about_line, translation
+from kinegami.joints import Joint, Waypoint, pose_array
+from kinegami.validation import check_bool, check_real, check_translation
+
+__all__ = ["KinematicTree"]
+
+
+class KinematicTree(_JointAssembly):
+    """A tree of tubular origami joints joined by CSC links.
+
+    Parameters
+    ----------
+    root : the root joint (copied; world coordinates).
+    maxAnglePerElbow : largest turn of a single elbow fitting, in (0, pi] (default pi/2).
+    requireClearance : refuse additions, edits and state changes that would make the tree pass
+        through itself (default False: apply them and emit a ClearanceWarning).
+
+    Examples
+    --------
+    >>> tree = KinematicTree(Waypoint(4, 1, SE3()))
+    >>> tree.addJoint(0, RevoluteJoint(4, 1, np.pi, SE3.Trans(3, 0, 4) * SE3.Ry(np.pi / 2)),
+    ...               safe=False, fixedPosition=True, fixedOrientation=True)
+    1
+    >>> tree.addJoint(0, RevoluteJoint(4, 1, np.pi, SE3.Trans(-3, 0, 4) * SE3.Ry(np.pi / 2)),
+    ...               safe=False, fixedPosition=True, fixedOrientation=True)
+    2
+    >>> tree.Parents, tree.Children
+    ((-1, 0, 0), ((1, 2), (), ()))
+    """
+
+    _noun = "tree"
+
+    def __init__(
+        self,
+        root: Joint,
+        maxAnglePerElbow: float = np.pi / 2,
+        requireClearance: bool = False,
+    ):
+        super().__init__(root, maxAnglePerElbow, requireClearance)
+        self._parents: list[int] = [-1]
+
+    # --- published read-only views -----------------------------------------------------------
+    @property
+    def Parents(self) -> tuple[int, ...]:
+        """Parent index of every joint (-1 for the root)."""
+        return tuple(self._parents)
+
+    @property
+    def Children(self) -> tuple[tuple[int, ...], ...]:
+        """The children of every joint, in the order they were added."""
+        children: list[list[int]] = [[] for _ in self._joints]
+        for k, p in enumerate(self._parents):
+            if p >= 0:
+                children[p].append(k)
+        return tuple(tuple(c) for c in children)
+
+    def __repr__(self) -> str:
+        leaves = sum(1 for c in self.Children if not c)
+        return (
+            f"KinematicTree({len(self._joints)} joints, {leaves} leaves; "
+            f"path length {self.totalPathLength():.6g})"
+        )
+
+    def branchingParametersFrom(self, jointIndex: int) -> list[list[float]]:
+        """The branching parameters of the links to each child of ``jointIndex``
+        (``LinkCSC.branchingParameters``: degrees and lengths), in the order of ``Children``."""
+        j = self._index(jointIndex)
+        return [self._links[k].branchingParameters() for k in self.Children[j]]
+
+    def subtree(self, jointIndex: int) -> tuple[int, ...]:
+        """``jointIndex`` and all its descendants, in index order."""
+        j = self._index(jointIndex)
+        return tuple(self._subtree(j))
+
+    # --- the hooks of the shared part ----------------------------------------------------------
+    def _parent_list(self) -> list[int]:
+        return list(self._parents)
+
+    def _overlap(self, joints, links, parents, since: int = 0):
+        parents = self._parents if parents is None else parents
+        return tree_worst_overlap(joints, links, parents, self.r, since=since)
+
+    def _commit(self, joints, links, ball=None, parents=None):
+        super()._commit(joints, links, ball)
+        if parents is not None:
+            self._parents = list(parents)
+
+    def _subtree(self, j: int, parents: Sequence[int] | None = None) -> list[int]:
+        """j and its descendants in index order (children always follow their parent)."""
+        parents = self._parents if parents is None else parents
+        inside = {j}
+        for k in range(j + 1, len(parents)):
+            if parents[k] in inside:
+                inside.add(k)
+        return sorted(inside)
+
+    def _children_of(self, j: int) -> list[int]:
+        return [k for k, p in enumerate(self._parents) if p == j]
+
+    # --- building ----------------------------------------------------------------------------
+    def addJoint(
+        self,
+        parentIndex: int,
+        newJoint: Joint,
+        relative: bool = True,
+        safe: bool = True,
+        fixedPosition: bool = False,
+        fixedOrientation: bool = False,
+    ) -> int | None:
+        """Add ``newJoint`` as a child of joint ``parentIndex`` and return its index.
+
+        Parameters
+        ----------
+        parentIndex : the parent joint (negative counts from the end).
+        newJoint : the joint; its Pose gives the axis of motion (z). It is copied.
+        relative : the Pose is relative to the parent's Pose (True) or global (False).
+        safe : place with the safe algorithm (waypoints from the parent, beyond the whole
+            tree's ball) rather than compact (docs/placement.md). Safe placement of a later
+            sibling never runs through an earlier one: candidates that would are passed over
+            (docs/trees.md).
+        fixedPosition, fixedOrientation : keep the given position / orientation (safe=False).
+
+        Returns the new joint's index (waypoints that safe placement adds take the indices just
+        before it), or None with a PlacementWarning (tree unchanged) when no link reaches it.
+        """
+        p = self._index(parentIndex, "parentIndex")
+        return self._place("addJoint", p, newJoint, relative, safe, fixedPosition,
+                           fixedOrientation)  # fmt: skip
+
+    # --- edits ---------------------------------------------------------------------------------
+    def _moved(self, j: int, T: np.ndarray, propagate: bool, joints=None, links=None):
+        """New joint and link lists with joint j moved by world transform T (docs/trees.md)."""
+        joints = list(self._joints) if joints is None else joints
+        links = list(self._links) if links is None else links
+        joints[j] = joints[j].transformed(T)
+        if propagate:
+            for k in self._subtree(j)[1:]:
+                joints[k] = joints[k].transformed(T)
+                links[k] = links[k].transformed(T)
+        else:
+            for k in self._children_of(j):
+                links[k] = self._link(joints[j], joints[k])
+        if j > 0:
+            links[j] = self._link(joints[self._parents[j]], joints[j])
+        else:
+            links[0] = links[0].transformed(T)
+        return joints, links
+
+    def transformJoint(
+        self,
+        jointIndex: int,
+        Transformation,
+        propogate: bool = _PROPAGATE_DEFAULT,
+        *,
+        propagate: bool | None = None,
+    ) -> bool:
+        """Move joint ``jointIndex`` by the world transform ``Transformation``.
+
+        With propagation its whole subtree moves with it (only the link into the joint is
+        re-solved); without, only this joint moves (the link into it and the links to its
+        children are re-solved). Returns True, or False with a PlacementWarning (tree
+        unchanged) when a link cannot be built.
+        """
+        j = self._index(jointIndex)
+        T = pose_array(Transformation, "Transformation", r=self.r)
+        prop = _propagate_flag(propogate, propagate)
+        return self._try_edit("transformJoint", lambda: self._moved(j, T, prop))
+
+    def _axis_edit(self, what, jointIndex, T_of_joint, propogate, propagate,
+                   applyToPreviousWaypoint) -> bool:  # fmt: skip
+        j = self._index(jointIndex)
+        prop = _propagate_flag(propogate, propagate)
+        applyToPreviousWaypoint = check_bool("applyToPreviousWaypoint", applyToPreviousWaypoint)
+        T = T_of_joint(self._joints[j])
+        w = self._parents[j] if j > 0 else -1
+        # the previous waypoint is the parent, and only when j is its only child (moving it
+        # would otherwise move j's siblings too)
+        if (
+            applyToPreviousWaypoint
+            and w >= 0
+            and isinstance(self._joints[w], Waypoint)
+            and self._children_of(w) == [j]
+        ):
+            if prop:
+                return self._try_edit(what, lambda: self._moved(w, T, True))
+
+            def both():
+                joints = list(self._joints)
+                joints[w] = joints[w].transformed(T)
+                joints[j] = joints[j].transformed(T)
+                links = list(self._links)
+                for k in [w, j, *self._children_of(j)]:
+                    if k == 0:
+                        links[0] = links[0].transformed(T)
+                    else:
+                        links[k] = self._link(joints[self._parents[k]], joints[k])
+                return joints, links
+
+            return self._try_edit(what, both)
+        return self._try_edit(what, lambda: self._moved(j, T, prop))
+
+    def translateJointAlongAxisOfMotion(
+        self,
+        jointIndex: int,
+        distance: float,
+        propogate: bool = _PROPAGATE_DEFAULT,
+        applyToPreviousWaypoint: bool = False,
+        *,
+        propagate: bool | None = None,
+    ) -> bool:
+        """Slide joint ``jointIndex`` by ``distance`` along its axis of motion (z); with
+        propagation its subtree follows. ``applyToPreviousWaypoint`` moves the parent with it
+        when the parent is a waypoint whose only child is this joint."""
+        d = check_translation("distance", distance, self.r)
+        return self._axis_edit(
+            "translateJointAlongAxisOfMotion",
+            jointIndex,
+            lambda joint: translation(d * joint.pose_matrix[:3, 2]),
+            propogate,
+            propagate,
+            applyToPreviousWaypoint,
+        )
+
+    def rotateJointAboutAxisOfMotion(
+        self,
+        jointIndex: int,
+        angle: float,
+        propogate: bool = _PROPAGATE_DEFAULT,
+        applyToPreviousWaypoint: bool = False,
+        *,
+        propagate: bool | None = None,
+    ) -> bool:
+        """Turn joint ``jointIndex`` by ``angle`` (radians) about its axis of motion."""
+        a = check_real("angle", angle)
+        return self._axis_edit(
+            "rotateJointAboutAxisOfMotion",
+            jointIndex,
+            lambda joint: rotation_about_line(
+                joint.pose_matrix[:3, 2], joint.pose_matrix[:3, 3], a
+            ),
+            propogate,
+            propagate,
+            applyToPreviousWaypoint,
+        )
+
+    def delete(self, jointIndex: int) -> bool:
+        """Remove joint ``jointIndex`` and link its children to its parent.
+
+        Each child's link is re-solved from the removed joint's parent; deleting the root is
+        possible when it has exactly one child (that child becomes the root). Returns True, or
+        False with a PlacementWarning (tree unchanged) when a new link cannot be built.
+        """
+        j = self._index(jointIndex)
+        kids = self._children_of(j)
+        if j == 0 and len(kids) != 1:
+            self._reject(
+                "delete failed: the root can be deleted only when it has exactly one child "
+                f"(it has {len(kids)})"
+            )
+            return False
+        up = self._parents[j]
+        parents = []
+        for k, p in enumerate(self._parents):
+            if k != j:
+                q = up if p == j else p
+                parents.append(q - 1 if q > j else q)
+
+        def build():
+            joints = self._joints[:j] + self._joints[j + 1 :]
+            links = self._links[:j] + self._links[j + 1 :]
+            for child in kids:
+                k = child - 1  # its index after the deletion
+                if parents[k] < 0:
+                    links[k] = self._root_link(joints[k])
+                else:
+                    links[k] = self._link(joints[parents[k]], joints[k])
+            return joints, links
+
+        try:
+            joints, links = build()
+            ball = self._ball_of(joints, links)
+        except KinegamiError as error:
+            self._reject(f"delete failed: {error}")
+            return False
+        return self._accept("delete", joints, links, ball, parents)
+
+    # --- states --------------------------------------------------------------------------------
+    def setJointState(self, jointIndex: int, newState: float) -> bool:
+        """Set joint ``jointIndex`` to ``newState`` (radians or length): the subtrees beyond it
+        move; the joint itself, its siblings and every other branch stay. Returns False with a
+        PlacementWarning (tree unchanged) if ``newState`` is outside ``stateRange()``."""
+        j = self._index(jointIndex)
+        s = check_real("newState", newState)
+        joint = self._joints[j]
+        lo, hi = joint.stateRange()
+        if not lo <= s <= hi:
+            self._reject(
+                f"setJointState failed: state {s!r} of joint {j} ({type(joint).__name__}) "
+                f"is outside its range [{lo:.6g}, {hi:.6g}]"
+            )
+            return False
+        G = joint.state_transform(s - joint.state)
+        joints = list(self._joints)
+        links = list(self._links)
+        joints[j] = joint.with_state(s)
+        for k in self._subtree(j)[1:]:
+            joints[k] = joints[k].transformed(G)
+            links[k] = links[k].transformed(G)
+        return self._accept("setJointState", joints, links)
+
+    def setJointStates(self, states: Sequence[float]) -> bool:
+        """Set every joint's state at once (one value per joint, in index order); all or
+        nothing."""
+        if isinstance(states, str | bytes) or not hasattr(states, "__len__"):
+            raise InvalidTypeError(f"states must be a sequence of numbers, got {states!r}")
+        if len(states) != len(self._joints):
+            raise InvalidParameterError(
+                f"states must have one value per joint ({len(self._joints)}), got {len(states)}"
+            )
+        values = [check_real(f"states[{i}]", s) for i, s in enumerate(states)]
+        for i, (joint, s) in enumerate(zip(self._joints, values, strict=True)):
+            lo, hi = joint.stateRange()
+            if not lo <= s <= hi:
+                self._reject(
+                    f"setJointStates failed: state {s!r} of joint {i} is outside "
+                    f"[{lo:.6g}, {hi:.6g}]"
+                )
+                return False
+        joints, links = self._configured(values)
+        return self._accept("setJointStates", joints, links)
+
+    def _configured(self, values: Sequence[float]) -> tuple[list, list]:
+        """Joint and link lists at the (checked) states ``values``, one per joint."""
+        joints = list(self._joints)
+        links = list(self._links)
+        # the motion of everything beyond joint k's distal side, from the changes on its path
+        beyond: list[np.ndarray | None] = [None] * len(joints)
+        for k in range(len(joints)):
+            p = self._parents[k]
+            moved = beyond[p] if p >= 0 else None
+            if moved is not None:
+                joints[k] = joints[k].transformed(moved)
+                links[k] = links[k].transformed(moved)
+            joint = joints[k]
+            if values[k] != joint.state:
+                G = joint.state_transform(values[k] - joint.state)
+                joints[k] = joint.with_state(values[k])
+                moved = G if moved is None else G @ moved
+            beyond[k] = moved
+        return joints, links
+
+    # --- output --------------------------------------------------------------------------------
+    def clearance(self, states=None):
+        """Self-intersection at the current states or at ``states`` (one per joint): a
+        ClearanceReport (``.ok``, ``.min_clearance``, ``.pairs``); see docs/trees.md."""
+        from kinegami.clearance import tree_clearance
+
+        return tree_clearance(self, states)
+
+    def show(self, **options):
+        """Draw the tree in 3D with matplotlib; returns (figure, axes). See kinegami.viz."""
+        from kinegami.viz.chain_plot import show_chain
+
+        return show_chain(self, **options)
