@@ -59,6 +59,8 @@ __all__ = [
 #: What the connector does on the parent's side of D (docs/junctions.md).
 ParentSide = Literal["socket", "flange", "base", "none"]
 PARENT_SIDES: tuple[str, ...] = ("socket", "flange", "base", "none")
+#: Where a socket starts (:class:`ConnectorOptions`).
+SOCKET_RULES: tuple[str, ...] = ("clear", "overlap")
 
 #: Centreline points closer than this many r to a sibling's centreline overlap it.
 OVERLAP_FACTOR = 2.0
@@ -100,7 +102,11 @@ def _check_step(step, r: float) -> float:
 
 
 def sibling_overlap_lengths(
-    links: Sequence[LinkCSC], r: float, step: float | None = None
+    links: Sequence[LinkCSC],
+    r: float,
+    step: float | None = None,
+    *,
+    distance: float | None = None,
 ) -> np.ndarray:
     """The overlap length of each child link with its siblings (units of r).
 
@@ -114,6 +120,9 @@ def sibling_overlap_lengths(
     links : the child links (at least 2), all starting at the branch node's distal frame.
     r : tube radius.
     step : sampling step along each link, in (0, 0.01 r].
+    distance : the threshold, in [2r, 100 r] (default 2r; :func:`junction_sockets` also uses
+        R_in + R_out, the centreline distance at which a socket's wall is clear of its
+        siblings).
 
     Returns
     -------
@@ -124,12 +133,23 @@ def sibling_overlap_lengths(
     >>> a = LinkCSC(1, SE3(), SE3.Trans(10, 6, 0))
     >>> b = LinkCSC(1, SE3(), SE3.Trans(10, -6, 0))
     >>> sibling_overlap_lengths([a, b], 1.0).round(3).tolist()
-    [1.977, 1.977]
+    [2.482, 2.482]
     """
     r = check_radius(r)
     links = _check_links(links, r)
     step = _check_step(step, r)
-    limit = OVERLAP_FACTOR * r
+    if distance is None:
+        limit = OVERLAP_FACTOR * r
+    else:
+        limit = check_in_range(
+            "distance",
+            distance,
+            OVERLAP_FACTOR * r,
+            100.0 * r,
+            low_inclusive=True,
+            high_inclusive=True,
+            range_text=f"[2 r, 100 r] = [{2 * r:g}, {100 * r:g}] (r = {r:g})",
+        )
     out = np.zeros(len(links))
     for k, link in enumerate(links):
         others = [other.path for j, other in enumerate(links) if j != k]
@@ -209,6 +229,10 @@ class ConnectorOptions:
     plate : thickness of the flange and of the base plate, in (0, 10 r] (default = wall).
     mitre_angle : largest turn of one mitred prism where a channel follows an arc, in
         (0, pi/2] (default pi/16).
+    socket_rule : where a socket starts. ``"clear"`` (default): at l_clear(c), the last arc
+        length within (R_in + R_out) / cos(mitre_angle / 2) of a sibling's centreline, so no
+        sibling's void or paper tube enters the socket's wall; ``"overlap"``: at l_ov(c) (2r),
+        the shortest socket, whose wall a sibling's void may nick where the socket starts.
     """
 
     thickness: float | None = None
@@ -218,6 +242,7 @@ class ConnectorOptions:
     extension: float | None = None
     plate: float | None = None
     mitre_angle: float = math.pi / 16
+    socket_rule: Literal["clear", "overlap"] = "clear"
 
     def resolved(self, r: float) -> ConnectorOptions:
         """The options with every default filled in for the tube radius ``r``, checked."""
@@ -241,6 +266,11 @@ class ConnectorOptions:
             )
 
         wall = length("wall", self.wall, 0.2 * r, 0.0, 2.0, False)
+        if self.socket_rule not in SOCKET_RULES:
+            raise InvalidParameterError(
+                f"socket_rule must be one of {', '.join(map(repr, SOCKET_RULES))}, "
+                f"got {self.socket_rule!r}"
+            )
         return ConnectorOptions(
             thickness=length("thickness", self.thickness, 0.01 * r, 0.0, 0.5, True),
             clearance=length("clearance", self.clearance, 0.02 * r, 0.0, 0.5, True),
@@ -256,6 +286,7 @@ class ConnectorOptions:
                 high_inclusive=True,
                 range_text="(0, pi/2]",
             ),
+            socket_rule=self.socket_rule,
         )
 
     def inner_radius(self, r: float, numSides: int) -> float:
@@ -290,11 +321,14 @@ class JunctionSocket:
     Attributes
     ----------
     child : index of the child in the links given.
-    trunk : True for the trunk (a sleeve over [-d_s, overlap] around the continuous tube).
-    overlap : l_ov(c).
-    socket_end : sigma_c = l_ov(c) + d_s, where the connector ends (trunk: l_ov(t)).
-    sheet_start : sigma_c - d_s = l_ov(c), where the child's paper tube (its sheet) starts
-        (trunk: None, its sheet runs through).
+    trunk : True for the trunk (a sleeve over [-d_s, start] around the continuous tube).
+    overlap : l_ov(c) (centreline within 2r of a sibling's).
+    clear : l_clear(c) (within (R_in + R_out) / cos(mitre_angle / 2)); >= overlap.
+    start : where the socket starts: ``clear`` or ``overlap`` (``ConnectorOptions.socket_rule``).
+    socket_end : sigma_c = start + d_s >= l_ov(c) + d_s, where the connector ends (trunk:
+        ``start``, where its sleeve ends).
+    sheet_start : sigma_c - d_s, where the child's paper tube (its sheet) starts (trunk: None,
+        its sheet runs through).
     frame : read-only 4x4 frame on the link at ``sheet_start`` (trunk: at ``socket_end``).
     link_length : l(L_c).
     """
@@ -302,6 +336,8 @@ class JunctionSocket:
     child: int
     trunk: bool
     overlap: float
+    clear: float
+    start: float
     socket_end: float
     sheet_start: float | None
     frame: np.ndarray
@@ -355,46 +391,65 @@ def _check_trunk(trunk, count: int) -> int | None:
 def junction_sockets(
     links: Sequence[LinkCSC],
     r: float,
+    numSides: int,
     *,
     trunk: int | None = None,
     options: ConnectorOptions | None = None,
     step: float | None = None,
 ) -> tuple[JunctionSocket, ...]:
-    """The socket of each child: overlap, socket end, sheet start and its frame.
+    """The socket of each child: overlaps, socket end, sheet start and its frame.
 
-    sigma_c = l_ov(c) + d_s for every child but the trunk; the child's sheet starts at
-    sigma_c - d_s, at the frame :func:`link_frame_at` gives there. Feasible only if
+    A socket starts at l_clear(c) (``socket_rule="clear"``, the default) or l_ov(c)
+    (``"overlap"``) and ends d_s further, at sigma_c; the child's sheet starts where the
+    socket starts, at the frame :func:`link_frame_at` gives there. Feasible only if
     sigma_c <= l(L_c): otherwise InvalidParameterError (naming the child, sigma_c and the link
-    length); slide the child along its axis or re-place it first. The trunk's sleeve ends at
-    l_ov(t) and is always feasible.
+    length); slide the child along its axis or re-place it first. The trunk gets no socket: its
+    sleeve ends where its socket would start, and is always feasible.
+
+    Examples
+    --------
+    >>> a = LinkCSC(1, SE3(), SE3.Trans(10, 6, 0))
+    >>> b = LinkCSC(1, SE3(), SE3.Trans(10, -6, 0))
+    >>> [round(s.socket_end, 3) for s in junction_sockets([a, b], 1.0, 4)]
+    [3.901, 3.901]
     """
     r = check_radius(r)
+    n = check_num_sides(numSides)
     links = _check_links(links, r)
     trunk = _check_trunk(trunk, len(links))
     opts = _options(options, r)
     overlaps = sibling_overlap_lengths(links, r, step)
+    wall_distance = (opts.inner_radius(r, n) + opts.outer_radius(r, n)) / math.cos(
+        opts.mitre_angle / 2.0
+    )
+    clears = sibling_overlap_lengths(links, r, step, distance=wall_distance)
+    clears = np.maximum(clears, overlaps)
+    d_s = opts.socket_depth
     sockets = []
-    for k, (link, ov) in enumerate(zip(links, overlaps, strict=True)):
+    for k, (link, ov, cl) in enumerate(zip(links, overlaps, clears, strict=True)):
+        ov, cl = float(ov), float(cl)
         length = link.length
+        start = cl if opts.socket_rule == "clear" else ov
         if k == trunk:
-            frame = link_frame_at(link, float(ov))
+            frame = link_frame_at(link, start)
             frame.setflags(write=False)
-            sockets.append(JunctionSocket(k, True, float(ov), float(ov), None, frame, length))
+            sockets.append(JunctionSocket(k, True, ov, cl, start, start, None, frame, length))
             continue
-        end = float(ov) + opts.socket_depth
+        end = start + d_s
         if end > length + 1e-12 * r:
+            rule = "l_clear" if opts.socket_rule == "clear" else "l_ov"
             raise InvalidParameterError(
-                f"junction child {k} is infeasible: its socket would end at sigma_c = l_ov + d_s "
-                f"= {ov:.6g} + {opts.socket_depth:.6g} = {end:.6g}, past the end of its link "
-                f"(length {length:.6g}); sigma_c must lie in [l_ov + d_s, l(L_c)] = "
-                f"[{end:.6g}, {length:.6g}], which is empty. Slide the child along its axis (or "
-                "re-place it) so that its link is longer, or reduce socket_depth"
+                f"junction child {k} is infeasible: its socket would end at sigma_c = {rule} + "
+                f"d_s = {start:.6g} + {d_s:.6g} = {end:.6g}, past the end of its link (length "
+                f"{length:.6g}; l_ov = {ov:.6g}, l_clear = {cl:.6g}); sigma_c must lie in "
+                f"[{rule} + d_s, l(L_c)] = [{end:.6g}, {length:.6g}], which is empty. Slide the "
+                "child along its axis (or re-place it) so that its link is longer, or reduce "
+                "socket_depth"
             )
         end = min(end, length)
-        start = end - opts.socket_depth
-        frame = link_frame_at(link, start)
+        frame = link_frame_at(link, end - d_s)
         frame.setflags(write=False)
-        sockets.append(JunctionSocket(k, False, float(ov), end, start, frame, length))
+        sockets.append(JunctionSocket(k, False, ov, cl, start, end, end - d_s, frame, length))
     return tuple(sockets)
 
 
@@ -458,23 +513,28 @@ def _straight_sweep(frame: np.ndarray, s0: float, s1: float) -> _Sweep:
     return _Sweep(pts, G[None])
 
 
-def _leg_point_sets(sweep: _Sweep, radius: float, n: int, overlap: float = 0.0) -> list[np.ndarray]:
-    """The 2n vertices of each leg's mitred prism (its section projected along the leg onto
-    the planes at both ends), pushed ``overlap`` past each mitre plane so that neighbouring
-    legs overlap instead of touching (a union of solids that only touch is fragile)."""
+def _leg_point_sets(
+    sweep: _Sweep, radius: float, n: int, pairs: bool, overlap: float = 0.0
+) -> list[np.ndarray]:
+    """Point sets whose convex hulls make up the channel swept along ``sweep``.
+
+    Each leg is a mitred prism: its section projected along the leg onto the planes at both
+    ends (2n points), pushed ``overlap`` past each interior mitre so that neighbouring legs
+    overlap instead of only touching (fragile in a boolean kernel). With ``pairs`` the pieces
+    are the hulls of consecutive legs instead: they also fill the notch that the legs leave on
+    the inside of a bend where the section reaches past the turning radius (for the outside of
+    a channel; a void must not grow there)."""
     P, F = sweep.points, sweep.frames
     m = len(F)
     A = F[:, :3, 0]
-    out = []
+    legs = []
     for i in range(m):
         a = A[i]
-        # neighbouring legs differ in radius by ``overlap``: no coplanar side faces either
-        R = radius + (i % 2) * overlap
         n0 = a if i == 0 else A[i - 1] + A[i]
         n1 = a if i == m - 1 else A[i] + A[i + 1]
         G = F[i].copy()
         G[:3, 3] = P[i]
-        poly = section_polygon(G, R, n)
+        poly = section_polygon(G, radius, n)
         ends = []
         for q, normal, push in (
             (P[i], n0, -overlap if i > 0 else 0.0),
@@ -482,8 +542,10 @@ def _leg_point_sets(sweep: _Sweep, radius: float, n: int, overlap: float = 0.0) 
         ):
             lam = ((q - poly) @ normal) / float(a @ normal) + push
             ends.append(poly + lam[:, None] * a)
-        out.append(np.vstack(ends))
-    return out
+        legs.append(np.vstack(ends))
+    if not pairs or m < 2:
+        return legs
+    return [np.vstack(pair) for pair in zip(legs[:-1], legs[1:], strict=True)]
 
 
 def _manifold():
@@ -542,7 +604,7 @@ def junction_connector(
     most ``options.mitre_angle``), outer circumradius R_out, void R_in (see
     :class:`ConnectorOptions`); the body is the union of the outer channels minus the union
     of the voids, which reach ``options.extension`` past every open end. The trunk (if given)
-    gets a sleeve over [-d_s, l_ov(t)] open at both ends instead of a socket.
+    gets a sleeve open at both ends, over [-d_s, l_clear(t)] (or l_ov(t)), instead of a socket.
 
     ``parent_side`` (docs/junctions.md) says what the connector does behind D, along -a_D:
     ``"socket"``: a socket over [-d_s, 0] for a parent that ends in a plain tube at least d_s
@@ -576,23 +638,43 @@ def junction_connector(
     _check_starts(links, D, r)
     parent_side = _check_parent_side(parent_side)
     opts = _options(options, r)
-    sockets = junction_sockets(links, r, trunk=trunk, options=opts, step=step)
+    sockets = junction_sockets(links, r, n, trunk=trunk, options=opts, step=step)
     mf = _manifold()
-    return _to_trimesh(_connector_solid(mf, n, D, links, sockets, parent_side, opts, r))
+    return _clean_mesh(mf, n, D, links, sockets, parent_side, opts, r)
 
 
-#: Size of the deliberate offsets that keep the boolean kernel away from coincident faces
-#: (units of r): neighbouring legs of a channel overlap by this and alternate their radius by
-#: it, and child k's channel is 2 (k + 1) times this larger than the nominal one.
-_SEPARATION = 2e-5
+#: How far the legs of a void reach past each mitre into their neighbours (units of r), tried
+#: in turn until the mesh has no two surfaces touching along an edge (see _clean_mesh).
+_OVERLAPS = (1e-4, 3e-4, 1e-3, 3e-3)
 
 
-def _connector_solid(mf, n, D, links, sockets, parent_side, opts, r):
+def _clean_mesh(mf, n, D, links, sockets, parent_side, opts, r):
+    """The connector as a trimesh that stays watertight when its vertices are merged.
+
+    Where channels share faces the boolean kernel may return surfaces that touch along an
+    edge (valid as a manifold, with coincident vertices, but not after a reader merges them):
+    the voids' overlaps at the mitres are varied until that does not happen; if it always
+    does, the last mesh is returned without merging (still closed and oriented)."""
+    import trimesh
+
+    for overlap in _OVERLAPS:
+        solid = _connector_solid(mf, n, D, links, sockets, parent_side, opts, r, overlap * r)
+        mesh = _to_trimesh(solid)
+        if mesh.is_watertight and mesh.is_volume:
+            return mesh
+    raw = solid.to_mesh64()
+    return trimesh.Trimesh(
+        vertices=np.asarray(raw.vert_properties, dtype=float)[:, :3],
+        faces=np.asarray(raw.tri_verts, dtype=np.int64),
+        process=False,
+    )
+
+
+def _connector_solid(mf, n, D, links, sockets, parent_side, opts, r, overlap):
     R_in = opts.inner_radius(r, n)
     R_out = opts.outer_radius(r, n)
     eps = opts.extension
     d_s = opts.socket_depth
-    eta = _SEPARATION * r
     # how far the parts reach behind D (outer) and whether the voids open there
     if parent_side == "socket":
         back, open_back = d_s, True
@@ -606,19 +688,17 @@ def _connector_solid(mf, n, D, links, sockets, parent_side, opts, r):
     inner_sets: list[np.ndarray] = []
     # children start along a_D: a short overlap behind D joins them to the parent side
     join = min(eps, back) if back > 0 else 0.0
-    for k, (link, sock) in enumerate(zip(links, sockets, strict=True)):
+    for link, sock in zip(links, sockets, strict=True):
         end = sock.socket_end
-        # channels that start in one frame would have coincident faces: a tiny radius step
-        # per child keeps the boolean kernel from leaving surfaces that touch along an edge
-        grow = 2 * (k + 1) * eta
         outer = _link_sweep(link, -join, end, opts.mitre_angle)
         inner = _link_sweep(link, -eps if open_back else 0.0, end + eps, opts.mitre_angle)
-        outer_sets += _leg_point_sets(outer, R_out + grow, n, eta)
-        inner_sets += _leg_point_sets(inner, R_in + grow, n, eta)
+        outer_sets += _leg_point_sets(outer, R_out, n, True)
+        inner_sets += _leg_point_sets(inner, R_in, n, False, overlap)
     if back > 0.0:
-        outer_sets += _leg_point_sets(_straight_sweep(D, -back, 0.0), R_out, n, eta)
+        outer_sets += _leg_point_sets(_straight_sweep(D, -back, 0.0), R_out, n, True)
         if open_back:
-            inner_sets += _leg_point_sets(_straight_sweep(D, -back - eps, eps), R_in, n, eta)
+            void = _straight_sweep(D, -back - eps, eps)
+            inner_sets += _leg_point_sets(void, R_in, n, False, overlap)
     return _solid(mf, outer_sets) - _solid(mf, inner_sets)
 
 
