@@ -2,9 +2,9 @@
 
 A cylindrical joint rotates about and slides along one axis: two degrees of freedom that are
 not coupled. Here a revolute joint and a prismatic joint share the axis z. This is the
-"cylindrical variant" of spec chain.md section 11.5, scaled to a tube radius of 10 mm: safe
-placement routes the link around the revolute joint with two waypoints and puts the prismatic
-joint at (0, 0, 71.256513) on the same axis.
+"cylindrical variant" of the planar compound joint of docs/theory/chain.md §9, scaled to a tube
+radius of 10 mm: safe placement routes the link around the revolute joint with two waypoints and
+puts the prismatic joint at (0, 0, 71.256513) on the same axis.
 
 Run: ``python examples/cylindrical_joint.py [output-folder]``. It writes the 3D view, the crease
 pattern drawing and the pattern as DXF into ``examples/output/cylindrical_joint/`` (or the folder

@@ -1,8 +1,8 @@
 """A planar joint built from three revolute joints with parallel axes (paper Figure 3(a-c)).
 
 A planar joint moves a body within a plane (two translations and a rotation). Three revolute
-joints whose axes are parallel (all along z) do the same. This is spec chain.md section 11.5,
-scaled to a tube radius of 10 mm, and shows the editing tools at work:
+joints whose axes are parallel (all along z) do the same. This is the planar compound joint of
+docs/theory/chain.md §9, scaled to a tube radius of 10 mm, and shows the editing tools at work:
 
 1. safe placement appends the joints 40 mm apart in x; it lifts each one along its axis and
    adds two waypoints per joint (total path length 196.39 mm);

@@ -1,9 +1,10 @@
-"""A spiral of prismatic joints (paper Figure 3(e-g)); spec chain.md section 11.6.
+"""A spiral of prismatic joints (paper Figure 3(e-g)): the prismatic spiral of
+docs/theory/chain.md §9.
 
 Each prismatic joint's axis is the previous one's turned by 45 degrees about its y axis, and
 compact placement (``safe=False``) puts each new joint at least 4r beyond the chain built so far,
-so the chain of five REBO prismatic joints curls round in a spiral. The numbers are those of
-chain.md 11.6 scaled to a tube radius of 10 mm: total path length 281.96046 mm.
+so the chain of five REBO prismatic joints curls round in a spiral. The numbers are the published
+ones (tests/reference_values.py) scaled to a tube radius of 10 mm: total path length 281.96046 mm.
 
 Run: ``python examples/prismatic_spiral.py [output-folder]``. It writes the 3D view, the crease
 pattern drawing and the pattern as DXF into ``examples/output/prismatic_spiral/`` (or the folder

@@ -3,7 +3,7 @@
 Each revolute joint's axis is the previous one's turned by 45 degrees about its y axis. Compact
 placement (``safe=False``) puts every new joint at least 4r beyond the chain built so far, and
 the axes keep turning, so the chain winds outwards in a spiral. The orientation of each joint
-about its axis follows the common normal with the previous axis (chain.md section 4.5).
+about its axis follows the common normal with the previous axis (docs/theory/placement.md §3).
 
 Run: ``python examples/revolute_spiral.py [output-folder]``. It writes the 3D view, the crease
 pattern drawing and the pattern as DXF into ``examples/output/revolute_spiral/`` (or the folder

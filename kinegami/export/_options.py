@@ -1,4 +1,5 @@
-"""Options shared by the sheet exporters (DXF, SVG): units, scale, perforation, B10 skipping."""
+"""Options shared by the sheet exporters (DXF, SVG, PDF): units, scale, perforation, B10 skipping
+(docs/theory/patterns.md §6)."""
 
 from __future__ import annotations
 
@@ -46,7 +47,8 @@ class SheetOptions:
     dash, gap : float
         Dash and gap lengths in millimetres (used when ``perforate``).
     skip_creases_on_cut : bool
-        Drop creases lying on the top or bottom edge of the sheet (spec B10).
+        Drop creases lying on the top or bottom edge of the sheet (B10,
+        docs/theory/patterns.md §6).
     extra : dict
         The exporter-specific options, unchecked.
     """

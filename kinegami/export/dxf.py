@@ -1,4 +1,5 @@
-"""DXF export of the flat sheet (spec/patterns.md section 5), for laser cutters.
+"""DXF export of the flat sheet (docs/theory/patterns.md §5, docs/fabrication.md), for laser
+cutters.
 
 The file is DXF R2013 with four layers, each line a LINE entity on its layer with its colour also
 set on the entity (laser programs often map entity colours to cut settings):
@@ -133,7 +134,8 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
     dash, gap : float, optional
         Dash and gap lengths in mm (default 1 and 1); the last dash of a line may be shorter.
     skip_creases_on_cut : bool, optional
-        Drop creases lying on the sheet's top or bottom edge (spec B10); default False.
+        Drop creases lying on the sheet's top or bottom edge (B10, docs/theory/patterns.md
+        §6); default False.
 
     Raises
     ------

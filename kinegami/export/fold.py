@@ -3,7 +3,7 @@
 FOLD (https://github.com/edemaine/fold) is the JSON origami format read by Origami Simulator and
 Rabbit Ear. The file written here has
 
-* frame 0, class ``creasePattern``: the flattened sheet of spec/patterns.md section 5 (the sheet of
+* frame 0, class ``creasePattern``: the flattened sheet of docs/theory/patterns.md §5 (the sheet of
   the DXF and SVG files: x in [-b/2, W + b/2], y in [y0, y0 + H], the glue tab being the second copy
   of the starting panel) as a planar graph, drawn from the pattern's unsnapped geometry
   (:func:`kinegami.pattern.folded.unsnapped_form`: no vertex moved by the catalog's eps = 1e-4 b
@@ -17,7 +17,8 @@ Rabbit Ear. The file written here has
   straight crease) is split by flat ``F`` diagonals. Origami Simulator turns such corners into
   zero-area triangles, and its solver blows up on them;
 * ``edges_assignment``: ``M`` and ``V`` for the creases, ``B`` for the sheet outline (including
-  creases lying on the top or bottom edge, spec B10, and the glue tab's outer edge), ``F`` for
+  creases lying on the top or bottom edge, B10 of docs/theory/patterns.md §6, and the glue tab's
+  outer edge), ``F`` for
   those diagonals (the catalog's patterns need none). The sheet has no slits, so ``C`` never
   occurs;
 * ``edges_foldAngle`` in degrees, FOLD's sign convention (valley > 0, mountain < 0, 0 for

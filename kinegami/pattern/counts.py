@@ -1,4 +1,5 @@
-"""Vertex and crease counts of the catalog modules (with the fixes B2 and B6).
+"""Vertex and crease counts of the catalog modules (with the fixes B2 and B6 of
+docs/theory/patterns.md §6).
 
 Each module file gives its closed-form counts in its catalog entry (``ModuleKind.counts``),
 written independently of the module's builder, so that :meth:`TubularPattern.validate` can

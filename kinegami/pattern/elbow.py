@@ -1,6 +1,6 @@
 """Elbow fitting: a bend of the tube by a tucked, flat-folded strip.
 
-See docs/theory/patterns.md 3.3.
+See docs/theory/patterns.md 3.3; the fixes B6 and B9 are in its §6.
 """
 
 from __future__ import annotations
@@ -117,7 +117,8 @@ def elbow_geometry(prism: Prism, bendingAngle: float, rotationalAxisAngle: float
     polygon = np.arccos(np.minimum(np.maximum(cos_b, -1.0), 1.0))
     tuck = 0.5 * (flat - polygon)
     # a column collapses when its tuck vertices L, M, O would lie within eps of each other:
-    # h_k >= H_m - eps (spec), or the offset (H_m - h_k) tan(eps_k) of O_k below eps (fix B6)
+    # h_k >= H_m - eps (section 3.3), or the offset (H_m - h_k) tan(eps_k) of O_k below eps
+    # (fix B6)
     collapsed = (h >= H_m - eps) | ((H_m - h) * np.tan(tuck) < eps)
     low = (h < eps) & ~collapsed
     return ElbowGeometry(theta, phi, d_w, h, H_m, tuck, collapsed, low)

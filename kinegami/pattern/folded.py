@@ -16,9 +16,9 @@ at state 0: every module end coincides with the chain's joint and link frames. T
 follow the pattern rather than the kinematic model, because the pattern cannot fold otherwise:
 
 * a prismatic joint's pattern folds to length d' + L instead of the kinematic d: the sleeve adds
-  L = d / sin(coneAngle) (spec B7) and the bellows, folded with rigid faces, is
-  d' = :func:`rebo_folded_length` >= d long; everything after a prismatic joint is translated by
-  d' + L - d along its axis;
+  L = d / sin(coneAngle) (B7 of docs/theory/patterns.md §6) and the bellows, folded with rigid
+  faces, is d' = :func:`rebo_folded_length` >= d long; everything after a prismatic joint is
+  translated by d' + L - d along its axis;
 * turns and twists of at most 0.01 rad that the link builder leaves out of the pattern, and tubes
   shorter than eps = 1e-4 b, are missing from the folded form too (docs/theory/patterns.md §4).
 

@@ -539,8 +539,8 @@ class TubularPattern:
         Checks: vertices with x outside [0, W), duplicate vertices (closer than eps), zero-length
         creases, duplicate creases, collinear overlapping creases, vertices lying inside a crease
         they do not end on, creases wider than one panel (|dx| > b + eps), bases that do not
-        match their markers (section 7.1 item 1) and, for patterns made of catalog modules,
-        vertex / crease counts that differ from the formulas of section 7.1 item 4.
+        match their markers (section 1.4) and, for patterns made of catalog modules,
+        vertex / crease counts that differ from the closed-form counts of section 3.
         """
         from kinegami.pattern._audit import audit_pattern
 

@@ -104,7 +104,8 @@ def show_pattern(pattern: TubularPattern, **options: Any) -> tuple[Figure, Axes]
     showGlueTab, showBoundary, showCut : bool, optional
         Draw the glue tab shading, the boundary and the cut outline (default True).
     showCreasesOnCut : bool, optional
-        Draw creases lying on the top or bottom edge of the sheet (spec B10; default True).
+        Draw creases lying on the top or bottom edge of the sheet (B10 of
+        docs/theory/patterns.md §6; default True).
     linewidth : float, optional
         Line width in points (default 1).
     title : str, optional
