@@ -39,6 +39,7 @@ from kinegami.export import export
 
 __all__ = [
     "KinematicChain",
+    "KinematicTree",
     "RevoluteJoint",
     "ExtendedRevoluteJoint",
     "PrismaticJoint",
@@ -65,6 +66,7 @@ __all__ = [
 #: Names imported on first use: name -> (module, attribute; None for the module itself).
 _LAZY = {
     "KinematicChain": ("kinegami.chain", "KinematicChain"),
+    "KinematicTree": ("kinegami.tree", "KinematicTree"),
     "PlacementWarning": ("kinegami.chain", "PlacementWarning"),
     "RevoluteJoint": ("kinegami.joints", "RevoluteJoint"),
     "ExtendedRevoluteJoint": ("kinegami.joints", "ExtendedRevoluteJoint"),

@@ -72,6 +72,7 @@ __all__ = [
     "link_polyline",
     "Overlap",
     "CONTACT_TOLERANCE",
+    "JUNCTION_REACH",
     "TURN_TOLERANCE",
     "JOINT_FIXED",
     "JOINT_REVOLUTE",
@@ -681,6 +682,11 @@ def capsule_model(chain, names=None, twistPortion: float = 0.2) -> CapsuleModel:
 
 
 # --- trees -----------------------------------------------------------------------------------
+#: Longest stretch (in r, along each tube from the branching frame) that a junction body covers:
+#: tubes leaving the same joint may run within 2r of each other that far; beyond it they collide.
+JUNCTION_REACH = 5.0
+
+
 def link_polyline(link) -> np.ndarray:
     """The link's centreline polyline (units of r, world): its start, every elbow vertex of
     both arcs, its end; shape (k, 3). The tube lies within r of it except at mitred corners."""
@@ -706,24 +712,30 @@ def _polyline_samples(points: np.ndarray, step: float) -> tuple[np.ndarray, np.n
     return points[k] + t[:, None] * d[k], s
 
 
-def junction_extent(polyline: np.ndarray, siblings: tuple[np.ndarray, ...], r: float) -> float:
+def junction_extent(polyline: np.ndarray, own: tuple, siblings: tuple, r: float) -> float:
     """How far (along ``polyline``, from its start) a tube leaving a branching joint runs
-    within 2r of a sibling tube leaving the same frame before it first separates from all of
-    them: the part a junction body covers (docs/trees.md). 0 without siblings."""
-    if not siblings:
+    within 2r of a sibling tube leaving the same frame: the distance along it of the last
+    point of its capsules (``own``: segment starts and ends) within 2r of a sibling capsule
+    (``siblings``), sampled every 0.02 r. The junction body covers the tube up to there
+    (docs/trees.md). 0 when nothing is that close."""
+    a, b = siblings
+    if a.shape[0] == 0 or own[0].shape[0] == 0:
         return 0.0
-    points, s = _polyline_samples(polyline, 0.02 * r)
-    a = np.concatenate([p[:-1] for p in siblings if len(p) > 1])
-    b = np.concatenate([p[1:] for p in siblings if len(p) > 1])
-    if a.size == 0:
-        return 0.0
+    starts, ends = own
+    lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
+    counts = np.maximum(2, np.ceil(lengths / (0.02 * r)).astype(np.int64) + 1)
+    owner = np.repeat(np.arange(starts.shape[0]), counts)
+    first = np.cumsum(counts) - counts
+    u = (np.arange(owner.size) - first[owner]) / (counts[owner] - 1)
+    points = starts[owner] + u[:, None] * (ends - starts)[owner]
     t = _point_params(points[:, None, :], a[None], b[None])
     nearest = a[None] + t[..., None] * (b - a)[None]
     distance = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)
-    apart = np.flatnonzero(distance >= 2.0 * r * (1.0 - CONTACT_TOLERANCE))
-    if apart.size == 0:
-        return float(s[-1])
-    return float(s[apart[0]])
+    close = distance < 2.0 * r * (1.0 - CONTACT_TOLERANCE)
+    if not close.any():
+        return 0.0
+    along = _polyline_distance(points[close], polyline)
+    return float(along.max()) + 0.02 * r
 
 
 def _point_params(points, a, b) -> np.ndarray:
@@ -805,17 +817,28 @@ def tree_pair_distances(
     before = np.where(is_link & (parent_of[node] < 0), 0.0, before)
     tau = own + before + np.where(body_a >= 0, kinks[np.maximum(body_a, 0)], 0.0)
 
-    # junctions: how far each child link of a branching joint runs with its siblings
+    # junctions: how far the tube to each child of a branching joint (continued through
+    # waypoints with one child, which add no part) runs with its siblings
     extent = np.zeros(n)
-    polylines = {}
+    polylines: dict[int, np.ndarray] = {}
+    branch_of: dict[int, int] = {}  # node -> the child of a branching joint it continues
     for kids in children:
         if len(kids) < 2:
             continue
         for k in kids:
-            polylines[k] = link_polyline(links[k])
+            path = [k]
+            while isinstance(joints[path[-1]], Waypoint) and len(children[path[-1]]) == 1:
+                path.append(children[path[-1]][0])
+            for node_k in path:
+                branch_of[node_k] = k
+            points = [link_polyline(links[node_k]) for node_k in path]
+            polylines[k] = np.concatenate([points[0]] + [pts[1:] for pts in points[1:]])
         for k in kids:
-            others = tuple(polylines[o] for o in kids if o != k)
-            extent[k] = junction_extent(polylines[k], others, r)
+            mine = np.isin(node, [m for m, top in branch_of.items() if top == k]) & is_link
+            theirs = np.isin(node, [m for m, top in branch_of.items() if top in kids and top != k])
+            theirs &= is_link
+            found = junction_extent(polylines[k], (a[mine], b[mine]), (a[theirs], b[theirs]), r)
+            extent[k] = min(found, JUNCTION_REACH * r)
 
     centre = 0.5 * (a + b)
     half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
@@ -851,6 +874,7 @@ def tree_pair_distances(
     clip_i = np.zeros(i.size)  # distance along a junction link from which a part counts
     clip_j = np.zeros(i.size)
     junction_pair = np.zeros(i.size, dtype=bool)
+    via: dict[int, tuple[int, int]] = {}
     for q in range(i.size):
         x, y = int(node[i[q]]), int(node[j[q]])
         c = lca(x, y)
@@ -862,21 +886,25 @@ def tree_pair_distances(
         # the two children of c the parts descend from
         cx = lineage[x][lineage[x].index(c) - 1]
         cy = lineage[y][lineage[y].index(c) - 1]
-        if cx == x and cy == y and is_link[i[q]] and is_link[j[q]]:
+        if (is_link[i[q]] and is_link[j[q]] and branch_of.get(x) == cx
+                and branch_of.get(y) == cy):  # fmt: skip
             junction_pair[q] = True
-            clip_i[q], clip_j[q] = extent[x], extent[y]
-    i, j = i[tested], j[tested]
-    junction_pair, clip_i, clip_j = junction_pair[tested], clip_i[tested], clip_j[tested]
+            clip_i[q], clip_j[q] = extent[cx], extent[cy]
+            via[q] = (cx, cy)
+    kept = np.flatnonzero(tested)
+    i, j = i[kept], j[kept]
+    junction_pair, clip_i, clip_j = junction_pair[kept], clip_i[kept], clip_j[kept]
+    via = {new: via[old] for new, old in enumerate(kept) if old in via}
     if i.size == 0:
         return None
     dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
     for q in np.flatnonzero(junction_pair):
         # both parts inside the junction do not count: the distance of the rest
-        x, y = int(node[i[q]]), int(node[j[q]])
+        cx, cy = via[int(q)]
         best = (math.inf, 0.0, 0.0)
         for (p0, p1, e0, line), (o0, o1) in (
-            ((a[i[q]], b[i[q]], clip_i[q], polylines[x]), (a[j[q]], b[j[q]])),
-            ((a[j[q]], b[j[q]], clip_j[q], polylines[y]), (a[i[q]], b[i[q]])),
+            ((a[i[q]], b[i[q]], clip_i[q], polylines[cx]), (a[j[q]], b[j[q]])),
+            ((a[j[q]], b[j[q]], clip_j[q], polylines[cy]), (a[i[q]], b[i[q]])),
         ):
             d0, d1 = _polyline_distance(np.array([p0, p1]), line)
             if max(d0, d1) <= e0:

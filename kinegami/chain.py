@@ -374,7 +374,7 @@ class _JointAssembly:
             return self._overlap(joints, links, parents, first_new) is None
 
         fallbacks = []
-        for reverse in (False, True):
+        for reverse in (False, True) if self._published_placement_allowed(p) else ():
             try:
                 extended = self._extended(
                     published_safe_placement(distal, k, joint, self._ball, reverse=reverse), p
@@ -415,6 +415,11 @@ class _JointAssembly:
             if ok and growth <= max(growth_r, limits[0]) and path <= max(path_r, limits[1]):
                 return extended
         return radial
+
+    def _published_placement_allowed(self, p: int) -> bool:
+        """Whether safe placement may try the published rule under joint ``p`` (a tree says
+        no for a parent that already has a child: the rule would reuse that child's ray)."""
+        return True
 
     def _radial_variants(self, distal: np.ndarray, k: int, p: int):
         """RADIAL_VARIANTS, then the same escaping sideways first: away from the tube that

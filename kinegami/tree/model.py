@@ -19,8 +19,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from kinegami.bodies import tree_worst_overlap
-from kinegami.chain import _PROPAGATE_DEFAULT, _JointAssembly, _propagate_flag
+from kinegami.bodies import link_polyline, tree_worst_overlap
+from kinegami.chain import _PROPAGATE_DEFAULT, RADIAL_VARIANTS, _JointAssembly, _propagate_flag
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
 from kinegami.geometry.frames import rotation_about_line, translation
 from kinegami.joints import Joint, Waypoint, pose_array
@@ -108,6 +108,43 @@ class KinematicTree(_JointAssembly):
         super()._commit(joints, links, ball)
         if parents is not None:
             self._parents = list(parents)
+
+    def _published_placement_allowed(self, p: int) -> bool:
+        # the published rule puts every child's first waypoint on the parent's path ray, so a
+        # later sibling would run through the earlier ones (docs/trees.md)
+        return not self._children_of(p)
+
+    def _radial_variants(self, distal: np.ndarray, k: int, p: int):
+        """For a parent that already has children: the radial construction escaping first
+        away from the directions in which they leave, then sideways; then the chain's."""
+        d1 = distal[:3, k]
+        A = distal[:3, 3]
+        away = np.zeros(3)
+        for child in self._children_of(p):
+            # where the child's tube (followed through waypoints) first leaves the parent's ray
+            node = child
+            while True:
+                points = link_polyline(self._links[node]) - A
+                sides = points - np.outer(points @ d1, d1)
+                norms = np.sqrt((sides**2).sum(axis=1))
+                off = np.flatnonzero(norms > 1e-6 * self.r)
+                if off.size or not isinstance(self._joints[node], Waypoint):
+                    break
+                kids = self._children_of(node)
+                if len(kids) != 1:
+                    break
+                node = kids[0]
+            if off.size:
+                away -= sides[off[0]] / norms[off[0]]
+        if float(np.linalg.norm(away)) < 1e-9:
+            away = distal[:3, (k + 1) % 3]  # any direction across the parent's path
+        away = away - float(away @ d1) * d1
+        away /= float(np.linalg.norm(away))
+        side = np.cross(d1, away)
+        for escape in (away, side, -side, -away):
+            for variant in RADIAL_VARIANTS:
+                yield {**variant, "escape": escape}
+        yield from super()._radial_variants(distal, k, p)
 
     def _subtree(self, j: int, parents: Sequence[int] | None = None) -> list[int]:
         """j and its descendants in index order (children always follow their parent)."""
