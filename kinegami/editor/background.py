@@ -18,7 +18,8 @@ class Debounced:
     """Call ``func()`` in a background thread ``delay`` seconds after the last :meth:`trigger`.
 
     ``func`` takes its own locks. An exception it raises is kept in :attr:`error` (the thread
-    goes on). :meth:`flush` runs a pending call at once in the caller's thread.
+    goes on). :meth:`flush` runs a pending call at once in the caller's thread, after waiting
+    for a call in progress (so call it without holding a lock that ``func`` takes).
     """
 
     def __init__(self, func: Callable[[], object], delay: float, name: str = "debounced"):
@@ -29,6 +30,7 @@ class Debounced:
         self._due: float | None = None  # when the pending call runs; None: none pending
         self._closed = False
         self._thread: threading.Thread | None = None
+        self._running = threading.Lock()  # held while func runs (one call at a time)
         #: The last exception ``func`` raised in the background thread, or None.
         self.error: BaseException | None = None
 
@@ -49,12 +51,14 @@ class Debounced:
             self._cond.notify()
 
     def flush(self) -> bool:
-        """Run the pending call now, in this thread; False when none was pending."""
+        """Run the pending call now, in this thread, once a call in progress has finished;
+        False when none was pending."""
         with self._cond:
-            if self._due is None:
+            due, self._due = self._due, None
+        with self._running:
+            if due is None:
                 return False
-            self._due = None
-        self._func()
+            self._func()
         return True
 
     def close(self, flush: bool = False) -> None:
@@ -81,6 +85,7 @@ class Debounced:
                     return
                 self._due = None
             try:
-                self._func()
+                with self._running:
+                    self._func()
             except Exception as error:  # noqa: BLE001 - kept for the owner; the thread goes on
                 self.error = error

@@ -192,6 +192,7 @@ class EditorView:
         self._unsubscribe = self.model.subscribe(self._on_change)
         self._redraw_all()
         self.frame_camera()
+        self._pattern_redraw.trigger()
         self._recovery_modal = None
         if recovery is not None:
             self.offer_recovery(recovery, on_recovery)
@@ -215,6 +216,7 @@ class EditorView:
         self._clear_scene()
         self._redraw_all()
         self.frame_camera()
+        self._pattern_redraw.trigger()
 
     def frame_camera(self) -> None:
         """Point a browser tab's camera at the whole chain (a server target has none)."""

@@ -207,3 +207,239 @@ def test_clicking_a_joint_mesh_selects_it(view):
     assert view.model.selected == 4
     assert view._gizmo.visible
     assert_allclose(view._gizmo.position, view.model.chain.Joints[4].pose_matrix[:3, 3], atol=1e-6)
+
+
+# --- the crease-pattern panel -------------------------------------------------------------------
+def test_the_pattern_panel_shows_the_sheet_and_its_size(view):
+    view.flush()
+    html = view.pattern_html
+    assert "<svg" in html and 'class="kinegami-M"' in html and 'class="kinegami-V"' in html
+    pattern = view.model.pattern()
+    from kinegami.pattern.sheet import flatten
+
+    sheet = flatten(pattern)
+    xmin, y0, xmax, y1 = sheet.bounds
+    # example1 is in cm: the sheet's size in mm is ten times its size in pattern units
+    assert f"Sheet {10 * (y1 - y0):.1f} x {10 * (xmax - xmin):.1f} mm" in html
+    assert f"{sheet.count('M')} mountain, {sheet.count('V')} valley" in html
+
+
+def test_the_pattern_is_drawn_after_a_pause_not_in_the_edit(view):
+    view.flush()
+    draws, before = view.pattern_draws, view.pattern_html
+    assert view.act(lambda: view.model.slide(4, 0.5, propagate=False)).ok
+    assert view.pattern_draws == draws  # nothing drawn while the edit runs
+    view.flush()
+    assert view.pattern_draws == draws + 1 and view.pattern_html != before
+
+
+def test_the_pattern_is_drawn_again_only_when_it_or_the_selection_changed(view):
+    view.act(lambda: view.model.select(4))
+    view.flush()
+    draws = view.pattern_draws
+    view.set_state(4, 0.3)  # states move the chain, not its crease pattern
+    view.flush()
+    assert view.pattern_draws == draws
+    view.act(lambda: view.model.select(2))
+    view.flush()
+    assert view.pattern_draws == draws + 1
+
+
+def test_selecting_a_joint_highlights_its_modules(view):
+    import re
+
+    from kinegami.editor.sheet_drawing import joint_span
+
+    view.click_joint(4)
+    view.flush()
+    pattern = view.model.pattern()
+    lo, hi = joint_span(pattern, view.model.joint_modules()[4])
+    y0 = float(pattern.proximalMarker[1])
+    match = re.search(r'class="kinegami-highlight" x="([-\d.e]+)" y="0" width="([-\d.e]+)"',
+                      view.pattern_html)  # fmt: skip
+    assert match is not None
+    assert float(match[1]) == pytest.approx(lo - y0, rel=1e-4)
+    assert float(match[2]) == pytest.approx(hi - lo, rel=1e-4)
+    # the revolute joint's own vertices span what is highlighted
+    ys = pattern.vertices_coords[pattern.module_vertices[view.model.joint_modules()[4][0]], 1]
+    assert (ys.min(), ys.max()) == pytest.approx((lo, hi))
+    assert "close-up: joint 4 (RevoluteJoint &#x27;revolute&#x27;)" in view.pattern_html
+
+
+def test_a_waypoint_is_marked_by_a_line(view):
+    view.act(lambda: view.model.select(3))
+    view.flush()
+    assert "no modules of its own" in view.pattern_html
+    assert 'stroke-width="3"' in view.pattern_html
+
+
+# --- animation --------------------------------------------------------------------------------
+def _wait(condition, timeout: float = 30.0):
+    import time
+
+    end = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < end, "timed out"
+        time.sleep(0.02)
+
+
+def test_animate_sweeps_the_joints_without_undo_entries(view):
+    base = view.model.document
+    seen = set()
+
+    def watch(change):
+        seen.add(round(float(view.model.chain.Joints[4].state), 3))
+
+    view.model.subscribe(watch)
+    assert view.toggle_animation() and view.animating
+    _wait(lambda: view.animation_frames >= 5)
+    assert len(seen) >= 3  # the revolute joint moved through several states
+    assert not view.model.can_undo and not view.model.dirty
+    assert view.model.base_document is base
+    assert not view.toggle_animation() and not view.animating
+    assert view.model.document is base  # the states are back as they were
+
+
+def test_animate_reaches_both_ends_of_the_ranges(view):
+    lo, hi = view.model.joint_table()[4].state_range
+    states = []
+    view.model.subscribe(lambda change: states.append(float(view.model.chain.Joints[4].state)))
+    view.animate(period=0.6, fps=60.0)
+    _wait(lambda: view.animation_frames >= 40)
+    view.stop_animation()
+    assert min(states) < lo + 0.2 * (hi - lo) and max(states) > hi - 0.2 * (hi - lo)
+    assert all(lo - 1e-12 <= s <= hi + 1e-12 for s in states)
+
+
+def test_an_edit_stops_the_animation_and_applies_to_the_design(view):
+    base = view.model.document
+    view.animate()
+    _wait(lambda: view.animation_frames >= 2)
+    assert view.act(lambda: view.model.slide(4, 0.5)).ok
+    assert not view.animating
+    assert view.model.undo_labels == ("slide joint 4 by 0.5",)
+    view.act(view.model.undo)
+    assert view.model.document is base
+
+
+# --- autosave, saving and recovery ----------------------------------------------------------------
+@pytest.fixture
+def design(tmp_path):
+    import shutil
+
+    path = tmp_path / "arm.json"
+    shutil.copyfile(EXAMPLE1, path)
+    return path
+
+
+def _edited(server) -> tuple:
+    view = server.new_view(server.server)
+    assert view.act(lambda: view.model.slide(4, 0.5, propagate=False)).ok
+    view.autosave.flush()
+    return view, view.model.document.design_text
+
+
+def test_edits_are_autosaved_beside_the_design(design):
+    server = EditorServer(design, port=0)
+    try:
+        view, text = _edited(server)
+        autosave = design.parent / ".arm.json.autosave"
+        assert autosave.read_text(encoding="utf-8") == text
+        assert design.read_bytes() == EXAMPLE1.read_bytes()
+    finally:
+        server.stop()
+
+
+def test_save_to_file_writes_the_design_and_removes_the_autosave(design):
+    server = EditorServer(design, port=0)
+    try:
+        view, text = _edited(server)
+        assert view._save_file.visible and view._save_file.label == "Save to arm.json"
+        assert view.save_file().ok
+        assert design.read_text(encoding="utf-8") == text
+        assert not (design.parent / ".arm.json.autosave").exists()
+        assert not view.model.dirty
+    finally:
+        server.stop()
+
+
+def test_a_new_start_offers_the_autosave_back(design):
+    server = EditorServer(design, port=0)
+    try:
+        _, text = _edited(server)
+    finally:
+        server.stop()  # as after a crash: the design file was never saved
+    again = EditorServer(design, port=0)
+    try:
+        assert again.recovery is not None and again.recovery.document.design_text == text
+        view = again.new_view(again.server)
+        assert view._recovery_modal is not None  # the dialog asks
+        assert view.model.document.design_text != text
+        view.choose_recovery(again.recovery, "recover")
+        assert view.model.document.design_text == text and view.model.dirty
+        assert view.model.undo_labels[-1].startswith("recover the autosave")
+        view.act(view.model.undo)
+        assert view.model.document is again.document
+    finally:
+        again.stop()
+
+
+def test_discarding_the_offer_removes_the_autosave(design):
+    server = EditorServer(design, port=0)
+    try:
+        _edited(server)
+    finally:
+        server.stop()
+    again = EditorServer(design, port=0)
+    try:
+        view = again.new_view(again.server)
+        view.choose_recovery(again.recovery, "discard")
+        assert not (design.parent / ".arm.json.autosave").exists()
+        assert view.model.document is again.document
+    finally:
+        again.stop()
+
+
+def test_recover_starts_every_tab_from_the_autosave(design):
+    server = EditorServer(design, port=0)
+    try:
+        _, text = _edited(server)
+    finally:
+        server.stop()
+    again = EditorServer(design, port=0, recover=True)
+    try:
+        view = again.new_view(again.server)
+        assert view._recovery_modal is None
+        assert view.model.document.design_text == text and view.model.dirty
+    finally:
+        again.stop()
+
+
+def test_without_a_file_the_autosave_is_in_the_data_folder(monkeypatch, tmp_path):
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    server = EditorServer(port=0)
+    try:
+        view, text = _edited(server)
+        autosave = tmp_path / "data" / "kinegami" / "untitled.json.autosave"
+        assert autosave.read_text(encoding="utf-8") == text
+        assert not view._save_file.visible and not view.save_file().ok
+        view.download(".json")  # with no file on the server, the download is the save
+        assert not autosave.exists()
+    finally:
+        server.stop()
+
+
+def test_a_design_opened_in_the_browser_autosaves_in_the_data_folder(monkeypatch, tmp_path,
+                                                                     design):  # fmt: skip
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    server = EditorServer(design, port=0)
+    try:
+        view = server.new_view(server.server)
+        assert view.open_example("puma")
+        assert view.act(lambda: view.model.slide(1, 0.5)).ok
+        view.autosave.flush()
+        assert (tmp_path / "data" / "kinegami" / "untitled.json.autosave").exists()
+        assert not (design.parent / ".arm.json.autosave").exists()
+        assert not view._save_file.visible
+    finally:
+        server.stop()
