@@ -117,6 +117,9 @@ class KinematicTree(_JointAssembly):
     def _radial_variants(self, distal: np.ndarray, k: int, p: int):
         """For a parent that already has children: the radial construction escaping first
         away from the directions in which they leave, then sideways; then the chain's."""
+        if not self._children_of(p):
+            yield from super()._radial_variants(distal, k, p)
+            return
         d1 = distal[:3, k]
         A = distal[:3, 3]
         away = np.zeros(3)

@@ -1,0 +1,46 @@
+"""The paper's hand as a KinematicTree, built from the reference fixture (fixtures/hand.json)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from spatialmath import SE3
+
+from kinegami import EndTip, KinematicTree, RevoluteJoint, Waypoint
+
+FIXTURES = Path(__file__).resolve().parents[2].parent / "shared" / "fixtures"
+HAND = FIXTURES / "hand.json"
+
+
+def load_fixture(path: Path = HAND) -> dict:
+    with open(path, encoding="utf-8") as f:
+        return json.load(f)
+
+
+def pose_of(steps) -> SE3:
+    """Elementary motions ``[["Trans", [x, y, z]], ["Rx", a], ...]`` composed left to right."""
+    T = SE3()
+    for name, value in steps:
+        T = T * (SE3.Trans(*value) if name == "Trans" else getattr(SE3, name)(value))
+    return T
+
+
+def hand_tree(**options) -> KinematicTree:
+    """The paper's three-finger hand: every joint added with its exact pose (relative to its
+    parent's pose), in the fixture's order."""
+    data = load_fixture()
+    joints = data["joints"]
+    tree = KinematicTree(Waypoint(4, 1, pose_of(joints[0]["relative_pose"])), **options)
+    for spec in joints[1:]:
+        pose = pose_of(spec["relative_pose"])
+        params = spec["params"]
+        if spec["type"] == "RevoluteJoint":
+            joint = RevoluteJoint(4, 1, params["totalBendingAngle"], pose,
+                                  numSinkLayers=params["numSinkLayers"])  # fmt: skip
+        else:
+            joint = EndTip(4, 1, pose, params["length"])
+        index = tree.addJoint(spec["parent"], joint, relative=True, safe=False,
+                              fixedPosition=True, fixedOrientation=True)  # fmt: skip
+        assert index == spec["index"]
+    return tree
