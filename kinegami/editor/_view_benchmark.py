@@ -1,10 +1,17 @@
 """The cost of a drag step in the browser view: ``python -m kinegami.editor._view_benchmark``.
 
 The 32-joint compact chain of benchmarks/run.py in an :class:`~kinegami.editor.view.EditorView`
-drawn on a viser server with no tab connected: each step is a slide (the command, the
-clearance report and the new meshes and poses, which the view's listener makes from the
-Change) and then the crease pattern. Prints the medians in milliseconds and the meshes each
-step sent. See docs/editor.md (The browser view).
+drawn on a viser server with no tab connected (so sending over the network is not counted).
+For joints near the start, middle and end, with and without propagation, 11 steps each of:
+
+* a live handle drag (:meth:`EditorView.drag_preview`): the slide as a preview, the clearance
+  report and the meshes and poses the listener makes, with the crease-pattern panel deferred
+  to the pause after the drag;
+* the pause after it: the crease pattern and its drawing (:meth:`EditorView.flush`);
+* a slide as a command (the drag's end, or the Slide buttons), pattern deferred likewise.
+
+Prints the medians in milliseconds and the meshes each step sent. See docs/editor.md (The
+browser view).
 """
 
 from __future__ import annotations
@@ -16,6 +23,10 @@ from kinegami.editor._benchmark import compact_chain
 from kinegami.editor.model import EditorModel
 
 
+def _median_ms(values) -> float:
+    return statistics.median(values) * 1e3
+
+
 def main() -> None:
     from kinegami.editor.server import EditorServer
 
@@ -23,27 +34,40 @@ def main() -> None:
     try:
         view = server.new_view(server.server)
         view.set_model(EditorModel(compact_chain()))
-        view.model.pattern()
-        print("drag step on a 32-joint chain, median ms: edit+clearance+meshes + pattern = total")
+        view.flush()
+        print("32-joint chain, median ms: live drag step | pattern panel after the pause | "
+              "slide command (meshes sent per step)")  # fmt: skip
         for joint in (2, 16, 30):
             for propagate in (True, False):
-                rows = []
+                view.model.propagate = propagate
+                view.act(lambda j=joint: view.model.select(j))
+                pose = view.model.chain.Joints[joint].pose_matrix.copy()
+                drags, pauses, commands, sent = [], [], [], []
                 for k in range(11):
-                    sent = view.meshes_sent
+                    target = pose[:3, 3] + (0.05 if k % 2 == 0 else 0.1) * pose[:3, 2]
+                    before = view.meshes_sent
+                    t0 = time.perf_counter()
+                    result = view.drag_preview(target, view._gizmo.wxyz)
+                    t1 = time.perf_counter()
+                    view.flush()
+                    t2 = time.perf_counter()
+                    if result is not None and result.ok:
+                        drags.append(t1 - t0)
+                        pauses.append(t2 - t1)
+                        sent.append(view.meshes_sent - before)
+                view.drag_to(pose[:3, 3], view._gizmo.wxyz)  # back where it began
+                for k in range(11):
                     t0 = time.perf_counter()
                     result = view.act(lambda k=k, j=joint, p=propagate: view.model.slide(
                         j, 0.05 if k % 2 == 0 else -0.05, propagate=p))  # fmt: skip
                     t1 = time.perf_counter()
-                    view.model.pattern()
-                    t2 = time.perf_counter()
+                    view.flush()
                     if result.ok:
-                        rows.append((t1 - t0, t2 - t1, view.meshes_sent - sent))
-                edit = statistics.median(r[0] for r in rows) * 1e3
-                pattern = statistics.median(r[1] for r in rows) * 1e3
-                total = statistics.median(r[0] + r[1] for r in rows) * 1e3
-                meshes = statistics.median(r[2] for r in rows)
-                print(f"  joint {joint:2d}, propagate={propagate!s:5}: {edit:5.1f} + "
-                      f"{pattern:5.1f} = {total:5.1f} ({meshes:g} meshes sent)")  # fmt: skip
+                        commands.append(t1 - t0)
+                print(f"  joint {joint:2d}, propagate={propagate!s:5}: drag "
+                      f"{_median_ms(drags):5.1f} | pattern {_median_ms(pauses):5.1f} | "
+                      f"command {_median_ms(commands):5.1f} "
+                      f"({statistics.median(sent):g} meshes)")  # fmt: skip
     finally:
         server.stop()
 

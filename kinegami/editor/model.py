@@ -250,6 +250,7 @@ class EditorModel:
         self._listeners: list[Callable[[Change], None]] = []
         self._patterns = PatternCache()
         self._preview_base: Document | None = None  # the document under a preview
+        self._shown: Document | None = None  # what listeners saw, after _leave_preview
         #: Default of ``propagate`` for the move helpers (:meth:`slide`, :meth:`roll`,
         #: :meth:`transform`): move the later joints too. A view's toggle sets it.
         self.propagate = True
@@ -396,16 +397,17 @@ class EditorModel:
             return CommandResult(
                 False, "command", f"command must be an editor Command, got {command!r}"
             )
-        self.end_preview()
+        self._leave_preview()
         before = self._document
         try:
             outcome = command.apply(before)
         except CommandError as error:
-            return CommandResult(False, command.label, str(error))
+            return self._refused(CommandResult(False, command.label, str(error)))
         except (KinegamiError, ValueError, TypeError, IndexError, ArithmeticError) as error:
-            return CommandResult(False, command.label, f"{command.label}: {error}")
+            return self._refused(CommandResult(False, command.label, f"{command.label}: {error}"))
         if not isinstance(outcome, Outcome):  # pragma: no cover - a broken command class
-            return CommandResult(False, command.label, "the command returned no document")
+            return self._refused(CommandResult(False, command.label, "the command returned no "
+                                               "document"))  # fmt: skip
         after = outcome.document
         selected = self._selection_after(before, after, outcome)
         self._undo.append(_Step(command, before, after, self._selected, selected))
@@ -424,9 +426,23 @@ class EditorModel:
                     return i
         return self._clamped(self._selected, after)
 
+    def _leave_preview(self) -> None:
+        """Stop a preview without telling the listeners: the next change they hear is from
+        the preview they saw to the new document (one redraw, not two)."""
+        if self._preview_base is not None:
+            self._shown = self._document
+            self._document, self._preview_base = self._preview_base, None
+
+    def _refused(self, result: CommandResult) -> CommandResult:
+        """A refused command after :meth:`_leave_preview`: the listeners see the base again."""
+        if self._shown is not None:
+            self._switch(self._document, self._selected, "preview", "end preview")
+        return result
+
     def _switch(self, document: Document, selected, kind: str, action: str,
                 warnings=(), sources=None) -> CommandResult:  # fmt: skip
-        change = compare(self._document, document, kind, sources)
+        shown, self._shown = self._shown, None
+        change = compare(self._document if shown is None else shown, document, kind, sources)
         self._document = document
         self._selected = selected
         change = Change(**{**change.__dict__, "selected": selected, "dirty": self.dirty})
@@ -435,18 +451,18 @@ class EditorModel:
 
     def undo(self) -> CommandResult:
         """Undo the last command (the document and selection before it come back exactly)."""
-        self.end_preview()
+        self._leave_preview()
         if not self._undo:
-            return CommandResult(False, "undo", "there is nothing to undo")
+            return self._refused(CommandResult(False, "undo", "there is nothing to undo"))
         step = self._undo.pop()
         self._redo.append(step)
         return self._switch(step.before, step.selected_before, "undo", "undo")
 
     def redo(self) -> CommandResult:
         """Redo the last undone command (its document comes back exactly)."""
-        self.end_preview()
+        self._leave_preview()
         if not self._redo:
-            return CommandResult(False, "redo", "there is nothing to redo")
+            return self._refused(CommandResult(False, "redo", "there is nothing to redo"))
         step = self._redo.pop()
         self._undo.append(step)
         return self._switch(step.after, step.selected_after, "redo", "redo")

@@ -10,8 +10,10 @@ handles it is given, so tests can drive it with a server and no browser.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import io
+import itertools
 import math
 import threading
 import time
@@ -25,7 +27,7 @@ import numpy as np
 
 from kinegami.editor import sheet_drawing
 from kinegami.editor.background import Debounced
-from kinegami.editor.commands import ReplaceDocument, SetJointStates
+from kinegami.editor.commands import ReplaceDocument, RollJoint, SetJointStates, SlideJoint
 from kinegami.editor.document import Document
 from kinegami.editor.model import Change, CommandResult, EditorModel
 from kinegami.errors import KinegamiError
@@ -175,6 +177,9 @@ class EditorView:
         self._sliders: list = []
         self._gizmo = None
         self._gizmo_pose: np.ndarray | None = None
+        self._dragging = False  # a handle drag is previewed (the handle is the user's)
+        self._drags = itertools.count(1)
+        self._drag_latest = 0
         self._autosave_for = autosave_for
         self.autosave = None if autosave_for is None else autosave_for(self.model.path)
         self._animation: threading.Event | None = None
@@ -268,13 +273,16 @@ class EditorView:
 
     def _on_change(self, change: Change) -> None:
         self._pattern_redraw.trigger()
-        if change.kind == "select":
-            self._recolour()
-            self._update_gizmo()
-            self._update_panel()
-            return
-        self._update_scene(change)
-        self._update_panel(structure=change.structure)
+        atomic = getattr(self.target, "atomic", None)
+        # one batch: the tab applies the step at once, and the server wakes its sender once
+        with atomic() if atomic is not None else contextlib.nullcontext():
+            if change.kind == "select":
+                self._recolour()
+                self._update_gizmo()
+                self._update_panel()
+                return
+            self._update_scene(change)
+            self._update_panel(structure=change.structure)
         if self.autosave is not None:
             if change.kind == "save":
                 self.autosave.discard()
@@ -418,6 +426,13 @@ class EditorView:
                 else:
                     self._links[i].obj = links[i]
                     self._move(self._links[i], np.asarray(links[i].start_frame, dtype=float))
+            # the unchanged parts are equal values; keep the current objects (a later insertion
+            # or delete matches nodes to parts by identity)
+            for i, node in enumerate(self._joints):
+                node.obj = joints[i]
+            for i, node in enumerate(self._links):
+                if node is not None:
+                    node.obj = links[i]
         self._refresh_clearance()
         self._recolour()
         self._update_gizmo()
@@ -464,6 +479,8 @@ class EditorView:
 
     # --- handles ------------------------------------------------------------------------------
     def _update_gizmo(self) -> None:
+        if self._dragging:
+            return  # the handle follows the mouse; its start pose is what the drag measures from
         index = self.model.selected
         if index is None or index >= len(self.model.chain.Joints):
             if self._gizmo is not None:
@@ -482,28 +499,66 @@ class EditorView:
         self._gizmo.wxyz, self._gizmo.position = _wxyz(pose[:3, :3]), pose[:3, 3]
 
     def _on_gizmo(self, event) -> None:
-        if getattr(event, "phase", "end") != "end":
-            return
-        self.drag_to(np.asarray(self._gizmo.position, dtype=float), self._gizmo.wxyz)
+        phase = getattr(event, "phase", "end")
+        position = np.asarray(self._gizmo.position, dtype=float)
+        wxyz = tuple(self._gizmo.wxyz)
+        self._drag_latest = drag = next(self._drags)  # later events make earlier ones stale
+        if phase == "end":
+            self.drag_to(position, wxyz)
+        elif phase == "update":
+            self.drag_preview(position, wxyz, drag)
+
+    def _axis_motion(self, position, wxyz) -> tuple[float, float]:
+        """(slide along, roll about) the selected joint's axis from the drag's start pose."""
+        R0, p0 = self._gizmo_pose[:3, :3], self._gizmo_pose[:3, 3]
+        distance = float(np.dot(np.asarray(position, dtype=float) - p0, R0[:, 2]))
+        relative = R0.T @ _matrix(wxyz)
+        return distance, math.atan2(relative[1, 0], relative[0, 0])
+
+    @_locked
+    def drag_preview(self, position, wxyz, drag: int | None = None) -> CommandResult | None:
+        """Show a handle drag in progress: the slide (or roll) to ``position``/``wxyz`` as a
+        preview, so the chain follows the handle without entering the history; the drag's
+        end (:meth:`drag_to`) makes it a command. An event overtaken by a later one of the
+        same drag (``drag``) is skipped; a refused step shows the reason and keeps the last
+        good one."""
+        if drag is not None and drag != self._drag_latest:
+            return None
+        self.stop_animation()
+        if self._gizmo_pose is None or self.model.selected is None:
+            return None
+        self._dragging = True
+        distance, angle = self._axis_motion(position, wxyz)
+        joint, propagate = self.model.selected, bool(self.model.propagate)
+        if abs(distance) > 1e-9 * self._r:
+            command = SlideJoint(joint, distance, propagate)
+        elif abs(angle) > 1e-9:
+            command = RollJoint(joint, angle, propagate)
+        else:
+            self.model.end_preview()
+            return None
+        result = self.model.preview(command)
+        if not result.ok:
+            self._say(f"**Refused:** {result.reason}")
+        return result
 
     @_locked
     def drag_to(self, position, wxyz) -> CommandResult | None:
         """Apply a finished handle drag: the slide along the selected joint's axis and the
         roll about it that take its Pose to ``position``/``wxyz`` (other motion is ignored).
         A refused move snaps the handle back and shows the reason."""
+        self._dragging = False
         self.stop_animation()
-        pose = self._gizmo_pose
-        if pose is None or self.model.selected is None:
+        if self._gizmo_pose is None or self.model.selected is None:
+            self.model.end_preview()
             return None
-        R0, p0 = pose[:3, :3], pose[:3, 3]
-        distance = float(np.dot(np.asarray(position, dtype=float) - p0, R0[:, 2]))
-        relative = R0.T @ _matrix(wxyz)
-        angle = math.atan2(relative[1, 0], relative[0, 0])
+        distance, angle = self._axis_motion(position, wxyz)
         result = None
         if abs(distance) > 1e-9 * self._r:
             result = self.run(self.model.slide(None, distance))
         if (result is None or result.ok) and abs(angle) > 1e-9:
             result = self.run(self.model.roll(None, angle))
+        self.model.end_preview()  # a drag back to where it began applies nothing
         self._update_gizmo()  # snaps back when refused
         return result
 

@@ -443,3 +443,41 @@ def test_a_design_opened_in_the_browser_autosaves_in_the_data_folder(monkeypatch
         assert not view._save_file.visible
     finally:
         server.stop()
+
+
+# --- a live handle drag -------------------------------------------------------------------------
+def test_a_handle_drag_is_previewed_and_its_end_is_one_command(view):
+    view.click_joint(4)
+    pose = view.model.chain.Joints[4].pose_matrix.copy()
+    base = view.model.document
+    for k in range(1, 6):
+        result = view.drag_preview(pose[:3, 3] + 0.1 * k * pose[:3, 2], view._gizmo.wxyz)
+        assert result.ok and view.model.previewing
+        assert_allclose(view.model.chain.Joints[4].pose_matrix[:3, 3],
+                        pose[:3, 3] + 0.1 * k * pose[:3, 2], atol=1e-9)  # fmt: skip
+        assert_allclose(view._joints[4].frame.position, pose[:3, 3] + 0.1 * k * pose[:3, 2],
+                        atol=1e-6)  # fmt: skip
+    assert not view.model.can_undo and view.model.base_document is base
+    sent = view.meshes_sent
+    assert view.drag_to(pose[:3, 3] + 0.5 * pose[:3, 2], view._gizmo.wxyz).ok
+    assert view.meshes_sent == sent  # the last preview already showed it
+    assert len(view.model.undo_labels) == 1 and not view.model.previewing
+    assert_allclose(view.model.chain.Joints[4].pose_matrix[:3, 3], pose[:3, 3] + 0.5 * pose[:3, 2],
+                    atol=1e-9)  # fmt: skip
+
+
+def test_a_stale_drag_event_is_skipped(view):
+    view.click_joint(4)
+    pose = view.model.chain.Joints[4].pose_matrix.copy()
+    view._drag_latest = 7
+    assert view.drag_preview(pose[:3, 3] + pose[:3, 2], view._gizmo.wxyz, drag=6) is None
+    assert not view.model.previewing
+
+
+def test_a_drag_released_where_it_began_changes_nothing(view):
+    view.click_joint(4)
+    pose = view.model.chain.Joints[4].pose_matrix.copy()
+    base = view.model.document
+    view.drag_preview(pose[:3, 3] + pose[:3, 2], view._gizmo.wxyz)
+    assert view.drag_to(pose[:3, 3], view._gizmo.wxyz) is None
+    assert view.model.document is base and not view.model.can_undo
