@@ -2,9 +2,25 @@
 construction, and how a tree is fabricated from sheets and junctions (docs/trees.md).
 
 ``KinematicTree`` (published name) is the model; a ``KinematicChain`` is the tree in which each
-joint's parent is the joint before it.
+joint's parent is the joint before it. ``from_specification`` builds a tree from a joint
+specification (``JointSpecificationTree``, published name, or a file read by
+``load_joint_specification``).
 """
 
+from kinegami.tree.construction import (
+    JointSpecification,
+    JointSpecificationTree,
+    TreeConstruction,
+    from_specification,
+    load_joint_specification,
+)
 from kinegami.tree.model import KinematicTree
 
-__all__ = ["KinematicTree"]
+__all__ = [
+    "KinematicTree",
+    "JointSpecification",
+    "JointSpecificationTree",
+    "TreeConstruction",
+    "from_specification",
+    "load_joint_specification",
+]
