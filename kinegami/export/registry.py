@@ -54,7 +54,6 @@ from kinegami.errors import (
     InvalidTypeError,
     KinegamiError,
 )
-from kinegami.validation import check_bool
 
 __all__ = [
     "ACCEPTS",
@@ -228,7 +227,10 @@ def register(
             )
     if accepts not in ACCEPTS:
         raise InvalidParameterError(f"accepts must be one of {ACCEPTS}, got {accepts!r}")
-    binary, files = check_bool("binary", binary), check_bool("files", files)
+    if type(binary) is not bool or type(files) is not bool:  # validation imports numpy: only
+        from kinegami.validation import check_bool  # when needed (import kinegami stays light)
+
+        binary, files = check_bool("binary", binary), check_bool("files", files)
     if binary and files:
         raise InvalidParameterError("give binary=True or files=True, not both")
     if not isinstance(description, str):

@@ -7,23 +7,25 @@ copy of the starting panel, so that the two copies overlap face to face when the
 straight lines drawn on that sheet, as plain arrays that every exporter and plot reads:
 
 * every crease is drawn at its position in [0, W) and at the periodic copies x +- W, following
-  the shortest path on the tube (section 1.4), then clipped to the sheet, -b/2 <= x <= W + b/2
-  (the recommended fix of B8 of section 6.2). A piece is kept iff it has positive length strictly
-  inside the sheet, so pieces lying on the vertical cut edges are dropped (end points within
-  the pattern's tolerance eps = 1e-4 b of an edge count as on it); no zero-length and no
-  duplicate lines are produced. For every catalog crease (horizontal extent <= b) this is
-  exactly the reference copying rule of section 5.2 (the crease, plus copies shifted by +W / -W
-  when it touches the first / last panel column, or both halves of a wrapping crease) followed
-  by the clipping; tests/export compares the two on random patterns. It also settles the
-  exactly-opposite case of section 1.4 by the stored vertex order (the B8 wrap-test fix);
+  the shortest path on the tube (docs/theory/patterns.md §1.4), then clipped to the sheet,
+  -b/2 <= x <= W + b/2 (the fix of problem B8, docs/theory/patterns.md §6). A piece is kept
+  iff it has positive length strictly inside the sheet, so pieces lying on the vertical cut
+  edges are dropped (end points within the pattern's tolerance eps = 1e-4 b of an edge count as
+  on it); no zero-length and no duplicate lines are produced. For every catalog crease
+  (horizontal extent <= b) this is exactly the reference copying rule (docs/theory/patterns.md
+  §5.2: the crease, plus copies shifted by +W / -W when it touches the first / last panel
+  column, or both halves of a wrapping crease) followed by the clipping; tests/export compares
+  the two on random patterns. It also settles the exactly-opposite case of §1.4 by the stored
+  vertex order (the B8 wrap-test fix);
 * the Boundary: the rectangle x in [0, W] (the nominal tube, seam at both ends), 4 lines;
 * the Cut: the rectangle x in [-b/2, W + b/2] (the sheet outline), 4 lines
   (for a pattern of zero height, e.g. a lone waypoint, each rectangle is a single line).
 
 Creases lying on the top or bottom edge of the sheet (B10: the rings at the ends of a twist,
 revolute joint or REBO, the midline of a tip) are kept by default, as in the reference, so the
-line counts of section 7.4 hold; ``skip_creases_on_cut=True`` drops every crease lying wholly on
-those edges (the laser then does not pass twice over the cut edge).
+reference line counts hold (tests/export/reference_values.py); ``skip_creases_on_cut=True``
+drops every crease lying wholly on those edges (the laser then does not pass twice over the cut
+edge).
 
 Everything is in pattern units (the unit of the tube radius r); exporters scale it.
 """
@@ -37,6 +39,7 @@ import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.pattern._prism import periodic_dx
+from kinegami.validation import check_bool
 
 if TYPE_CHECKING:  # pragma: no cover
     from kinegami.pattern.tubular import TubularPattern
@@ -191,10 +194,7 @@ def flatten(pattern: TubularPattern, *, skip_creases_on_cut: bool = False) -> Sh
 
     if not isinstance(pattern, TubularPattern):
         raise InvalidTypeError(f"pattern must be a TubularPattern, got {type(pattern).__name__}")
-    if not isinstance(skip_creases_on_cut, bool | np.bool_):
-        raise InvalidTypeError(
-            f"skip_creases_on_cut must be True or False, got {skip_creases_on_cut!r}"
-        )
+    skip_creases_on_cut = check_bool("skip_creases_on_cut", skip_creases_on_cut)
     W, b = pattern.width, pattern.sideLength
     tol = TOLERANCE_FACTOR * pattern.r
     snap = pattern.eps
@@ -356,7 +356,8 @@ def _cluster_ids(values: np.ndarray, tol: float) -> np.ndarray:
 
 
 def check_periodicity(sheet: Sheet) -> list[str]:
-    """Check section 7.5: the creases in [W - b/2, W + b/2] are those in [-b/2, b/2] shifted by W.
+    """Check periodicity (docs/theory/patterns.md §5.3): the creases in [W - b/2, W + b/2] are
+    those in [-b/2, b/2] shifted by W.
 
     Both strips are read with :func:`clip_segments` (pieces of positive length strictly inside)
     and pieces equal within the tolerance are counted once (:func:`unique_segments`); segments

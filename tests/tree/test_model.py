@@ -33,6 +33,7 @@ from kinegami.clearance import chain_clearance
 from .helpers import hand_tree, load_fixture
 
 REF = load_fixture()["reference"]
+RY = SE3.Ry(math.pi / 2)  # a revolute joint's path (its x axis) along -z
 EXACT = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
 
 
@@ -291,9 +292,8 @@ def test_safe_siblings_do_not_overlap():
     tree = KinematicTree(Waypoint(4, 1, SE3()))
     with warnings.catch_warnings():
         warnings.simplefilter("error", ClearanceWarning)
-        first = tree.addJoint(0, RevoluteJoint(4, 1, math.pi, SE3.Trans(3, 0, 4) * SE3.Ry(math.pi / 2)))
-        second = tree.addJoint(0, RevoluteJoint(4, 1, math.pi,
-                                                SE3.Trans(-3, 0, 4) * SE3.Ry(math.pi / 2)))  # fmt: skip
+        first = tree.addJoint(0, RevoluteJoint(4, 1, math.pi, SE3.Trans(3, 0, 4) * RY))
+        second = tree.addJoint(0, RevoluteJoint(4, 1, math.pi, SE3.Trans(-3, 0, 4) * RY))
     assert tree.clearance().ok
     w1, w2 = tree.Children[0]
     assert isinstance(tree.Joints[w1], Waypoint) and isinstance(tree.Joints[w2], Waypoint)
@@ -383,8 +383,7 @@ def test_no_link_reaches_the_joint(snapshot):
     tree = KinematicTree(StartTip(4, 1, SE3(), 1.5))
     before = snapshot(tree)
     with pytest.warns(PlacementWarning, match="addJoint failed"):
-        index = tree.addJoint(0, RevoluteJoint(4, 1, math.pi, SE3.Trans(0, 0, 10) * SE3.Ry(math.pi / 2)),
-                              **EXACT)  # fmt: skip
+        index = tree.addJoint(0, RevoluteJoint(4, 1, math.pi, SE3.Trans(0, 0, 10) * RY), **EXACT)
     assert index is None
     assert snapshot(tree) == before
 
