@@ -1,8 +1,13 @@
-"""Design files: a kinematic chain as a JSON document (format "kinegami-design", version 1).
+"""Design files: a kinematic chain or tree as a JSON document (format "kinegami-design",
+versions 1 and 2).
 
 A design file lists the tube (``numSides``, ``r``), the joints as they would be appended in
 Python (or a DH table), optional edits and joint states; see docs/design-format.md and the JSON
-Schema shipped as ``kinegami/design/schema.json`` (:func:`design_schema`).
+Schema shipped as ``kinegami/design/schema.json`` (:func:`design_schema`). Version 2 adds trees:
+a joint may name its ``parent``, and the joints may be a joint specification that the tree
+construction places (:mod:`kinegami.design.trees`). Loading gives a
+:class:`~kinegami.chain.KinematicChain` for a chain and a :class:`~kinegami.tree.KinematicTree`
+for a tree; saving writes either.
 
 >>> chain = load_design("tests/design/data/example1.json")  # doctest: +SKIP
 >>> save_design(chain, "out/example1.json", name="Example 1")  # doctest: +SKIP
@@ -38,6 +43,7 @@ from kinegami.design.reader import (
 )
 from kinegami.design.schema import design_schema
 from kinegami.design.writer import design_to_dict, dumps_design, save_design
+from kinegami.tree import KinematicTree
 
 __all__ = [
     "DesignError",
@@ -64,13 +70,19 @@ __all__ = [
 ]
 
 
-def _with_info(document, file) -> tuple[KinematicChain, DesignInfo]:
+def _with_info(document, file) -> tuple[KinematicChain | KinematicTree, DesignInfo]:
     plan = check_document(document, file)
     return build_plan(plan, file)[0], DesignInfo.of(document, file)
 
 
-def load_design_with_info(path: str | os.PathLike) -> tuple[KinematicChain, DesignInfo]:
-    """The chain of the design file ``path`` and the file's metadata (units, name, ...).
+def load_design_with_info(
+    path: str | os.PathLike,
+) -> tuple[KinematicChain | KinematicTree, DesignInfo]:
+    """The chain (or tree) of the design file ``path`` and the file's metadata (units, name,
+    ...).
+
+    A KinematicTree when the design is a tree (``"structure": "tree"``, a joint whose
+    ``parent`` is not the previous entry, or a joint specification), else a KinematicChain.
 
     Raises
     ------
@@ -84,21 +96,26 @@ def load_design_with_info(path: str | os.PathLike) -> tuple[KinematicChain, Desi
     return _with_info(document, file)
 
 
-def load_design(path: str | os.PathLike) -> KinematicChain:
-    """The chain described by the design file ``path`` (lengths in the file's units).
+def load_design(path: str | os.PathLike) -> KinematicChain | KinematicTree:
+    """The chain or tree described by the design file ``path`` (lengths in the file's units).
 
     Raises DesignError for any problem (see :func:`load_design_with_info`).
     """
     return load_design_with_info(path)[0]
 
 
-def loads_design(text: str, file: str | os.PathLike | None = None) -> KinematicChain:
-    """The chain described by the design JSON ``text``; ``file`` only names it in errors."""
+def loads_design(
+    text: str, file: str | os.PathLike | None = None
+) -> KinematicChain | KinematicTree:
+    """The chain or tree described by the design JSON ``text``; ``file`` only names it in
+    errors."""
     return _with_info(parse_design_text(text, file), file)[0]
 
 
-def chain_from_dict(data: dict, file: str | os.PathLike | None = None) -> KinematicChain:
-    """The chain described by an already parsed design document (a dict)."""
+def chain_from_dict(
+    data: dict, file: str | os.PathLike | None = None
+) -> KinematicChain | KinematicTree:
+    """The chain or tree described by an already parsed design document (a dict)."""
     return _with_info(data, file)[0]
 
 
@@ -118,7 +135,7 @@ def validate_design(path: str | os.PathLike) -> None:
 
     Parses the JSON, validates it against the schema and runs the checks the schema cannot
     express (lengths within 1e6 r, rigid matrices, axes, joint order, placement options,
-    unique joint names and the names edits use, joint parameters). Whether
+    unique joint names and the names edits use, parents, joint parameters). Whether
     every joint can be placed and every edit and state applied is only known by building the
     chain: use :func:`load_design` for the full check. Raises DesignError; returns None.
     """

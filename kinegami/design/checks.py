@@ -23,14 +23,17 @@ from kinegami.design.reader import (
 )
 from kinegami.errors import InvalidTypeError, KinegamiError
 from kinegami.pattern import TubularPattern
+from kinegami.tree import KinematicTree
 from kinegami.validation import shorten
 
 __all__ = ["check_pattern", "joint_table"]
 
 
 def _check_chain(chain) -> None:
-    if not isinstance(chain, KinematicChain):
-        raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
+    if not isinstance(chain, KinematicChain | KinematicTree):
+        raise InvalidTypeError(
+            f"chain must be a KinematicChain or a KinematicTree, got {type(chain).__name__}"
+        )
 
 
 def _field_of(origin: DesignOrigin | None, index: int) -> str:
@@ -74,7 +77,7 @@ def _reason(error: Exception) -> str:
 
 
 def check_pattern(
-    chain: KinematicChain,
+    chain: KinematicChain | KinematicTree,
     info: DesignInfo | None = None,
     file: str | os.PathLike | None = None,
 ) -> TubularPattern:
@@ -82,7 +85,8 @@ def check_pattern(
 
     Parameters
     ----------
-    chain : a chain, usually from :func:`kinegami.design.load_design_with_info`.
+    chain : a chain, usually from :func:`kinegami.design.load_design_with_info`. A tree has
+        no single crease pattern: a DesignError says building trees is not yet supported.
     info : the design's info; gives ``twistPortion`` (default 0.2 without it) and the file.
     file : the design file named in errors (default ``info.file``, else the file the chain
         was loaded from, if known).
@@ -112,6 +116,13 @@ def check_pattern(
         file = info.file
     if file is None and origin is not None:
         file = origin.file
+    if not hasattr(chain, "creasePattern"):  # a tree: one pattern per sheet, not yet
+        raise DesignError(
+            "building trees (a crease pattern per sheet) is not yet supported: the design "
+            f"loads as a KinematicTree of {len(chain.Joints)} joints, which has no single "
+            "crease pattern",
+            file=file,
+        )
     try:
         with numeric_errors("$", file):
             return chain.creasePattern(twistPortion=twistPortion)
@@ -148,7 +159,9 @@ def _consistent(origin: DesignOrigin | None, entries: list, types: tuple) -> boo
     return True
 
 
-def joint_table(chain: KinematicChain, document: dict) -> list[tuple[int, str, str | None]]:
+def joint_table(
+    chain: KinematicChain | KinematicTree, document: dict
+) -> list[tuple[int, str, str | None]]:
     """The joints of ``chain`` as ``(index, type name, name or None)``, in chain order.
 
     ``index`` is the joint's index in ``chain.Joints`` (what ``edits`` and ``states`` use),

@@ -1,9 +1,11 @@
-"""Reading design files: parse, check (schema, then semantics) and build the chain.
+"""Reading design files: parse, check (schema, then semantics) and build the chain or tree.
 
 Building uses exactly the Python calls a user would type: ``KinematicChain(root,
 maxAnglePerElbow=...)``, ``append(joint, relative, safe, fixedPosition, fixedOrientation)`` per
 joint (or ``KinematicChain.from_dh`` for a DH table), the edit methods in order, then
-``setJointStates``. A PlacementWarning or a rejected edit becomes a DesignError naming
+``setJointStates``. A tree (version 2, :mod:`kinegami.design.trees`) is built the same way with
+``KinematicTree(root, ...)`` and ``addJoint(parent, joint, ...)``, or by the tree construction
+for a joint specification. A PlacementWarning or a rejected edit becomes a DesignError naming
 ``joints[i]`` or ``edits[i]``; nothing is printed. With ``"requireClearance": true`` the chain
 is built with ``requireClearance=True``, so a placement, edit or state that makes it pass
 through itself is rejected like any infeasible one (a DH design is checked once built). All
@@ -40,6 +42,12 @@ from kinegami.design.limits import (
 )
 from kinegami.design.poses import pose_from_json, to_radians
 from kinegami.design.schema import PLACEMENT_KEYS, check_schema, check_top_level
+from kinegami.design.trees import (
+    TreeSpecification,
+    check_tree_fields,
+    check_version_features,
+    construct_tree,
+)
 from kinegami.errors import ClearanceWarning, JointIndexError, KinegamiError
 from kinegami.joints import (
     EndTip,
@@ -49,6 +57,7 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
+from kinegami.tree import KinematicTree
 from kinegami.validation import shorten, shown
 
 __all__ = [
@@ -66,7 +75,7 @@ __all__ = [
 ]
 
 FORMAT = "kinegami-design"
-VERSIONS = (1,)
+VERSIONS = (1, 2)
 UNITS = ("mm", "cm", "m", "in")
 DEFAULT_TWIST_PORTION = 0.2
 
@@ -485,6 +494,9 @@ class _Plan:
     states: list | None
     names: tuple = ()  # the "name" of every entry of "joints" (None where it has none)
     require_clearance: bool = False  # the design's "requireClearance"
+    tree: bool = False  # build a KinematicTree (version 2)
+    parents: tuple = ()  # per entry of "joints", the entry it is added to (-1: the root)
+    specification: TreeSpecification | None = None  # a joint specification to construct
 
 
 #: Top-level fields that library messages may name.
@@ -542,22 +554,24 @@ def _make_joint(spec: dict, i: int, numSides: int, r: float, units: str, file):
         raise _library_error(error, path, set(spec), file) from None
 
 
-def _check_joint_order(joints, file) -> None:
+def _check_joint_order(joints, file, chain: bool = True) -> None:
+    """The order of a chain's joint types (a tree's: :func:`check_tree_fields`) and the
+    placement options of every joint."""
     last = len(joints) - 1
     for i, spec in enumerate(joints):
         kind = spec["type"]
         where = json_path(["joints", i, "type"])
-        if kind == "StartTip" and i > 0:
+        if chain and kind == "StartTip" and i > 0:
             raise DesignError(
                 "a StartTip can only be the first joint (joints[0])",
                 field=where, value=kind, file=file,
             )  # fmt: skip
-        if kind == "EndTip" and i == 0:
+        if chain and kind == "EndTip" and i == 0:
             raise DesignError(
                 "the first joint (the root) cannot be an EndTip: nothing may follow an EndTip",
                 field=where, value=kind, file=file,
             )  # fmt: skip
-        if kind == "EndTip" and i < last:
+        if chain and kind == "EndTip" and i < last:
             raise DesignError(
                 f"an EndTip must be the last joint (joints[{last}]): nothing may follow it",
                 field=where, value=kind, file=file,
@@ -694,10 +708,12 @@ def _check_document(document, file) -> _Plan:
             if key != "rows" or not isinstance(value, list):
                 _check_values(value, file, root=("dh", key))
     check_top_level(document, file)
+    check_version_features(document, file)
     _check_values(document, file)
     check_schema(document, file)
     check_lengths(document, file)
     names = _check_names(document, file)
+    fields = check_tree_fields(document, file)
     units = document.get("angleUnits", "rad")
     numSides = int(document["numSides"])
     r = float(document["r"])
@@ -706,13 +722,22 @@ def _check_document(document, file) -> _Plan:
         chain_options["maxAnglePerElbow"] = to_radians(document["maxAnglePerElbow"], units)
     joints = []
     dh = None
+    specification = None
     if "joints" in document:
         specs = document["joints"]
-        _check_joint_order(specs, file)
+        _check_joint_order(specs, file, chain=not fields.tree)
         for i, spec in enumerate(specs):
             joint = _make_joint(spec, i, numSides, r, units, file)
             options = {key: spec[key] for key in PLACEMENT_KEYS if key in spec}
             joints.append((joint, options))
+        if fields.specification:
+            specification = TreeSpecification.of(
+                document,
+                [joint for joint, _ in joints],
+                fields.parents,
+                [spec.get("relative", True) for spec in specs],
+                chain_options.get("maxAnglePerElbow"),
+            )
     else:
         dh = _plan_dh(document["dh"], units)
     edits = _plan_edits(document.get("edits", []), units)
@@ -720,6 +745,7 @@ def _check_document(document, file) -> _Plan:
     return _Plan(
         numSides, r, units, chain_options, joints, dh, edits, states, names,
         require_clearance=document.get("requireClearance", False),
+        tree=fields.tree, parents=fields.parents, specification=specification,
     )  # fmt: skip
 
 
@@ -832,13 +858,12 @@ def _reason(message: str | None, plan: _Plan, default: str) -> str:
     return message
 
 
-def _build_from_joints(plan: _Plan, file) -> tuple[KinematicChain, list]:
+def _build_from_joints(plan: _Plan, file) -> tuple[KinematicChain | KinematicTree, list]:
     root, _ = plan.joints[0]
     options = dict(plan.chain_options, requireClearance=plan.require_clearance)
+    kind = KinematicTree if plan.tree else KinematicChain
     try:
-        chain, _ = _recorded(
-            lambda: KinematicChain(root, **options), json_path(["joints", 0]), file
-        )
+        chain, _ = _recorded(lambda: kind(root, **options), json_path(["joints", 0]), file)
     except DesignError:
         raise
     except KinegamiError as error:
@@ -846,16 +871,22 @@ def _build_from_joints(plan: _Plan, file) -> tuple[KinematicChain, list]:
     sources = [0]
     for i, (joint, options) in enumerate(plan.joints[1:], start=1):
         where = json_path(["joints", i])
+        if plan.tree:  # the parent entry's joint, wherever placement put it
+            parent = sources.index(plan.parents[i])
+            add = lambda j=joint, o=options, p=parent: chain.addJoint(p, j, **o)  # noqa: E731
+        else:
+            add = lambda j=joint, o=options: chain.append(j, **o)  # noqa: E731
         try:
-            index, message = _recorded(lambda j=joint, o=options: chain.append(j, **o), where, file)
+            index, message = _recorded(add, where, file)
         except DesignError:
             raise
         except KinegamiError as error:
             raise _library_error(error, ["joints", i], set(PLACEMENT_KEYS), file) from None
         if index is None:
+            call = "addJoint" if plan.tree else "append"
             raise DesignError(
                 f"infeasible placement of the {type(joint).__name__}: "
-                f"{_reason(message, plan, 'append returned None')}",
+                f"{_reason(message, plan, f'{call} returned None')}",
                 field=where,
                 file=file,
             )
@@ -863,6 +894,36 @@ def _build_from_joints(plan: _Plan, file) -> tuple[KinematicChain, list]:
         sources.extend([None] * (index - len(sources)))
         sources.append(i)
     return chain, sources
+
+
+def _build_from_specification(plan: _Plan, file) -> tuple[KinematicTree, list]:
+    """The tree construction on the plan's joint specification (kinegami.design.trees)."""
+    try:
+        (tree, sources), _ = _recorded(
+            lambda: construct_tree(plan.specification, file),
+            "placement",
+            file,
+            clearance_errors=plan.require_clearance,
+        )
+    except DesignError:
+        raise
+    except KinegamiError as error:
+        raise DesignError(
+            f"the tree construction failed: {error}", field="placement", file=file
+        ) from None
+    if plan.require_clearance:
+        from kinegami.bodies import tree_worst_overlap
+
+        found = tree_worst_overlap(tree.Joints, tree.Links, tree.Parents, tree.r)
+        if found is not None:
+            raise DesignError(
+                f"the tree of the joint specification passes through itself ({found})"
+                f"{_REQUIRED}",
+                field="placement",
+                file=file,
+            )
+        tree.requireClearance = True
+    return tree, list(sources)
 
 
 def _build_from_dh(plan: _Plan, file) -> tuple[KinematicChain, list]:
@@ -919,6 +980,10 @@ def _edit_index(ref, plan: _Plan, sources: list, deleted: dict, where, file) -> 
     )
 
 
+def _noun(chain) -> str:
+    return "tree" if isinstance(chain, KinematicTree) else "chain"
+
+
 def _apply_edits(chain: KinematicChain, plan: _Plan, file, sources: list) -> None:
     deleted: dict[int, int] = {}  # entry of "joints" -> the edit that deleted it
     for i, (op, args, kwargs) in enumerate(plan.edits):
@@ -938,14 +1003,16 @@ def _apply_edits(chain: KinematicChain, plan: _Plan, file, sources: list) -> Non
         except JointIndexError:
             n = len(chain)
             raise DesignError(
-                f"no such joint: the chain has {n} joints at this edit (indices {-n} to {n - 1})",
+                f"no such joint: the {_noun(chain)} has {n} joints at this edit (indices {-n} to "
+                f"{n - 1})",
                 field=json_path([*where, "joint"]), value=args[0], file=file,
             ) from None  # fmt: skip
         except KinegamiError as error:
             raise _library_error(error, where, set(_ARGUMENTS[op]), file) from None
         if not ok:
             raise DesignError(
-                f"infeasible edit {op}: {_reason(message, plan, 'the chain rejected it')}",
+                f"infeasible edit {op}: "
+                f"{_reason(message, plan, f'the {_noun(chain)} rejected it')}",
                 field=json_path(where),
                 file=file,
             )
@@ -971,7 +1038,7 @@ def _apply_states(chain: KinematicChain, plan: _Plan, file) -> None:
     if len(states) != len(joints):
         kinds = ", ".join(type(j).__name__ for j in joints)
         raise DesignError(
-            f"must have one state per joint of the chain after the edits: {len(joints)} "
+            f"must have one state per joint of the {_noun(chain)} after the edits: {len(joints)} "
             f"({kinds}; safe placement adds waypoints); it has {len(states)}",
             field="states",
             value=states,
@@ -996,16 +1063,19 @@ def _apply_states(chain: KinematicChain, plan: _Plan, file) -> None:
     ok, message = _recorded(lambda: chain.setJointStates(values), "states", file)
     if not ok:  # ranges were checked above: the chain requires clearance
         raise DesignError(
-            f"infeasible states: {_reason(message, plan, 'the chain rejected them')}",
+            f"infeasible states: {_reason(message, plan, f'the {_noun(chain)} rejected them')}",
             field="states",
             file=file,
         )
 
 
-def build_plan(plan: _Plan, file=None) -> tuple[KinematicChain, DesignOrigin]:
-    """Execute a plan of :func:`check_document`; the chain and where its joints came from."""
+def build_plan(plan: _Plan, file=None) -> tuple[KinematicChain | KinematicTree, DesignOrigin]:
+    """Execute a plan of :func:`check_document`; the chain (or tree) and where its joints came
+    from."""
     if plan.dh is not None:
         chain, sources = _build_from_dh(plan, file)
+    elif plan.specification is not None:
+        chain, sources = _build_from_specification(plan, file)
     else:
         chain, sources = _build_from_joints(plan, file)
     _apply_edits(chain, plan, file, sources)
@@ -1022,6 +1092,6 @@ def build_plan(plan: _Plan, file=None) -> tuple[KinematicChain, DesignOrigin]:
     return chain, origin
 
 
-def build_chain(plan: _Plan, file=None) -> KinematicChain:
+def build_chain(plan: _Plan, file=None) -> KinematicChain | KinematicTree:
     """Execute a plan of :func:`check_document`: place, edit, set states."""
     return build_plan(plan, file)[0]

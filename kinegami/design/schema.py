@@ -47,6 +47,8 @@ EDIT_OPS = (
     "setJointState",
 )
 PLACEMENT_KEYS = ("relative", "safe", "fixedPosition", "fixedOrientation")
+#: Keys the root joint cannot have (it is placed by its global pose and has no parent).
+ROOT_FORBIDDEN = (*PLACEMENT_KEYS, "parent")
 
 #: Valid ranges of numeric fields as the messages state them (radians / degrees for angles).
 _LENGTH = "> 0 and <= 1e6 r (1e6 times the tube radius)"
@@ -109,6 +111,21 @@ _PRIORITY = {
 }
 
 
+#: What a joint's ``parent`` may be.
+_PARENT_TEXT = (
+    "must be the joint this one is added to: the index of an earlier entry of 'joints' (an "
+    "integer from 0) or its name (a string); a design has one root, joints[0], so a later "
+    "joint cannot be a root (leave 'parent' out to follow the previous entry)"
+)
+
+
+def _version_2_field(document) -> str:
+    for key in ("structure", "placement"):
+        if isinstance(document, dict) and key in document:
+            return f"'{key}' (a field of version 2)"
+    return "a field of version 2"
+
+
 @functools.cache
 def design_schema() -> dict:
     """The JSON Schema (draft 2020-12) of design files, as a dict (shipped as schema.json)."""
@@ -125,6 +142,11 @@ def _validator() -> jsonschema.Draft202012Validator:
 #: full check validates their items; their caps are checked without jsonschema, whose
 #: messages contain the whole list).
 _SIZE_KEYWORDS = ("type", "minItems")
+
+
+#: Top-level keywords of the schema the top-level check leaves out (``dependentSchemas``: the
+#: version-2 fields, which :func:`kinegami.design.trees.check_version_features` checks).
+_NOT_TOP_LEVEL = ("properties", "then", "else", "dependentSchemas")
 
 
 @functools.cache
@@ -149,7 +171,7 @@ def _top_level_validator() -> jsonschema.Draft202012Validator:
         for units, name in (("deg", "angleRangesDeg"), ("rad", "angleRangesRad"))
     }
     top = {
-        **{k: v for k, v in full.items() if k not in ("properties", "then", "else", "$defs")},
+        **{k: v for k, v in full.items() if k not in _NOT_TOP_LEVEL},
         "properties": properties,
         "then": angle["deg"],
         "else": angle["rad"],
@@ -270,6 +292,8 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
             return fail(
                 "must be a joint index (an integer) or a joint name (a string)", value=value
             )
+        if name == "parent" and len(path) == 3 and path[0] == "joints":
+            return fail(_PARENT_TEXT, value=value)
         kinds = expected if isinstance(expected, list) else [expected]
         what = " or ".join(_TYPE_NAMES.get(k, k) for k in kinds)
         text = _range_text(name, document) if set(kinds) & {"number", "integer"} else None
@@ -284,13 +308,19 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
         if name == "op":
             known = ", ".join(EDIT_OPS)
             return fail(f"unknown edit op {shown(value)}; known: {known}", value=value)
+        if path == ["version"]:
+            return fail("unsupported version; supported versions: 1, 2", value=value)
         return fail(f"must be one of {_quoted(expected)}", value=value)
     if keyword == "const":
         if path == ["format"]:
             return fail("not a kinegami design: format must be 'kinegami-design'", value=value)
-        if path == ["version"]:
-            return fail("unsupported version; supported versions: 1", value=value)
+        if path == ["version"] and error.validator_value == 2:  # a field of version 2
+            return fail(f"{_version_2_field(document)} needs \"version\": 2", value=value)
+        if path == ["placement", "method"]:
+            return fail(f"unknown placement method {shown(value)}; known: wafr2024", value=value)
         return fail(f"must be {format_value(expected)}", value=value)
+    if keyword == "minimum" and name == "parent":
+        return fail(_PARENT_TEXT, value=value)
     if keyword in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum", "multipleOf"):
         text = _range_text(name, document, error.schema)
         if text is None:
@@ -324,8 +354,8 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
     if keyword == "additionalProperties":
         allowed = list(error.schema.get("properties", {}))
         if path and path[0] == "joints" and len(path) == 2 and path[1] == 0:
-            allowed = [k for k in allowed if k not in PLACEMENT_KEYS]
-        unknown = [k for k in value if k not in allowed and k not in PLACEMENT_KEYS]
+            allowed = [k for k in allowed if k not in ROOT_FORBIDDEN]
+        unknown = [k for k in value if k not in allowed and k not in ROOT_FORBIDDEN]
         unknown = unknown or [k for k in value if k not in error.schema.get("properties", {})]
         listed = ", ".join(allowed)
         if len(unknown) == 1:
@@ -339,6 +369,12 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
         names += f", ... ({len(unknown)} keys)" if len(unknown) > 5 else ""
         return fail(f"unknown keys {names}; allowed keys: {listed}")
     if keyword == "propertyNames" or "propertyNames" in error.absolute_schema_path:
+        if value == "parent":
+            return fail(
+                "the root joint (joints[0]) cannot have a 'parent': a design has one root, "
+                "and every later joint has a parent (default: the previous entry)",
+                json_path([*path, value]),
+            )
         return fail(
             f"the root joint cannot have '{value}': its pose is global and "
             f"{', '.join(PLACEMENT_KEYS)} apply only to the joints appended after it",
@@ -351,7 +387,7 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
         if "joints" in value and "dh" in value:
             return fail("give exactly one of 'joints' and 'dh', not both")
         return fail("missing required field: one of 'joints' (a list) or 'dh' (a DH table)")
-    if keyword == "minLength" and name == "joint":
+    if keyword == "minLength" and name in ("joint", "parent"):
         return fail("a joint name must not be empty", value=value)
     if keyword == "pattern" and name == "jointTypes":
         return fail('must be a string of the letters R and P (e.g. "RRP")', value=value)

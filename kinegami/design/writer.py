@@ -1,4 +1,4 @@
-"""Writing chains as design files: exact 4x4 poses of the state-0 chain, plus the states.
+"""Writing chains and trees as design files: exact 4x4 poses at state 0, plus the states.
 
 Every joint is written with its own parameters and its Pose at state 0 (full precision; float
 ``repr`` round-trips exactly), and every non-root joint with ``relative: false, safe: false,
@@ -7,7 +7,10 @@ Non-zero states go to ``"states"``; loading builds the chain at state 0 and then
 A chain whose root is an EndTip (possible after deleting joint 0) is written as a waypoint
 root, the tip, and an edit deleting the waypoint. Joint names are kept for a chain loaded from a
 design (see :func:`kinegami.design.reader.origin_of`). A chain with ``requireClearance`` is
-written with ``"requireClearance": true``.
+written with ``"requireClearance": true``. A chain is written as version 1, exactly as before
+trees existed; a :class:`~kinegami.tree.KinematicTree` as version 2 with ``"structure": "tree"``
+and every non-root joint's ``"parent"`` (its name when it has one, else its index), so that
+loading gives a tree again, whatever its shape.
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ import os
 from pathlib import Path
 
 from kinegami._atomic import write_atomic
-from kinegami.bodies import worst_overlap
+from kinegami.bodies import tree_worst_overlap, worst_overlap
 from kinegami.chain import KinematicChain
 from kinegami.design.errors import DesignError
 from kinegami.design.reader import FORMAT, UNITS, check_document, origin_of
@@ -32,6 +35,7 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
+from kinegami.tree import KinematicTree
 from kinegami.validation import check_twist_portion
 
 __all__ = ["design_to_dict", "dumps_design", "save_design"]
@@ -76,8 +80,14 @@ def _matrix(T) -> list[list[float]]:
     return [[float(v) for v in row] for row in T]
 
 
+def _overlap(assembly):
+    if isinstance(assembly, KinematicTree):
+        return tree_worst_overlap(assembly.Joints, assembly.Links, assembly.Parents, assembly.r)
+    return worst_overlap(assembly.Joints, assembly.Links, assembly.r)
+
+
 def design_to_dict(
-    chain: KinematicChain,
+    chain: KinematicChain | KinematicTree,
     *,
     name: str | None = None,
     description: str | None = None,
@@ -88,7 +98,8 @@ def design_to_dict(
 
     Parameters
     ----------
-    chain : the chain (any edits and states).
+    chain : the chain or tree (any edits and states). A tree is written as version 2, with
+        ``"structure": "tree"`` and the parent of every joint.
     name, description : optional texts stored in the file.
     units : the length unit of the chain ("mm", "cm", "m" or "in"); metadata for exporters.
     twistPortion : stored for the crease pattern when given (in [0, 1)).
@@ -101,8 +112,11 @@ def design_to_dict(
     whose joints have names, each joint keeps its ``"name"`` (as long as the chain's joints
     still have the types they were loaded with; waypoints added by placement have none).
     """
-    if not isinstance(chain, KinematicChain):
-        raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
+    if not isinstance(chain, KinematicChain | KinematicTree):
+        raise InvalidTypeError(
+            f"chain must be a KinematicChain or a KinematicTree, got {type(chain).__name__}"
+        )
+    tree = isinstance(chain, KinematicTree)
     for key, text in (("name", name), ("description", description)):
         if text is not None and not isinstance(text, str):
             raise InvalidTypeError(f"{key} must be a string or None, got {text!r}")
@@ -121,14 +135,15 @@ def design_to_dict(
             raise InvalidParameterError("cannot return the chain to state 0")
     if chain.requireClearance:  # loading builds the chain at state 0, then sets the states
         for where, built in (("at state 0", rest), ("at its states", chain)):
-            found = worst_overlap(built.Joints, built.Links, built.r)
+            found = _overlap(built)
             if found is not None:
+                noun = "tree" if tree else "chain"
                 raise InvalidParameterError(
-                    "a chain with requireClearance cannot be saved when it passes through "
+                    f"a {noun} with requireClearance cannot be saved when it passes through "
                     f"itself {where} ({found}): loading it would fail; set requireClearance "
                     "to False or move it clear"
                 )
-    document = {"format": FORMAT, "version": 1}
+    document = {"format": FORMAT, "version": 2 if tree else 1}
     if name is not None:
         document["name"] = name
     if description is not None:
@@ -144,21 +159,27 @@ def design_to_dict(
         document["requireClearance"] = True
     if twistPortion is not None:
         document["twistPortion"] = check_twist_portion(twistPortion)
+    if tree:
+        document["structure"] = "tree"
+    # Deleting joint 0 can leave an EndTip as root, which nothing can start with: then a
+    # waypoint at the tip's proximal frame is written as root, and an edit deletes it again.
+    shift = 1 if isinstance(rest.Joints[0], EndTip) else 0
+    parents = rest.Parents
     joints = []
     for i, joint in enumerate(rest.Joints):
         entry = _joint_parameters(joint)
+        head = {"type": entry.pop("type")}
         if names[i] is not None:
-            entry = {"type": entry.pop("type"), "name": names[i], **entry}
-        if i > 0:
+            head["name"] = names[i]
+        if tree and i + shift > 0:
+            p = parents[i]
+            head["parent"] = 0 if p < 0 else names[p] if names[p] is not None else p + shift
+        entry = {**head, **entry}
+        if i + shift > 0:
             entry.update(_FIXED)
         entry["pose"] = _matrix(joint.pose_matrix)
         joints.append(entry)
-    if isinstance(rest.Joints[0], EndTip):
-        # Deleting joint 0 can leave an EndTip as root, which no chain can start with: write
-        # a waypoint at the tip's proximal frame as root and delete it again.
-        tip = joints[0]
-        pose = tip.pop("pose")
-        tip.update(_FIXED, pose=pose)
+    if shift:
         T = rest.Joints[0].proximal_frame()
         joints.insert(0, {"type": "Waypoint", "pathIndex": 2, "pose": _matrix(T)})
         document["joints"] = joints
@@ -192,7 +213,7 @@ def dumps_design(document: dict) -> str:
 
 
 def save_design(
-    chain: KinematicChain,
+    chain: KinematicChain | KinematicTree,
     path: str | os.PathLike,
     *,
     name: str | None = None,
@@ -200,7 +221,8 @@ def save_design(
     units: str = "mm",
     twistPortion: float | None = None,
 ) -> Path:
-    """Write ``chain`` to the design file ``path`` (suffix .json) atomically; return the path.
+    """Write ``chain`` (a chain or a tree) to the design file ``path`` (suffix .json)
+    atomically; return the path.
 
     See :func:`design_to_dict` for the content. The document is checked against the format
     before it is written, and a failed write leaves no file and an existing one as it was

@@ -159,9 +159,9 @@ SCHEMA_CASES = {
         ["root joint cannot have 'relative'"],
     ),
     "flag not boolean": (_joint(1, "safe", "no"), "joints[1].safe", '"no"', ["true or false"]),
-    "version 2": (_set("version", 2), "version", "2", ["supported versions: 1"]),
-    "version true": (_set("version", True), "version", "true", ["supported versions: 1"]),
-    "missing version": (_drop("version"), "version", None, ["supported versions: 1"]),
+    "version 3": (_set("version", 3), "version", "3", ["supported versions: 1, 2"]),
+    "version true": (_set("version", True), "version", "true", ["supported versions: 1, 2"]),
+    "missing version": (_drop("version"), "version", None, ["supported versions: 1, 2"]),
     "format": (
         _set("format", "kinegami"),
         "format",

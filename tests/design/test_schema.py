@@ -38,35 +38,36 @@ def test_schema_and_loader_agree_on_names():
     assert tuple(defs["edit"]["properties"]["op"]["enum"]) == EDIT_OPS
     for kind in JOINT_TYPES:
         properties = defs[kind]["properties"]
-        assert {"type", "name", "pose", *PLACEMENT_KEYS} <= set(properties)
+        assert {"type", "name", "pose", "parent", *PLACEMENT_KEYS} <= set(properties)
     top = design.design_schema()["properties"]
     assert set(top) == {
         "format", "version", "name", "description", "units", "angleUnits", "numSides", "r",
         "maxAnglePerElbow", "twistPortion", "joints", "dh", "edits", "states", "requireClearance",
+        "structure", "placement",
     }  # fmt: skip
+    assert top["version"]["enum"] == list(design.VERSIONS)
     assert top["units"]["enum"] == list(design.UNITS)
 
 
 def test_public_functions():
+    either = "KinematicChain | KinematicTree"
     signatures = {
-        "load_design": "(path: 'str | os.PathLike') -> 'KinematicChain'",
-        "loads_design": (
-            "(text: 'str', file: 'str | os.PathLike | None' = None) -> 'KinematicChain'"
-        ),
+        "load_design": f"(path: 'str | os.PathLike') -> '{either}'",
+        "loads_design": f"(text: 'str', file: 'str | os.PathLike | None' = None) -> '{either}'",
         "chain_from_dict": (
-            "(data: 'dict', file: 'str | os.PathLike | None' = None) -> 'KinematicChain'"
+            f"(data: 'dict', file: 'str | os.PathLike | None' = None) -> '{either}'"
         ),
         "read_design": "(path: 'str | os.PathLike') -> 'dict'",
         "validate_design": "(path: 'str | os.PathLike') -> 'None'",
         "load_design_with_info": (
-            "(path: 'str | os.PathLike') -> 'tuple[KinematicChain, DesignInfo]'"
+            f"(path: 'str | os.PathLike') -> 'tuple[{either}, DesignInfo]'"
         ),
         "check_pattern": (
-            "(chain: 'KinematicChain', info: 'DesignInfo | None' = None, "
+            f"(chain: '{either}', info: 'DesignInfo | None' = None, "
             "file: 'str | os.PathLike | None' = None) -> 'TubularPattern'"
         ),
         "joint_table": (
-            "(chain: 'KinematicChain', document: 'dict') -> 'list[tuple[int, str, str | None]]'"
+            f"(chain: '{either}', document: 'dict') -> 'list[tuple[int, str, str | None]]'"
         ),
         "origin_of": "(chain: 'KinematicChain') -> 'DesignOrigin | None'",
     }
