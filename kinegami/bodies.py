@@ -850,73 +850,53 @@ def tree_pair_distances(
     if i.size == 0:
         return None
 
-    def ancestors(k: int) -> list[int]:
-        path = []
-        while k >= 0:
-            path.append(k)
-            k = parents[k]
-        return path
-
-    lineage = {}
-
-    def lca(x: int, y: int) -> int:
-        if x not in lineage:
-            lineage[x] = ancestors(x)
-        if y not in lineage:
-            lineage[y] = ancestors(y)
-        ys = set(lineage[y])
-        for z in lineage[x]:
-            if z in ys:
-                return z
-        return -1  # pragma: no cover - every node descends from the root
-
-    tested = np.zeros(i.size, dtype=bool)
-    clip_i = np.zeros(i.size)  # distance along a junction link from which a part counts
-    clip_j = np.zeros(i.size)
-    junction_pair = np.zeros(i.size, dtype=bool)
-    via: dict[int, tuple[int, int]] = {}
-    for q in range(i.size):
-        x, y = int(node[i[q]]), int(node[j[q]])
-        c = lca(x, y)
-        if c == x or c == y:  # one path from the root: the chain rule
-            lo, hi = (i[q], j[q]) if tau[i[q]] <= tau[j[q]] else (j[q], i[q])
-            tested[q] = tau[hi] - tau[lo] >= math.pi - TURN_TOLERANCE
-            continue
-        tested[q] = True
-        # the two children of c the parts descend from
-        cx = lineage[x][lineage[x].index(c) - 1]
-        cy = lineage[y][lineage[y].index(c) - 1]
-        if (is_link[i[q]] and is_link[j[q]] and branch_of.get(x) == cx
-                and branch_of.get(y) == cy):  # fmt: skip
-            junction_pair[q] = True
-            clip_i[q], clip_j[q] = extent[cx], extent[cy]
-            via[q] = (cx, cy)
-    kept = np.flatnonzero(tested)
-    i, j = i[kept], j[kept]
-    junction_pair, clip_i, clip_j = junction_pair[kept], clip_i[kept], clip_j[kept]
-    via = {new: via[old] for new, old in enumerate(kept) if old in via}
+    # one path from the root (one node an ancestor of the other): the chain rule; different
+    # branches: always, but two parts of the tubes leaving one branching joint only beyond
+    # the junction
+    ancestor = np.zeros((n, n), dtype=bool)  # ancestor[x, y]: y is x or an ancestor of x
+    for x in range(n):
+        ancestor[x, x] = True
+        if parents[x] >= 0:
+            ancestor[x] |= ancestor[parents[x]]
+    nx, ny = node[i], node[j]
+    same_path = ancestor[nx, ny] | ancestor[ny, nx]
+    tested = ~same_path | (np.abs(tau[j] - tau[i]) >= math.pi - TURN_TOLERANCE)
+    i, j, nx, ny, same_path = i[tested], j[tested], nx[tested], ny[tested], same_path[tested]
     if i.size == 0:
         return None
+    top = np.full(n, -1, dtype=np.int64)  # the child of a branching joint a node continues
+    for m, k in branch_of.items():
+        top[m] = k
+    parent_of_top = np.where(top >= 0, parent_of[np.maximum(top, 0)], -2)
+    junction = (~same_path & is_link[i] & is_link[j] & (top[nx] >= 0) & (top[ny] >= 0)
+                & (parent_of_top[nx] == parent_of_top[ny]))  # fmt: skip
     dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
-    for q in np.flatnonzero(junction_pair):
-        # both parts inside the junction do not count: the distance of the rest
-        cx, cy = via[int(q)]
-        best = (math.inf, 0.0, 0.0)
-        for (p0, p1, e0, line), (o0, o1) in (
-            ((a[i[q]], b[i[q]], clip_i[q], polylines[cx]), (a[j[q]], b[j[q]])),
-            ((a[j[q]], b[j[q]], clip_j[q], polylines[cy]), (a[i[q]], b[i[q]])),
-        ):
-            d0, d1 = _polyline_distance(np.array([p0, p1]), line)
-            if max(d0, d1) <= e0:
-                continue
-            u = 0.0 if d1 == d0 else min(max((e0 - d0) / (d1 - d0), 0.0), 1.0)
-            if d1 < d0:
-                q0, q1 = p0, p0 + u * (p1 - p0)
-            else:
-                q0, q1 = p0 + u * (p1 - p0), p1
-            dd, _, _ = segment_distances(q0[None], q1[None], o0[None], o1[None])
-            best = min(best, (float(dd[0]), 0.0, 0.0))
-        dist[q] = best[0]
+    q = np.flatnonzero(junction)
+    if q.size:
+        # distances along each branch of the end points of its rows, once per row
+        along = np.full((S, 2), np.nan)
+        for k, line in polylines.items():
+            rows_k = np.flatnonzero((top[node] == k) & is_link)
+            if rows_k.size:
+                ends = np.concatenate([a[rows_k], b[rows_k]])
+                d = _polyline_distance(ends, line)
+                along[rows_k, 0], along[rows_k, 1] = d[: rows_k.size], d[rows_k.size :]
+        rest = np.full(q.size, np.inf)
+        # the part of one row beyond its junction, against the whole other row (both ways)
+        for mine, other in ((i[q], j[q]), (j[q], i[q])):
+            e = extent[top[node[mine]]]
+            d0, d1 = along[mine, 0], along[mine, 1]
+            beyond = np.maximum(d0, d1) > e
+            span = d1 - d0
+            u = np.clip(np.where(span != 0.0, (e - d0) / np.where(span != 0.0, span, 1.0), 0.0),
+                        0.0, 1.0)  # fmt: skip
+            p0, p1 = a[mine], b[mine]
+            cut = p0 + u[:, None] * (p1 - p0)
+            lo = np.where((d1 < d0)[:, None], p0, cut)
+            hi = np.where((d1 < d0)[:, None], cut, p1)
+            dd, _, _ = segment_distances(lo, hi, a[other], b[other])
+            rest = np.minimum(rest, np.where(beyond, dd, np.inf))
+        dist[q] = rest
     return i, j, dist, s, t, rows, a, b
 
 

@@ -22,17 +22,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinegami.bodies import worst_overlap
+from kinegami.bodies import tree_worst_overlap, worst_overlap
 from kinegami.chain import KinematicChain, PlacementWarning
 from kinegami.errors import (
     ClearanceWarning,
     CompactionError,
     InvalidParameterError,
     InvalidTypeError,
+    NoPathError,
 )
 from kinegami.geometry.csc import csc_lengths
 from kinegami.geometry.frames import rotation_about_line
 from kinegami.joints import Waypoint
+from kinegami.tree import KinematicTree
 from kinegami.validation import check_bool, check_int, check_positive
 
 __all__ = ["compact", "CompactionError", "shorten_by_axis_translations", "tube_length"]
@@ -47,10 +49,26 @@ def _objective(chain: KinematicChain, kind: str) -> float:
     return chain.boundingBall.r if kind == "ball" else tube_length(chain)
 
 
-def _overlap(chain: KinematicChain) -> float:
+def _worst(chain: KinematicChain | KinematicTree):
+    """The deepest overlap of a chain or a tree (an Overlap), or None when it is clear."""
+    if isinstance(chain, KinematicTree):
+        return tree_worst_overlap(chain.Joints, chain.Links, chain.Parents, chain.r)
+    return worst_overlap(chain.Joints, chain.Links, chain.r)
+
+
+def _overlap(chain: KinematicChain | KinematicTree) -> float:
     """Depth of the deepest overlap (0 when the chain is clear)."""
-    found = worst_overlap(chain.Joints, chain.Links, chain.r)
+    found = _worst(chain)
     return 0.0 if found is None else -found.clearance
+
+
+def _neighbours(chain, j: int) -> list[int]:
+    """The joints joined to joint j by a link: the one before and after it in a chain; the
+    parent and the children in a tree."""
+    if isinstance(chain, KinematicTree):
+        parent = chain.Parents[j]
+        return ([parent] if parent >= 0 else []) + list(chain.Children[j])
+    return [k for k in (j - 1, j + 1) if 0 <= k < len(chain.Joints)]
 
 
 @dataclass
@@ -104,11 +122,7 @@ def _moves(chain: KinematicChain, j: int, slide: float, roll: float, rolls: bool
     p, z = T[:3, 3], T[:3, 2]
     out = [("translateJointAlongAxisOfMotion", j, slide, False),
            ("translateJointAlongAxisOfMotion", j, -slide, False)]  # fmt: skip
-    targets = []
-    if j > 0:
-        targets.append(float((joints[j - 1].pose_matrix[:3, 3] - p) @ z))
-    if j + 1 < len(joints):
-        targets.append(float((joints[j + 1].pose_matrix[:3, 3] - p) @ z))
+    targets = [float((joints[k].pose_matrix[:3, 3] - p) @ z) for k in _neighbours(chain, j)]
     if len(targets) == 2:
         targets.append(0.5 * (targets[0] + targets[1]))
     for t in targets:
@@ -157,6 +171,8 @@ def _descend(
                 break
             if not isinstance(state.chain.Joints[j], Waypoint):
                 continue
+            if isinstance(state.chain, KinematicTree) and len(state.chain.Children[j]) > 1:
+                continue  # a branching waypoint holds its children's junction
             trial, overlap = _trial(state.chain, "delete", j, clear_only=state.overlap == 0.0)
             new = None if trial is None else _evaluate(trial, overlap, kind, state, tol)
             if new is not None:
@@ -214,15 +230,17 @@ class _Layers:
     """Candidate poses of every joint (slide t, roll theta from the joint's pose) and the CSC
     length of every candidate link."""
 
-    def __init__(self, chain: KinematicChain, joints: list, options: list, restarts: bool):
+    def __init__(self, chain, joints: list, options: list, restarts: bool, parents=None):
         self.r = chain.r
         self.max_angle = chain.maxAnglePerElbow
         self.base = joints
+        self.parents = parents  # None: a chain; else the parent of every joint (a tree)
         self.options = options  # per joint: (K, 2) array of (t, theta)
         self.joints = [[self._pose(j, t, th) for t, th in opts] for j, opts in enumerate(options)]
-        self.costs = []
+        self.costs = []  # chain: link j -> j + 1; tree: link parents[c] -> c at index c - 1
         for j in range(len(joints) - 1):
-            A, B = self.joints[j], self.joints[j + 1]
+            a, b = (j, j + 1) if parents is None else (parents[j + 1], j + 1)
+            A, B = self.joints[a], self.joints[b]
             Fa = np.array([c.distal_dubins_frame() for c in A])
             Fb = np.array([c.proximal_dubins_frame() for c in B])
             nA, nB = len(A), len(B)
@@ -245,6 +263,8 @@ class _Layers:
     def shortest(self, bans: set) -> tuple[float, list[int]]:
         """The shortest choice of one candidate per joint avoiding the banned (joint,
         candidate) pairs (Viterbi; ties go to the lower index)."""
+        if self.parents is not None:
+            return self._shortest_tree(bans)
         best = np.zeros(len(self.joints[0]))
         for bj, bc in bans:
             if bj == 0:
@@ -265,9 +285,36 @@ class _Layers:
             choice.append(int(k[choice[-1]]))
         return total, choice[::-1]
 
-    def build(self, choice: list[int], require: bool) -> tuple[KinematicChain | None, int]:
-        """The chain of the chosen candidates (compact placement at exactly those poses), or
-        (None, j) when the link into joint j cannot be built."""
+    def _shortest_tree(self, bans: set) -> tuple[float, list[int]]:
+        """:meth:`shortest` on a tree: each subtree's best cost per candidate of its root,
+        from the leaves up (children have larger indices than their parents)."""
+        parents = self.parents
+        best = [np.zeros(len(candidates)) for candidates in self.joints]
+        for bj, bc in bans:
+            best[bj][bc] = np.inf
+        back: dict[int, np.ndarray] = {}
+        for c in range(len(self.joints) - 1, 0, -1):
+            C = self.costs[c - 1] + best[c][None, :]
+            k = np.argmin(C, axis=1)
+            back[c] = k
+            best[parents[c]] = best[parents[c]] + C[np.arange(C.shape[0]), k]
+        root = int(np.argmin(best[0]))
+        choice = [root]
+        for c in range(1, len(self.joints)):
+            choice.append(int(back[c][choice[parents[c]]]))
+        return float(best[0][root]), choice
+
+    def build(self, choice: list[int], require: bool):
+        """The chain (or tree) of the chosen candidates (exactly those poses), or (None, j)
+        when the link into joint j cannot be built."""
+        if self.parents is not None:
+            chosen = [self.joints[j][c] for j, c in enumerate(choice)]
+            try:
+                tree = KinematicTree.from_joints(chosen, self.parents, self.max_angle)
+            except NoPathError as error:
+                return None, error.joint
+            tree.requireClearance = require
+            return tree, 0
         chain = KinematicChain(self.joints[0][choice[0]], self.max_angle)
         for j in range(1, len(choice)):
             if chain.append(self.joints[j][choice[j]], False, False, True, True) is None:
@@ -276,16 +323,18 @@ class _Layers:
         return chain, 0
 
 
-def _involved(elements: tuple[int, int], count: int) -> list[int]:
-    """The joints whose candidates decide the two parts' poses."""
+def _involved(elements: tuple[int, int], count: int, parents=None) -> list[int]:
+    """The joints whose candidates decide the two parts' poses (``parents``: of a tree)."""
     out = set()
     for e in elements:
         if e < 0:
             continue
         if e % 2 == 0:
             out.add(e // 2)
-        else:
+        elif parents is None:
             out.update(((e - 1) // 2, (e + 1) // 2))
+        else:
+            out.update((parents[(e + 1) // 2], (e + 1) // 2))
     return sorted(j for j in out if 0 <= j < count)
 
 
@@ -304,15 +353,16 @@ def _clear_choice(layers: _Layers, motion, require: bool, deadline: float | None
             return None
         chain, failed = layers.build(choice, require)
         if chain is None:  # the chain's own solver found no link where the estimate did
-            culprits = [failed - 1, failed]
+            before = failed - 1 if layers.parents is None else layers.parents[failed]
+            culprits = [before, failed]
         else:
-            found = worst_overlap(chain.Joints, chain.Links, chain.r)
+            found = _worst(chain)
             elements = None if found is None else found.elements
             if elements is None and motion is not None:
                 elements = _motion_collision(chain, motion)
             if elements is None:
                 return chain, choice
-            culprits = _involved(elements, len(choice))
+            culprits = _involved(elements, len(choice), layers.parents)
         options = []
         for j in culprits:
             ban = (j, choice[j])
@@ -350,7 +400,9 @@ def _motion_collision(chain: KinematicChain, motion) -> tuple[int, int] | None:
     return max(counts, key=lambda e: (counts[e], e))
 
 
-def _coarse_options(joints: list, r: float, rng: np.random.Generator | None) -> list:
+def _coarse_options(
+    joints: list, r: float, rng: np.random.Generator | None, parents=None
+) -> list:
     """Per joint, the first candidate set: slides around the feet of the common normals with
     its neighbours' axes (and the point itself), times four rolls when rolling matters. With
     ``rng``, the offsets are scaled and the rolls turned at random."""
@@ -362,10 +414,13 @@ def _coarse_options(joints: list, r: float, rng: np.random.Generator | None) -> 
         T = joints[j].pose_matrix
         p, z = T[:3, 3], T[:3, 2]
         feet = []
-        for k in (j - 1, j + 1):
-            if 0 <= k < len(joints):
-                U = joints[k].pose_matrix
-                feet.append(_axis_foot(p, z, U[:3, 3], U[:3, 2]))
+        if parents is None:
+            neighbours = [k for k in (j - 1, j + 1) if 0 <= k < len(joints)]
+        else:
+            neighbours = [k for k in range(len(joints)) if k == parents[j] or parents[k] == j]
+        for k in neighbours:
+            U = joints[k].pose_matrix
+            feet.append(_axis_foot(p, z, U[:3, 3], U[:3, 2]))
         scale = 1.0 if rng is None else float(rng.uniform(0.6, 1.4))
         slides = {0.0}
         for foot in feet:
@@ -405,6 +460,14 @@ def _dp_search(chain: KinematicChain, rng: np.random.Generator | None, motion, d
     The waypoints are dropped; when no clear chain is found without them, they are tried
     where they are.
     """
+    if isinstance(chain, KinematicTree):
+        kept, parents = _without_waypoints(chain)
+        joints = [chain.Joints[k] for k in kept]
+        found = _dp_search_joints(chain, joints, rng, motion, deadline, parents)
+        if found is None and len(joints) < len(chain.Joints):
+            found = _dp_search_joints(chain, list(chain.Joints), rng, motion, deadline,
+                                      list(chain.Parents))  # fmt: skip
+        return found
     joints = [j for i, j in enumerate(chain.Joints) if i == 0 or not isinstance(j, Waypoint)]
     found = _dp_search_joints(chain, joints, rng, motion, deadline)
     if found is None and len(joints) < len(chain.Joints):
@@ -412,11 +475,28 @@ def _dp_search(chain: KinematicChain, rng: np.random.Generator | None, motion, d
     return found
 
 
-def _dp_search_joints(chain: KinematicChain, joints: list, rng, motion, deadline):
+def _without_waypoints(tree: KinematicTree) -> tuple[list[int], list[int]]:
+    """The joints of ``tree`` to keep (the root, every joint that is not a waypoint, and the
+    waypoints where the tree branches) and the parent of each among them."""
+    children = tree.Children
+    kept = [k for k, joint in enumerate(tree.Joints)
+            if k == 0 or not isinstance(joint, Waypoint) or len(children[k]) > 1]  # fmt: skip
+    where = {k: i for i, k in enumerate(kept)}
+    parents = []
+    for k in kept:
+        p = tree.Parents[k]
+        while p >= 0 and p not in where:
+            p = tree.Parents[p]
+        parents.append(where[p] if p >= 0 else -1)
+    return kept, parents
+
+
+def _dp_search_joints(chain, joints: list, rng, motion, deadline, parents=None):
     if len(joints) < 2:
         return None
     require = chain.requireClearance
-    layers = _Layers(chain, joints, _coarse_options(joints, chain.r, rng), restarts=False)
+    layers = _Layers(chain, joints, _coarse_options(joints, chain.r, rng, parents),
+                     restarts=False, parents=parents)  # fmt: skip
     found = _clear_choice(layers, motion, require, deadline)
     if found is None:
         return None
@@ -424,7 +504,8 @@ def _dp_search_joints(chain: KinematicChain, joints: list, rng, motion, deadline
     for level in range(len(_FINE_SLIDES)):
         if deadline is not None and time.monotonic() > deadline:
             break
-        fine = _Layers(chain, joints, _fine_options(layers, choice, level), restarts=False)
+        fine = _Layers(chain, joints, _fine_options(layers, choice, level), restarts=False,
+                       parents=parents)  # fmt: skip
         keep = [0] * len(choice)  # candidate 0 of every layer is the current one
         found = _clear_choice(fine, motion, require, deadline, keep=keep)
         if found is None:
@@ -518,7 +599,7 @@ def _progress_bar(progress, total: int):
 
 
 def compact(
-    chain: KinematicChain,
+    chain: KinematicChain | KinematicTree,
     *,
     seed: int = 0,
     motion: bool = False,
@@ -528,8 +609,8 @@ def compact(
     objective: str = "length",
     starts: int = 4,
     samples: int = 200,
-) -> KinematicChain:
-    """A shorter chain with the same kinematics that does not pass through itself.
+) -> KinematicChain | KinematicTree:
+    """A shorter chain (or tree) with the same kinematics that does not pass through itself.
 
     Every joint keeps its type, parameters and axis line (joints only slide along and roll
     about their axes); waypoints may move, appear or disappear. The result is clear at the
@@ -537,15 +618,17 @@ def compact(
 
     Parameters
     ----------
-    chain : KinematicChain
-        Not changed.
+    chain : KinematicChain or KinematicTree
+        Not changed. For a tree, every link depends on a joint and its parent, so the same
+        search runs from the leaves up (docs/trees.md); waypoints where the tree branches stay
+        (they hold the junction).
     seed : int
         Seed of the search; the result depends only on it (and on ``time_limit``, when the
         limit cuts the search short), not on the executor (up to the last bit of rounding,
         which numpy may do differently in another process).
     motion : bool
         Also require that the fraction of ``samples`` random configurations in which the
-        chain collides is no larger than the input's.
+        chain collides is no larger than the input's (chains only).
     executor : concurrent.futures.Executor, optional
         Runs the starts (default: a local process pool). A Dask cluster works unchanged:
         ``distributed.Client(...).get_executor()``.
@@ -574,10 +657,17 @@ def compact(
     >>> tube_length(shorter) <= tube_length(chain)
     True
     """
-    if not isinstance(chain, KinematicChain):
-        raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
+    if not isinstance(chain, KinematicChain | KinematicTree):
+        raise InvalidTypeError(
+            f"chain must be a KinematicChain or a KinematicTree, got {type(chain).__name__}"
+        )
     seed = check_int("seed", seed)
     motion = check_bool("motion", motion)
+    if motion and isinstance(chain, KinematicTree):
+        raise InvalidParameterError(
+            "motion=True is available for chains only (the range-of-motion sweep does not "
+            "handle trees yet); compact the tree at its current states with motion=False"
+        )
     _check_executor(executor)
     if time_limit is not None:
         time_limit = check_positive("time_limit", time_limit)

@@ -21,9 +21,9 @@ import numpy as np
 
 from kinegami.bodies import link_polyline, tree_worst_overlap
 from kinegami.chain import _PROPAGATE_DEFAULT, RADIAL_VARIANTS, _JointAssembly, _propagate_flag
-from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
+from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
 from kinegami.geometry.frames import rotation_about_line, translation
-from kinegami.joints import Joint, Waypoint, pose_array
+from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube, pose_array
 from kinegami.validation import check_bool, check_real, check_translation
 
 __all__ = ["KinematicTree"]
@@ -62,6 +62,61 @@ class KinematicTree(_JointAssembly):
     ):
         super().__init__(root, maxAnglePerElbow, requireClearance)
         self._parents: list[int] = [-1]
+
+    @classmethod
+    def from_joints(
+        cls,
+        joints: Sequence[Joint],
+        parents: Sequence[int],
+        maxAnglePerElbow: float = np.pi / 2,
+    ) -> KinematicTree:
+        """A tree of ``joints`` at exactly their poses (world coordinates), joint k the child of
+        joint ``parents[k]`` (``parents[0] = -1``, every other parent an earlier joint).
+
+        The same tree as adding them one by one with exact poses, bit for bit, but checked for
+        clearance once (a ClearanceWarning when it passes through itself).
+
+        Raises
+        ------
+        NoPathError
+            When no link reaches joint k; the error's ``joint`` attribute is k.
+        InvalidParameterError, InvalidTypeError
+            For parents that do not describe a tree, or joints of another tube.
+        """
+        joints = list(joints)
+        parents = [int(p) for p in parents] if isinstance(parents, Sequence) else parents
+        if not isinstance(parents, list) or len(parents) != len(joints) or not joints:
+            raise InvalidParameterError(
+                f"parents must have one entry per joint ({len(joints)}), got {parents!r}"
+            )
+        for k, p in enumerate(parents):
+            if (k == 0 and p != -1) or (k > 0 and not 0 <= p < k):
+                raise InvalidParameterError(
+                    f"parents[{k}] must be {'-1 (the root)' if k == 0 else f'in [0, {k - 1}]'}, "
+                    f"got {p}"
+                )
+        tree = cls(joints[0], maxAnglePerElbow)
+        placed, links, ball = [tree._joints[0]], [tree._links[0]], tree._ball
+        for k in range(1, len(joints)):
+            check_same_tube(joints[k], tree.numSides, tree.r)
+            if isinstance(joints[k], StartTip):
+                raise InvalidParameterError(f"joint {k}: a StartTip can only be the root")
+            if isinstance(placed[parents[k]], EndTip):
+                raise InvalidParameterError(
+                    f"joint {k}: its parent {parents[k]} is an EndTip, which nothing can follow"
+                )
+            joint = joints[k]._copy()
+            try:
+                link = tree._link(placed[parents[k]], joint)
+            except NoPathError as error:
+                failure = NoPathError(f"joint {k}: {error}")
+                failure.joint = k
+                raise failure from None
+            ball = tree._merge_link_and_joint(ball, link, joint)
+            placed.append(joint)
+            links.append(link)
+        tree._accept("from_joints", placed, links, ball, parents)
+        return tree
 
     # --- published read-only views -----------------------------------------------------------
     @property
