@@ -772,6 +772,7 @@ class EditorView:
             self._pattern_html = self.gui.add_html("<div>drawing the crease pattern...</div>")
         self._pattern_panel.dock_left()
         self._pattern_panel.set_width(PATTERN_PANEL_WIDTH)
+        self.gui.main_panel.dock_right()  # the 3D view between the two panels, uncovered
 
     @property
     def pattern_html(self) -> str:
