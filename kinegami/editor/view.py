@@ -734,7 +734,12 @@ class EditorView:
         if path is None:
             self._say(f"**Refused:** no gallery design named {stem!r}")
             return False
-        return self._open(Document.load(path), f"opened example {stem}")
+        try:
+            document = Document.load(path)
+        except Exception as error:  # noqa: BLE001 - e.g. a gallery design the editor cannot edit
+            self._say(f"**Refused:** the example {stem!r} cannot be opened here: {error}")
+            return False
+        return self._open(document, f"opened example {stem}")
 
     @_locked
     def upload(self, name: str, content: bytes) -> bool:
