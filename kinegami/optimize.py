@@ -35,6 +35,7 @@ from kinegami.geometry.csc import csc_lengths
 from kinegami.geometry.frames import rotation_about_line
 from kinegami.joints import Waypoint
 from kinegami.tree import KinematicTree
+from kinegami.tree.sheets import junction_problems
 from kinegami.validation import check_bool, check_int, check_positive
 
 __all__ = ["compact", "CompactionError", "shorten_by_axis_translations", "tube_length"]
@@ -235,6 +236,7 @@ class _Layers:
         self.max_angle = chain.maxAnglePerElbow
         self.base = joints
         self.parents = parents  # None: a chain; else the parent of every joint (a tree)
+        self.junctions = False  # trees: also require every junction's sockets to fit
         self.options = options  # per joint: (K, 2) array of (t, theta)
         self.joints = [[self._pose(j, t, th) for t, th in opts] for j, opts in enumerate(options)]
         self.costs = []  # chain: link j -> j + 1; tree: link parents[c] -> c at index c - 1
@@ -345,7 +347,9 @@ def _clear_choice(layers: _Layers, motion, require: bool, deadline: float | None
     """
     bans: set = set()
     protected = set() if keep is None else set(enumerate(keep))
-    for _ in range(_MAX_BANS):
+    # a tree's branches crowd each other and its junctions add a constraint: more bans
+    limit = _MAX_BANS if layers.parents is None else max(_MAX_BANS, 8 * len(layers.joints))
+    for _ in range(limit):
         if deadline is not None and time.monotonic() > deadline:
             return None
         total, choice = layers.shortest(bans)
@@ -360,6 +364,10 @@ def _clear_choice(layers: _Layers, motion, require: bool, deadline: float | None
             elements = None if found is None else found.elements
             if elements is None and motion is not None:
                 elements = _motion_collision(chain, motion)
+            if elements is None and layers.junctions:
+                problems = junction_problems(chain)
+                if problems:  # a socket does not fit: that child must sit elsewhere
+                    elements = (2 * problems[0][0], -1)
             if elements is None:
                 return chain, choice
             culprits = _involved(elements, len(choice), layers.parents)
@@ -454,7 +462,7 @@ def _fine_options(layers: _Layers, choice: list[int], level: int) -> list:
     return options
 
 
-def _dp_search(chain: KinematicChain, rng: np.random.Generator | None, motion, deadline):
+def _dp_search(chain, rng: np.random.Generator | None, motion, deadline, junctions=False):
     """The shortest clear chain the layered search finds from ``chain``'s joints, or None.
 
     The waypoints are dropped; when no clear chain is found without them, they are tried
@@ -463,10 +471,10 @@ def _dp_search(chain: KinematicChain, rng: np.random.Generator | None, motion, d
     if isinstance(chain, KinematicTree):
         kept, parents = _without_waypoints(chain)
         joints = [chain.Joints[k] for k in kept]
-        found = _dp_search_joints(chain, joints, rng, motion, deadline, parents)
+        found = _dp_search_joints(chain, joints, rng, motion, deadline, parents, junctions)
         if found is None and len(joints) < len(chain.Joints):
             found = _dp_search_joints(chain, list(chain.Joints), rng, motion, deadline,
-                                      list(chain.Parents))  # fmt: skip
+                                      list(chain.Parents), junctions)  # fmt: skip
         return found
     joints = [j for i, j in enumerate(chain.Joints) if i == 0 or not isinstance(j, Waypoint)]
     found = _dp_search_joints(chain, joints, rng, motion, deadline)
@@ -491,12 +499,14 @@ def _without_waypoints(tree: KinematicTree) -> tuple[list[int], list[int]]:
     return kept, parents
 
 
-def _dp_search_joints(chain, joints: list, rng, motion, deadline, parents=None):
+def _dp_search_joints(chain, joints: list, rng, motion, deadline, parents=None,
+                      junctions=False):  # fmt: skip
     if len(joints) < 2:
         return None
     require = chain.requireClearance
     layers = _Layers(chain, joints, _coarse_options(joints, chain.r, rng, parents),
                      restarts=False, parents=parents)  # fmt: skip
+    layers.junctions = junctions
     found = _clear_choice(layers, motion, require, deadline)
     if found is None:
         return None
@@ -506,6 +516,7 @@ def _dp_search_joints(chain, joints: list, rng, motion, deadline, parents=None):
             break
         fine = _Layers(chain, joints, _fine_options(layers, choice, level), restarts=False,
                        parents=parents)  # fmt: skip
+        fine.junctions = junctions
         keep = [0] * len(choice)  # candidate 0 of every layer is the current one
         found = _clear_choice(fine, motion, require, deadline, keep=keep)
         if found is None:
@@ -538,7 +549,7 @@ def _colliding_fraction(chain: KinematicChain, movable_states: np.ndarray) -> fl
 def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
     """One start of :func:`compact` (a top-level function, so any executor can run it):
     (objective, overlap, start, chain), chain None when the start found no clear design."""
-    chain, k, seed, kind, deadline_seconds, motion = task
+    chain, k, seed, kind, deadline_seconds, motion, junctions = task
     deadline = None if deadline_seconds is None else time.monotonic() + deadline_seconds
     rng = np.random.default_rng([seed, k])
     # trial builds and edits that fail or collide warn; nobody wants thousands of those. Not a
@@ -546,7 +557,7 @@ def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
     # restores the caller's filters around the whole search; worker processes keep these).
     warnings.filterwarnings("ignore", category=PlacementWarning)
     warnings.filterwarnings("ignore", category=ClearanceWarning)
-    found = _dp_search(chain, None if k == 0 else rng, motion, deadline)
+    found = _dp_search(chain, None if k == 0 else rng, motion, deadline, junctions)
     if kind == "length" and found is not None:
         return tube_length(found), 0.0, k, found
     # the ball (or no clear design found): greedy descent from the shortest design (or the
@@ -609,6 +620,7 @@ def compact(
     objective: str = "length",
     starts: int = 4,
     samples: int = 200,
+    junctions: bool = True,
 ) -> KinematicChain | KinematicTree:
     """A shorter chain (or tree) with the same kinematics that does not pass through itself.
 
@@ -644,11 +656,15 @@ def compact(
         competes too when it is clear.
     samples : int
         Configurations sampled for ``motion`` (>= 1).
+    junctions : bool
+        Trees only: also require that every printed junction can be made, i.e. each branch
+        child's socket fits on its link (:func:`kinegami.tree.sheets.junction_problems`).
 
     Raises
     ------
     CompactionError
-        When the input passes through itself and no start found a clear design.
+        When the input passes through itself (or, for a tree, a socket does not fit) and no
+        start found a design without the problem.
 
     Examples
     --------
@@ -679,16 +695,20 @@ def compact(
     if motion:
         movable_states = _motion_configurations(chain, samples, seed)
         motion_task = (movable_states, _colliding_fraction(chain, movable_states))
-    tasks = [(chain, k, seed, objective, time_limit, motion_task) for k in range(starts)]
+    junctions = isinstance(chain, KinematicTree) and check_bool("junctions", junctions)
+    tasks = [(chain, k, seed, objective, time_limit, motion_task, junctions)
+             for k in range(starts)]  # fmt: skip
     own = executor is None
     if own:
         workers = min(starts, os.cpu_count() or 1)
         executor = concurrent.futures.ProcessPoolExecutor(max_workers=workers)
     with warnings.catch_warnings():  # the caller's filters, back after the search
         results = _run_all(executor, own, tasks, _progress_bar(progress, starts))
-    found = [res for res in results if res[3] is not None and res[1] == 0.0]
-    if _overlap(chain) == 0.0 and (motion_task is None or _motion_collision(chain, motion_task)
-                                   is None):  # fmt: skip
+    found = [res for res in results if res[3] is not None and res[1] == 0.0
+             and not (junctions and junction_problems(res[3]))]  # fmt: skip
+    if (_overlap(chain) == 0.0
+            and (motion_task is None or _motion_collision(chain, motion_task) is None)
+            and not (junctions and junction_problems(chain))):  # fmt: skip
         found.append((_objective(chain, objective), 0.0, starts, copy.copy(chain)))
     if not found:
         raise CompactionError(

@@ -331,6 +331,8 @@ class JunctionSocket:
         its sheet runs through).
     frame : read-only 4x4 frame on the link at ``sheet_start`` (trunk: at ``socket_end``).
     link_length : l(L_c).
+    fits : False when the socket would end past the link (only with ``strict=False``; the
+        socket is then clipped to the link's end).
     """
 
     child: int
@@ -342,6 +344,7 @@ class JunctionSocket:
     sheet_start: float | None
     frame: np.ndarray
     link_length: float
+    fits: bool = True
 
 
 def _check_frame(D, r: float) -> np.ndarray:
@@ -396,6 +399,7 @@ def junction_sockets(
     trunk: int | None = None,
     options: ConnectorOptions | None = None,
     step: float | None = None,
+    strict: bool = True,
 ) -> tuple[JunctionSocket, ...]:
     """The socket of each child: overlaps, socket end, sheet start and its frame.
 
@@ -404,7 +408,8 @@ def junction_sockets(
     socket starts, at the frame :func:`link_frame_at` gives there. Feasible only if
     sigma_c <= l(L_c): otherwise InvalidParameterError (naming the child, sigma_c and the link
     length); slide the child along its axis or re-place it first. The trunk gets no socket: its
-    sleeve ends where its socket would start, and is always feasible.
+    sleeve ends where its socket would start, and is always feasible. With ``strict=False``
+    an infeasible socket is returned with ``fits=False`` (clipped to the link) instead.
 
     Examples
     --------
@@ -436,6 +441,13 @@ def junction_sockets(
             sockets.append(JunctionSocket(k, True, ov, cl, start, start, None, frame, length))
             continue
         end = start + d_s
+        if end > length + 1e-12 * r and not strict:
+            frame = link_frame_at(link, max(length - d_s, 0.0))
+            frame.setflags(write=False)
+            sheet = max(length - d_s, 0.0)
+            sockets.append(JunctionSocket(k, False, ov, cl, start, length, sheet, frame, length,
+                                          False))  # fmt: skip
+            continue
         if end > length + 1e-12 * r:
             rule = "l_clear" if opts.socket_rule == "clear" else "l_ov"
             raise InvalidParameterError(
