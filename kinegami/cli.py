@@ -464,23 +464,30 @@ def cmd_edit(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from kinegami.design import read_design, validate_design
+    from kinegami.design import DesignInfo, read_design, validate_design
 
     validate_design(args.design)
     data = read_design(args.design)
+    tree = DesignInfo.of(data).structure == "tree"
     if args.build:
         from kinegami.design import joint_table
 
         chain, info = _load(args.design)
-        _check_pattern(BuildJob(chain, info))
-        print(f"{args.design}: valid; builds {len(chain.Joints)} joints and the crease pattern")
+        if tree:  # a tree has a crease pattern per sheet, which nothing builds yet
+            print(f"{args.design}: valid; builds a tree of {len(chain.Joints)} joints (its "
+                  "crease patterns are not checked: building trees is not yet supported)")
+        else:
+            _check_pattern(BuildJob(chain, info))
+            print(f"{args.design}: valid; builds {len(chain.Joints)} joints and the crease "
+                  "pattern")
         print("  index  joint (the indices edits and states use)")
         for index, kind, name in joint_table(chain, data):
             label = f" {_printable(name)!r}" if name else ""
-            print(f"  {index:>5}  {kind}{label}")
+            parent = f", parent {chain.Parents[index]}" if tree and index > 0 else ""
+            print(f"  {index:>5}  {kind}{label}{parent}")
         return 0
     if "joints" in data:
-        what = f"{len(data['joints'])} joints"
+        what = f"{len(data['joints'])} joints" + (", a tree" if tree else "")
     else:
         what = f"a DH table of {len(data['dh']['rows'])} rows"
     print(f"{args.design}: valid ({what}; placement not checked, use --build)")

@@ -47,6 +47,7 @@ from kinegami.design.trees import (
     check_tree_fields,
     check_version_features,
     construct_tree,
+    structure_of,
 )
 from kinegami.errors import ClearanceWarning, JointIndexError, KinegamiError
 from kinegami.joints import (
@@ -90,6 +91,8 @@ class DesignInfo:
     units : the length unit of every length in the file (and of the chain): mm, cm, m or in.
     twistPortion : share of each link's straight part given to its twist (crease pattern).
     file : the design file (None for a design given as text or a dict).
+    structure : ``"chain"`` or ``"tree"``: whether the design loads as a KinematicChain or a
+        KinematicTree (version 2).
     """
 
     name: str | None
@@ -97,6 +100,7 @@ class DesignInfo:
     units: str
     twistPortion: float
     file: str | None
+    structure: str = "chain"
 
     @classmethod
     def of(cls, document: dict, file=None) -> DesignInfo:
@@ -107,6 +111,7 @@ class DesignInfo:
             units=document.get("units", "mm"),
             twistPortion=float(document.get("twistPortion", DEFAULT_TWIST_PORTION)),
             file=None if file is None else os.fspath(file),
+            structure=structure_of(document),
         )
 
 
@@ -736,7 +741,8 @@ def _check_document(document, file) -> _Plan:
                 [joint for joint, _ in joints],
                 fields.parents,
                 [spec.get("relative", True) for spec in specs],
-                chain_options.get("maxAnglePerElbow"),
+                names,
+                lambda angle: to_radians(angle, units),
             )
     else:
         dh = _plan_dh(document["dh"], units)
@@ -838,7 +844,9 @@ def _recorded(call, where: str, file, clearance_errors: bool = False):
         elif issubclass(w.category, RuntimeWarning):
             raise DesignError(f"numeric problem: {w.message}", field=where, file=file)
         elif clearance_errors and issubclass(w.category, ClearanceWarning):
-            raise DesignError(f"{w.message}{_REQUIRED}", field=where, file=file)
+            text = str(w.message)
+            required = _REQUIRED.replace("a chain", "a tree") if "the tree" in text else _REQUIRED
+            raise DesignError(f"{text}{required}", field=where, file=file)
         else:  # not ours to swallow
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     return result, (messages[-1] if messages else None)
@@ -854,7 +862,7 @@ def _reason(message: str | None, plan: _Plan, default: str) -> str:
     if not message:
         return default
     if plan.require_clearance and "pass through itself" in message:
-        return message + _REQUIRED
+        return message + (_REQUIRED.replace("a chain", "a tree") if plan.tree else _REQUIRED)
     return message
 
 
@@ -908,8 +916,12 @@ def _build_from_specification(plan: _Plan, file) -> tuple[KinematicTree, list]:
     except DesignError:
         raise
     except KinegamiError as error:
+        message = str(error)
+        field = "placement"
+        if message.startswith("growth_direction") and plan.specification.growth_direction:
+            field = "placement.growthDirection"
         raise DesignError(
-            f"the tree construction failed: {error}", field="placement", file=file
+            f"the tree construction failed: {message}", field=field, file=file
         ) from None
     if plan.require_clearance:
         from kinegami.bodies import tree_worst_overlap
@@ -918,7 +930,7 @@ def _build_from_specification(plan: _Plan, file) -> tuple[KinematicTree, list]:
         if found is not None:
             raise DesignError(
                 f"the tree of the joint specification passes through itself ({found})"
-                f"{_REQUIRED}",
+                f"{_REQUIRED.replace('a chain', 'a tree')}",
                 field="placement",
                 file=file,
             )

@@ -18,14 +18,11 @@ the one place that calls the construction.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-
-import numpy as np
 
 from kinegami.design.errors import DesignError, json_path
 from kinegami.design.poses import _scaled
-from kinegami.joints import Joint, Waypoint
+from kinegami.joints import Joint
 from kinegami.validation import shorten
 
 __all__ = [
@@ -35,6 +32,7 @@ __all__ = [
     "TreeSpecification",
     "check_version_features",
     "check_tree_fields",
+    "structure_of",
     "construct_tree",
     "construction_available",
 ]
@@ -193,6 +191,13 @@ def check_tree_fields(document: dict, file=None) -> TreeFields:
     if tree:
         _check_tree_order(specs, parents, file)
     if specification:
+        _check_growth_direction(document["placement"], file)
+        if "maxAnglePerElbow" in document:
+            raise DesignError(
+                "a joint specification (\"placement\") has no maxAnglePerElbow: the tree "
+                "construction makes its elbows at most pi/10 (18 degrees); leave it out",
+                field="maxAnglePerElbow", value=document["maxAnglePerElbow"], file=file,
+            )  # fmt: skip
         for i, spec in enumerate(specs[1:], start=1):
             for key in _PLACED_BY_CONSTRUCTION:
                 if key in spec:
@@ -202,8 +207,22 @@ def check_tree_fields(document: dict, file=None) -> TreeFields:
                         "('relative' says whether the pose is relative to the parent's)",
                         field=json_path(["joints", i, key]), value=spec[key], file=file,
                     )  # fmt: skip
-        _check_growth_direction(document["placement"], file)
     return TreeFields(tree=tree, parents=tuple(parents), specification=specification)
+
+
+def structure_of(document: dict) -> str:
+    """``"tree"`` or ``"chain"``: what a checked design document loads as."""
+    if "structure" in document:
+        return document["structure"]
+    if "placement" in document:
+        return "tree"
+    specs = document.get("joints", ())
+    names = {spec.get("name"): k for k, spec in enumerate(specs)}  # unique when checked
+    for i, spec in enumerate(specs[1:], start=1):
+        ref = spec.get("parent", i - 1)
+        if (names.get(ref) if isinstance(ref, str) else ref) != i - 1:
+            return "tree"
+    return "chain"
 
 
 def _check_tree_order(specs, parents, file) -> None:
@@ -256,24 +275,30 @@ class TreeSpecification:
         already composed with the parent's specified pose); only type, parameters and the
         axis line (the pose's origin and z axis) bind the construction.
     parents : per joint, the index of its parent in ``joints`` (-1 for the root).
-    growth_direction : the unit vector the tree grows along, or None (the construction
-        chooses).
-    maxAnglePerElbow : the design's ``maxAnglePerElbow`` in radians, or None (the
-        construction's default).
+    names : per joint, its ``name`` in the file, or None.
+    growth_direction : the direction the tree grows along as written (non-zero; the
+        construction normalises it), or None (the construction chooses).
+    extra_roll : the published extra roll after each placement (None: the construction's
+        default, without).
+    sibling_azimuth : the azimuth step in radians between the routes of later siblings (None:
+        the construction's default; 0 gives the published construction).
     """
 
     method: str
     joints: tuple
     parents: tuple
+    names: tuple
     growth_direction: tuple | None = None
-    maxAnglePerElbow: float | None = None
+    extra_roll: bool | None = None
+    sibling_azimuth: float | None = None
 
     @classmethod
     def of(
-        cls, document: dict, joints: list, parents, relative: list, max_angle
+        cls, document: dict, joints: list, parents, relative: list, names, to_radians
     ) -> TreeSpecification:
         """The specification of a checked design: ``joints`` as constructed from the
-        entries (poses as written), ``relative`` per entry."""
+        entries (poses as written), ``relative`` per entry, ``to_radians`` the file's angle
+        unit conversion."""
         placed: list[Joint] = []
         for i, joint in enumerate(joints):
             p = parents[i]
@@ -282,16 +307,17 @@ class TreeSpecification:
             placed.append(joint)
         placement = document["placement"]
         direction = None
-        if "growthDirection" in placement:
-            v = _scaled(placement["growthDirection"])
-            v = v / math.sqrt(float(v @ v))
-            direction = tuple(float(c) for c in v)
+        if "growthDirection" in placement:  # as written: the construction normalises it
+            direction = tuple(float(c) for c in placement["growthDirection"])
+        azimuth = placement.get("siblingAzimuth")
         return cls(
             method=placement["method"],
             joints=tuple(placed),
             parents=tuple(parents),
+            names=tuple(names),
             growth_direction=direction,
-            maxAnglePerElbow=max_angle,
+            extra_roll=placement.get("extraRoll"),
+            sibling_azimuth=None if azimuth is None else to_radians(azimuth),
         )
 
 
@@ -309,70 +335,37 @@ def construct_tree(spec: TreeSpecification, file=None):
 
     Returns ``(tree, sources)``: the KinematicTree and, per joint of the tree, the index of the
     specified joint it places (None for the waypoints the construction adds). Imports the
-    construction on first use; a DesignError at ``placement`` when it is not available.
+    construction on first use; a DesignError at ``placement`` when it is not available. The
+    construction's own errors (a KinegamiError) are the caller's to report.
     """
     try:
         from kinegami.tree import construction
     except ImportError as error:
         raise DesignError(
-            "joint specifications cannot be built yet: the tree construction "
+            "joint specifications cannot be built: the tree construction "
             f"(kinegami.tree.construction) is not available ({error})",
             field="placement", file=file,
         ) from None  # fmt: skip
-    specification = construction.JointSpecificationTree(spec.joints[0])
-    for joint, parent in zip(spec.joints[1:], spec.parents[1:], strict=True):
-        specification.addJoint(parent, joint, relative=False)
+    taken = {name for name in spec.names if name is not None}
+
+    def name_of(i: int) -> str | None:  # the construction's messages name the joints
+        if spec.names[i] is not None:
+            return spec.names[i]
+        label = f"joints[{i}]"
+        return None if label in taken else label
+
+    specification = construction.JointSpecificationTree(spec.joints[0], name_of(0) or "root")
+    for i in range(1, len(spec.joints)):
+        specification.addJoint(spec.parents[i], spec.joints[i], relative=False, name=name_of(i))
     options = {}
     if spec.growth_direction is not None:
-        options["growth_direction"] = np.array(spec.growth_direction)
-    if spec.maxAnglePerElbow is not None:
-        options["maxAnglePerElbow"] = spec.maxAnglePerElbow
+        options["growth_direction"] = spec.growth_direction
+    if spec.extra_roll is not None:
+        options["extra_roll"] = spec.extra_roll
+    if spec.sibling_azimuth is not None:
+        options["sibling_azimuth"] = spec.sibling_azimuth
     tree = construction.from_specification(specification, **options)
-    return tree, _sources(tree, spec)
-
-
-#: A tree joint lies on the axis line of a specified joint within this times max(1, |p|, r).
-_ON_AXIS_TOL = 1e-6
-
-
-def _on_axis(joint: Joint, specified: Joint) -> bool:
-    """Whether ``joint`` has the type of ``specified`` and lies on its axis line."""
-    if type(joint) is not type(specified):
-        return False
-    A, B = joint.pose_matrix, specified.pose_matrix
-    z = B[:3, 2]
-    if float(np.linalg.norm(np.cross(A[:3, 2], z))) > _ON_AXIS_TOL:
-        return False
-    d = A[:3, 3] - B[:3, 3]
-    off = d - float(d @ z) * z
-    scale = max(1.0, float(np.max(np.abs(B[:3, 3]))), joint.r)
-    return float(np.linalg.norm(off)) <= _ON_AXIS_TOL * scale
-
-
-def _sources(tree, spec: TreeSpecification) -> list:
-    """Per joint of the constructed tree, the specified joint it places (None: an added
-    waypoint). Each specified joint is the first joint of its type on its axis line below its
-    parent's joint, reached through added waypoints only."""
-    children = tree.Children
     sources: list = [None] * len(tree.Joints)
-    node_of = {0: 0}
-    sources[0] = 0
-    for j in range(1, len(spec.joints)):
-        start = node_of.get(spec.parents[j])
-        found = None
-        frontier = list(children[start]) if start is not None else []
-        while frontier and found is None:
-            following = []
-            for k in frontier:
-                if sources[k] is not None:
-                    continue
-                if _on_axis(tree.Joints[k], spec.joints[j]):
-                    found = k
-                    break
-                if type(tree.Joints[k]) is Waypoint:
-                    following.extend(children[k])
-            frontier = following
-        if found is not None:
-            node_of[j] = found
-            sources[found] = j
-    return sources
+    for k, node in enumerate(tree.construction.node_of):
+        sources[node] = k
+    return tree, sources

@@ -1,0 +1,156 @@
+"""Versions 1 and 2 of the format: version-1 designs load and save exactly as before version 2
+existed, and version-2 fields in a version-1 file are reported.
+
+The fingerprints (tests/design/data/version1_fingerprints.json) were computed before version 2
+existed, by :func:`fingerprint` on every version-1 design of the gallery and of tests/design/data.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import warnings
+from pathlib import Path
+
+import jsonschema
+import numpy as np
+import pytest
+
+from kinegami import KinematicChain
+from kinegami.design import (
+    DesignError,
+    chain_from_dict,
+    design_schema,
+    design_to_dict,
+    dumps_design,
+    load_design,
+)
+from kinegami.errors import ClearanceWarning
+from kinegami.tree import KinematicTree
+
+from . import DATA
+
+GALLERY = Path(__file__).resolve().parents[2] / "examples" / "designs"
+FINGERPRINTS = json.loads((DATA / "version1_fingerprints.json").read_text(encoding="utf-8"))
+
+
+def _hex(values) -> str:
+    return ",".join(float(v).hex() for v in np.ravel(np.asarray(values, dtype=float)))
+
+
+def fingerprint(assembly, with_class: bool = True) -> str:
+    """SHA-256 of everything a loaded design is made of, bit for bit: its class (unless not
+    ``with_class``), parents, tube, joint types, poses, states, lengths and path axes, link
+    frames and paths, and the ball."""
+    h = hashlib.sha256()
+
+    def put(text: str) -> None:
+        h.update(text.encode())
+        h.update(b";")
+
+    put(type(assembly).__name__ if with_class else "")
+    put(repr(tuple(assembly.Parents)))
+    put(_hex([assembly.r, assembly.maxAnglePerElbow, assembly.numSides]))
+    for joint in assembly.Joints:
+        put(type(joint).__name__)
+        put(_hex(joint.pose_matrix))
+        put(_hex([joint.state, joint.neutralLength, joint.pathIndex()]))
+    for link in assembly.Links:
+        p = link.path
+        put(_hex(link.start_frame))
+        put(_hex(link.end_frame))
+        put(_hex([p.theta1, p.tMag, p.theta2]))
+    ball = assembly.boundingBall
+    put(_hex([*ball.c, ball.r]))
+    return h.hexdigest()
+
+
+def _path(name: str) -> Path:
+    return DATA / name.removeprefix("tests/") if name.startswith("tests/") else GALLERY / name
+
+
+def _quiet_load(path: Path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)  # example 1B's state overlaps
+        return load_design(path)
+
+
+@pytest.mark.parametrize("name", sorted(FINGERPRINTS["loaded"]))
+def test_version_1_designs_load_bit_for_bit_as_before(name):
+    chain = _quiet_load(_path(name))
+    assert type(chain) is KinematicChain
+    assert fingerprint(chain) == FINGERPRINTS["loaded"][name]
+
+
+@pytest.mark.parametrize("name", sorted(FINGERPRINTS["saved"]))
+def test_version_1_designs_save_the_same_text_as_before(name):
+    text = dumps_design(design_to_dict(load_design(GALLERY / name), name="x"))
+    assert hashlib.sha256(text.encode()).hexdigest() == FINGERPRINTS["saved"][name]
+    assert json.loads(text)["version"] == 1 and "structure" not in text
+
+
+def test_every_version_1_gallery_design_is_fingerprinted():
+    ones = [p.name for p in GALLERY.glob("*.json") if json.loads(p.read_text())["version"] == 1]
+    assert sorted(ones) == sorted(FINGERPRINTS["saved"])
+
+
+@pytest.mark.parametrize("name", sorted(FINGERPRINTS["saved"]))
+def test_a_version_1_design_written_as_version_2_is_the_same_chain(name):
+    document = json.loads((GALLERY / name).read_text(encoding="utf-8"))
+    document["version"] = 2
+    chain = chain_from_dict(document)
+    assert type(chain) is KinematicChain
+    assert fingerprint(chain) == FINGERPRINTS["loaded"][name]
+
+
+def _joints_design(name: str) -> dict:
+    document = json.loads((GALLERY / name).read_text(encoding="utf-8"))
+    assert "joints" in document
+    return document
+
+
+def test_a_chain_as_structure_tree_is_the_same_tree_bit_for_bit():
+    """"structure": "tree" loads a chain design as a KinematicTree whose joints and links are
+    the chain's (the tree in which every parent is the previous joint), edits included."""
+    document = _joints_design("example1.json")
+    chain = chain_from_dict(document)
+    tree = chain_from_dict({**document, "version": 2, "structure": "tree"})
+    assert type(tree) is KinematicTree
+    assert tree.Parents == chain.Parents
+    assert fingerprint(tree, with_class=False) == fingerprint(chain, with_class=False)
+
+
+def _v1_with(change) -> dict:
+    document = copy.deepcopy(_joints_design("example1.json"))
+    change(document)
+    return document
+
+
+@pytest.mark.parametrize(
+    ("change", "field", "words"),
+    [
+        (lambda d: d["joints"][2].update(parent=0), "joints[2].parent", "version 2"),
+        (lambda d: d["joints"][2].update(parent="start"), "joints[2].parent", "version 2"),
+        (lambda d: d.update(structure="tree"), "structure", "version 2"),
+        (lambda d: d.update(structure="chain"), "structure", "version 2"),
+        (lambda d: d.update(placement={"method": "wafr2024"}), "placement", "version 2"),
+    ],
+)
+def test_version_2_fields_in_a_version_1_file_are_errors(change, field, words):
+    document = _v1_with(change)
+    with pytest.raises(DesignError) as caught:
+        chain_from_dict(document, "arm.json")
+    error = caught.value
+    assert error.field == field, str(error)
+    assert words in error.reason and '"version": 2' in error.reason
+    assert str(error).startswith(f"arm.json: {field}: ")
+    # an independent validator also refuses it
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.Draft202012Validator(design_schema()).validate(document)
+
+
+def test_version_2_designs_are_valid_for_a_plain_validator():
+    validator = jsonschema.Draft202012Validator(design_schema())
+    for path in (GALLERY / "hand.json", DATA / "algorithmic_hand.json"):
+        validator.validate(json.loads(path.read_text(encoding="utf-8")))
