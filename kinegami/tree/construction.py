@@ -12,11 +12,11 @@ is slid along its axis until it lies beyond a bounding cylinder of everything bu
 1
 >>> spec.addJoint(0, EndTip(4, 1, SE3.Trans(3, 0, 2), 1))
 2
->>> tree = from_specification(spec, growth_direction=(0, 0, 1))
->>> tree.Parents
-(-1, 0, 0, 3, 4)
+>>> tree = from_specification(spec, growth_direction=(1, 0, 1))
+>>> tree.Parents  # the tip comes after two waypoints (nodes 2 and 3)
+(-1, 0, 0, 2, 3)
 >>> tree.construction.node_of
-(0, 1, 5)
+(0, 1, 4)
 """
 
 from __future__ import annotations
@@ -72,10 +72,11 @@ __all__ = [
 JOINT_TREE_FORMAT = "kinegami.joint_tree/1"
 #: Elbow size of the constructed tree (radians).
 MAX_ANGLE_PER_ELBOW = math.pi / 10
-#: Azimuth step (radians) between the routes of successive later siblings of one parent: the
-#: golden angle, so any number of siblings leave in well-spread directions (docs/trees.md).
-#: 0.0 gives the published construction, in which they all leave in almost the same direction.
-SIBLING_AZIMUTH = math.pi * (3.0 - math.sqrt(5.0))
+#: Azimuth step (radians) about n between the routes of successive later siblings of one parent
+#: (docs/trees.md): large enough that two routes leaving the same frame are 2r apart within a
+#: few r, small enough that the waypoints stay near the parent's side of the cylinder. 0.0
+#: gives the published construction, in which the routes run side by side.
+SIBLING_AZIMUTH = 0.5
 #: Smallest |z . n| accepted for a given growth direction (a joint's slide grows as 1/|z . n|).
 MIN_GROWTH_DOT = 1e-6
 #: Number of points of the Fibonacci lattice searched for the growth direction.
@@ -749,8 +750,9 @@ def from_specification(
         which keeps every revolute joint's path direction as close to n as its axis allows and
         gives shorter trees).
     sibling_azimuth : the azimuth step (radians) about n between the routes of successive later
-        siblings of one parent (default the golden angle, SIBLING_AZIMUTH). 0.0 gives the
-        published construction, whose routes from one parent run side by side.
+        siblings of one parent (default SIBLING_AZIMUTH = 0.5): the k-th later sibling's route
+        leaves at (k - 1) times this angle from the published one. 0.0 gives the published
+        construction, whose routes from one parent run side by side.
 
     Raises
     ------
