@@ -1,4 +1,4 @@
-"""STL and OBJ of a chain's 3D model in its current configuration (docs/mesh.md).
+"""STL and OBJ of a chain's (or a tree's) 3D model in its current configuration (docs/mesh.md).
 
 The model is made of closed triangle meshes, one per *part*, built from the shapes of the
 body model (:mod:`kinegami.bodies`) that ``KinematicChain.show()`` also draws, but with the
@@ -21,6 +21,10 @@ part name                   shape                                               
                             angle in [0, 2 pi / n) (the rest is a relabelling)
 ``link_i_tube``             the rest of the straight part: an n-gon prism             yes
 ==========================  ========================================================  ==========
+
+A :class:`~kinegami.tree.KinematicTree` has the same parts for every joint i and for the link
+into it (``Links[i]``, from the distal frame of joint ``Parents[i]``), named by the tree index;
+a chain is the tree whose parents are i - 1, and gives the same parts as before, byte for byte.
 
 Waypoints have no part. Features below ``MESH_TOLERANCE`` r (1e-4 r) are not modelled:
 straight parts shorter than that are left out, and the vertices of a swept part closer than
@@ -75,6 +79,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from kinegami.chain import KinematicChain
     from kinegami.links import LinkCSC
+    from kinegami.tree.model import KinematicTree
 
 __all__ = [
     "MeshPart",
@@ -106,6 +111,7 @@ MIN_SEGMENT_LENGTH = MESH_TOLERANCE
 MIN_ARC_ANGLE = 1e-3
 
 _STL_HEADER = b"kinegami chain mesh, millimetres"
+_TREE_STL_HEADER = b"kinegami tree mesh, millimetres"
 
 
 @dataclass(frozen=True, eq=False)
@@ -379,24 +385,38 @@ def link_parts(
 # --- whole chain ---------------------------------------------------------------------------
 
 
-def _check_chain(chain: Any, fmt: str) -> KinematicChain:
+def _check_chain(chain: Any, fmt: str) -> KinematicChain | KinematicTree:
+    """``chain`` if it is a KinematicChain or a KinematicTree, else an InvalidTypeError."""
     from kinegami.chain import KinematicChain
+    from kinegami.tree.model import KinematicTree
 
-    if not isinstance(chain, KinematicChain):
+    if not isinstance(chain, KinematicChain | KinematicTree):
         raise InvalidTypeError(
-            f"the {fmt} exporter needs a KinematicChain, got {type(chain).__name__}"
+            f"the {fmt} exporter needs a KinematicChain or a KinematicTree, got "
+            f"{type(chain).__name__}"
         )
     return chain
 
 
+def _is_tree(obj: Any) -> bool:
+    """True for a tree that branches somewhere (a tree whose parents are i - 1 is a chain and
+    gives the chain's files)."""
+    parents = tuple(obj.Parents)
+    return parents != tuple(range(-1, len(parents) - 1))
+
+
 def chain_parts(
-    chain: KinematicChain, *, twistPortion: float = 0.2, split_joints: bool = False
+    chain: KinematicChain | KinematicTree,
+    *,
+    twistPortion: float = 0.2,
+    split_joints: bool = False,
 ) -> list[MeshPart]:
-    """All parts of the chain in its current configuration, in order along the tube.
+    """All parts of the chain (or tree) in its current configuration, in order along the tube
+    (for a tree: in index order, each joint after the link into it from its parent).
 
     Parameters
     ----------
-    chain : KinematicChain
+    chain : KinematicChain or KinematicTree
     twistPortion : float, optional
         Fraction of each straight part taken by its twist fitting, in [0, 1] (as for
         ``creasePattern``); default 0.2.
@@ -406,7 +426,8 @@ def chain_parts(
     Returns
     -------
     list of MeshPart
-        World coordinates, chain units: joint 0, link 1, joint 1, link 2, ...
+        World coordinates, chain units: joint 0, link 1, joint 1, link 2, ... (link i runs
+        from joint ``Parents[i]`` to joint i).
     """
     chain = _check_chain(chain, "mesh")
     twistPortion = check_twist_portion(twistPortion)
@@ -433,7 +454,7 @@ def _scaled_parts(chain: Any, options: dict[str, Any], fmt: str) -> list[MeshPar
     return [p.transformed(np.eye(4), factor) for p in parts]
 
 
-def chain_mesh(chain: KinematicChain, **options: Any) -> trimesh.Trimesh:
+def chain_mesh(chain: KinematicChain | KinematicTree, **options: Any) -> trimesh.Trimesh:
     """All parts in one ``trimesh.Trimesh`` (millimetres; options as for :func:`write_stl`).
 
     The parts are concatenated, not merged: the result is a set of closed shells.
@@ -468,12 +489,12 @@ def stl_bytes(vertices: np.ndarray, faces: np.ndarray, header: bytes = _STL_HEAD
     return head + np.uint32(tri.shape[0]).astype("<u4").tobytes() + data.tobytes()
 
 
-def stl_data(chain: KinematicChain, **options: Any) -> bytes:
-    """The chain's model as one binary STL (millimetres, current configuration).
+def stl_data(chain: KinematicChain | KinematicTree, **options: Any) -> bytes:
+    """The chain's (or tree's) model as one binary STL (millimetres, current configuration).
 
     Parameters
     ----------
-    chain : KinematicChain
+    chain : KinematicChain or KinematicTree
     units : {'mm', 'cm', 'm', 'in'}, optional
         Length of one chain unit (the unit of r); default ``'mm'``.
     scale : float, optional
@@ -484,27 +505,28 @@ def stl_data(chain: KinematicChain, **options: Any) -> bytes:
     Raises
     ------
     InvalidTypeError
-        For an object that is not a KinematicChain or an unknown option.
+        For an object that is not a KinematicChain or KinematicTree, or an unknown option.
     InvalidParameterError
         For a bad option value.
     """
     parts = _scaled_parts(chain, options, "STL")
-    return stl_bytes(*_concatenate(parts))
+    return stl_bytes(*_concatenate(parts), _TREE_STL_HEADER if _is_tree(chain) else _STL_HEADER)
 
 
-def write_stl(chain: KinematicChain, stream: BinaryIO, **options: Any) -> None:
+def write_stl(chain: KinematicChain | KinematicTree, stream: BinaryIO, **options: Any) -> None:
     """Write :func:`stl_data` of ``chain`` to a binary stream (options as there)."""
     stream.write(stl_data(chain, **options))
 
 
-def obj_data(chain: KinematicChain, **options: Any) -> str:
-    """The chain's model as Wavefront OBJ text, one object per part (millimetres).
+def obj_data(chain: KinematicChain | KinematicTree, **options: Any) -> str:
+    """The chain's (or tree's) model as Wavefront OBJ text, one object per part (millimetres).
 
     Options as for :func:`stl_data`. Vertices are written with 12 significant digits.
     """
     parts = _scaled_parts(chain, options, "OBJ")
     out = [
-        "# kinegami chain mesh: one object per part, millimetres, current configuration\n",
+        f"# kinegami {'tree' if _is_tree(chain) else 'chain'} mesh: one object per part, "
+        "millimetres, current configuration\n",
         f"# {len(parts)} parts\n",
     ]
     offset = 1
@@ -516,7 +538,7 @@ def obj_data(chain: KinematicChain, **options: Any) -> str:
     return "".join(out)
 
 
-def write_obj(chain: KinematicChain, stream: TextIO, **options: Any) -> None:
+def write_obj(chain: KinematicChain | KinematicTree, stream: TextIO, **options: Any) -> None:
     """Write :func:`obj_data` of ``chain`` to a text stream (options as there)."""
     stream.write(obj_data(chain, **options))
 

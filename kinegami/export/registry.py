@@ -17,6 +17,10 @@ suffix    object   exporter                                        needs
 ``.urdf`` chain    :func:`kinegami.export.urdf.urdf_files`         trimesh (``[mesh]``)
 ========  =======  ==============================================  =======================
 
+The ``chain`` formats take a :class:`~kinegami.tree.KinematicTree` too. A tree is folded from
+several sheets, so the pattern formats (and ``.fold``) refuse it with an InvalidTypeError that
+says to export each sheet.
+
 Every entry point goes through here: :func:`export`, :func:`save_pattern` (what
 ``TubularPattern.save`` calls), chain exports and ``kinegami build --formats``. A
 :class:`~kinegami.chain.KinematicChain` given for a pattern format is exported as
@@ -70,7 +74,8 @@ __all__ = [
     "write_atomic_files",
 ]
 
-#: What an exporter takes: a TubularPattern, a KinematicChain, or either as given.
+#: What an exporter takes: a TubularPattern, a KinematicChain (or KinematicTree), or either as
+#: given.
 ACCEPTS = ("pattern", "chain", "any")
 
 #: The same writer as :func:`kinegami._atomic.write_atomic` (bytes or text), by its old name.
@@ -203,7 +208,8 @@ def register(
         ``func(obj, path, **options) -> {relative path: bytes}``), or its
         ``"package.module:function"`` name, imported when first used.
     accepts : {'pattern', 'chain', 'any'}
-        What ``func`` takes. For ``'pattern'``, chains are given as their crease pattern.
+        What ``func`` takes. For ``'pattern'``, chains are given as their crease pattern;
+        ``'chain'`` formats take a KinematicTree too.
     binary : bool
         The file is binary (``func`` returns bytes).
     description : str
@@ -332,13 +338,22 @@ def _subject(obj: Any, fmt: ExportFormat, options: dict[str, Any]) -> Any:
     """The object the exporter takes (a chain's crease pattern for pattern formats)."""
     from kinegami.chain import KinematicChain
     from kinegami.pattern.tubular import TubularPattern
+    from kinegami.tree.model import KinematicTree
 
     if fmt.accepts == "chain":
-        if not isinstance(obj, KinematicChain):
+        if not isinstance(obj, KinematicChain | KinematicTree):
             raise InvalidTypeError(
-                f"{fmt.suffix} files are made from a KinematicChain, got {type(obj).__name__}"
+                f"{fmt.suffix} files are made from a KinematicChain or a KinematicTree, got "
+                f"{type(obj).__name__}"
             )
         return obj
+    if isinstance(obj, KinematicTree):
+        sheets = sum(1 for kids in obj.Children if not kids)
+        raise InvalidTypeError(
+            f"{fmt.suffix} files hold one crease pattern, but a KinematicTree is folded from "
+            f"{sheets} sheet{'s' if sheets != 1 else ''} (one per leaf): export each sheet's "
+            "pattern (kinegami.tree.sheets.fabricate(tree).sheets[k].pattern)"
+        )
     if not isinstance(obj, KinematicChain | TubularPattern):
         raise InvalidTypeError(
             f"{fmt.suffix} files are made from a TubularPattern or a KinematicChain, got "
@@ -362,13 +377,15 @@ def _write(obj: Any, target: Path, options: dict[str, Any]) -> Path:
 
 
 def export(obj: Any, path: str | os.PathLike, **options: Any) -> Path:
-    """Write ``obj`` (a KinematicChain or a TubularPattern) to ``path`` in the suffix's format.
+    """Write ``obj`` (a KinematicChain, KinematicTree or TubularPattern) to ``path`` in the
+    suffix's format.
 
     Parameters
     ----------
-    obj : KinematicChain or TubularPattern
+    obj : KinematicChain, KinematicTree or TubularPattern
         Chains can be written in every format (pattern formats get
-        ``chain.creasePattern(twistPortion)``); patterns in the pattern formats.
+        ``chain.creasePattern(twistPortion)``); trees in the chain formats (``.stl``,
+        ``.obj``, ``.urdf``); patterns in the pattern formats.
     path : str or os.PathLike
         Target file; missing parent folders are created and an existing file is replaced.
     **options

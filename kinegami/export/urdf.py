@@ -1,4 +1,4 @@
-"""URDF of a kinematic chain, for robot simulators (docs/urdf.md).
+"""URDF of a kinematic chain or tree, for robot simulators (docs/urdf.md).
 
 Bodies
     One URDF ``<link>`` per rigid body: ``body_0`` holds everything before the first revolute
@@ -7,6 +7,15 @@ Bodies
     joint's proximal half belongs to the body before it and its distal half to the body after.
     A chain without movable joints gives one URDF link per chain joint (with the link into
     it), joined by fixed joints ``joint_k``; a single-joint chain is a single link.
+
+Trees
+    A :class:`~kinegami.tree.KinematicTree` is split the same way along every path from the
+    root: the body "before" joint i is the one its parent's distal side belongs to (the link
+    into i, from joint ``Parents[i]``, lies in it), and the b-th movable joint in index order
+    starts ``body_b``. The URDF is then one kinematic tree: the joints of sibling branches have
+    the same parent body (a URDF link with several child joints). Without movable joints every
+    tree joint is a link, fixed to its parent's. A chain is the tree whose parents are i - 1 and
+    gives the same file as before, byte for byte.
 
 Joints
     Chain joint i, if revolute or prismatic, is the URDF ``<joint name="joint_i">`` of that type
@@ -20,7 +29,7 @@ Frames
     origin). Joint origins are therefore pure translations (``rpy="0 0 0"``, no Euler-angle
     round-off) and ``<axis>`` is the joint's z axis at state 0 in world coordinates. Forward
     kinematics at a configuration q (one value per URDF joint, i.e. per movable chain joint in
-    chain order) reproduces the chain after ``chain.setJointStates`` with those states: a
+    chain order) reproduces the chain (tree) after ``setJointStates`` with those states: a
     revolute joint turns everything after it about its z axis through its centre, a prismatic
     joint slides it along z (docs/theory/chain.md §1). The exported zero configuration is the
     chain with all states 0, whatever the chain's current states are.
@@ -57,6 +66,7 @@ import numpy as np
 from kinegami.errors import InvalidParameterError
 from kinegami.export.mesh import (
     _check_chain,
+    _is_tree,
     chain_parts,
     mesh_factor,
     shell_mass_properties,
@@ -74,6 +84,7 @@ from kinegami.validation import (
 
 if TYPE_CHECKING:  # pragma: no cover
     from kinegami.chain import KinematicChain
+    from kinegami.tree.model import KinematicTree
 
 __all__ = [
     "URDF_DEFAULTS",
@@ -104,15 +115,16 @@ _LINK_RGBA = "0.827 0.827 0.827 1.0"  # lightgray, as show()
 
 @dataclass(frozen=True)
 class ChainBodies:
-    """How a chain splits into rigid bodies (world coordinates, chain units).
+    """How a chain (or tree) splits into rigid bodies (world coordinates, chain units).
 
     Attributes
     ----------
     movable : tuple of int
         Indices of the revolute and prismatic joints; joint ``movable[b - 1]`` starts body b.
     proximal_body, distal_body : tuple of int
-        Per chain joint: the body holding its Pose and proximal side, and the body holding its
-        distal side (different only for movable joints).
+        Per joint: the body holding its Pose and proximal side (the distal body of its parent;
+        0 for the root), and the body holding its distal side (different only for movable
+        joints).
     zero_poses : numpy.ndarray, shape (J, 4, 4)
         Every joint's Pose with all states 0.
     motions : numpy.ndarray, shape (B, 4, 4)
@@ -154,21 +166,28 @@ def _joint_motion(joint, state: float) -> np.ndarray:
     return T
 
 
-def chain_bodies(chain: KinematicChain) -> ChainBodies:
-    """Split ``chain`` into rigid bodies at its revolute and prismatic joints (see module doc)."""
+def _parents(chain: KinematicChain | KinematicTree) -> tuple[int, ...]:
+    """Parent of every joint (-1 for the root): ``Parents`` of a tree, i - 1 in a chain."""
+    return tuple(int(p) for p in chain.Parents)
+
+
+def chain_bodies(chain: KinematicChain | KinematicTree) -> ChainBodies:
+    """Split ``chain`` (or a tree) into rigid bodies at its revolute and prismatic joints (see
+    module doc). A joint's proximal side lies in the body of its parent's distal side."""
     chain = _check_chain(chain, "URDF")
+    parents = _parents(chain)
     movable, proximal, distal = [], [], []
     zero = np.empty((len(chain.Joints), 4, 4))
     motions = [np.eye(4)]
-    body = 0
     for k, joint in enumerate(chain.Joints):
+        body = distal[parents[k]] if parents[k] >= 0 else 0
         pose = joint.pose_matrix
         zero[k] = inverse(motions[body]) @ pose
         proximal.append(body)
         if isinstance(joint, RevoluteJoint | PrismaticJoint):
             movable.append(k)
             motions.append(pose @ _joint_motion(joint, joint.state) @ inverse(zero[k]))
-            body += 1
+            body = len(motions) - 1
         distal.append(body)
     return ChainBodies(tuple(movable), tuple(proximal), tuple(distal), zero, np.stack(motions))
 
@@ -209,14 +228,15 @@ def _check_name(name: Any, what: str) -> str:
     return name
 
 
-def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
-    """The URDF of ``chain`` and its mesh files, in memory.
+def urdf_model(chain: KinematicChain | KinematicTree, **options: Any) -> UrdfModel:
+    """The URDF of ``chain`` (or of a tree: one kinematic tree) and its mesh files, in memory.
 
     Parameters
     ----------
-    chain : KinematicChain
+    chain : KinematicChain or KinematicTree
     name : str, optional
-        Robot name (default ``'kinegami_chain'``); also names the mesh folder.
+        Robot name (default ``'kinegami_chain'``, ``'kinegami_tree'`` for a tree); also names
+        the mesh folder.
     units : {'mm', 'cm', 'm', 'in'}, optional
         Length of one chain unit; default ``'mm'``. The URDF is in metres.
     scale : float, optional
@@ -241,13 +261,17 @@ def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
     Raises
     ------
     InvalidTypeError
-        If ``chain`` is not a KinematicChain or an option is unknown or of the wrong type.
+        If ``chain`` is not a KinematicChain or KinematicTree, or an option is unknown or of
+        the wrong type.
     InvalidParameterError
         For a bad option value.
     """
     chain = _check_chain(chain, "URDF")
+    parents = _parents(chain)
+    tree = _is_tree(chain)
     opts = resolve_options(options, URDF_DEFAULTS, "URDF export")
-    name = _check_name("kinegami_chain" if opts["name"] is None else opts["name"], "name")
+    default_name = "kinegami_tree" if tree else "kinegami_chain"
+    name = _check_name(default_name if opts["name"] is None else opts["name"], "name")
     metres = mesh_factor(opts["units"], opts["scale"]) / 1000.0
     effort = check_positive("effort", opts["effort"])
     velocity = check_positive("velocity", opts["velocity"])
@@ -260,8 +284,8 @@ def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
 
     bodies = chain_bodies(chain)
     parts = chain_parts(chain, twistPortion=twist_portion, split_joints=True)
-    # Without movable joints, each chain joint (and the link into it) is its own URDF link,
-    # joined to the previous one by a fixed joint; otherwise one URDF link per rigid body.
+    # Without movable joints, each joint (and the link into it) is its own URDF link, fixed
+    # to its parent's (the previous joint's in a chain); otherwise one URDF link per rigid body.
     fixed = not bodies.movable and len(chain.Joints) > 1
     if fixed:
         origins = [bodies.zero_poses[k][:3, 3] for k in range(len(chain.Joints))]
@@ -282,9 +306,14 @@ def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
         body_parts[b].append(part.transformed(to_body[b], metres))
 
     robot = ET.Element("robot", name=name)
+    if tree:
+        leaves = sum(1 for kids in chain.Children if not kids)
+        what = f"tree: {len(chain.Joints)} joints ({leaves} leaves)"
+    else:
+        what = f"chain: {len(chain.Joints)} joints"
     robot.append(
         ET.Comment(
-            f" kinegami chain: {len(chain.Joints)} joints, {len(bodies.movable)} movable; "
+            f" kinegami {what}, {len(bodies.movable)} movable; "
             f"metres (1 chain unit = {_number(metres)} m); body frames parallel to the world "
             f"at zero configuration "
         )
@@ -315,9 +344,9 @@ def urdf_model(chain: KinematicChain, **options: Any) -> UrdfModel:
     if fixed:
         for k in range(1, len(frames)):
             element = ET.SubElement(robot, "joint", name=f"joint_{k}", type="fixed")
-            ET.SubElement(element, "parent", link=f"body_{k - 1}")
+            ET.SubElement(element, "parent", link=f"body_{parents[k]}")
             ET.SubElement(element, "child", link=f"body_{k}")
-            offset = (origins[k] - origins[k - 1]) * metres
+            offset = (origins[k] - origins[parents[k]]) * metres
             ET.SubElement(element, "origin", xyz=_vector(offset), rpy="0 0 0")
     for b, k in enumerate(bodies.movable, start=1):
         joint = chain.Joints[k]
@@ -372,7 +401,9 @@ def _inertial(link: ET.Element, parts: list, density: float) -> None:
     )
 
 
-def urdf_files(chain: KinematicChain, path: Path, **options: Any) -> dict[str, bytes]:
+def urdf_files(
+    chain: KinematicChain | KinematicTree, path: Path, **options: Any
+) -> dict[str, bytes]:
     """All files of the URDF export to ``path``, relative to its folder (for the registry).
 
     The robot name defaults to the file's stem, the mesh folder to ``<stem>_meshes``.
@@ -388,8 +419,9 @@ def urdf_files(chain: KinematicChain, path: Path, **options: Any) -> dict[str, b
     return files
 
 
-def write_urdf(chain: KinematicChain, stream: TextIO, **options: Any) -> None:
-    """Write the URDF text of ``chain`` to ``stream`` (options as for :func:`urdf_model`).
+def write_urdf(chain: KinematicChain | KinematicTree, stream: TextIO, **options: Any) -> None:
+    """Write the URDF text of ``chain`` (or a tree) to ``stream`` (options as for
+    :func:`urdf_model`).
 
     Mesh files cannot go to a stream, so ``meshes`` defaults to False here; use
     ``kinegami.export(chain, "robot.urdf")`` (or :func:`urdf_model`) to get them too.
