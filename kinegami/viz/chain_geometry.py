@@ -1,11 +1,13 @@
-"""What ``KinematicChain.show`` draws, as plain numpy geometry (docs/theory/chain.md §6).
+"""What ``KinematicChain.show`` and ``KinematicTree.show`` draw, as plain numpy geometry
+(docs/theory/chain.md §6).
 
 Pure functions from joints and links to vertex arrays (world coordinates, units of r); no
-matplotlib. The drawing in :mod:`kinegami.viz.chain_plot` only hands these arrays to
-matplotlib, so everything drawn can be tested without rendering. The shapes of the parts (the
-n-gons, the point sets whose hulls are the joints) come from :mod:`kinegami.bodies`, the body
-model shared with the mesh exporter and the clearance engine; their names stay importable from
-here.
+matplotlib. Each takes one joint or one link on its own (a link carries its start and end
+frames), so the same functions draw a chain and a tree. The drawing in
+:mod:`kinegami.viz.chain_plot` only hands these arrays to matplotlib, so everything drawn can
+be tested without rendering. The shapes of the parts (the n-gons, the point sets whose hulls are
+the joints) come from :mod:`kinegami.bodies`, the body model shared with the mesh exporter and
+the clearance engine; their names stay importable from here.
 
 Polygons of a joint lie in the plane spanned by the second and third axes (b, c) of one of its
 Dubins frames (first axis a = path direction); vertex k sits at angle pi/n + 2 pi k/n from b

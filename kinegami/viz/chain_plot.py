@@ -1,4 +1,11 @@
-"""3D matplotlib view of a kinematic chain: ``KinematicChain.show`` (docs/theory/chain.md §6).
+"""3D matplotlib view of a kinematic chain or tree: ``KinematicChain.show`` and
+``KinematicTree.show`` (docs/theory/chain.md §6).
+
+Nothing here assumes that joint i follows joint i - 1: every joint is drawn at its own frames
+and every link ``Links[i]`` along its own path, which runs from the distal frame of joint
+``Parents[i]`` (i - 1 in a chain) to joint i, so a tree's branches are drawn from the joint
+they leave. ``showCollisions`` asks the object for its own ``clearance()`` (the tree's pair
+rule for a tree) and names parts by their index (:func:`kinegami.export.mesh.chain_parts`).
 
 The geometry comes from :mod:`kinegami.viz.chain_geometry`; this module only turns it into
 matplotlib artists, one collection per kind of thing (joint bodies, elbows, tubes, ...), each
@@ -29,6 +36,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from mpl_toolkits.mplot3d.axes3d import Axes3D
 
     from kinegami.chain import KinematicChain
+    from kinegami.tree.model import KinematicTree
 
 __all__ = ["show_chain", "resolve_chain_options", "ARTIST_GIDS", "CHAIN_PLOT_OPTIONS"]
 
@@ -47,7 +55,7 @@ ARTIST_GIDS = {
     "joint-origins-distal": "distal frame origins",
     "link-elbows": "elbow surfaces (2 * sides quadrilaterals per elbow)",
     "link-tubes": "straight tubes (sides quadrilaterals per tube)",
-    "link-path": "link centrelines (NaN between links)",
+    "link-path": "link centrelines, each from its parent joint (NaN between links)",
     "link-path-markers": "q1, q2 of every link",
     "path-circles-start": "turning circles of arc 1",
     "path-circles-end": "turning circles of arc 2",
@@ -57,7 +65,7 @@ ARTIST_GIDS = {
     "link-rotation-axes": "rotation axes of the elbows",
     "link-tangents": "start and end tangents of each link",
     "joint-spheres": "bounding balls of the joints",
-    "chain-sphere": "bounding ball of the chain (wireframe)",
+    "chain-sphere": "bounding ball of the chain or tree (wireframe)",
     "global-frame-x": "world x arrow",
     "global-frame-y": "world y arrow",
     "global-frame-z": "world z arrow",
@@ -296,7 +304,8 @@ def _draw_joint_poses(scene, chain, opts):
 
 
 def _drawn_links(chain):
-    """Links with a non-empty path (the root's empty link is skipped)."""
+    """Links with a non-empty path (the root's empty link is skipped), in index order; link i
+    starts at the distal frame of joint ``Parents[i]``."""
     return [link for link in chain.Links if link.path.length > 0.0]
 
 
@@ -437,7 +446,8 @@ def _clearance_title(report) -> str:
 
 
 def _draw_collisions(scene, chain) -> str:
-    """The colliding pairs of ``chain.clearance()`` in red; returns the title text."""
+    """The colliding pairs of ``chain.clearance()`` (a tree's: ``tree.clearance()``) in red;
+    returns the title text."""
     report = chain.clearance()
     if report.pairs:
         from kinegami.export.mesh import chain_parts
@@ -497,12 +507,13 @@ def _set_equal_limits(ax, scene, had_data: bool, r: float):
     ax.set_box_aspect(tuple(high - low), zoom=1.15)
 
 
-def show_chain(chain: KinematicChain, **options) -> tuple[Figure, Axes3D]:
-    """Draw a chain in 3D with matplotlib (docs/theory/chain.md §6).
+def show_chain(chain: KinematicChain | KinematicTree, **options) -> tuple[Figure, Axes3D]:
+    """Draw a chain or a tree in 3D with matplotlib (docs/theory/chain.md §6).
 
     Parameters
     ----------
-    chain : the KinematicChain to draw.
+    chain : the KinematicChain or KinematicTree to draw (a tree's links from their parents;
+        ``showCollisions`` uses ``tree.clearance()``).
     **options : see :data:`kinegami.style.CHAIN_PLOT_DEFAULTS` for names and defaults.
         Lengths scale with the tube radius r: frames are r long, axes of motion
         p -+ jointAxisScale r z, the world frame globalAxisScale r, the ground plane
@@ -518,6 +529,7 @@ def show_chain(chain: KinematicChain, **options) -> tuple[Figure, Axes3D]:
     --------
     >>> fig, ax = chain.show(showGlobalFrame=True)  # doctest: +SKIP
     >>> fig.savefig("chain.png")  # doctest: +SKIP
+    >>> fig, ax = hand.show(showCollisions=True)  # a KinematicTree  # doctest: +SKIP
     """
     opts = resolve_chain_options(options)
     import matplotlib.pyplot as plt
