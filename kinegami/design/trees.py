@@ -9,7 +9,8 @@ Version 2 of the format adds three things to version 1, which loads unchanged:
   design is a joint specification, a :class:`~kinegami.chain.KinematicChain` otherwise);
 * ``"placement": {"method": "wafr2024", "growthDirection": [x, y, z]}``: the joints are a *joint
   specification* (type, parameters, axis line, parent) that the tree construction places
-  (:func:`kinegami.tree.from_specification`, imported only when such a design is loaded).
+  (:func:`kinegami.tree.from_specification`, reached only through :func:`construct_tree`,
+  which imports it when such a design is loaded).
 
 This module checks what the schema cannot say about them (:func:`check_tree_fields`) and turns a
 specification into a plain description (:class:`TreeSpecification`); :func:`construct_tree` is

@@ -82,3 +82,47 @@ def test_the_bounds_are_documented():
         assert text in section, text
     for name in ("check_pattern(chain", "joint_table(chain, document)", "origin_of(chain)"):
         assert name in PAGE
+
+
+def test_the_tree_example_is_the_python_listing():
+    from spatialmath import SE3
+
+    from kinegami import EndTip, KinematicTree, RevoluteJoint, Waypoint
+
+    from .test_trees import assert_same_tree_bits
+
+    document = _example('{\n  "format": "kinegami-design",\n  "version": 2,\n  "name": "two')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tree = chain_from_dict(document)
+    assert type(tree) is KinematicTree and tree.Parents == (-1, 0, 0, 2, 3)
+    fixed = dict(safe=False, fixedPosition=True, fixedOrientation=True)
+    listing = KinematicTree(Waypoint(4, 1, SE3()))
+    pi = 3.141592653589793
+    listing.addJoint(0, RevoluteJoint(4, 1, pi, SE3.Trans(-3, 0, 4) * SE3.Ry(-pi / 2)), **fixed)
+    right = listing.addJoint(
+        0, RevoluteJoint(4, 1, pi, SE3.Trans(3, 0, 4) * SE3.Ry(-pi / 2)), **fixed
+    )
+    tip = listing.addJoint(right, RevoluteJoint(4, 1, pi, SE3.Tx(4)), **fixed)
+    listing.addJoint(tip, EndTip(4, 1, SE3.Tx(4) * SE3.Ry(pi / 2), 1), **fixed)
+    assert_same_tree_bits(tree, listing)
+
+
+def test_the_joint_specification_example_reads_and_builds():
+    from kinegami.design.reader import check_document
+    from kinegami.design.trees import construction_available
+
+    document = _example('{\n  "format": "kinegami-design",\n  "version": 2,\n  "name": "spec')
+    spec = check_document(document).specification
+    assert spec.parents == (-1, 0, 0) and spec.growth_direction == (1.0, 0.0, 1.0)
+    if construction_available():
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            tree = chain_from_dict(document)
+        assert tree.construction.node_of == (0, 1, 4)
+
+
+def test_the_version_2_fields_are_documented():
+    for text in ('`parent`', '`structure`', '`placement`', '`growthDirection`', '`extraRoll`',
+                 '`siblingAzimuth`', "examples/designs/hand.json"):  # fmt: skip
+        assert text in PAGE, text
