@@ -10,10 +10,12 @@ from typing import Any
 import numpy as np
 
 from kinegami._format import shown
-from kinegami.errors import InvalidParameterError
+from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.validation import check_bool, check_options, check_positive
 
 __all__ = [
+    "LABEL_HEIGHT",
+    "check_label",
     "UNITS_IN_MM",
     "DEFAULT_DASH",
     "DEFAULT_GAP",
@@ -32,6 +34,26 @@ DEFAULT_DASH = 1.0
 DEFAULT_GAP = 1.0
 
 _COMMON = ("units", "scale", "perforate", "dash", "gap", "skip_creases_on_cut")
+
+#: Height of a sheet's label text, millimetres (the ``label`` option of DXF and SVG).
+LABEL_HEIGHT = 3.0
+#: Longest label accepted (characters).
+MAX_LABEL = 500
+
+
+def check_label(label: Any) -> str | None:
+    """The ``label`` option: None, or one line of printable text (at most MAX_LABEL
+    characters) written beside the sheet, e.g. "sheet 2: joints 5 to 7 ..." for a tree."""
+    if label is None:
+        return None
+    if not isinstance(label, str):
+        raise InvalidTypeError(f"label must be a string or None, got {type(label).__name__}")
+    if len(label) > MAX_LABEL or not label.isprintable():
+        raise InvalidParameterError(
+            f"label must be one line of printable text of at most {MAX_LABEL} characters, "
+            f"got {len(label)} characters" + ("" if label.isprintable() else " with control codes")
+        )
+    return label
 
 
 @dataclass(frozen=True)

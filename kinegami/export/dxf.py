@@ -39,7 +39,13 @@ from typing import TYPE_CHECKING, Any, TextIO
 import numpy as np
 
 from kinegami.errors import KinegamiError
-from kinegami.export._options import format_numbers, resolve_sheet_options, sheet_lines
+from kinegami.export._options import (
+    LABEL_HEIGHT,
+    check_label,
+    format_numbers,
+    resolve_sheet_options,
+    sheet_lines,
+)
 from kinegami.pattern.sheet import SHEET_KINDS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -105,7 +111,8 @@ def dxf_document(pattern: TubularPattern, **options: Any) -> Drawing:
     from kinegami.export.registry import import_library
 
     import_library("ezdxf", "dxf_document", "dxf")
-    opts = resolve_sheet_options(options, {}, "DXF")
+    opts = resolve_sheet_options(options, {"label": None}, "DXF")
+    label = check_label(opts.extra["label"])
     segments, kinds, bounds = sheet_lines(pattern, opts)
     doc = _new_document(bounds)
     msp = doc.modelspace()
@@ -114,6 +121,9 @@ def dxf_document(pattern: TubularPattern, **options: Any) -> Drawing:
         attribs = {"layer": name, "color": color}
         for (x0, y0), (x1, y1) in segments[kinds == kind].tolist():
             msp.add_line((x0, y0), (x1, y1), dxfattribs=attribs)
+    if label:
+        msp.add_text(label, height=LABEL_HEIGHT,
+                     dxfattribs={"layer": "0", "insert": _label_point(bounds)})  # fmt: skip
     return doc
 
 
@@ -136,6 +146,9 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
     skip_creases_on_cut : bool, optional
         Drop creases lying on the sheet's top or bottom edge (B10, docs/theory/patterns.md
         §6); default False.
+    label : str, optional
+        One line of text written below the sheet (TEXT on layer 0, 3 mm high), for example
+        which sheet of a tree this is; default none.
 
     Raises
     ------
@@ -150,9 +163,17 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
     """
     from kinegami.export import _dxf_template as template
 
-    opts = resolve_sheet_options(options, {}, "DXF")
+    opts = resolve_sheet_options(options, {"label": None}, "DXF")
+    label = check_label(opts.extra["label"])
     segments, kinds, bounds = sheet_lines(pattern, opts)
     count = segments.shape[0]
+    entities = _line_entities(segments, kinds, template.FIRST_HANDLE, template.OWNER, bounds)
+    if label:  # one TEXT entity, after the lines, as ezdxf writes it
+        x, y = (repr(float(v)) for v in _label_point(bounds))
+        entities += (f"  0\nTEXT\n  5\n{template.FIRST_HANDLE + count:X}\n330\n{template.OWNER}\n"
+                     f"100\nAcDbEntity\n  8\n0\n100\nAcDbText\n 10\n{x}\n 20\n{y}\n 30\n0.0\n"
+                     f" 40\n{LABEL_HEIGHT!r}\n  1\n{label}\n100\nAcDbText\n")  # fmt: skip
+        count += 1
     now = datetime.datetime.now(datetime.UTC)
     julian = 2440587.5 + time.time() / 86400.0  # the Julian date, as ezdxf writes $TDUPDATE
     xmin, ymin, xmax, ymax = (repr(float(v)) for v in bounds)
@@ -168,12 +189,18 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
         "TDUPDATE": repr(julian),
         "CREATED": f"{template.EZDXF_VERSION} @ {now.isoformat()}",
         "WRITTEN": f"{template.EZDXF_VERSION} @ {now.isoformat()}",
-        "ENTITIES": _line_entities(segments, kinds, template.FIRST_HANDLE, template.OWNER, bounds),
+        "ENTITIES": entities,
     }
     parts = list(template.PARTS)
     for i in range(1, len(parts), 2):
         parts[i] = fields[parts[i]]
     return "".join(parts)
+
+
+def _label_point(bounds: tuple) -> tuple[float, float]:
+    """Where a label starts: below the sheet's lower left corner (mm)."""
+    xmin, ymin = float(bounds[0]), float(bounds[1])
+    return (xmin, ymin - 2.0 * LABEL_HEIGHT)
 
 
 def write_dxf(pattern: TubularPattern, stream: TextIO, **options: Any) -> None:

@@ -53,6 +53,7 @@ __all__ = [
     "Tile",
     "PdfLayout",
     "pdf_layout",
+    "sheets_pdf_data",
     "draw_page",
     "pdf_data",
     "write_pdf",
@@ -549,6 +550,36 @@ def pdf_data(pattern: TubularPattern, **options: Any) -> bytes:
         for index in range(layout.page_count):
             figure = draw_page(layout, index)
             pdf.savefig(figure)
+    return stream.getvalue()
+
+
+def sheets_pdf_data(patterns, titles=None, **options: Any) -> bytes:
+    """Several sheets (a tree's) in one PDF, each tiled at 1:1 as :func:`pdf_data` does, one
+    after the other; ``titles`` (one per sheet) go in each sheet's footer.
+
+    Options as for :func:`pdf_data` (``title`` names the whole document).
+    """
+    import io
+
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    patterns = list(patterns)
+    if not patterns:
+        raise InvalidParameterError("sheets_pdf_data needs at least one pattern, got none")
+    titles = [None] * len(patterns) if titles is None else list(titles)
+    if len(titles) != len(patterns):
+        raise InvalidParameterError(
+            f"titles must have one entry per pattern ({len(patterns)}), got {len(titles)}"
+        )
+    document = options.pop("title", PDF_DEFAULTS["title"])
+    layouts = [pdf_layout(p, **options, **({} if t is None else {"title": t}))
+               for p, t in zip(patterns, titles, strict=True)]  # fmt: skip
+    stream = io.BytesIO()
+    metadata = {"Title": document, "Creator": "kinegami", "CreationDate": None}
+    with PdfPages(stream, metadata=metadata) as pdf:
+        for layout in layouts:
+            for index in range(layout.page_count):
+                pdf.savefig(draw_page(layout, index))
     return stream.getvalue()
 
 

@@ -32,12 +32,14 @@ from __future__ import annotations
 import io
 import math
 from typing import TYPE_CHECKING, Any, TextIO
-from xml.sax.saxutils import quoteattr
+from xml.sax.saxutils import escape, quoteattr
 
 import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export._options import (
+    LABEL_HEIGHT,
+    check_label,
     format_numbers,
     resolve_sheet_options,
     sheet_lines,
@@ -84,7 +86,7 @@ _MERGE_MARGIN = 10.0
 
 _DEFAULT_STROKE_WIDTH = 0.1  # mm
 _LASER_ONLY = ("perforate", "dash", "gap", "skip_creases_on_cut", "colors")
-_SIMULATOR_OPTIONS = ("units", "scale", "stroke_width", "flavour")
+_SIMULATOR_OPTIONS = ("units", "scale", "stroke_width", "flavour", "label")
 
 
 def _check_colors(colors: Any) -> dict[str, str]:
@@ -104,6 +106,10 @@ def _check_colors(colors: Any) -> dict[str, str]:
     merged = dict(SVG_COLORS)
     merged.update(colors)
     return merged
+
+
+def _title(title: str, label: str | None) -> str:
+    return escape(title if not label else f"{label} ({title})")
 
 
 def _stroke_width(value: Any) -> float:
@@ -138,6 +144,9 @@ def write_svg(pattern: TubularPattern, stream: TextIO, **options: Any) -> None:
         as for :func:`kinegami.export.dxf.write_dxf`.
     stroke_width : float, optional
         Line width in mm (default 0.1).
+    label : str, optional
+        One line of text naming the sheet: in the title, and in the laser flavour also as text
+        below the sheet (3 mm high); default none.
     perforate, dash, gap, skip_creases_on_cut, colors
         Laser flavour only: as for :func:`kinegami.export.dxf.write_dxf`; ``colors`` maps a
         kind (``"M"``, ``"V"``, ``"B"``, ``"C"``) to a colour replacing :data:`SVG_COLORS`.
@@ -166,12 +175,16 @@ def write_svg(pattern: TubularPattern, stream: TextIO, **options: Any) -> None:
 
 def _write_laser(pattern, stream: TextIO, options: dict[str, Any]) -> None:
     opts = resolve_sheet_options(
-        options, {"colors": None, "stroke_width": _DEFAULT_STROKE_WIDTH}, "SVG"
+        options, {"colors": None, "stroke_width": _DEFAULT_STROKE_WIDTH, "label": None}, "SVG"
     )
+    label = check_label(opts.extra["label"])
     colors = _check_colors(opts.extra["colors"])
     stroke_width = _stroke_width(opts.extra["stroke_width"])
     segments, kinds, bounds = sheet_lines(pattern, opts)
     xmin, ymin, xmax, ymax = bounds
+    text_y = ymin - 1.5 * LABEL_HEIGHT  # the label's baseline, below the sheet (mm)
+    if label:
+        ymin = ymin - 2.5 * LABEL_HEIGHT  # the drawing takes the label in
     extent = max(abs(v) for v in bounds) or 1.0
     flipped = segments.copy()
     flipped[:, :, 1] *= -1.0
@@ -182,7 +195,7 @@ def _write_laser(pattern, stream: TextIO, options: dict[str, Any]) -> None:
         '<?xml version="1.0" encoding="UTF-8" standalone="no"?>\n',
         f'<svg xmlns="http://www.w3.org/2000/svg" version="1.1" width="{width}mm" '
         f'height="{height}mm" viewBox="{left} {top} {width} {height}">\n',
-        "<title>kinegami tubular crease pattern (laser cutting)</title>\n",
+        f"<title>{_title('kinegami tubular crease pattern (laser cutting)', label)}</title>\n",
     ]
     for kind in SHEET_KINDS:
         color = quoteattr(colors[kind])
@@ -195,6 +208,11 @@ def _write_laser(pattern, stream: TextIO, options: dict[str, Any]) -> None:
             x1, y1, x2, y2 = numbers[4 * i : 4 * i + 4]
             out.append(f'<line x1="{x1}" y1="{y1}" x2="{x2}" y2="{y2}" stroke={color}/>\n')
         out.append("</g>\n")
+    if label:  # below the sheet's lower edge, inside the drawing's width
+        size = format_numbers(np.array([LABEL_HEIGHT]), 1.0)[0]
+        x, y = format_numbers(np.array([xmin, -text_y]), extent)
+        out.append(f'<text id="label" x="{x}" y="{y}" font-family="sans-serif" '
+                   f'font-size="{size}" fill="black" stroke="none">{escape(label)}</text>\n')
     out.append("</svg>\n")
     stream.write("".join(out))
 
@@ -260,6 +278,7 @@ def _write_simulator(pattern, stream: TextIO, options: dict[str, Any]) -> None:
     from kinegami.pattern.folded import FoldedFormError
 
     factor, stroke_mm = _simulator_options(options)
+    label = check_label(options.get("label"))
     try:
         graph = sheet_graph(pattern, folded=True)
     except FoldedFormError as exc:
@@ -287,7 +306,8 @@ def _write_simulator(pattern, stream: TextIO, options: dict[str, Any]) -> None:
         '<?xml version="1.0" encoding="UTF-8" standalone="no"?>\n',
         f'<svg xmlns="http://www.w3.org/2000/svg" version="1.1" width="{width_mm}mm" '
         f'height="{height_mm}mm" viewBox="{left} {top} {width} {height}">\n',
-        "<title>kinegami tubular crease pattern (Origami Simulator)</title>\n",
+        f"<title>{_title('kinegami tubular crease pattern (Origami Simulator)', label)}"
+        "</title>\n",
         f"<desc>One user unit is {unit_text} mm. Stroke opacity = |fold angle| / 180 degrees "
         "(folded form at joint state 0).</desc>\n",
     ]

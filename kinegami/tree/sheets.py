@@ -44,6 +44,7 @@ __all__ = [
     "default_trunks",
     "junction_problems",
     "choose_trunks",
+    "fit_junctions",
 ]
 
 
@@ -323,3 +324,70 @@ def fabricate(
         pattern = TubularPattern.concatenate(modules)
         sheets.append(TreeSheet(len(sheets), tuple(path), junction, arc, pattern))
     return TreeFabrication(tree, tuple(sheets), tuple(junctions), options)
+
+
+#: Slides tried (in r, smallest first) to give a branch child's socket room (fit_junctions).
+FIT_SLIDES = tuple(s * sign for s in (0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0)
+                   for sign in (1.0, -1.0))  # fmt: skip
+
+
+def fit_junctions(
+    tree: KinematicTree,
+    *,
+    trunks: Mapping[int, int] | None = None,
+    options: ConnectorOptions | None = None,
+) -> tuple[KinematicTree, list[tuple[int, float]]]:
+    """A copy of ``tree`` in which every branch child's socket fits, and the slides made.
+
+    A child whose socket does not fit is slid along its own axis of motion (its subtree
+    follows), by the smallest of :data:`FIT_SLIDES` that makes it fit without making the tree
+    pass through itself more than before: the axes, hence the kinematics, stay as they were.
+    ``tree`` is not changed. Returns ``(tree, [(joint, slide in units of r), ...])``.
+
+    Raises
+    ------
+    InvalidParameterError
+        When no slide makes some socket fit (the message names the joint).
+    """
+    import copy
+    import warnings
+
+    from kinegami.errors import ClearanceWarning, PlacementWarning
+
+    fitted = copy.copy(tree)
+    moves: list[tuple[int, float]] = []
+
+    def depth(t: KinematicTree) -> float:
+        report = t.clearance()
+        return 0.0 if report.ok else -report.min_clearance
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        warnings.simplefilter("ignore", PlacementWarning)
+        for _ in range(len(tree.Joints)):
+            problems = junction_problems(fitted, trunks=trunks, options=options)
+            if not problems:
+                return fitted, moves
+            child, reason = problems[0]
+            before = depth(fitted)
+            for slide in FIT_SLIDES:
+                trial = copy.copy(fitted)
+                if not trial.translateJointAlongAxisOfMotion(child, slide * tree.r):
+                    continue
+                if child in [c for c, _ in junction_problems(trial, trunks=trunks,
+                                                            options=options)]:  # fmt: skip
+                    continue
+                if depth(trial) > before + 1e-9 * tree.r:
+                    continue
+                fitted = trial
+                moves.append((child, slide * tree.r))
+                break
+            else:
+                raise InvalidParameterError(
+                    f"the tree cannot be made with printed junctions: {reason}, and no slide of "
+                    f"joint {child} along its axis within +-{max(FIT_SLIDES):g} r makes room "
+                    "without a new collision; re-place it (or compact the tree)"
+                )
+    raise InvalidParameterError(  # pragma: no cover - each round fixes one child
+        "fit_junctions did not converge"
+    )

@@ -1,0 +1,109 @@
+"""The files of a tree's build (docs/trees.md): a sheet per leaf, the junction connectors and
+the whole tree.
+
+``kinegami build TREE.json`` writes, for the stem ``hand``:
+
+* ``hand_sheet_<k>.dxf``, ``.svg``, ``.fold``: every sheet's crease pattern, labelled (which
+  sheet, its joints, the junction it starts in);
+* ``hand.pdf``: every sheet at 1:1, one after the other, each titled with its label;
+* ``hand_junction_<k>.stl`` and ``.3mf``: the printed connector of every junction (mm);
+* ``hand.stl``, ``hand.obj``, ``hand.urdf`` (with ``hand_meshes/``): the whole tree.
+
+Each format is a name of ``--formats``; :data:`TREE_FORMATS` lists them. Every file goes
+through the exporter registry or the one atomic writer.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from kinegami._atomic import write_atomic
+from kinegami.errors import InvalidParameterError
+from kinegami.export._options import UNITS_IN_MM
+
+__all__ = ["TREE_FORMATS", "DEFAULT_TREE_FORMATS", "write_tree_files", "sheet_labels"]
+
+#: ``--formats`` names for trees and what each writes.
+TREE_FORMATS = {
+    "dxf": "DXF of every sheet (<stem>_sheet_<k>.dxf), labelled",
+    "svg": "SVG of every sheet (<stem>_sheet_<k>.svg; Origami Simulator flavour), labelled",
+    "fold": "FOLD of every sheet (<stem>_sheet_<k>.fold)",
+    "pdf": "one PDF with every sheet at 1:1 (<stem>.pdf), each titled with its label",
+    "junctions": "the printed junction connectors (<stem>_junction_<k>.stl and .3mf, mm)",
+    "stl": "binary STL of the whole tree (<stem>.stl, mm)",
+    "obj": "Wavefront OBJ of the whole tree (<stem>.obj, mm)",
+    "urdf": "URDF of the whole tree (<stem>.urdf, metres, meshes in <stem>_meshes/)",
+}
+DEFAULT_TREE_FORMATS = ("dxf", "svg", "fold", "pdf", "junctions", "urdf")
+
+
+def sheet_labels(fabrication, names: Sequence[str | None] | None = None) -> list[str]:
+    """The label of every sheet (:meth:`kinegami.tree.sheets.TreeSheet.label`)."""
+    return [sheet.label(fabrication.tree, names) for sheet in fabrication.sheets]
+
+
+def write_tree_files(
+    fabrication,
+    folder: str | Path,
+    stem: str,
+    formats: Sequence[str],
+    *,
+    units: str = "mm",
+    twistPortion: float = 0.2,
+    names: Sequence[str | None] | None = None,
+) -> list[Path]:
+    """Write the files of ``formats`` for a :class:`~kinegami.tree.sheets.TreeFabrication`
+    into ``folder`` and return their paths (in the order written).
+
+    Raises
+    ------
+    InvalidParameterError
+        For an unknown format name.
+    ExporterUnavailableError
+        When a format's library is missing (the message names the ``pip install`` extra).
+    """
+    from kinegami.export import registry
+
+    unknown = [f for f in formats if f not in TREE_FORMATS]
+    if unknown:
+        raise InvalidParameterError(
+            f"formats: unknown tree format {unknown[0]!r}; known: {', '.join(TREE_FORMATS)}"
+        )
+    folder = Path(folder)
+    labels = sheet_labels(fabrication, names)
+    tree = fabrication.tree
+    written: list[Path] = []
+    for fmt in formats:
+        if fmt in ("dxf", "svg", "fold"):
+            for sheet, label in zip(fabrication.sheets, labels, strict=True):
+                path = folder / f"{stem}_sheet_{sheet.index}.{fmt}"
+                extra = {} if fmt == "fold" else {"label": label}
+                registry.export(sheet.pattern, path, units=units, **extra)
+                written.append(path)
+        elif fmt == "pdf":
+            registry.import_library("matplotlib", "the PDF of a tree's sheets", "pdf")
+            from kinegami.export.pdf import sheets_pdf_data
+
+            path = folder / f"{stem}.pdf"
+            data = sheets_pdf_data([s.pattern for s in fabrication.sheets], labels, units=units,
+                                   title=f"{stem}: {len(labels)} sheets")  # fmt: skip
+            written.append(write_atomic(path, data))
+        elif fmt == "junctions":
+            factor = UNITS_IN_MM[units]
+            for junction in fabrication.junctions:
+                mesh = fabrication.connector(junction.index).copy()
+                mesh.apply_scale(factor)
+                for suffix in ("stl", "3mf"):
+                    if suffix == "3mf":
+                        registry.import_library("lxml", "3MF connectors", "print")
+                        registry.import_library("networkx", "3MF connectors", "print")
+                    path = folder / f"{stem}_junction_{junction.index}.{suffix}"
+                    written.append(write_atomic(path, mesh.export(file_type=suffix)))
+        else:  # the whole tree: stl, obj, urdf
+            path = folder / f"{stem}.{fmt}"
+            registry.export(tree, path, units=units, twistPortion=twistPortion)
+            written.append(path)
+            if fmt == "urdf":
+                written.append(folder / f"{stem}_meshes")
+    return written
