@@ -231,8 +231,10 @@ def _joint_names(chain) -> tuple | None:
 
 
 def _clearance(chain):
-    from kinegami.clearance import chain_clearance
+    from kinegami.clearance import chain_clearance, tree_clearance
 
+    if _is_tree(chain):
+        return tree_clearance(chain, names=_joint_names(chain))
     return chain_clearance(chain, names=_joint_names(chain))
 
 
@@ -345,12 +347,155 @@ def _check_output(out: Path) -> None:
             raise CommandError(f"-o: {named} {where}")
 
 
+def _is_tree(chain) -> bool:
+    from kinegami.tree import KinematicTree
+
+    return isinstance(chain, KinematicTree)
+
+
+def _parse_tree_formats(text: str | None) -> list[str]:
+    """``--formats`` of a tree: the names of kinegami.export.tree_build.TREE_FORMATS and png."""
+    from kinegami.export.tree_build import DEFAULT_TREE_FORMATS, TREE_FORMATS
+
+    known = [*TREE_FORMATS, "png"]
+    if text is None:
+        return [*DEFAULT_TREE_FORMATS, "png"]
+    names = [item.strip().lower().lstrip(".") for item in text.split(",") if item.strip()]
+    if not names:
+        raise CommandError(f"--formats: no format given; known for trees: {', '.join(known)}, all")
+    unknown = [name for name in names if name not in known and name != "all"]
+    if unknown:
+        raise CommandError(
+            f"--formats: unknown format for a tree {shown(unknown[0])}; known for trees: "
+            f"{', '.join(known)}, all"
+        )
+    return known if "all" in names else list(dict.fromkeys(names))
+
+
+def _write_tree_pictures(fabrication, folder: Path, stem: str) -> list[Path]:
+    """The 3D picture of the tree and a picture of every sheet's pattern (PNG)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    from kinegami._atomic import write_atomic
+
+    def save(fig, path: Path) -> Path:
+        import io
+
+        buffer = io.BytesIO()
+        try:
+            fig.savefig(buffer, format="png", dpi=150, bbox_inches="tight")
+        finally:
+            plt.close(fig)
+        return write_atomic(path, buffer.getvalue())
+
+    written = [save(fabrication.tree.show(block=False)[0], folder / f"{stem}_3d.png")]
+    for sheet in fabrication.sheets:
+        fig, _ = sheet.pattern.show()
+        written.append(save(fig, folder / f"{stem}_sheet_{sheet.index}_pattern.png"))
+    return written
+
+
+def _tree_summary(tree, info, design: str, fabrication, moves) -> list[str]:
+    from collections import Counter
+
+    from kinegami.export.tree_build import sheet_labels
+    from kinegami.pattern.sheet import flatten
+
+    factor = UNITS_IN_MM[info.units]
+    counts = Counter(type(joint).__name__ for joint in tree.Joints)
+    kinds = ", ".join(f"{count} {name}" for name, count in counts.items())
+    joints_length = sum(joint.neutralLength for joint in tree.Joints)
+    links_length = tree.totalPathLength()
+    names = _joint_names(tree)
+    title = f"{_printable(info.name)} ({design})" if info.name else design
+    lines = [
+        title,
+        f"  joints: {len(tree.Joints)} ({kinds}), a tree with {len(fabrication.sheets)} leaves",
+        f"  tube: {tree.numSides} sides, r = {tree.r * factor:g} mm",
+        f"  total tube length: {(links_length + joints_length) * factor:.1f} mm "
+        f"(links {links_length * factor:.1f} mm, joints {joints_length * factor:.1f} mm)",
+        "  clearance: " + _printable(_clearance_summary(_clearance(tree), _Lengths(tree.r,
+                                                                                 info.units))),
+        f"  sheets: {len(fabrication.sheets)} (one per leaf)",
+    ]  # fmt: skip
+    labels = sheet_labels(fabrication, names, info.units)
+    for sheet, label in zip(fabrication.sheets, labels, strict=True):
+        xmin, ymin, xmax, ymax = flatten(sheet.pattern).bounds
+        lines.append(f"    {_printable(label)}; "
+                     f"{(xmax - xmin) * factor:.1f} mm x {(ymax - ymin) * factor:.1f} mm")
+    lines.append(f"  junctions: {len(fabrication.junctions)} (printed connectors)")
+    for junction in fabrication.junctions:
+        kids = ", ".join(str(c) for c in junction.children)
+        lines.append(f"    junction {junction.index}: at joint {junction.joint}, children "
+                     f"{kids}, trunk {junction.trunk} (its sheet runs through)")  # fmt: skip
+    for joint, slide in moves:
+        lines.append(f"  note: joint {joint} slid {slide * factor:.1f} mm along its axis so that "
+                     "its socket fits (the kinematics are unchanged)")  # fmt: skip
+    return lines
+
+
+def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> int:
+    """``kinegami build`` of a tree: a sheet per leaf, the junction connectors and the whole
+    tree (kinegami.export.tree_build), published as one transaction."""
+    from kinegami.export.publish import open_staging
+    from kinegami.export.tree_build import write_tree_files
+    from kinegami.tree.sheets import fabricate, fit_junctions
+
+    formats = _parse_tree_formats(args.formats)
+    from kinegami.design.reader import carry_origin
+
+    try:
+        fitted, moves = fit_junctions(tree)
+        carry_origin(tree, fitted)  # the joint names
+        fabrication = fabricate(fitted, twistPortion=info.twistPortion)
+    except KinegamiError as error:
+        raise CommandError(f"{args.design}: {error}") from None
+    lines = _tree_summary(fitted, info, args.design, fabrication, moves)
+    report = _clearance(fitted)
+    if not report.ok:
+        first = report.pairs[0]
+        _warn(args.command, f"{args.design} self-intersects at its states: {first.first} and "
+                            f"{first.second} overlap (the files are written all the same; "
+                            "'kinegami check' lists every pair)")  # fmt: skip
+    try:
+        staging = open_staging(out)
+    except OSError as error:
+        if isinstance(error, KinegamiError):
+            raise
+        raise CommandError(f"-o: cannot write in {str(out)!r}: {error.strerror}") from None
+    try:
+        if staging.note:
+            _note(args.command, staging.note)
+        try:
+            data = [f for f in formats if f != "png"]
+            write_tree_files(fabrication, staging.new, stem, data, units=info.units,
+                             twistPortion=info.twistPortion, names=_joint_names(fitted))
+            if "png" in formats:
+                _write_tree_pictures(fabrication, staging.new, stem)
+        except KinegamiError as error:
+            raise CommandError(f"{args.design}: {error}") from None
+        except OSError as error:
+            raise CommandError(f"cannot write {str(out)!r}: {error.strerror or error}") from None
+        written = staging.publish()
+    finally:
+        staging.close()
+    lines.append("  files written:")
+    lines.extend(f"    {path}{os.sep if path.is_dir() else ''}" for path in written)
+    print("\n".join(lines))
+    return 0
+
+
 def cmd_build(args: argparse.Namespace) -> int:
-    formats = _parse_formats(args.formats)
     stem = _plain_stem(args.name if args.name is not None else Path(args.design).stem)
     out = Path(args.output)
     _check_output(out)
     chain, info = _load(args.design)
+    if _is_tree(chain):
+        return _build_tree(args, chain, info, stem, out)
+    formats = _parse_formats(",".join(DEFAULT_FORMATS) if args.formats is None else args.formats)
     job = BuildJob(chain, info)
     _check_pattern(job)
     lines = _summary(job, args.design)
@@ -643,13 +788,16 @@ def _check_lines(chain, info, design, report, motion, seed) -> list[str]:
 def cmd_check(args: argparse.Namespace) -> int:
     import json
 
-    from kinegami.clearance import chain_clearance, sweep
+    from kinegami.clearance import sweep
 
     samples = None if args.motion is None else _integer("--motion", args.motion, 1, MAX_MOTION)
     seed = _integer("--seed", args.seed, 0)
     chain, info = _load(args.design)
     names = _joint_names(chain)
-    report = chain_clearance(chain, names=names)
+    if _is_tree(chain) and samples is not None:
+        raise CommandError("--motion: the range-of-motion sweep handles chains only; "
+                           "'kinegami check' without --motion checks a tree at its states")
+    report = _clearance(chain)
     motion = None if samples is None else sweep(chain, samples, seed, names=names)
     if args.json:
         data = _check_json(chain, info, args.design, report, motion, seed)
@@ -725,6 +873,17 @@ def _compaction_lines(job: BuildJob, before: BuildJob | None = None) -> list[str
     lengths = _Lengths(chain.r, job.info.units)
     counts = Counter(type(joint).__name__ for joint in chain.Joints)
     kinds = ", ".join(f"{count} {name}" for name, count in counts.items())
+    if _is_tree(chain):
+        from kinegami.tree.sheets import junction_problems
+
+        problems = junction_problems(chain)
+        leaves = sum(1 for c in chain.Children if not c)
+        sheet = f"{leaves} sheets (one per leaf), " + (
+            "every junction's sockets fit" if not problems
+            else f"{len(problems)} socket(s) do not fit ({problems[0][1]})"
+        )  # fmt: skip
+    else:
+        sheet = _sheet_size(job)
     tube = f"{lengths(tube_length(chain))}"
     if before is not None:
         old, new = tube_length(before.chain), tube_length(chain)
@@ -733,7 +892,7 @@ def _compaction_lines(job: BuildJob, before: BuildJob | None = None) -> list[str
     return [
         f"    joints: {len(chain.Joints)} ({kinds})",
         f"    total tube length: {tube}",
-        f"    sheet: {_sheet_size(job)}",
+        f"    sheet{'s' if _is_tree(chain) else ''}: {sheet}",
         f"    clearance: {_clearance_summary(job.clearance, lengths, own_units=True)}",
     ]
 
@@ -749,7 +908,8 @@ def cmd_compact(args: argparse.Namespace) -> int:
     _check_design_output(out, args.design, args.force)
     chain, info = _load(args.design)
     before = BuildJob(chain, info)
-    _check_pattern(before)
+    if not _is_tree(chain):  # a tree's sheets are checked by build
+        _check_pattern(before)
     try:
         compacted = compact(chain, seed=seed, motion=args.motion, time_limit=limit)
     except CompactionError as error:
@@ -758,7 +918,8 @@ def cmd_compact(args: argparse.Namespace) -> int:
     compacted.requireClearance = chain.requireClearance
     carry_origin(chain, compacted)  # the joint names, for the summary and the file
     after = BuildJob(compacted, info)
-    _check_pattern(after)
+    if not _is_tree(compacted):
+        _check_pattern(after)
     title = f"{_printable(info.name)} ({args.design})" if info.name else args.design
     lines = [
         f"{title}: compacted (seed {seed}{', motion kept' if args.motion else ''})",
@@ -801,10 +962,13 @@ def make_parser() -> argparse.ArgumentParser:
     known = output_formats()
     build.add_argument(
         "--formats",
-        default=",".join(DEFAULT_FORMATS),
+        default=None,
         metavar="LIST",
-        help="comma-separated outputs (default: %(default)s; 'all' for every one): "
-        + "; ".join(f"{name} = {fmt.description}" for name, fmt in known.items()),
+        help=f"comma-separated outputs (default: {','.join(DEFAULT_FORMATS)} for a chain, "
+        "dxf,svg,fold,pdf,junctions,urdf,png for a tree; 'all' for every one): "
+        + "; ".join(f"{name} = {fmt.description}" for name, fmt in known.items())
+        + "; for a tree, junctions = the printed connectors (STL and 3MF), and dxf, svg, fold "
+        "write one file per sheet",
     )
     build.add_argument(
         "--name", metavar="STEM", help="file name stem of the outputs (default: the design file's)"

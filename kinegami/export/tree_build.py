@@ -38,9 +38,15 @@ TREE_FORMATS = {
 DEFAULT_TREE_FORMATS = ("dxf", "svg", "fold", "pdf", "junctions", "urdf")
 
 
-def sheet_labels(fabrication, names: Sequence[str | None] | None = None) -> list[str]:
-    """The label of every sheet (:meth:`kinegami.tree.sheets.TreeSheet.label`)."""
-    return [sheet.label(fabrication.tree, names) for sheet in fabrication.sheets]
+def sheet_labels(fabrication, names: Sequence[str | None] | None = None,
+                 units: str | None = None) -> list[str]:  # fmt: skip
+    """The label of every sheet (:meth:`kinegami.tree.sheets.TreeSheet.label`; lengths in mm
+    when the design's ``units`` are given)."""
+    length = None
+    if units is not None:
+        factor = UNITS_IN_MM[units]
+        length = lambda v: f"{v * factor:.1f} mm"  # noqa: E731
+    return [sheet.label(fabrication.tree, names, length) for sheet in fabrication.sheets]
 
 
 def write_tree_files(
@@ -71,7 +77,7 @@ def write_tree_files(
             f"formats: unknown tree format {unknown[0]!r}; known: {', '.join(TREE_FORMATS)}"
         )
     folder = Path(folder)
-    labels = sheet_labels(fabrication, names)
+    labels = sheet_labels(fabrication, names, units)
     tree = fabrication.tree
     written: list[Path] = []
     for fmt in formats:

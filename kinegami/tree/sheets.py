@@ -101,8 +101,10 @@ class TreeSheet:
     def name(self) -> str:
         return f"sheet {self.index}"
 
-    def label(self, tree: KinematicTree, names=None) -> str:
-        """One line for the drawings: the sheet, its joints, where it starts, where it is glued."""
+    def label(self, tree: KinematicTree, names=None, length=None) -> str:
+        """One line for the drawings: the sheet, its joints, where it starts, where it is glued
+        (``names``: the joint names; ``length``: formats a length, default in units of r)."""
+        length = (lambda v: f"{v:.3g} r") if length is None else length
 
         def joint(k: int) -> str:
             if names is not None and k < len(names) and names[k]:
@@ -114,8 +116,8 @@ class TreeSheet:
             start = "starts at the root"
         else:
             start = (f"starts in junction {self.junction} (at joint "
-                     f"{joint(tree.Parents[self.joints[0]])}), {self.start_arc:.3g} r along the "
-                     "link")  # fmt: skip
+                     f"{joint(tree.Parents[self.joints[0]])}), {length(self.start_arc)} along "
+                     "its link")  # fmt: skip
         return f"{self.name}: {span}; {start}; glue the tab along the long edge"
 
 
