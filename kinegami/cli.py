@@ -618,9 +618,17 @@ def cmd_validate(args: argparse.Namespace) -> int:
         from kinegami.design import joint_table
 
         chain, info = _load(args.design)
-        if tree:  # a tree has a crease pattern per sheet, which nothing builds yet
-            print(f"{args.design}: valid; builds a tree of {len(chain.Joints)} joints (its "
-                  "crease patterns are not checked: building trees is not yet supported)")
+        if tree:  # a crease pattern per sheet, and the junctions
+            from kinegami.tree.sheets import fabricate, fit_junctions
+
+            try:
+                fitted, moves = fit_junctions(chain)
+                made = fabricate(fitted, twistPortion=info.twistPortion)
+            except KinegamiError as error:
+                raise CommandError(f"{args.design}: {error}") from None
+            slid = f"; {len(moves)} joint(s) slid so that their sockets fit" if moves else ""
+            print(f"{args.design}: valid; builds a tree of {len(chain.Joints)} joints, "
+                  f"{len(made.sheets)} sheets and {len(made.junctions)} junction(s){slid}")
         else:
             _check_pattern(BuildJob(chain, info))
             print(f"{args.design}: valid; builds {len(chain.Joints)} joints and the crease "

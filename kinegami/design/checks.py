@@ -86,7 +86,7 @@ def check_pattern(
     Parameters
     ----------
     chain : a chain, usually from :func:`kinegami.design.load_design_with_info`. A tree has
-        no single crease pattern: a DesignError says building trees is not yet supported.
+        no single crease pattern: a DesignError points to its sheets.
     info : the design's info; gives ``twistPortion`` (default 0.2 without it) and the file.
     file : the design file named in errors (default ``info.file``, else the file the chain
         was loaded from, if known).
@@ -116,11 +116,11 @@ def check_pattern(
         file = info.file
     if file is None and origin is not None:
         file = origin.file
-    if not hasattr(chain, "creasePattern"):  # a tree: one pattern per sheet, not yet
+    if not hasattr(chain, "creasePattern"):  # a tree: one pattern per sheet
         raise DesignError(
-            "building trees (a crease pattern per sheet) is not yet supported: the design "
-            f"loads as a KinematicTree of {len(chain.Joints)} joints, which has no single "
-            "crease pattern",
+            f"the design loads as a KinematicTree of {len(chain.Joints)} joints, which has no "
+            "single crease pattern but one per sheet: kinegami.tree.sheets.fabricate(tree) "
+            "builds them ('kinegami build' writes them)",
             file=file,
         )
     try:

@@ -4,6 +4,7 @@ reports in words, sweeps and free intervals, bad input."""
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,7 @@ from kinegami.clearance import (
     sweep,
 )
 from kinegami.design import load_design
-from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
+from kinegami.errors import ClearanceWarning, InvalidParameterError, InvalidTypeError, KinegamiError
 from kinegami.geometry.segments import segment_distances
 
 from .helpers import FIXED, frame, through, tip_pose
@@ -119,10 +120,20 @@ def test_u_turn_tighter_than_2r_is_caught_across_links():
                for p in report.pairs)  # fmt: skip
 
 
+#: Gallery designs that are published as they are and pass through themselves: the paper's
+#: hand, whose palm comes within 1.75 r of the tube to the pointer (docs/trees.md).
+NOT_CLEAR = {"hand.json": 1}
+
+
 def test_gallery_designs_are_clear_at_their_states():
     for path in DESIGNS:
-        report = load_design(path).clearance()
-        assert report.ok, (path.name, str(report))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ClearanceWarning)
+            report = load_design(path).clearance()
+        if path.name in NOT_CLEAR:
+            assert len(report.pairs) == NOT_CLEAR[path.name], (path.name, str(report))
+        else:
+            assert report.ok, (path.name, str(report))
 
 
 def test_names_appear_in_the_pairs():

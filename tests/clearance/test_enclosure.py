@@ -15,11 +15,10 @@ checked against the capsules moved by the translations of the prismatic joints b
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from export.test_mesh import random_chains  # the mesh tests' random chains
+from gallery_designs import CHAIN_DESIGNS
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -31,7 +30,7 @@ from kinegami.design import load_design
 from kinegami.export.mesh import chain_parts
 from kinegami.pattern.folded import folded_form
 
-DESIGNS = sorted((Path(__file__).parents[2] / "examples" / "designs").glob("*.json"))
+DESIGNS = CHAIN_DESIGNS  # a chain pattern's folded form (trees: one per sheet)
 #: Vertices may lie this many r outside their capsules (round-off).
 TOLERANCE = 1e-6
 

@@ -9,9 +9,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+from gallery_designs import CHAIN_DESIGNS
+
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE1 = ROOT / "examples" / "designs" / "example1.json"  # in cm, r = 1 cm
-GALLERY = sorted((ROOT / "examples" / "designs").glob("*.json"))
+GALLERY = CHAIN_DESIGNS  # the chains (trees: TREE_DESIGNS)
 
 DESIGN = {
     "format": "kinegami-design",

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from gallery_designs import CHAIN_DESIGNS
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
@@ -77,7 +78,7 @@ ISO = 1e-6  # isometry tolerance, times r (the requirement); exact modules reach
 RING = 1e-9  # module ends on their frames, times r
 PLANAR = 1e-9  # planarity of every face, times r (exact modules reach ~1e-14)
 PI = math.pi
-DESIGNS = sorted((Path(__file__).parents[2] / "examples" / "designs").glob("*.json"))
+DESIGNS = CHAIN_DESIGNS  # one crease pattern each (a tree's sheets: tests/tree)
 
 # --- module catalogue --------------------------------------------------------------------------
 
