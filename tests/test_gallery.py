@@ -58,6 +58,9 @@ ENTRIES = {
     "doubling_back": "doubling_back.py",
 }
 SCRIPTS = sorted(name for name, script in ENTRIES.items() if script)
+#: the gallery's trees (tested in tests/tree and tests/design/test_trees.py): entry -> joints,
+#: leaves, total link length (design units)
+TREE_ENTRIES = {"hand": (12, 3, 32.276748)}
 
 #: spec chain.md 11.5 and 11.6 (r = 1), and the PUMA 560 table of examples/puma.py.
 SCALE = 10.0  # the gallery's r (mm) for the chain.md examples
@@ -104,9 +107,23 @@ GALLERY_TABLE = {
 
 
 def test_every_design_is_a_gallery_entry():
-    assert sorted(p.stem for p in DESIGNS.glob("*.json")) == sorted(ENTRIES)
+    assert sorted(p.stem for p in DESIGNS.glob("*.json")) == sorted([*ENTRIES, *TREE_ENTRIES])
     for script in SCRIPTS:
         assert (EXAMPLES / f"{script}.py").is_file()
+
+
+@pytest.mark.parametrize("name", sorted(TREE_ENTRIES))
+def test_tree_entries(name):
+    from kinegami import ClearanceWarning, KinematicTree
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)  # the paper's hand: one near contact
+        tree = load_design(DESIGNS / f"{name}.json")
+    joints, leaves, length = TREE_ENTRIES[name]
+    assert isinstance(tree, KinematicTree)
+    assert len(tree.Joints) == joints
+    assert sum(1 for c in tree.Children if not c) == leaves
+    assert tree.totalPathLength() == pytest.approx(length, abs=1e-6)
 
 
 # --- loading ----------------------------------------------------------------------------------
