@@ -283,8 +283,10 @@ def specifications(draw):
 
 
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(spec=specifications(), extra_roll=st.booleans(), azimuth=st.sampled_from([0.0, 0.5]))
+@given(spec=specifications(), extra_roll=st.just(False), azimuth=st.sampled_from([0.0, 0.5]))
 def test_invariants_on_random_specifications(spec, extra_roll, azimuth):
+    # without the published extra roll (the default): with it x.n can turn negative on random
+    # trees, which voids the theorem's hypothesis, so a link may fail (docs/theory/trees.md)
     tree = from_specification(spec, extra_roll=extra_roll, sibling_azimuth=azimuth)
     check_invariants(spec, tree, extra_roll)
     assert tree.construction.chosen
