@@ -463,6 +463,55 @@ class _JointAssembly:
         self._commit(joints, links, self._ball.transformed(T))
         return True
 
+    def translateJointAlongAxisOfMotion(
+        self,
+        jointIndex: int,
+        distance: float,
+        propogate: bool = _PROPAGATE_DEFAULT,
+        applyToPreviousWaypoint: bool = False,
+        *,
+        propagate: bool | None = None,
+    ) -> bool:
+        """Slide joint ``jointIndex`` by ``distance`` along its axis of motion (z).
+
+        The axis line is kept, so the kinematics are unchanged. With
+        ``applyToPreviousWaypoint`` the waypoint the joint follows moves with it (in a tree:
+        its parent, when that is a waypoint whose only child is this joint).
+        ``distance`` lies within +-1e6 r (an InvalidParameterError names it otherwise, and the
+        chain is unchanged).
+        """
+        d = check_translation("distance", distance, self.r)
+        return self._axis_edit(
+            "translateJointAlongAxisOfMotion",
+            jointIndex,
+            lambda joint: translation(d * joint.pose_matrix[:3, 2]),
+            propogate,
+            propagate,
+            applyToPreviousWaypoint,
+        )
+
+    def rotateJointAboutAxisOfMotion(
+        self,
+        jointIndex: int,
+        angle: float,
+        propogate: bool = _PROPAGATE_DEFAULT,
+        applyToPreviousWaypoint: bool = False,
+        *,
+        propagate: bool | None = None,
+    ) -> bool:
+        """Turn joint ``jointIndex`` by ``angle`` (radians) about its axis of motion."""
+        a = check_real("angle", angle)
+        return self._axis_edit(
+            "rotateJointAboutAxisOfMotion",
+            jointIndex,
+            lambda joint: rotation_about_line(
+                joint.pose_matrix[:3, 2], joint.pose_matrix[:3, 3], a
+            ),
+            propogate,
+            propagate,
+            applyToPreviousWaypoint,
+        )
+
 
 class KinematicChain(_JointAssembly):
     """A serial chain of tubular origami joints joined by CSC links.
@@ -646,54 +695,6 @@ class KinematicChain(_JointAssembly):
 
             return self._try_edit(what, both)
         return self._try_edit(what, lambda: self._moved(j, T, prop))
-
-    def translateJointAlongAxisOfMotion(
-        self,
-        jointIndex: int,
-        distance: float,
-        propogate: bool = _PROPAGATE_DEFAULT,
-        applyToPreviousWaypoint: bool = False,
-        *,
-        propagate: bool | None = None,
-    ) -> bool:
-        """Slide joint ``jointIndex`` by ``distance`` along its axis of motion (z).
-
-        The axis line is kept, so the chain's kinematics are unchanged. With
-        ``applyToPreviousWaypoint`` a waypoint just before the joint moves with it.
-        ``distance`` lies within +-1e6 r (an InvalidParameterError names it otherwise, and the
-        chain is unchanged).
-        """
-        d = check_translation("distance", distance, self.r)
-        return self._axis_edit(
-            "translateJointAlongAxisOfMotion",
-            jointIndex,
-            lambda joint: translation(d * joint.pose_matrix[:3, 2]),
-            propogate,
-            propagate,
-            applyToPreviousWaypoint,
-        )
-
-    def rotateJointAboutAxisOfMotion(
-        self,
-        jointIndex: int,
-        angle: float,
-        propogate: bool = _PROPAGATE_DEFAULT,
-        applyToPreviousWaypoint: bool = False,
-        *,
-        propagate: bool | None = None,
-    ) -> bool:
-        """Turn joint ``jointIndex`` by ``angle`` (radians) about its axis of motion."""
-        a = check_real("angle", angle)
-        return self._axis_edit(
-            "rotateJointAboutAxisOfMotion",
-            jointIndex,
-            lambda joint: rotation_about_line(
-                joint.pose_matrix[:3, 2], joint.pose_matrix[:3, 3], a
-            ),
-            propogate,
-            propagate,
-            applyToPreviousWaypoint,
-        )
 
     def delete(self, jointIndex: int) -> bool:
         """Remove joint ``jointIndex`` and join its neighbours by a new link.

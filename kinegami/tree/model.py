@@ -22,9 +22,8 @@ import numpy as np
 from kinegami.bodies import link_polyline, tree_worst_overlap
 from kinegami.chain import _PROPAGATE_DEFAULT, RADIAL_VARIANTS, _JointAssembly, _propagate_flag
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
-from kinegami.geometry.frames import rotation_about_line, translation
 from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube, pose_array
-from kinegami.validation import check_bool, check_real, check_translation
+from kinegami.validation import check_bool, check_real
 
 __all__ = ["KinematicTree"]
 
@@ -317,50 +316,6 @@ class KinematicTree(_JointAssembly):
 
             return self._try_edit(what, both)
         return self._try_edit(what, lambda: self._moved(j, T, prop))
-
-    def translateJointAlongAxisOfMotion(
-        self,
-        jointIndex: int,
-        distance: float,
-        propogate: bool = _PROPAGATE_DEFAULT,
-        applyToPreviousWaypoint: bool = False,
-        *,
-        propagate: bool | None = None,
-    ) -> bool:
-        """Slide joint ``jointIndex`` by ``distance`` along its axis of motion (z); with
-        propagation its subtree follows. ``applyToPreviousWaypoint`` moves the parent with it
-        when the parent is a waypoint whose only child is this joint."""
-        d = check_translation("distance", distance, self.r)
-        return self._axis_edit(
-            "translateJointAlongAxisOfMotion",
-            jointIndex,
-            lambda joint: translation(d * joint.pose_matrix[:3, 2]),
-            propogate,
-            propagate,
-            applyToPreviousWaypoint,
-        )
-
-    def rotateJointAboutAxisOfMotion(
-        self,
-        jointIndex: int,
-        angle: float,
-        propogate: bool = _PROPAGATE_DEFAULT,
-        applyToPreviousWaypoint: bool = False,
-        *,
-        propagate: bool | None = None,
-    ) -> bool:
-        """Turn joint ``jointIndex`` by ``angle`` (radians) about its axis of motion."""
-        a = check_real("angle", angle)
-        return self._axis_edit(
-            "rotateJointAboutAxisOfMotion",
-            jointIndex,
-            lambda joint: rotation_about_line(
-                joint.pose_matrix[:3, 2], joint.pose_matrix[:3, 3], a
-            ),
-            propogate,
-            propagate,
-            applyToPreviousWaypoint,
-        )
 
     def delete(self, jointIndex: int) -> bool:
         """Remove joint ``jointIndex`` and link its children to its parent.
