@@ -445,6 +445,15 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
     from kinegami.tree.sheets import fabricate, fit_junctions
 
     formats = _parse_tree_formats(args.formats)
+    if args.formats is None:  # the defaults: leave out what an optional library missing stops
+        import importlib.util
+
+        needs = {"junctions": ("manifold3d", "print"), "urdf": ("trimesh", "mesh")}
+        for fmt, (module, extra) in needs.items():
+            if fmt in formats and importlib.util.find_spec(module) is None:
+                formats.remove(fmt)
+                _note(args.command, f"{fmt} not written: it needs {module} "
+                                    f"(pip install 'kinegami[{extra}]')")  # fmt: skip
     from kinegami.design.reader import carry_origin
 
     try:
