@@ -293,8 +293,7 @@ def _clearance_summary(report, lengths: _Lengths, own_units: bool = False) -> st
     first = report.pairs[0]
     more = f"; {len(report.pairs)} pairs overlap" if len(report.pairs) > 1 else ""
     return (
-        f"{length(report.min_clearance)}: self-intersects "
-        f"({first.first} and {first.second}{more})"
+        f"{length(report.min_clearance)}: self-intersects ({first.first} and {first.second}{more})"
     )
 
 
@@ -424,8 +423,10 @@ def _tree_summary(tree, info, design: str, fabrication, moves) -> list[str]:
     labels = sheet_labels(fabrication, names, info.units)
     for sheet, label in zip(fabrication.sheets, labels, strict=True):
         xmin, ymin, xmax, ymax = flatten(sheet.pattern).bounds
-        lines.append(f"    {_printable(label)}; "
-                     f"{(xmax - xmin) * factor:.1f} mm x {(ymax - ymin) * factor:.1f} mm")
+        lines.append(
+            f"    {_printable(label)}; "
+            f"{(xmax - xmin) * factor:.1f} mm x {(ymax - ymin) * factor:.1f} mm"
+        )
     lines.append(f"  junctions: {len(fabrication.junctions)} (printed connectors)")
     for junction in fabrication.junctions:
         kids = ", ".join(str(c) for c in junction.children)
@@ -437,6 +438,17 @@ def _tree_summary(tree, info, design: str, fabrication, moves) -> list[str]:
     return lines
 
 
+def _importable(module: str) -> bool:
+    """Whether ``module`` imports (an optional library is installed and works)."""
+    import importlib
+
+    try:
+        importlib.import_module(module)
+    except ImportError:
+        return False
+    return True
+
+
 def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> int:
     """``kinegami build`` of a tree: a sheet per leaf, the junction connectors and the whole
     tree (kinegami.export.tree_build), published as one transaction."""
@@ -445,14 +457,13 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
     from kinegami.tree.sheets import fabricate, fit_junctions
 
     formats = _parse_tree_formats(args.formats)
-    if args.formats is None:  # the defaults: leave out what an optional library missing stops
-        import importlib.util
-
-        needs = {"junctions": ("manifold3d", "print"), "urdf": ("trimesh", "mesh")}
-        for fmt, (module, extra) in needs.items():
-            if fmt in formats and importlib.util.find_spec(module) is None:
+    if args.formats is None:  # the defaults: leave out what a missing optional library stops
+        needs = {"junctions": (("manifold3d", "trimesh"), "print"), "urdf": (("trimesh",), "mesh")}
+        for fmt, (modules, extra) in needs.items():
+            missing = [m for m in modules if not _importable(m)]
+            if fmt in formats and missing:
                 formats.remove(fmt)
-                _note(args.command, f"{fmt} not written: it needs {module} "
+                _note(args.command, f"{fmt} not written: it needs {missing[0]} "
                                     f"(pip install 'kinegami[{extra}]')")  # fmt: skip
     from kinegami.design.reader import carry_origin
 
@@ -480,8 +491,15 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
             _note(args.command, staging.note)
         try:
             data = [f for f in formats if f != "png"]
-            write_tree_files(fabrication, staging.new, stem, data, units=info.units,
-                             twistPortion=info.twistPortion, names=_joint_names(fitted))
+            write_tree_files(
+                fabrication,
+                staging.new,
+                stem,
+                data,
+                units=info.units,
+                twistPortion=info.twistPortion,
+                names=_joint_names(fitted),
+            )
             if "png" in formats:
                 _write_tree_pictures(fabrication, staging.new, stem)
         except KinegamiError as error:
@@ -603,8 +621,11 @@ def cmd_edit(args: argparse.Namespace) -> int:
                 print(f"kinegami edit: each tab starts from the autosave {where} "
                       f"({recovery.describe()})", flush=True)  # fmt: skip
             else:
-                print(f"kinegami edit: found the autosave {where} ({recovery.describe()}); "
-                      "the editor offers it back (or start with --recover)", flush=True)
+                print(
+                    f"kinegami edit: found the autosave {where} ({recovery.describe()}); "
+                    "the editor offers it back (or start with --recover)",
+                    flush=True,
+                )
         elif args.recover:
             _note("edit", "--recover: there is no autosave newer than the design; starting "
                           "from the design")  # fmt: skip
@@ -636,12 +657,13 @@ def cmd_validate(args: argparse.Namespace) -> int:
             except KinegamiError as error:
                 raise CommandError(f"{args.design}: {error}") from None
             slid = f"; {len(moves)} joint(s) slid so that their sockets fit" if moves else ""
-            print(f"{args.design}: valid; builds a tree of {len(chain.Joints)} joints, "
-                  f"{len(made.sheets)} sheets and {len(made.junctions)} junction(s){slid}")
+            print(
+                f"{args.design}: valid; builds a tree of {len(chain.Joints)} joints, "
+                f"{len(made.sheets)} sheets and {len(made.junctions)} junction(s){slid}"
+            )
         else:
             _check_pattern(BuildJob(chain, info))
-            print(f"{args.design}: valid; builds {len(chain.Joints)} joints and the crease "
-                  "pattern")
+            print(f"{args.design}: valid; builds {len(chain.Joints)} joints and the crease pattern")
         print("  index  joint (the indices edits and states use)")
         for index, kind, name in joint_table(chain, data):
             label = f" {_printable(name)!r}" if name else ""
@@ -812,8 +834,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     chain, info = _load(args.design)
     names = _joint_names(chain)
     if _is_tree(chain) and samples is not None:
-        raise CommandError("--motion: the range-of-motion sweep handles chains only; "
-                           "'kinegami check' without --motion checks a tree at its states")
+        raise CommandError(
+            "--motion: the range-of-motion sweep handles chains only; "
+            "'kinegami check' without --motion checks a tree at its states"
+        )
     report = _clearance(chain)
     motion = None if samples is None else sweep(chain, samples, seed, names=names)
     if args.json:
@@ -1096,9 +1120,13 @@ def make_parser() -> argparse.ArgumentParser:
                       "0: a free one)")  # fmt: skip
     edit.add_argument("--host", metavar="H", default="127.0.0.1", help="address to listen on "
                       "(default: %(default)s, this machine only)")  # fmt: skip
-    edit.add_argument("--recover", action="store_true", help="start from the autosave of "
-                      "DESIGN (.DESIGN.autosave beside it; without DESIGN, in the user's data "
-                      "folder) when it is newer than DESIGN, instead of asking in the browser")
+    edit.add_argument(
+        "--recover",
+        action="store_true",
+        help="start from the autosave of "
+        "DESIGN (.DESIGN.autosave beside it; without DESIGN, in the user's data "
+        "folder) when it is newer than DESIGN, instead of asking in the browser",
+    )
     edit.set_defaults(run=cmd_edit)
     return parser
 
