@@ -249,6 +249,95 @@ class _JointAssembly:
         """The parent of every joint (-1 for the root)."""
         return list(range(-1, len(self._joints) - 1))
 
+    def _parent_of(self, j: int) -> int:
+        """The parent of joint j > 0 (a chain: j - 1)."""
+        return j - 1
+
+    def _children_of(self, j: int) -> list[int]:
+        """The children of joint j (a chain: j + 1, if there is one)."""
+        return [j + 1] if j + 1 < len(self._joints) else []
+
+    def _subtree(self, j: int) -> list[int]:
+        """j and every joint that moves with it, in index order (a chain: j to the end)."""
+        return list(range(j, len(self._joints)))
+
+    # --- edits shared by chains and trees (docs/theory/chain.md §5, docs/trees.md) -------------
+    def _moved(self, j: int, T: np.ndarray, propagate: bool):
+        """New joint and link lists with joint j moved by world transform T: with propagation
+        its subtree moves along and only the link into j is re-solved; without, the links into
+        j and to its children are re-solved."""
+        joints = list(self._joints)
+        links = list(self._links)
+        joints[j] = joints[j].transformed(T)
+        if propagate:
+            for k in self._subtree(j)[1:]:
+                joints[k] = joints[k].transformed(T)
+                links[k] = links[k].transformed(T)
+        else:
+            for k in self._children_of(j):
+                links[k] = self._link(joints[j], joints[k])
+        if j > 0:
+            links[j] = self._link(joints[self._parent_of(j)], joints[j])
+        else:
+            links[0] = links[0].transformed(T)
+        return joints, links
+
+    def transformJoint(
+        self,
+        jointIndex: int,
+        Transformation,
+        propogate: bool = _PROPAGATE_DEFAULT,
+        *,
+        propagate: bool | None = None,
+    ) -> bool:
+        """Move joint ``jointIndex`` by the world transform ``Transformation``.
+
+        With propagation everything after it moves with it (a chain: every later joint; a
+        tree: its subtree) and only the link into the joint is re-solved; without, only this
+        joint moves (the link into it and the links to its children are re-solved). Returns
+        True, or False with a PlacementWarning (nothing changed) when a link cannot be built.
+        The translation of ``Transformation`` lies within +-1e6 r (InvalidParameterError
+        otherwise).
+        """
+        j = self._index(jointIndex)
+        T = pose_array(Transformation, "Transformation", r=self.r)
+        prop = _propagate_flag(propogate, propagate)
+        return self._try_edit("transformJoint", lambda: self._moved(j, T, prop))
+
+    def _axis_edit(
+        self, what: str, jointIndex, T_of_joint, propogate, propagate, applyToPreviousWaypoint
+    ) -> bool:
+        """Move joint ``jointIndex`` by ``T_of_joint(joint)``; with applyToPreviousWaypoint a
+        Waypoint parent moves too, when j is its only child (otherwise j's siblings would)."""
+        j = self._index(jointIndex)
+        prop = _propagate_flag(propogate, propagate)
+        applyToPreviousWaypoint = check_bool("applyToPreviousWaypoint", applyToPreviousWaypoint)
+        T = T_of_joint(self._joints[j])
+        w = self._parent_of(j) if j > 0 else -1
+        if (
+            applyToPreviousWaypoint
+            and w >= 0
+            and isinstance(self._joints[w], Waypoint)
+            and self._children_of(w) == [j]
+        ):
+            if prop:
+                return self._try_edit(what, lambda: self._moved(w, T, True))
+
+            def both():
+                joints = list(self._joints)
+                joints[w] = joints[w].transformed(T)
+                joints[j] = joints[j].transformed(T)
+                links = list(self._links)
+                for k in [w, j, *self._children_of(j)]:
+                    if k == 0:
+                        links[0] = links[0].transformed(T)
+                    else:
+                        links[k] = self._link(joints[self._parent_of(k)], joints[k])
+                return joints, links
+
+            return self._try_edit(what, both)
+        return self._try_edit(what, lambda: self._moved(j, T, prop))
+
     # --- placement ----------------------------------------------------------------------------
     def _place(
         self, what: str, p: int, newJoint: Joint, relative, safe, fixedPosition, fixedOrientation
@@ -592,7 +681,7 @@ class KinematicChain(_JointAssembly):
     @property
     def Parents(self) -> tuple[int, ...]:
         """Parent index of every joint (-1 for the root)."""
-        return tuple(range(-1, len(self._joints) - 1))
+        return tuple(self._parent_list())
 
     def __repr__(self) -> str:
         kinds = ", ".join(type(j).__name__ for j in self._joints)
@@ -629,73 +718,6 @@ class KinematicChain(_JointAssembly):
         )  # fmt: skip
 
     # --- edits ---------------------------------------------------------------------------------
-    def _moved(self, j: int, T: np.ndarray, propagate: bool):
-        """New joint and link lists with joint j moved by world transform T.
-
-        See docs/theory/chain.md §5.
-        """
-        joints = list(self._joints)
-        links = list(self._links)
-        joints[j] = joints[j].transformed(T)
-        if propagate:
-            for k in range(j + 1, len(joints)):
-                joints[k] = joints[k].transformed(T)
-                links[k] = links[k].transformed(T)
-        elif j + 1 < len(joints):
-            links[j + 1] = self._link(joints[j], joints[j + 1])
-        if j > 0:
-            links[j] = self._link(joints[j - 1], joints[j])
-        else:
-            links[0] = links[0].transformed(T)
-        return joints, links
-
-    def transformJoint(
-        self,
-        jointIndex: int,
-        Transformation,
-        propogate: bool = _PROPAGATE_DEFAULT,
-        *,
-        propagate: bool | None = None,
-    ) -> bool:
-        """Move joint ``jointIndex`` by the world transform ``Transformation``.
-
-        With propagation every later joint moves with it (only the link into the joint is
-        re-solved); without, only this joint moves (its two links are re-solved). Returns True,
-        or False with a PlacementWarning (chain unchanged) when a link cannot be built. The
-        translation of ``Transformation`` lies within +-1e6 r (InvalidParameterError otherwise).
-        """
-        j = self._index(jointIndex)
-        T = pose_array(Transformation, "Transformation", r=self.r)
-        prop = _propagate_flag(propogate, propagate)
-        return self._try_edit("transformJoint", lambda: self._moved(j, T, prop))
-
-    def _axis_edit(
-        self, what: str, jointIndex, T_of_joint, propogate, propagate, applyToPreviousWaypoint
-    ) -> bool:
-        j = self._index(jointIndex)
-        prop = _propagate_flag(propogate, propagate)
-        applyToPreviousWaypoint = check_bool("applyToPreviousWaypoint", applyToPreviousWaypoint)
-        T = T_of_joint(self._joints[j])
-        if applyToPreviousWaypoint and j > 0 and isinstance(self._joints[j - 1], Waypoint):
-            w = j - 1
-            if prop:
-                return self._try_edit(what, lambda: self._moved(w, T, True))
-
-            def both():
-                joints = list(self._joints)
-                links = list(self._links)
-                joints[w] = joints[w].transformed(T)
-                joints[j] = joints[j].transformed(T)
-                for k in (w, j, j + 1):
-                    if k == 0:
-                        links[0] = links[0].transformed(T)
-                    elif k < len(joints):
-                        links[k] = self._link(joints[k - 1], joints[k])
-                return joints, links
-
-            return self._try_edit(what, both)
-        return self._try_edit(what, lambda: self._moved(j, T, prop))
-
     def delete(self, jointIndex: int) -> bool:
         """Remove joint ``jointIndex`` and join its neighbours by a new link.
 

@@ -20,10 +20,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from kinegami.bodies import link_polyline, tree_worst_overlap
-from kinegami.chain import _PROPAGATE_DEFAULT, RADIAL_VARIANTS, _JointAssembly, _propagate_flag
+from kinegami.chain import RADIAL_VARIANTS, _JointAssembly
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
-from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube, pose_array
-from kinegami.validation import check_bool, check_real
+from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube
+from kinegami.validation import check_real
 
 __all__ = ["KinematicTree"]
 
@@ -215,6 +215,9 @@ class KinematicTree(_JointAssembly):
     def _children_of(self, j: int) -> list[int]:
         return [k for k, p in enumerate(self._parents) if p == j]
 
+    def _parent_of(self, j: int) -> int:
+        return self._parents[j]
+
     # --- building ----------------------------------------------------------------------------
     def addJoint(
         self,
@@ -246,77 +249,6 @@ class KinematicTree(_JointAssembly):
                            fixedOrientation)  # fmt: skip
 
     # --- edits ---------------------------------------------------------------------------------
-    def _moved(self, j: int, T: np.ndarray, propagate: bool, joints=None, links=None):
-        """New joint and link lists with joint j moved by world transform T (docs/trees.md)."""
-        joints = list(self._joints) if joints is None else joints
-        links = list(self._links) if links is None else links
-        joints[j] = joints[j].transformed(T)
-        if propagate:
-            for k in self._subtree(j)[1:]:
-                joints[k] = joints[k].transformed(T)
-                links[k] = links[k].transformed(T)
-        else:
-            for k in self._children_of(j):
-                links[k] = self._link(joints[j], joints[k])
-        if j > 0:
-            links[j] = self._link(joints[self._parents[j]], joints[j])
-        else:
-            links[0] = links[0].transformed(T)
-        return joints, links
-
-    def transformJoint(
-        self,
-        jointIndex: int,
-        Transformation,
-        propogate: bool = _PROPAGATE_DEFAULT,
-        *,
-        propagate: bool | None = None,
-    ) -> bool:
-        """Move joint ``jointIndex`` by the world transform ``Transformation``.
-
-        With propagation its whole subtree moves with it (only the link into the joint is
-        re-solved); without, only this joint moves (the link into it and the links to its
-        children are re-solved). Returns True, or False with a PlacementWarning (tree
-        unchanged) when a link cannot be built.
-        """
-        j = self._index(jointIndex)
-        T = pose_array(Transformation, "Transformation", r=self.r)
-        prop = _propagate_flag(propogate, propagate)
-        return self._try_edit("transformJoint", lambda: self._moved(j, T, prop))
-
-    def _axis_edit(self, what, jointIndex, T_of_joint, propogate, propagate,
-                   applyToPreviousWaypoint) -> bool:  # fmt: skip
-        j = self._index(jointIndex)
-        prop = _propagate_flag(propogate, propagate)
-        applyToPreviousWaypoint = check_bool("applyToPreviousWaypoint", applyToPreviousWaypoint)
-        T = T_of_joint(self._joints[j])
-        w = self._parents[j] if j > 0 else -1
-        # the previous waypoint is the parent, and only when j is its only child (moving it
-        # would otherwise move j's siblings too)
-        if (
-            applyToPreviousWaypoint
-            and w >= 0
-            and isinstance(self._joints[w], Waypoint)
-            and self._children_of(w) == [j]
-        ):
-            if prop:
-                return self._try_edit(what, lambda: self._moved(w, T, True))
-
-            def both():
-                joints = list(self._joints)
-                joints[w] = joints[w].transformed(T)
-                joints[j] = joints[j].transformed(T)
-                links = list(self._links)
-                for k in [w, j, *self._children_of(j)]:
-                    if k == 0:
-                        links[0] = links[0].transformed(T)
-                    else:
-                        links[k] = self._link(joints[self._parents[k]], joints[k])
-                return joints, links
-
-            return self._try_edit(what, both)
-        return self._try_edit(what, lambda: self._moved(j, T, prop))
-
     def delete(self, jointIndex: int) -> bool:
         """Remove joint ``jointIndex`` and link its children to its parent.
 
