@@ -611,11 +611,17 @@ def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overla
     if i.size == 0:
         return None
     dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
+    return _deepest(i, j, dist, s, t, rows, joints, names, r)
+
+
+def _deepest(i, j, dist, s, t, rows, joints, names, r: float) -> Overlap | None:
+    """The Overlap of the closest of the candidate pairs (row indices i, j at distance
+    ``dist``, curve parameters s, t), or None when even it is clear (a contact within
+    CONTACT_TOLERANCE r counts as clear)."""
     k = int(np.argmin(dist))
     worst = float(dist[k]) - 2.0 * r
     if worst >= -CONTACT_TOLERANCE * r:
         return None
-
     first_row, second_row = rows[int(i[k])], rows[int(j[k])]
     return Overlap(worst, part_label(first_row, float(s[k]), joints, names),
                    part_label(second_row, float(t[k]), joints, names),
@@ -914,14 +920,7 @@ def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int 
     if found is None:
         return None
     i, j, dist, s, t, rows, _, _ = found
-    k = int(np.argmin(dist))
-    worst = float(dist[k]) - 2.0 * r
-    if worst >= -CONTACT_TOLERANCE * r:
-        return None
-    first_row, second_row = rows[int(i[k])], rows[int(j[k])]
-    return Overlap(worst, part_label(first_row, float(s[k]), joints, names),
-                   part_label(second_row, float(t[k]), joints, names),
-                   (int(first_row[5]), int(second_row[5])))  # fmt: skip
+    return _deepest(i, j, dist, s, t, rows, joints, names, r)
 
 
 def part_label(row, param: float, joints, names=None) -> str:

@@ -449,10 +449,26 @@ def _importable(module: str) -> bool:
     return True
 
 
+def _open_staging(command: str, out: Path):
+    """The staging folder of a build into ``out`` (kinegami.export.publish): the files go there
+    and are published as one transaction; a note says when a build killed earlier was
+    recovered first."""
+    from kinegami.export.publish import open_staging
+
+    try:
+        staging = open_staging(out)
+    except OSError as error:
+        if isinstance(error, KinegamiError):
+            raise
+        raise CommandError(f"-o: cannot write in {str(out)!r}: {error.strerror}") from None
+    if staging.note:
+        _note(command, staging.note)
+    return staging
+
+
 def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> int:
     """``kinegami build`` of a tree: a sheet per leaf, the junction connectors and the whole
     tree (kinegami.export.tree_build), published as one transaction."""
-    from kinegami.export.publish import open_staging
     from kinegami.export.tree_build import write_tree_files
     from kinegami.tree.sheets import fabricate, fit_junctions
 
@@ -480,15 +496,8 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
         _warn(args.command, f"{args.design} self-intersects at its states: {first.first} and "
                             f"{first.second} overlap (the files are written all the same; "
                             "'kinegami check' lists every pair)")  # fmt: skip
+    staging = _open_staging(args.command, out)
     try:
-        staging = open_staging(out)
-    except OSError as error:
-        if isinstance(error, KinegamiError):
-            raise
-        raise CommandError(f"-o: cannot write in {str(out)!r}: {error.strerror}") from None
-    try:
-        if staging.note:
-            _note(args.command, staging.note)
         try:
             data = [f for f in formats if f != "png"]
             write_tree_files(
@@ -531,17 +540,8 @@ def cmd_build(args: argparse.Namespace) -> int:
     # write everything into a hidden staging folder in the target, then publish it as one
     # transaction (kinegami.export.publish): a failure or an interrupt leaves the folder as
     # it was, and a build killed earlier is recovered first
-    from kinegami.export.publish import open_staging
-
+    staging = _open_staging(args.command, out)
     try:
-        staging = open_staging(out)
-    except OSError as error:
-        if isinstance(error, KinegamiError):
-            raise
-        raise CommandError(f"-o: cannot write in {str(out)!r}: {error.strerror}") from None
-    try:
-        if staging.note:
-            _note(args.command, staging.note)
         for fmt in formats:
             try:
                 fmt.write(job, [staging.new / f"{stem}{suffix}" for suffix in fmt.suffixes])
