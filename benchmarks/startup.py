@@ -1,5 +1,7 @@
 """Start-up costs, each measured in fresh Python processes: what a user waits for once.
 
+* the first ``creasePattern()`` of a 32-joint compact chain, including the pattern modules it
+  imports (the chain is built first, untimed);
 * the first DXF save of a 32-joint compact chain's crease pattern, including every import it
   pays (the chain and its pattern are built first, untimed);
 * ``kinegami validate examples/designs/example1.json``, the whole process;
@@ -36,6 +38,16 @@ with tempfile.TemporaryDirectory() as folder:
     t0 = time.perf_counter()
     pattern.save(dxfName=folder + "/chain.dxf")
     print(time.perf_counter() - t0)
+"""
+
+_FIRST_PATTERN = """
+import sys, time
+sys.path.insert(0, {benchmarks!r})
+from run import compact_chain
+chain = compact_chain()
+t0 = time.perf_counter()
+chain.creasePattern()
+print(time.perf_counter() - t0)
 """
 
 _IMPORT = """
@@ -82,12 +94,16 @@ def rows(repeat: int = REPEAT) -> list[tuple[str, str, str]]:
     """(measurement, result, goal) rows of the start-up costs (fresh processes)."""
     with tempfile.TemporaryDirectory(prefix="kinegami-pycache-") as cache:
         env = _environment(cache)
+        code = _FIRST_PATTERN.format(benchmarks=str(ROOT / "benchmarks"))
+        first_pattern = _median(lambda: _reported(code, env), repeat)
         code = _FIRST_DXF_SAVE.format(benchmarks=str(ROOT / "benchmarks"))
         first_save = _median(lambda: _reported(code, env), repeat)
         validate = [*_kinegami_command(), "validate", str(EXAMPLE)]
         validate_time = _median(lambda: _process(validate, env), repeat)
         import_time = _median(lambda: _reported(_IMPORT, env), repeat)
     return [
+        ("first creasePattern() in a fresh process, 32-joint compact chain (with its imports)",
+         f"{first_pattern * 1e3:.1f} ms", "<= 8.2 ms (10x the reference's 82 ms)"),
         ("first DXF save in a fresh process, 32-joint compact chain (with its imports)",
          f"{first_save * 1e3:.1f} ms", "<= 35 ms (10x the reference's 352 ms)"),
         ("kinegami validate example1.json, whole process", f"{validate_time:.2f} s", "<= 0.5 s"),

@@ -13,8 +13,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -51,8 +50,7 @@ def identity_unsnapped(prism: Prism, catalog: TubularPattern, params: Mapping[st
     return catalog, np.arange(catalog.numVertices)
 
 
-@dataclass(frozen=True, eq=False)
-class ModuleKind:
+class ModuleKind(NamedTuple):
     """The catalog entry of one module kind.
 
     Attributes

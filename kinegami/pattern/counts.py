@@ -8,7 +8,7 @@ compare a pattern with them.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from kinegami.pattern._prism import Prism
 from kinegami.pattern.tubular import ModuleRecord
@@ -16,8 +16,7 @@ from kinegami.pattern.tubular import ModuleRecord
 __all__ = ["ModuleCounts", "expected_counts"]
 
 
-@dataclass(frozen=True)
-class ModuleCounts:
+class ModuleCounts(NamedTuple):
     """Expected numbers of vertices, creases and (when known) mountain creases."""
 
     numVertices: int

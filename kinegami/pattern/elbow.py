@@ -6,7 +6,7 @@ See docs/theory/patterns.md 3.3; the fixes B6 and B9 are in its §6.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -34,8 +34,7 @@ __all__ = ["ELBOW_ANGLE_TOL", "ElbowFittingPattern", "ElbowGeometry", "elbow_geo
 ELBOW_ANGLE_TOL = 1e-6
 
 
-@dataclass(frozen=True)
-class ElbowGeometry:
+class ElbowGeometry(NamedTuple):
     """Derived quantities of an elbow (section 3.3); lengths in units of r, angles in radians.
 
     Attributes

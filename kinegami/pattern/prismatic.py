@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -36,8 +36,7 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True)
-class REBOGeometry:
+class REBOGeometry(NamedTuple):
     """Derived quantities of a REBO (section 3.7); lengths in units of r, angles in radians.
 
     Attributes

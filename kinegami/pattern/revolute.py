@@ -6,7 +6,7 @@ See docs/theory/patterns.md 3.4-3.6.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -28,8 +28,7 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True)
-class RevoluteGeometry:
+class RevoluteGeometry(NamedTuple):
     """Derived quantities of a revolute joint or tip (sections 3.4, 3.6); lengths in units of r.
 
     Attributes

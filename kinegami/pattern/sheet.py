@@ -32,8 +32,7 @@ Everything is in pattern units (the unit of the tube radius r); exporters scale 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -63,8 +62,7 @@ TOLERANCE_FACTOR = 1e-9
 _KIND_DTYPE = np.dtype("<U1")
 
 
-@dataclass(frozen=True, eq=False)
-class Sheet:
+class Sheet(NamedTuple):
     """The lines drawn on the flat sheet of a tubular pattern (docs/fabrication.md).
 
     Attributes

@@ -15,12 +15,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.errors import InvalidParameterError, InvalidTypeError, ReadOnlyError
 from kinegami.pattern._prism import EPS_FACTOR, make_prism, periodic_dx, wrap_scalar, wrap_x
 from kinegami.validation import check_nonnegative
 
@@ -36,6 +35,12 @@ _FROZEN_PARAMS_HELP = (
     "by every joint and link built with the same parameters, so changing it would change them "
     "all. Build a new record instead, e.g. ModuleRecord(record.kind, {**record.params, name: "
     "value}), or a new pattern from the module's constructor"
+)
+
+
+_RECORD_HELP = (
+    "a record is shared by every pattern built with the same parameters; build a new one, e.g. "
+    "ModuleRecord(record.kind, {**record.params, name: value})"
 )
 
 
@@ -87,9 +92,15 @@ class FrozenParams(Mapping):
         return (FrozenParams, (self._data,))
 
 
-@dataclass(frozen=True)
-class ModuleRecord:
+class _RecordFields(NamedTuple):
+    kind: str
+    params: Mapping[str, Any]
+
+
+class ModuleRecord(_RecordFields):
     """Which catalog module (and with which parameters) a piece of a pattern came from.
+
+    A value: read-only, equal and hashable by kind and parameters.
 
     Attributes
     ----------
@@ -103,26 +114,31 @@ class ModuleRecord:
         with the same parameters.
     """
 
-    kind: str
-    params: Mapping[str, Any] = field(default_factory=FrozenParams)
+    __slots__ = ()
 
-    def __post_init__(self) -> None:
-        if not isinstance(self.params, FrozenParams):
-            object.__setattr__(self, "params", FrozenParams(self.params))
+    def __new__(cls, kind: str, params: Mapping[str, Any] | None = None) -> ModuleRecord:
+        if not isinstance(params, FrozenParams):
+            params = FrozenParams(() if params is None else params)
+        return tuple.__new__(cls, (kind, params))
 
     @classmethod
     def _of(cls, kind: str, params: dict) -> ModuleRecord:
         """A record taking ownership of the new dict ``params`` (the builders' fast path)."""
-        self = object.__new__(cls)
         frozen = object.__new__(FrozenParams)
         object.__setattr__(frozen, "_data", params)
-        object.__setattr__(self, "kind", kind)
-        object.__setattr__(self, "params", frozen)
-        return self
+        return tuple.__new__(cls, (kind, frozen))
+
+    def __setattr__(self, name: str, value) -> None:
+        raise ReadOnlyError(f"ModuleRecord.{name} is read-only: {_RECORD_HELP}")
+
+    def __delattr__(self, name: str) -> None:
+        raise ReadOnlyError(f"ModuleRecord.{name} is read-only (not deletable): {_RECORD_HELP}")
+
+    def __reduce__(self):
+        return (ModuleRecord, (self.kind, self.params))
 
 
-@dataclass(frozen=True)
-class ValidationReport:
+class ValidationReport(NamedTuple):
     """Result of :meth:`TubularPattern.validate`: every problem found (empty when fine)."""
 
     problems: tuple[str, ...] = ()
@@ -769,8 +785,7 @@ def _check_composable(
         )
 
 
-@dataclass(frozen=True)
-class _ComposeState:
+class _ComposeState(NamedTuple):
     """What composition needs to know about the pattern built so far."""
 
     n: int
@@ -797,8 +812,7 @@ class _ComposeState:
         )
 
 
-@dataclass(frozen=True)
-class _Step:
+class _Step(NamedTuple):
     mapping: np.ndarray  # composite vertex of each of the module's vertices
     vertices: np.ndarray
     edges: np.ndarray

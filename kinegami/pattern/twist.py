@@ -6,7 +6,7 @@ See docs/theory/patterns.md 3.2.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -21,8 +21,7 @@ from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 __all__ = ["TwistFittingPattern", "TwistGeometry", "twist_geometry"]
 
 
-@dataclass(frozen=True)
-class TwistGeometry:
+class TwistGeometry(NamedTuple):
     """Derived quantities of a twist (section 3.2); lengths in units of r, angles in radians.
 
     Attributes

@@ -1,7 +1,6 @@
 """Flattening (spec/patterns.md section 5, fix B8, B10) and the periodicity check 7.5."""
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -85,7 +84,7 @@ def test_periodicity_check_finds_a_missing_copy(revolute6):
     victim = int(np.flatnonzero(right)[0])
     keep = np.ones(sheet.numLines, dtype=bool)
     keep[victim] = False
-    broken = replace(sheet, segments=sheet.segments[keep], kinds=sheet.kinds[keep])
+    broken = sheet._replace(segments=sheet.segments[keep], kinds=sheet.kinds[keep])
     problems = check_periodicity(broken)
     assert problems and any("no counterpart" in p or "pieces" in p for p in problems)
 
@@ -97,7 +96,7 @@ def test_periodicity_check_finds_a_relabelled_copy(revolute6):
     inside = (sheet.segments[:, :, 0] < b / 2 - 1e-6).all(axis=1) & np.isin(kinds, ("M", "V"))
     i = int(np.flatnonzero(inside)[0])
     kinds[i] = "V" if kinds[i] == "M" else "M"
-    broken = replace(sheet, kinds=kinds)
+    broken = sheet._replace(kinds=kinds)
     assert check_periodicity(broken)
 
 
