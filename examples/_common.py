@@ -1,12 +1,17 @@
 """What the gallery scripts share: axis poses, the output folder and the written files.
 
-The gallery scripts (``python examples/<name>.py [folder]``) build one chain each, then call
-:func:`save_outputs`, which writes into ``examples/output/<name>/`` (or the folder given on the
-command line) the 3D view ``<name>.png``, the crease pattern drawing ``<name>_pattern.png`` and
-the pattern for a laser cutter ``<name>.dxf``. Every file is written atomically (a temporary file
-in the same folder, then ``os.replace``), so an interrupted run leaves no partial file.
-``examples/make_gallery.py`` draws the gallery pictures with the same :func:`draw_chain` and
-:func:`draw_pattern`, so every picture has the same view and size.
+The gallery scripts (``python examples/<name>.py [folder]``) build one chain or tree each. A
+chain's script calls :func:`save_outputs`, which writes into ``examples/output/<name>/`` (or the
+folder given on the command line) the 3D view ``<name>.png``, the crease pattern drawing
+``<name>_pattern.png`` and the pattern for a laser cutter ``<name>.dxf``. A tree is folded from
+one sheet per leaf joined by printed junctions (:func:`tree_sheets`); its script calls
+:func:`save_tree_outputs`, which writes the 3D view ``<name>.png`` and, for every sheet k,
+``<name>_sheet_<k>_pattern.png`` and ``<name>_sheet_<k>.dxf`` (and a 3D view
+``<name>_<pose>.png`` of every named configuration it is given, such as the hand's grasps).
+Every file is written atomically (a temporary file in the same folder, then ``os.replace``), so
+an interrupted run leaves no partial file. ``examples/make_gallery.py`` draws the gallery
+pictures with the same :func:`draw_chain`, :func:`draw_tree` and :func:`draw_pattern`, so every
+picture has the same view and size.
 """
 
 from __future__ import annotations
@@ -29,6 +34,8 @@ CHAIN_DPI = 80
 VIEW = {"elev": 30.0, "azim": -60.0}
 #: Magnification of the 3D box (show() uses 1.15; the chains rarely fill the box's corners).
 ZOOM = 1.5
+#: Magnification of a tree's 3D box: branches reach into the corners (legs, fingers), so less.
+TREE_ZOOM = 1.15
 PATTERN_DPI = 80
 #: PNG text chunks: none, so that a new matplotlib version alone does not change the files.
 PNG_METADATA = {"Software": None}
@@ -88,7 +95,7 @@ def save_figure(fig, path: Path, dpi: int, tight: bool = False) -> Path:
     return write_bytes_atomic(path, buffer.getvalue())
 
 
-def draw_chain(chain):
+def draw_chain(chain, zoom: float = ZOOM):
     """The gallery's 3D view of a chain: fixed figure size and camera; returns the figure."""
     import matplotlib.pyplot as plt
 
@@ -97,8 +104,13 @@ def draw_chain(chain):
     chain.show(ax=ax, showJointPoses=False)
     ax.view_init(**VIEW)
     box = [np.ptp(limits) for limits in (ax.get_xlim3d(), ax.get_ylim3d(), ax.get_zlim3d())]
-    ax.set_box_aspect(box, zoom=ZOOM)
+    ax.set_box_aspect(box, zoom=zoom)
     return fig
+
+
+def draw_tree(tree):
+    """The gallery's 3D view of a tree: the chains' view, magnified by TREE_ZOOM."""
+    return draw_chain(tree, zoom=TREE_ZOOM)
 
 
 def draw_pattern(pattern):
@@ -142,6 +154,83 @@ def report(chain, name: str, written: list[Path], units: str = "mm") -> None:
         f"  crease pattern: {pattern.width:.1f} {units} x {pattern.height:.1f} {units}, without "
         f"the glue tab; sheet: {xmax - xmin:.1f} {units} x {ymax - ymin:.1f} {units} with it"
     )
+    print("wrote:")
+    for path in written:
+        print(f"  {path}")
+
+
+# --- trees -------------------------------------------------------------------------------------
+def tree_sheets(tree):
+    """The sheets and junctions of a tree as ``kinegami build`` makes them: first every branch
+    joint whose socket has no room on its link slides along its own axis (the kinematics stay;
+    ``kinegami.tree.sheets.fit_junctions``), then the tree is cut into one sheet per leaf.
+
+    Returns ``(fabrication, slides)``: the ``TreeFabrication`` (``.sheets``, ``.junctions``)
+    and the slides made, ``[(joint, distance), ...]`` in the tree's units.
+    """
+    from kinegami.tree.sheets import fabricate, fit_junctions
+
+    fitted, slides = fit_junctions(tree)
+    return fabricate(fitted), slides
+
+
+def save_tree_outputs(tree, name: str, folder: Path, poses=None, fabrication=None,
+                      units: str = "mm") -> list[Path]:  # fmt: skip
+    """Write ``<name>.png`` (3D), ``<name>_sheet_<k>_pattern.png`` and ``<name>_sheet_<k>.dxf``
+    for every sheet k of ``tree`` into ``folder``, and ``<name>_<pose>.png`` for every entry of
+    ``poses`` (pose name -> one state per joint; the tree is not changed).
+    ``fabrication``: the tree's sheets if already made (default: :func:`tree_sheets`);
+    ``units``: the tree's length unit, so that the DXF sheets are true size."""
+    import copy
+    import warnings
+
+    from kinegami import ClearanceWarning
+
+    folder = Path(folder)
+    if fabrication is None:
+        fabrication, _ = tree_sheets(tree)
+    written = [save_figure(draw_tree(tree), folder / f"{name}.png", CHAIN_DPI)]
+    for sheet in fabrication.sheets:
+        stem = folder / f"{name}_sheet_{sheet.index}"
+        written.append(save_figure(draw_pattern(sheet.pattern), Path(f"{stem}_pattern.png"),
+                                   PATTERN_DPI, tight=True))  # fmt: skip
+        written.append(Path(sheet.pattern.save(dxfName=Path(f"{stem}.dxf"), units=units)))
+    for pose, states in (poses or {}).items():
+        posed = copy.copy(tree)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ClearanceWarning)  # drawn as it is; checked apart
+            if not posed.setJointStates(states):
+                raise ValueError(f"pose {pose!r}: a state is outside its joint's range")
+        written.append(save_figure(draw_tree(posed), folder / f"{name}_{pose}.png", CHAIN_DPI))
+    return written
+
+
+def report_tree(tree, name: str, fabrication, slides, written: list[Path],
+                units: str = "mm") -> None:  # fmt: skip
+    """Print the tree's size and clearance, its sheets (pattern sizes without the glue tab),
+    its junctions and the slides that made room for their sockets, and the files written."""
+    leaves = sum(1 for children in tree.Children if not children)
+    print(
+        f"{name}: {len(tree.Joints)} joints, {leaves} leaves, total link length "
+        f"{tree.totalPathLength():.2f} {units}; clearance in {units}: {tree.clearance()}"
+    )
+    for sheet in fabrication.sheets:
+        start = (
+            "the root"
+            if sheet.junction is None
+            else f"junction {sheet.junction}, {sheet.start_arc:.1f} {units} along its link"
+        )
+        print(
+            f"  sheet {sheet.index}: joints {sheet.joints[0]} to {sheet.leaf}, starts at "
+            f"{start}; crease pattern {sheet.pattern.width:.1f} {units} x "
+            f"{sheet.pattern.height:.1f} {units}"
+        )  # fmt: skip
+    for junction in fabrication.junctions:
+        children = ", ".join(map(str, junction.children))
+        print(f"  junction {junction.index}: at joint {junction.joint}, children {children}, "
+              f"trunk {junction.trunk}")  # fmt: skip
+    for joint, distance in slides:
+        print(f"  joint {joint} slid {distance:+.2f} {units} along its axis (its socket's room)")
     print("wrote:")
     for path in written:
         print(f"  {path}")

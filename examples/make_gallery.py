@@ -3,10 +3,15 @@
     python examples/make_gallery.py [NAME ...] [--output FOLDER]
 
 For every design file ``examples/designs/<name>.json`` (or only the names given), this loads the
-chain with the design loader and writes, into ``docs/images/gallery/`` (or FOLDER):
+chain or tree with the design loader and writes, into ``docs/images/gallery/`` (or FOLDER):
 
-* ``<name>.png``: the 3D view of the chain, 640 x 560 pixels, the same camera for every entry;
-* ``<name>_pattern.png``: its crease pattern (valley folds red, mountain folds blue).
+* ``<name>.png``: the 3D view, 640 x 560 pixels, the same camera for every entry;
+* for a chain, ``<name>_pattern.png``: its crease pattern (valley folds red, mountain folds
+  blue);
+* for a tree, ``<name>_sheet_<k>_pattern.png``: the crease pattern of every sheet k, as
+  ``kinegami build`` cuts the tree (one sheet per leaf, branch joints slid where their junction
+  sockets need room), and ``<name>_<pose>.png``: the 3D view in every named configuration of
+  the entry's script (its ``POSES``: the hand's grasps).
 
 The pictures are reproducible byte for byte: a second run, or a run on another machine with the
 same versions of matplotlib and numpy, writes the same files (no version stamp in the PNGs, faces
@@ -21,6 +26,8 @@ written to a temporary file and then renamed).
 from __future__ import annotations
 
 import argparse
+import copy
+import importlib.util
 import sys
 import time
 import warnings
@@ -36,10 +43,12 @@ from _common import (  # noqa: E402
     PATTERN_DPI,
     draw_chain,
     draw_pattern,
+    draw_tree,
     save_figure,
+    tree_sheets,
 )
 
-from kinegami import PlacementWarning  # noqa: E402
+from kinegami import ClearanceWarning, KinematicTree, PlacementWarning  # noqa: E402
 from kinegami.design import DesignError, load_design  # noqa: E402
 
 DESIGNS = EXAMPLES / "designs"
@@ -51,11 +60,45 @@ def design_names() -> list[str]:
     return sorted(path.stem for path in DESIGNS.glob("*.json"))
 
 
+def poses_of(name: str) -> dict:
+    """The named configurations of the entry's script ``examples/<name>.py`` (its ``POSES``:
+    pose name -> one state per joint), or none."""
+    script = EXAMPLES / f"{name}.py"
+    if not script.is_file():
+        return {}
+    spec = importlib.util.spec_from_file_location(f"gallery_{name}", script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)  # the scripts only define things unless run as programs
+    return dict(getattr(module, "POSES", {}))
+
+
+def draw_tree_entry(tree: KinematicTree, name: str, folder: Path) -> list[Path]:
+    """The 3D view of a tree, every sheet's crease pattern and the script's poses."""
+    fabrication, _ = tree_sheets(tree)
+    written = [save_figure(draw_tree(tree), folder / f"{name}.png", CHAIN_DPI)]
+    for sheet in fabrication.sheets:
+        path = folder / f"{name}_sheet_{sheet.index}_pattern.png"
+        written.append(save_figure(draw_pattern(sheet.pattern), path, PATTERN_DPI, tight=True))
+    for pose, states in poses_of(name).items():
+        posed = copy.copy(tree)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PlacementWarning)  # a refused state returns False
+            moved = posed.setJointStates(states)
+        if not moved:
+            raise DesignError(f"pose {pose!r}: a state is outside its joint's range",
+                              field="POSES", file=EXAMPLES / f"{name}.py")  # fmt: skip
+        written.append(save_figure(draw_tree(posed), folder / f"{name}_{pose}.png", CHAIN_DPI))
+    return written
+
+
 def draw_entry(name: str, folder: Path) -> list[Path]:
-    """Load ``examples/designs/<name>.json`` and write its two pictures into ``folder``."""
+    """Load ``examples/designs/<name>.json`` and write its pictures into ``folder``."""
     with warnings.catch_warnings():
         warnings.simplefilter("error", PlacementWarning)
+        warnings.simplefilter("ignore", ClearanceWarning)  # the gallery states the clearance
         chain = load_design(DESIGNS / f"{name}.json")
+        if isinstance(chain, KinematicTree):
+            return draw_tree_entry(chain, name, folder)
     return [
         save_figure(draw_chain(chain), folder / f"{name}.png", CHAIN_DPI),
         save_figure(

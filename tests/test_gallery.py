@@ -58,9 +58,15 @@ ENTRIES = {
     "doubling_back": "doubling_back.py",
 }
 SCRIPTS = sorted(name for name, script in ENTRIES.items() if script)
-#: the gallery's trees (tested in tests/tree and tests/design/test_trees.py): entry -> joints,
-#: leaves, total link length (design units)
-TREE_ENTRIES = {"hand": (12, 3, 32.276748)}
+#: the gallery's trees (also tested in tests/tree, tests/design/test_trees.py and
+#: tests/cli/test_gallery_trees.py): entry -> joints, leaves, total link length (design units).
+#: Each has a script examples/<entry>.py.
+TREE_ENTRIES = {
+    "hand": (12, 3, 32.276748),
+    "algorithmic_hand": (16, 3, 754.588015),
+    "quadruped": (18, 4, 774.985756),
+    "gripper": (10, 2, 285.281991),
+}
 
 #: spec chain.md 11.5 and 11.6 (r = 1), and the PUMA 560 table of examples/puma.py.
 SCALE = 10.0  # the gallery's r (mm) for the chain.md examples
