@@ -821,7 +821,15 @@ def tree_pair_distances(
     parent_of = np.array(parents)
     before = np.where(is_link, path_links[np.maximum(parent_of[node], 0)], path_links[node])
     before = np.where(is_link & (parent_of[node] < 0), 0.0, before)
-    tau = own + before + np.where(body_a >= 0, kinks[np.maximum(body_a, 0)], 0.0)
+    # the hinges before a part: a joint's distal half (body = its own index) moves after its
+    # own hinge; everything else of node j (its link, a proximal half) after its parent's
+    # (bodies are numbered as in a chain, where the parent of j is j - 1)
+    hinges_before = np.where(
+        body_a == node,
+        kinks[node],
+        np.where(parent_of[node] >= 0, kinks[np.maximum(parent_of[node], 0)], 0.0),
+    )
+    tau = own + before + hinges_before
 
     # junctions: how far the tube to each child of a branching joint (continued through
     # waypoints with one child, which add no part) runs with its siblings

@@ -833,11 +833,6 @@ def cmd_check(args: argparse.Namespace) -> int:
     seed = _integer("--seed", args.seed, 0)
     chain, info = _load(args.design)
     names = _joint_names(chain)
-    if _is_tree(chain) and samples is not None:
-        raise CommandError(
-            "--motion: the range-of-motion sweep handles chains only; "
-            "'kinegami check' without --motion checks a tree at its states"
-        )
     report = _clearance(chain)
     motion = None if samples is None else sweep(chain, samples, seed, names=names)
     if args.json:

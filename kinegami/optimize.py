@@ -681,8 +681,9 @@ def compact(
     motion = check_bool("motion", motion)
     if motion and isinstance(chain, KinematicTree):
         raise InvalidParameterError(
-            "motion=True is available for chains only (the range-of-motion sweep does not "
-            "handle trees yet); compact the tree at its current states with motion=False"
+            "motion=True is available for chains only (a tree's configurations are tested one "
+            "at a time, too slowly to sweep every candidate); compact the tree with "
+            "motion=False, then check its motion with kinegami.clearance.sweep"
         )
     _check_executor(executor)
     if time_limit is not None:
