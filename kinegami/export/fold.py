@@ -145,7 +145,10 @@ def sheet_graph(pattern_or_chain, *, folded: bool = True, frame=None, twistPorti
 
     Parameters
     ----------
-    pattern_or_chain : TubularPattern or KinematicChain
+    pattern_or_chain : TubularPattern, CutPattern or KinematicChain
+        A :class:`~kinegami.pattern.cutout.CutPattern` (a sheet with take-off holes or a skirt)
+        is cut as :mod:`kinegami.export._cut_graph` says; its folded form starts at its
+        ``frame`` unless ``frame`` is given.
     folded : bool, optional
         Also compute the folded 3D position of every sheet vertex (default True).
     frame, twistPortion
@@ -161,8 +164,13 @@ def sheet_graph(pattern_or_chain, *, folded: bool = True, frame=None, twistPorti
         If the sheet has zero area, or its creases cross or overlap so that the faces do not
         tile the sheet.
     """
+    from kinegami.pattern.cutout import CutPattern
     from kinegami.pattern.folded import _resolve_input, unsnapped_form
 
+    if isinstance(pattern_or_chain, CutPattern):  # a sheet with take-off holes or a skirt
+        from kinegami.export._cut_graph import cut_sheet_graph
+
+        return cut_sheet_graph(pattern_or_chain, folded=folded, frame=frame)
     pattern, base = _resolve_input(pattern_or_chain, twistPortion)
     if not pattern.modules and not folded:  # a hand-made pattern: its own geometry
         return _build_graph(pattern, None)
@@ -493,12 +501,13 @@ def _signed_area(poly: np.ndarray) -> float:
     return 0.5 * float(np.dot(x[:-1], y[1:]) - np.dot(y[:-1], x[1:]))
 
 
-def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float):
+def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float | None):
     """Faces of the planar straight-line graph (P, E): counter-clockwise vertex cycles.
 
     Half-edge h = 2i goes E[i, 0] -> E[i, 1], h = 2i + 1 the other way. Around each vertex the
     outgoing half-edges are sorted by angle; the face to the left of u -> v continues with the
-    outgoing half-edge of v just clockwise of v -> u.
+    outgoing half-edge of v just clockwise of v -> u. The faces must cover ``sheet_area``
+    (None: the area inside the one boundary loop, for a sheet that is no rectangle).
     """
     m = E.shape[0]
     tail = np.empty(2 * m, dtype=np.intp)
@@ -542,7 +551,9 @@ def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float):
     problems = []
     if len(outer) != 1:
         problems.append(f"{len(outer)} boundary loops (expected 1: creases not connected)")
-    if not math.isclose(total, sheet_area, rel_tol=1e-9):
+    elif sheet_area is None:
+        sheet_area = -_signed_area(P[outer[0]])
+    if sheet_area is not None and not math.isclose(total, sheet_area, rel_tol=1e-9):
         problems.append(f"faces cover {total!r} instead of the sheet area {sheet_area!r}")
     repeated = sum(1 for f in faces if np.unique(f).size != f.size)
     if repeated:

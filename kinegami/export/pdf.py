@@ -251,9 +251,10 @@ def pdf_layout(pattern: TubularPattern, **options: Any) -> PdfLayout:
         For an unknown option or a bad value, a page too small for its margins, or more
         pages than ``max_pages``.
     """
+    from kinegami.pattern.cutout import CutPattern
     from kinegami.pattern.tubular import TubularPattern
 
-    if not isinstance(pattern, TubularPattern):
+    if not isinstance(pattern, TubularPattern | CutPattern):
         raise InvalidTypeError(f"pattern must be a TubularPattern, got {type(pattern).__name__}")
     opts = resolve_sheet_options(options, PDF_DEFAULTS, "PDF")
     extra = opts.extra

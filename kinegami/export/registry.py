@@ -355,6 +355,10 @@ def _subject(obj: Any, fmt: ExportFormat, options: dict[str, Any]) -> Any:
             "pattern (kinegami.tree.sheets.fabricate(tree).sheets[k].pattern)"
         )
     if not isinstance(obj, KinematicChain | TubularPattern):
+        from kinegami.pattern.cutout import CutPattern
+
+        if isinstance(obj, CutPattern):  # a tree's sheet with take-off holes or a skirt
+            return obj
         raise InvalidTypeError(
             f"{fmt.suffix} files are made from a TubularPattern or a KinematicChain, got "
             f"{type(obj).__name__}"

@@ -169,8 +169,10 @@ def flatten(pattern: TubularPattern, *, skip_creases_on_cut: bool = False) -> Sh
 
     Parameters
     ----------
-    pattern : TubularPattern
-        The pattern (a module or a whole chain).
+    pattern : TubularPattern or CutPattern
+        The pattern (a module or a whole chain); a
+        :class:`~kinegami.pattern.cutout.CutPattern` (a sheet with take-off holes or a skirt)
+        is drawn by :func:`~kinegami.pattern.cutout.flatten_cut`.
     skip_creases_on_cut : bool, optional
         Drop the crease pieces lying on the top or bottom edge of the sheet (y = y0 or
         y = y0 + H; B10). Default False: keep them, as the reference does.
@@ -191,6 +193,10 @@ def flatten(pattern: TubularPattern, *, skip_creases_on_cut: bool = False) -> Sh
     from kinegami.pattern.tubular import TubularPattern
 
     if not isinstance(pattern, TubularPattern):
+        from kinegami.pattern.cutout import CutPattern, flatten_cut
+
+        if isinstance(pattern, CutPattern):  # a sheet with take-off holes or a skirt
+            return flatten_cut(pattern, skip_creases_on_cut=skip_creases_on_cut)
         raise InvalidTypeError(f"pattern must be a TubularPattern, got {type(pattern).__name__}")
     skip_creases_on_cut = check_bool("skip_creases_on_cut", skip_creases_on_cut)
     W, b = pattern.width, pattern.sideLength

@@ -870,8 +870,10 @@ def _skirt_counts(prism: Prism, params) -> ModuleCounts:
     return ModuleCounts(fm.shape[0] + columns, columns + hinges, columns)
 
 
-#: The catalog entry of the skirt (not registered here: ``catalog.register(SKIRT_KIND)`` makes
-#: the folded form and validate() know the kind). It folds as a straight tube.
-SKIRT_KIND = catalog.ModuleKind(
-    "takeoff_skirt", TakeoffSkirtPattern, ("stubLength",), _skirt_counts, fold_straight
+#: The catalog entry of the skirt (registered on import, so that the folded form and
+#: validate() of a branch sheet know the kind). It folds as a straight tube.
+SKIRT_KIND = catalog.register(
+    catalog.ModuleKind(
+        "takeoff_skirt", TakeoffSkirtPattern, ("stubLength",), _skirt_counts, fold_straight
+    )
 )

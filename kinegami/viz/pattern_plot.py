@@ -133,10 +133,11 @@ def show_pattern(pattern: TubularPattern, **options: Any) -> tuple[Figure, Axes]
     >>> fig, ax = show_pattern(RevoluteJointPattern(6, 1.0, np.pi))  # doctest: +SKIP
     >>> fig.savefig("revolute.png")  # doctest: +SKIP
     """
+    from kinegami.pattern.cutout import CutPattern
     from kinegami.pattern.sheet import flatten
     from kinegami.pattern.tubular import TubularPattern
 
-    if not isinstance(pattern, TubularPattern):
+    if not isinstance(pattern, TubularPattern | CutPattern):
         raise InvalidTypeError(f"pattern must be a TubularPattern, got {type(pattern).__name__}")
     opts = _resolve_options(options)
     import matplotlib.pyplot as plt
