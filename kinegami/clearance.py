@@ -616,11 +616,12 @@ def sweep(
         The colliding fraction, the worst pairs, and each joint's free interval around the
         chain's current states.
     """
-    from kinegami.tree.model import KinematicTree
+    from kinegami.chain import KinematicChain, _JointAssembly
 
-    engine = (
-        TreeMotion(chain, names) if isinstance(chain, KinematicTree) else engine_for(chain, names)
-    )
+    if isinstance(chain, _JointAssembly) and not isinstance(chain, KinematicChain):
+        engine = TreeMotion(chain, names)  # a KinematicTree (a layer above this one)
+    else:
+        engine = engine_for(chain, names)
     if isinstance(resolution, bool) or not isinstance(resolution, int | np.integer):
         raise InvalidTypeError(f"resolution must be an integer >= 1, got {resolution!r}")
     if resolution < 1:
