@@ -156,16 +156,16 @@ class CutRegions:
     def classify(self, points: np.ndarray) -> np.ndarray:
         """What lies at each point: ``"P"`` paper of the tube, ``"T"`` paper of a glue tab,
         ``"H"`` cut away (a hole, or below the fish-mouth outside the tabs), ``"O"`` outside the
-        pattern's sheet."""
+        pattern's sheet (always beyond the strip -b/2 < x < W + b/2)."""
         points = np.asarray(points, dtype=float).reshape(-1, 2)
         xmin, ymin, xmax, ymax = self.bounds
         x, y = points[:, 0], points[:, 1]
-        inside = (x > xmin) & (x < xmax) & (y > ymin) & (y < ymax)
+        strip = (x > xmin) & (x < xmax)
+        inside = strip & (y > ymin) & (y < ymax)
         out = np.where(inside, "P", "O").astype("<U1")
-        below = y < self.mouth_height(x)
-        out[inside & below] = "H"
-        out[self.in_hole(points)] = "H"
-        out[self.tab_index(points) >= 0] = "T"
+        out[inside & (y < self.mouth_height(x))] = "H"
+        out[strip & self.in_hole(points)] = "H"
+        out[strip & (self.tab_index(points) >= 0)] = "T"
         return out
 
     # --- the cut lines ---------------------------------------------------------------------

@@ -1,9 +1,10 @@
-"""How a tree is made: sheets and printed junctions (docs/trees.md).
+"""How a tree is made: sheets, printed junctions and folded take-offs (docs/trees.md,
+docs/junctions.md).
 
-A tree is folded from several sheets joined by printed connectors. At every joint with k >= 2
-children one child, the *trunk*, continues the joint's sheet; each of the other k - 1 starts a
-sheet of its own at a junction. Every sheet therefore ends at exactly one leaf and every leaf
-ends one sheet: a tree has as many sheets as leaves.
+A tree is folded from several sheets joined by printed connectors or by folded take-off
+junctions. At every joint with k >= 2 children one child, the *trunk*, continues the joint's
+sheet; each of the other k - 1 starts a sheet of its own at a junction. Every sheet therefore
+ends at exactly one leaf and every leaf ends one sheet: a tree has as many sheets as leaves.
 
 * **Trunk rule.** By default the trunk is the child whose longest path to a leaf (links plus
   joints) is longest (ties: the smaller index), unless the socket of one other child does not
@@ -17,9 +18,15 @@ ends one sheet: a tree has as many sheets as leaves.
   its socket, on its link: its first modules are the rest of that link (the same CSC path from
   there on), then its joint, and so on to its leaf. The trunk's tube runs through the
   connector's sleeve, so the trunk's sheet simply continues.
+* **Folded take-offs** (``junction="takeoff"``): no connector; each side branch leaves a face of
+  the trunk's link (its plain tube part) at right angles (:mod:`kinegami.tree.takeoffs`). The
+  trunk's sheet gets a hole there; the branch's sheet starts with a skirt cut to the trunk's
+  shape, with glue tabs that fold in and are glued inside the trunk around the hole, then a new
+  link to the branch child (the joints stay where they are).
 
-Each sheet is an ordinary chain crease pattern (a :class:`~kinegami.pattern.TubularPattern`):
-everything that exports or folds a chain's pattern exports or folds a sheet.
+Each sheet is a chain crease pattern (a :class:`~kinegami.pattern.TubularPattern`), or, with
+take-offs, one with cut-outs (a :class:`~kinegami.pattern.cutout.CutPattern`): everything that
+exports or folds a chain's pattern exports or folds a sheet.
 """
 
 from __future__ import annotations
@@ -32,13 +39,24 @@ import numpy as np
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.links import LinkCSC
 from kinegami.pattern import TubularPattern
+from kinegami.pattern.cutout import CutPattern, SheetHole
 from kinegami.tree.connector import ConnectorOptions, JunctionSocket, junction_sockets
 from kinegami.tree.model import KinematicTree
+from kinegami.tree.takeoffs import (
+    JUNCTION_KINDS,
+    Takeoff,
+    TakeoffOptions,
+    hole_name,
+    place_takeoffs,
+)
 from kinegami.validation import check_twist_portion
 
 __all__ = [
     "TreeSheet",
     "Junction",
+    "Takeoff",
+    "TakeoffOptions",
+    "JUNCTION_KINDS",
     "TreeFabrication",
     "fabricate",
     "default_trunks",
@@ -80,10 +98,18 @@ class TreeSheet:
     ----------
     index : the sheet's number k (files ``<stem>_sheet_<k>``).
     joints : the tree joints the sheet carries, root end first, ending at its leaf.
-    junction : the :class:`Junction` number it starts at, or None (sheet 0 starts at the root).
+    junction : the :class:`Junction` (printed connector) number it starts at, or None (sheet 0
+        starts at the root; a take-off sheet at its take-off).
     start_arc : where on its first link the sheet starts (arc length from the junction, units of
-        r; 0 for sheet 0).
-    pattern : the sheet's crease pattern.
+        r; 0 for sheet 0 and for take-off sheets).
+    pattern : the sheet's crease pattern: a TubularPattern, or a CutPattern when the sheet has
+        take-off holes or starts with a skirt.
+    frame : world Dubins frame (4x4) where the sheet's pattern starts: its folded form lies on
+        the tree from there.
+    takeoff : the name of the :class:`~kinegami.tree.takeoffs.Takeoff` it starts at, or None.
+    takeoff_sheet : the sheet holding that take-off's hole, or None.
+    holes : ``(name, branch sheet)`` of every take-off hole in this sheet.
+    tabs : number of glue tabs of its skirt (0 without one).
     """
 
     index: int
@@ -91,6 +117,11 @@ class TreeSheet:
     junction: int | None
     start_arc: float
     pattern: object = field(repr=False)
+    frame: np.ndarray | None = field(default=None, repr=False, compare=False)
+    takeoff: str | None = None
+    takeoff_sheet: int | None = None
+    holes: tuple[tuple[str, int], ...] = ()
+    tabs: int = 0
 
     @property
     def leaf(self) -> int:
@@ -112,23 +143,58 @@ class TreeSheet:
             return str(k)
 
         span = f"joints {joint(self.joints[0])} to {joint(self.leaf)}"
-        if self.junction is None:
+        if self.takeoff is not None:
+            start = (f"starts at take-off {self.takeoff} (joint "
+                     f"{joint(tree.Parents[self.joints[0]])}): fold its {self.tabs} skirt tabs in "
+                     f"and glue them inside hole {self.takeoff} of sheet {self.takeoff_sheet}"
+                     )  # fmt: skip
+        elif self.junction is None:
             start = "starts at the root"
         else:
             start = (f"starts in junction {self.junction} (at joint "
                      f"{joint(tree.Parents[self.joints[0]])}), {length(self.start_arc)} along "
                      "its link")  # fmt: skip
-        return f"{self.name}: {span}; {start}; glue the tab along the long edge"
+        holes = ""
+        if self.holes:
+            holes = "; cut out " + ", ".join(f"hole {name} (sheet {k}'s skirt glues in)"
+                                             for name, k in self.holes)  # fmt: skip
+        return f"{self.name}: {span}; {start}{holes}; glue the tab along the long edge"
 
 
 @dataclass(frozen=True)
 class TreeFabrication:
-    """The sheets and junctions of a tree (:func:`fabricate`)."""
+    """The sheets and junctions of a tree (:func:`fabricate`).
+
+    Attributes
+    ----------
+    tree : the tree.
+    sheets : one :class:`TreeSheet` per leaf.
+    junctions : the printed connectors (:class:`Junction`).
+    options : the connector options.
+    takeoffs : the folded take-off junctions (:class:`~kinegami.tree.takeoffs.Takeoff`), one per
+        side branch that leaves its trunk through a face.
+    notes : what the fabrication chose on its own (a joint given a connector because no
+        take-off could be made there).
+    links : the links as folded: the tree's, except that every take-off branch's first link
+        starts at its take-off frame.
+    """
 
     tree: KinematicTree = field(repr=False)
     sheets: tuple[TreeSheet, ...]
     junctions: tuple[Junction, ...]
     options: ConnectorOptions = field(repr=False)
+    takeoffs: tuple[Takeoff, ...] = ()
+    notes: tuple[str, ...] = ()
+    links: tuple = field(default=(), repr=False)
+
+    def overlap(self):
+        """The deepest overlap of the folded body (the tree's joints with :attr:`links`), by
+        the tree's clearance rules, or None when it does not pass through itself."""
+        from kinegami.bodies import tree_worst_overlap
+
+        tree = self.tree
+        links = list(self.links) if self.links else list(tree.Links)
+        return tree_worst_overlap(tree.Joints, links, tree.Parents, tree.r)
 
     def connector(self, k: int):
         """The printed connector of junction ``k`` as a watertight trimesh (world frame, units
@@ -249,8 +315,10 @@ def fabricate(
     trunks: Mapping[int, int] | None = None,
     options: ConnectorOptions | None = None,
     twistPortion: float = 0.2,
+    junction: str | Mapping[int, str] = "connector",
+    takeoff: TakeoffOptions | None = None,
 ) -> TreeFabrication:
-    """The sheets and printed junctions of ``tree`` at its current states.
+    """The sheets and junctions of ``tree`` at its current states.
 
     Parameters
     ----------
@@ -258,12 +326,20 @@ def fabricate(
     trunks : ``{joint: child}`` for the joints whose trunk is not the default one.
     options : connector options (wall, clearance, socket depth; docs/junctions.md).
     twistPortion : fraction of each straight part taken by its twist fitting (default 0.2).
+    junction : how the children of a branching joint are joined: ``"connector"`` (default, a
+        printed connector), ``"takeoff"`` (every side branch leaves the trunk's link through a
+        face, folded: the trunk's sheet gets a hole, the branch's sheet starts with a skirt and
+        glue tabs), ``"auto"`` (take-offs where they can be made, else a connector, with a note
+        in ``notes``), or ``{joint: kind}`` for some joints (the others: connectors).
+    takeoff : dimensions of the take-offs (:class:`~kinegami.tree.takeoffs.TakeoffOptions`).
 
     Raises
     ------
     InvalidParameterError
         When a branch child's socket does not fit on its link (its link is shorter than the
-        stretch it runs with its siblings plus the socket): slide or compact the tree first.
+        stretch it runs with its siblings plus the socket): slide or compact the tree first;
+        when a joint asked to be made with take-offs cannot be (the message names the joint and
+        why); for a bad ``junction`` value.
     """
     if not isinstance(tree, KinematicTree):
         raise InvalidTypeError(f"tree must be a KinematicTree, got {type(tree).__name__}")
@@ -271,13 +347,89 @@ def fabricate(
     options = ConnectorOptions() if options is None else options
     if not isinstance(options, ConnectorOptions):
         raise InvalidTypeError(f"options must be ConnectorOptions, got {options!r}")
-    trunk_of, problems = choose_trunks(tree, trunks, options)
+    takeoff = TakeoffOptions() if takeoff is None else takeoff
+    if not isinstance(takeoff, TakeoffOptions):
+        raise InvalidTypeError(f"takeoff must be TakeoffOptions, got {takeoff!r}")
+    takeoff = takeoff.resolved(tree.r)
+    requested = _junction_kinds(tree, junction)
+    kinds = {k: ("connector" if kind == "connector" else "takeoff")
+             for k, kind in requested.items()}  # fmt: skip
+    notes: list[str] = []
+    while True:
+        try:
+            return _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, tuple(notes))
+        except _NoTakeoffError as failure:
+            if requested[failure.joint] != "auto":
+                raise InvalidParameterError(
+                    f"junction at joint {failure.joint}: no folded take-off can be made: "
+                    f"{failure.reason}; use junction='connector' (or 'auto') for it"
+                ) from None
+            kinds[failure.joint] = "connector"
+            notes.append(f"joint {failure.joint} has a printed connector: no folded take-off "
+                         f"can be made ({failure.reason})")  # fmt: skip
+
+
+def _junction_kinds(tree: KinematicTree, junction) -> dict[int, str]:
+    """The kind asked for at every branching joint."""
+    branching = [k for k, kids in enumerate(tree.Children) if len(kids) > 1]
+    choices = ", ".join(map(repr, JUNCTION_KINDS))
+    if isinstance(junction, str):
+        if junction not in JUNCTION_KINDS:
+            raise InvalidParameterError(f"junction must be one of {choices} or a mapping "
+                                        f"{{joint: kind}}, got {junction!r}")  # fmt: skip
+        return dict.fromkeys(branching, junction)
+    if not isinstance(junction, Mapping):
+        raise InvalidTypeError(
+            f"junction must be one of {choices} or a mapping {{joint: kind}}, got {junction!r}"
+        )
+    kinds = dict.fromkeys(branching, "connector")
+    for joint, kind in junction.items():
+        if joint not in kinds:
+            raise InvalidParameterError(
+                f"junction: joint {joint!r} does not branch (joints with several children: "
+                f"{branching})"
+            )
+        if kind not in JUNCTION_KINDS:
+            raise InvalidParameterError(
+                f"junction[{joint}] must be one of {choices}, got {kind!r}"
+            )
+        kinds[joint] = kind
+    return kinds
+
+
+class _NoTakeoffError(Exception):
+    """Raised inside :func:`_fabricate` when a joint's take-offs cannot be placed."""
+
+    def __init__(self, joint: int, reason: str):
+        super().__init__(joint, reason)
+        self.joint, self.reason = joint, reason
+
+
+def _record_count(patterns) -> int:
+    """How many module records ``TubularPattern.concatenate(patterns)`` keeps (an empty
+    pattern after the first adds none)."""
+    return sum(len(p.modules) for i, p in enumerate(patterns) if i == 0 or not p.isEmpty)
+
+
+def _trunk_candidates(tree, joint: int, trunks, longest) -> list[int]:
+    if trunks is not None and joint in trunks:
+        return [int(trunks[joint])]
+    return sorted(tree.Children[joint], key=lambda c: (-longest[c], c))
+
+
+def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes) -> TreeFabrication:
+    from kinegami.pattern.folded import UVA_TO_DUBINS, unsnapped_form
+
+    connector_kinds = {k for k, kind in kinds.items() if kind == "connector"}
+    chosen, problems = choose_trunks(tree, trunks, options)
+    problems = [(c, p) for c, p in problems if tree.Parents[c] in connector_kinds]
     if problems:
         raise InvalidParameterError(
             "the tree cannot be made with printed junctions: " + "; ".join(p for _, p in problems)
             + ". Slide those joints along their axes (or compact the tree: kinegami compact) "
             "so that their links get longer"
         )
+    trunk_of = {k: chosen[k] for k in sorted(connector_kinds)}
     longest = _downstream(tree)
     children = tree.Children
     n, r = tree.numSides, tree.r
@@ -295,37 +447,116 @@ def fabricate(
     junction_at = {j.joint: j.index for j in junctions}
 
     # sheets: follow trunks from each start to a leaf; branch children start later sheets
-    sheets: list[TreeSheet] = []
+    built: list[dict] = []
+    placed: dict[int, dict] = {}  # branch child -> its take-off (placement, trunk sheet, ...)
+    fabricated_links = list(tree.Links)
     starts = [0]
     while starts:
         first = starts.pop(0)
-        path = [first]
-        while children[path[-1]]:
-            k = path[-1]
-            path.append(trunk_of.get(k, children[k][0]))
-        branches = []
-        for k in path:
-            for c in children[k]:
-                if k in trunk_of and c != trunk_of[k]:
-                    branches.append(c)
-        # the sheets starting along this one, joint by joint, longest first (breadth first)
-        starts += sorted(branches, key=lambda c: (path.index(tree.Parents[c]), -longest[c], c))
+        sheet_index = len(built)
+        start = placed.get(first)
         if first == 0:
             modules = [tree.Joints[0].pattern]
-            arc, junction = 0.0, None
-        else:
+            arc, junction, frame = 0.0, None, tree.Joints[0].proximal_dubins_frame()
+        elif start is None:
             socket = socket_of[first]
             arc = float(socket.sheet_start)
             junction = junction_at[tree.Parents[first]]
-            rest = LinkCSC(r, np.asarray(socket.frame), tree.Joints[first].proximal_dubins_frame(),
+            frame = np.asarray(socket.frame)
+            rest = LinkCSC(r, frame, tree.Joints[first].proximal_dubins_frame(),
                            tree.maxAnglePerElbow)  # fmt: skip
             modules = rest.pattern_modules(n, twistPortion) + [tree.Joints[first].pattern]
-        for k in path[1:]:
-            modules += tree.Links[k].pattern_modules(n, twistPortion)
-            modules.append(tree.Joints[k].pattern)
+        else:
+            J = start["placement"].junction
+            arc, junction = 0.0, None
+            frame = J.skirt_frame(start["tube_frame"])
+            link = start["placement"].link
+            modules = ([J.skirt_pattern()] + link.pattern_modules(n, twistPortion)
+                       + [tree.Joints[first].pattern])  # fmt: skip
+            start["branch_sheet"] = sheet_index
+        path = [first]
+        holes = []
+        branches = []
+        while children[path[-1]]:
+            k = path[-1]
+            kids = children[k]
+            if len(kids) == 1:
+                t = kids[0]
+                link_modules = tree.Links[t].pattern_modules(n, twistPortion)
+            elif kinds[k] == "connector":
+                t = trunk_of[k]
+                link_modules = tree.Links[t].pattern_modules(n, twistPortion)
+                branches += [c for c in kids if c != t]
+            else:
+                reasons = []
+                for t in _trunk_candidates(tree, k, trunks, longest):
+                    link = tree.Links[t]
+                    link_modules = link.pattern_modules(n, twistPortion)
+                    at = next(i for i, m in enumerate(link_modules) if m.modules[0].kind == "tube")
+                    index = _record_count(modules + link_modules[:at])
+                    prefix = TubularPattern.concatenate(modules + link_modules[: at + 1])
+                    form = unsnapped_form(prefix, frame=frame)
+                    tube = form.modules[index]
+                    height = float(tube.record.params["height"])
+                    tube_frame = tube.proximal @ UVA_TO_DUBINS
+                    found, reason = place_takeoffs(tree, k, t, tube_frame, height, takeoff,
+                                                   fabricated_links)  # fmt: skip
+                    if found is not None:
+                        break
+                    reasons.append(f"trunk {t}: {reason}")
+                else:
+                    raise _NoTakeoffError(k, "; ".join(reasons))
+                twist = twistPortion * link.path.tMag if link.hasTwist else 0.0
+                before = r * link.path.theta1 + twist  # arc length to the tube's start
+                for placement in found:
+                    name = hole_name(len(placed))
+                    placed[placement.child] = {
+                        "name": name, "placement": placement, "tube_frame": tube_frame,
+                        "joint": k, "trunk": t, "sheet": sheet_index, "module": index,
+                        "arc": before + placement.junction.y0,
+                    }  # fmt: skip
+                    fabricated_links[placement.child] = placement.link
+                    holes.append(SheetHole(name, index, placement.junction))
+                    branches.append(placement.child)
+            modules += link_modules + [tree.Joints[t].pattern]
+            path.append(t)
+        # the sheets starting along this one, joint by joint, longest first (breadth first)
+        starts += sorted(branches, key=lambda c: (path.index(tree.Parents[c]), -longest[c], c))
         pattern = TubularPattern.concatenate(modules)
-        sheets.append(TreeSheet(len(sheets), tuple(path), junction, arc, pattern))
-    return TreeFabrication(tree, tuple(sheets), tuple(junctions), options)
+        if holes or start is not None:
+            pattern = CutPattern(pattern, holes=tuple(holes),
+                                 skirt=None if start is None else start["placement"].junction,
+                                 skirt_name=None if start is None else start["name"],
+                                 frame=frame)  # fmt: skip
+        built.append({"joints": tuple(path), "junction": junction, "arc": arc,
+                      "pattern": pattern, "frame": frame, "start": start})  # fmt: skip
+
+    takeoffs = tuple(
+        Takeoff(info["name"], info["joint"], child, info["trunk"], info["sheet"],
+                info["branch_sheet"], info["module"], info["arc"],
+                info["placement"].junction, info["placement"].frame, info["placement"].link)
+        for child, info in placed.items()
+    )  # fmt: skip
+    sheets = []
+    for k, info in enumerate(built):
+        start = info["start"]
+        holes = tuple((t.name, t.branch_sheet) for t in takeoffs if t.sheet == k)
+        sheets.append(TreeSheet(
+            k, info["joints"], info["junction"], info["arc"], info["pattern"],
+            frame=_readonly_frame(info["frame"]),
+            takeoff=None if start is None else start["name"],
+            takeoff_sheet=None if start is None else start["sheet"],
+            holes=holes,
+            tabs=0 if start is None else len(start["placement"].junction.tabs),
+        ))  # fmt: skip
+    return TreeFabrication(tree, tuple(sheets), tuple(junctions), options, takeoffs, notes,
+                           tuple(fabricated_links))  # fmt: skip
+
+
+def _readonly_frame(frame) -> np.ndarray:
+    frame = np.array(frame, dtype=float)
+    frame.flags.writeable = False
+    return frame
 
 
 #: Slides tried (in r, smallest first) to give a branch child's socket room (fit_junctions).
