@@ -466,6 +466,30 @@ def _open_staging(command: str, out: Path):
     return staging
 
 
+def _takeoff_summary(fabrication, info) -> list[str]:
+    """The build summary's lines on folded take-offs (none for printed connectors only)."""
+    if not fabrication.takeoffs and not fabrication.notes:
+        return []
+    lengths = _Lengths(fabrication.tree.r, info.units)
+    lines = [f"  take-offs: {len(fabrication.takeoffs)} (folded)"]
+    for t in fabrication.takeoffs:
+        lines.append(
+            f"    take-off {t.name}: joint {t.child} leaves joint {t.trunk}'s link through face "
+            f"{t.face}, {lengths.mm(t.arc)} from joint {t.joint}: hole {t.name} in sheet "
+            f"{t.sheet}, sheet {t.branch_sheet} starts with its skirt ({t.tabs} glue tabs); "
+            f"new link {lengths.mm(t.link.length)}"
+        )
+    if fabrication.takeoffs:
+        overlap = fabrication.overlap()
+        body = "clear" if overlap is None else (
+            f"{lengths.mm(overlap.clearance)}: self-intersects ({overlap.first} and "
+            f"{overlap.second})"
+        )  # fmt: skip
+        lines.append(f"    folded body with the take-off links: {_printable(body)}")
+    lines += [f"  note: {_printable(note)}" for note in fabrication.notes]
+    return lines
+
+
 def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> int:
     """``kinegami build`` of a tree: a sheet per leaf, the junction connectors and the whole
     tree (kinegami.export.tree_build), published as one transaction."""
@@ -482,14 +506,29 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
                 _note(args.command, f"{fmt} not written: it needs {missing[0]} "
                                     f"(pip install 'kinegami[{extra}]')")  # fmt: skip
     from kinegami.design.reader import carry_origin
+    from kinegami.errors import InvalidParameterError
+    from kinegami.tree.takeoffs import JUNCTION_KINDS
 
+    kind = "connector" if args.junctions is None else args.junctions
+    if kind not in JUNCTION_KINDS:
+        raise CommandError(f"--junctions: unknown kind {shown(kind)}; known: "
+                           f"{', '.join(JUNCTION_KINDS)}")  # fmt: skip
     try:
-        fitted, moves = fit_junctions(tree)
-        carry_origin(tree, fitted)  # the joint names
-        fabrication = fabricate(fitted, twistPortion=info.twistPortion)
+        fitted, moves, fabrication = tree, [], None
+        if kind != "connector":  # take-offs need no room for sockets: try the tree as it is
+            try:
+                fabrication = fabricate(tree, twistPortion=info.twistPortion, junction=kind)
+            except InvalidParameterError:
+                if kind == "takeoff":
+                    raise
+        if fabrication is None:  # slide the children whose socket does not fit
+            fitted, moves = fit_junctions(tree)
+            carry_origin(tree, fitted)  # the joint names
+            fabrication = fabricate(fitted, twistPortion=info.twistPortion, junction=kind)
     except KinegamiError as error:
         raise CommandError(f"{args.design}: {error}") from None
     lines = _tree_summary(fitted, info, args.design, fabrication, moves)
+    lines += _takeoff_summary(fabrication, info)
     report = _clearance(fitted)
     if not report.ok:
         first = report.pairs[0]
@@ -1009,6 +1048,14 @@ def make_parser() -> argparse.ArgumentParser:
     build.add_argument(
         "--name", metavar="STEM", help="file name stem of the outputs (default: the design file's)"
     )
+    build.add_argument(
+        "--junctions", metavar="KIND", default=None,
+        help="trees only: how the branches of a joint with several children are joined: "
+        "connector (default; a printed connector, STL and 3MF), takeoff (folded: each side "
+        "branch leaves a face of the trunk's tube, the trunk's sheet gets a hole and the "
+        "branch's sheet a skirt with glue tabs), auto (take-offs where they can be made, "
+        "connectors elsewhere)",
+    )  # fmt: skip
     build.set_defaults(run=cmd_build)
 
     show = commands.add_parser(
