@@ -390,7 +390,9 @@ def _write_tree_pictures(fabrication, folder: Path, stem: str) -> list[Path]:
             plt.close(fig)
         return write_atomic(path, buffer.getvalue())
 
-    written = [save(fabrication.tree.show(block=False)[0], folder / f"{stem}_3d.png")]
+    # the connectors in the 3D view too, when they can be made here
+    view = fabrication.tree.show(block=False, showJunctions=_importable("manifold3d"))
+    written = [save(view[0], folder / f"{stem}_3d.png")]
     for sheet in fabrication.sheets:
         fig, _ = sheet.pattern.show()
         written.append(save(fig, folder / f"{stem}_sheet_{sheet.index}_pattern.png"))

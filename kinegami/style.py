@@ -54,6 +54,8 @@ distalColor = "y"
 # --- bodies and surfaces ---
 jointColor = "darkblue"
 linkColor = "lightgray"
+#: Colour of a tree's printed junction connectors (``showJunctions``).
+junctionColor = "darkorange"
 #: Alpha of joint and link surfaces.
 surfaceOpacity = 0.5
 #: Straight tubes and elbows are drawn with this many sides (smooth, independent of numSides).
@@ -124,6 +126,8 @@ CHAIN_PLOT_DEFAULTS = MappingProxyType(
         "groundPlaneColor": groundPlaneColor,
         "showAxisGrids": False,
         "showCollisions": False,
+        "showJunctions": False,
+        "junctionColor": junctionColor,
         "block": None,
         "ax": None,
     }

@@ -561,8 +561,10 @@ def _leg_point_sets(
 
 
 def _manifold():
+    """manifold3d, once trimesh (which the mesh is returned as) is known to import too."""
     try:
         import manifold3d
+        import trimesh  # noqa: F401
     except ImportError as exc:
         missing = getattr(exc, "name", None) or "manifold3d"
         raise ExporterUnavailableError(

@@ -66,6 +66,7 @@ ARTIST_GIDS = {
     "link-tangents": "start and end tangents of each link",
     "joint-spheres": "bounding balls of the joints",
     "chain-sphere": "bounding ball of the chain or tree (wireframe)",
+    "junctions": "a tree's printed junction connectors (showJunctions)",
     "global-frame-x": "world x arrow",
     "global-frame-y": "world y arrow",
     "global-frame-z": "world z arrow",
@@ -87,6 +88,7 @@ _BOOL_OPTIONS = (
     "showGroundPlane",
     "showAxisGrids",
     "showCollisions",
+    "showJunctions",
 )
 _COLOR_OPTIONS = (
     "xColor",
@@ -97,6 +99,7 @@ _COLOR_OPTIONS = (
     "distalColor",
     "jointColor",
     "linkColor",
+    "junctionColor",
     "pathColor",
     "sphereColor",
     "groundPlaneColor",
@@ -281,6 +284,30 @@ def _draw_joint_bodies(scene, chain, opts):
     scene.segments(
         axes, "joint-axes", style.jointAxisColor, linewidth=1.0, linestyle=style.jointAxisLineStyle
     )
+
+
+def _draw_junctions(scene, chain, opts):
+    """A tree's printed junction connectors (kinegami.tree.sheets.fabricate), shaded; nothing
+    for a chain. A connector that cannot be made (a socket that does not fit its link, or
+    manifold3d missing) is left out with a warning saying why."""
+    import warnings
+
+    from kinegami.chain import KinematicChain
+
+    if isinstance(chain, KinematicChain) or not any(len(c) > 1 for c in chain.Children):
+        return
+    from kinegami.errors import KinegamiError
+    from kinegami.tree.sheets import fabricate
+
+    try:
+        fabrication = fabricate(chain)
+        meshes = [fabrication.connector(k) for k in range(len(fabrication.junctions))]
+    except KinegamiError as error:
+        warnings.warn(f"showJunctions: the junctions are not drawn: {error}", stacklevel=4)
+        return
+    faces = [mesh.vertices[mesh.faces] for mesh in meshes]
+    scene.polygons(np.concatenate(faces), "junctions", opts["junctionColor"],
+                   min(1.0, opts["surfaceOpacity"] + 0.3), shade=True)  # fmt: skip
 
 
 def _draw_joint_poses(scene, chain, opts):
@@ -564,6 +591,8 @@ def show_chain(chain: KinematicChain | KinematicTree, **options) -> tuple[Figure
         _draw_global_frame(scene, chain, opts)
     if opts["showGroundPlane"]:
         _draw_ground_plane(scene, chain, opts)
+    if opts["showJunctions"]:
+        _draw_junctions(scene, chain, opts)
     if opts["showCollisions"]:
         title = _draw_collisions(scene, chain)
         # inside the figure when the axes fill it (no axis grids)

@@ -9,6 +9,7 @@ from matplotlib.colors import to_rgba
 from matplotlib.figure import Figure
 from mpl_toolkits.mplot3d.axes3d import Axes3D
 from numpy.testing import assert_allclose
+from spatialmath import SE3
 
 from kinegami import style
 from kinegami.errors import InvalidParameterError, InvalidTypeError
@@ -56,7 +57,7 @@ def test_default_drawing_has_joints_links_and_path(example_1a):
         "link-path-markers",
         "joint-frame-x",
     } <= _gids(ax)
-    assert "global-frame-x" not in _gids(ax)
+    assert "global-frame-x" not in _collection_gids(ax)
     assert not _axes_shown(ax)
 
 
@@ -212,7 +213,7 @@ def test_bad_option_values(example_1a, options, error):
 def test_no_elbow_chain_with_link_poses(straight_chain):
     assert all(link.elbows1.count + link.elbows2.count == 0 for link in straight_chain.Links)
     _, ax = straight_chain.show(showLinkPoses=True)
-    assert "link-pose-a" not in _gids(ax)
+    assert "link-pose-a" not in _collection_gids(ax)
     assert "link-tangents" in _gids(ax)
     assert _legend_labels(ax) == [r"$\hat{x}$", r"$\hat{y}$", r"$\hat{z}$"]
 
@@ -285,7 +286,7 @@ def test_agg_is_not_interactive():
 
 def test_show_chain_is_the_delegate(example_1a):
     fig, ax = show_chain(example_1a, showLinkPath=False)
-    assert "link-path" not in _gids(ax)
+    assert "link-path" not in _collection_gids(ax)
 
 
 def test_fifty_joint_chain_draws_quickly():
@@ -341,3 +342,79 @@ def test_elbow_triangles_are_shaded_by_their_plane(example_1a):
     assert_allclose(
         drawn[np.lexsort(drawn.T[::-1])], expected[np.lexsort(expected.T[::-1])], atol=1e-9
     )
+
+
+# --- a tree's junction connectors (showJunctions) ------------------------------------------------
+
+
+def _three_finger_tree():
+    import warnings
+
+    from kinegami import ClearanceWarning, EndTip, KinematicTree, RevoluteJoint, Waypoint
+
+    tree = KinematicTree(Waypoint(4, 1, SE3()))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        for k in range(3):
+            pose = SE3.Rz(2 * np.pi * k / 3) * SE3.Trans(3, 0, 4) * SE3.Ry(np.pi / 2)
+            a = tree.addJoint(0, RevoluteJoint(4, 1, np.pi, pose))
+            tree.addJoint(a, EndTip(4, 1, SE3.Trans(4, 0, 0) * SE3.Ry(np.pi / 2), 1.5))
+    return tree
+
+
+def _collection_gids(ax) -> set:
+    return {artist.get_gid() for artist in ax.collections}
+
+
+def test_show_junctions_draws_every_connector_of_a_tree():
+    pytest.importorskip("manifold3d")
+    from kinegami.tree.sheets import fabricate, fit_junctions
+
+    tree, _ = fit_junctions(_three_finger_tree())
+    fig, ax = show_chain(tree, showJunctions=True)
+    try:
+        [junctions] = [c for c in ax.collections if c.get_gid() == "junctions"]
+        fabrication = fabricate(tree)
+        meshes = [fabrication.connector(k) for k in range(len(fabrication.junctions))]
+        fig.canvas.draw()  # mplot3d projects its polygons when drawn
+        assert len(junctions.get_paths()) == sum(len(m.faces) for m in meshes)
+        # the view's limits hold every connector
+        lo = np.min([m.bounds[0] for m in meshes], axis=0)
+        hi = np.max([m.bounds[1] for m in meshes], axis=0)
+        for (a, b), low, high in zip(
+            (ax.get_xlim(), ax.get_ylim(), ax.get_zlim()), lo, hi, strict=True
+        ):
+            assert a <= low + 1e-9 and high <= b + 1e-9
+    finally:
+        plt.close(fig)
+    fig, ax = show_chain(tree)  # off by default
+    assert "junctions" not in _collection_gids(ax)
+    plt.close(fig)
+
+
+def test_show_junctions_on_a_chain_draws_nothing_more():
+    from kinegami import KinematicChain, RevoluteJoint, StartTip
+
+    chain = KinematicChain(StartTip(4, 1, SE3(), 1.5))
+    chain.append(RevoluteJoint(4, 1, np.pi, SE3.Trans(0, 0, 6)))
+    fig, ax = show_chain(chain, showJunctions=True)
+    assert "junctions" not in _collection_gids(ax)
+    plt.close(fig)
+
+
+def test_a_connector_that_cannot_be_made_is_left_out_with_a_warning():
+    import warnings
+    from pathlib import Path
+
+    from kinegami import ClearanceWarning
+    from kinegami.design import load_design
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        # the paper's hand as designed: the palm's tube has no room for its socket
+        hand = load_design(Path(__file__).resolve().parents[2] / "examples/designs/hand.json")
+    with pytest.warns(UserWarning, match="showJunctions: the junctions are not drawn.*joint 1"):
+        fig, ax = show_chain(hand, showJunctions=True)
+    assert "junctions" not in _collection_gids(ax)
+    assert "joint-bodies" in _collection_gids(ax)
+    plt.close(fig)
