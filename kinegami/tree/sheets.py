@@ -187,14 +187,15 @@ class TreeFabrication:
     notes: tuple[str, ...] = ()
     links: tuple = field(default=(), repr=False)
 
-    def overlap(self):
-        """The deepest overlap of the folded body (the tree's joints with :attr:`links`), by
-        the tree's clearance rules, or None when it does not pass through itself."""
-        from kinegami.bodies import tree_worst_overlap
+    def overlap(self, names=None):
+        """The deepest overlap of the folded body (the tree's joints, :attr:`links`, every
+        trunk link cut at its take-off points: :func:`~kinegami.tree.takeoffs.takeoff_body`),
+        by the tree's clearance rules, or None when it does not pass through itself (``names``:
+        the joints' names for the labels)."""
+        from kinegami.tree.takeoffs import takeoff_overlap
 
-        tree = self.tree
-        links = list(self.links) if self.links else list(tree.Links)
-        return tree_worst_overlap(tree.Joints, links, tree.Parents, tree.r)
+        body = [(t.trunk, t.arc, t.child, t.link) for t in self.takeoffs]
+        return takeoff_overlap(self.tree, body, names=names)
 
     def connector(self, k: int):
         """The printed connector of junction ``k`` as a watertight trimesh (world frame, units
@@ -450,6 +451,7 @@ def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes) -> Tr
     built: list[dict] = []
     placed: dict[int, dict] = {}  # branch child -> its take-off (placement, trunk sheet, ...)
     fabricated_links = list(tree.Links)
+    body: list = []  # the take-offs as the folded body needs them (takeoffs.takeoff_body)
     starts = [0]
     while starts:
         first = starts.pop(0)
@@ -499,15 +501,15 @@ def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes) -> Tr
                     tube = form.modules[index]
                     height = float(tube.record.params["height"])
                     tube_frame = tube.proximal @ UVA_TO_DUBINS
-                    found, reason = place_takeoffs(tree, k, t, tube_frame, height, takeoff,
-                                                   fabricated_links)  # fmt: skip
+                    twist = twistPortion * link.path.tMag if link.hasTwist else 0.0
+                    before = r * link.path.theta1 + twist  # arc length to the tube's start
+                    found, reason = place_takeoffs(tree, k, t, tube_frame, height, before,
+                                                   takeoff, body)  # fmt: skip
                     if found is not None:
                         break
                     reasons.append(f"trunk {t}: {reason}")
                 else:
                     raise _NoTakeoffError(k, "; ".join(reasons))
-                twist = twistPortion * link.path.tMag if link.hasTwist else 0.0
-                before = r * link.path.theta1 + twist  # arc length to the tube's start
                 for placement in found:
                     name = hole_name(len(placed))
                     placed[placement.child] = {
@@ -516,6 +518,8 @@ def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes) -> Tr
                         "arc": before + placement.junction.y0,
                     }  # fmt: skip
                     fabricated_links[placement.child] = placement.link
+                    body.append((t, before + placement.junction.y0, placement.child,
+                                 placement.link))  # fmt: skip
                     holes.append(SheetHole(name, index, placement.junction))
                     branches.append(placement.child)
             modules += link_modules + [tree.Joints[t].pattern]

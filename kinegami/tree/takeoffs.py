@@ -11,21 +11,31 @@ unchanged; only the tube between the trunk and c is routed anew.
 For each branch the face p and the hole's height y0 are chosen among every face and
 ``TakeoffOptions.heights`` heights spread over the part of the tube that holds the hole and its
 margin: those from which a CSC path to c exists, preferring the placement whose body passes
-least through itself (the deepest overlap of the tree with the new links, by the rules of
-:func:`kinegami.bodies.tree_worst_overlap`), then the shortest new link; the branches of one
+least through itself (:func:`takeoff_overlap`), then the shortest new link; the branches of one
 joint are placed together, their holes (with margins) apart.
+
+The folded body is measured as a tree of its own (:func:`takeoff_body`): the trunk's link is
+cut at every take-off point O (the trunk's axis point at the hole's centre) by a zero-length
+waypoint whose children are the rest of the trunk and the branches leaving there. So the
+clearance rules of :func:`kinegami.bodies.tree_worst_overlap` treat the trunk and a branch
+like the tubes leaving one joint: not where they still run together next to the take-off, and
+as any two branches beyond.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from kinegami.bodies import tree_worst_overlap
+from kinegami.bodies import Overlap, tree_worst_overlap
 from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
+from kinegami.geometry.csc_centreline import csc_transported_frame
+from kinegami.joints import Waypoint
 from kinegami.links import LinkCSC
 from kinegami.pattern.takeoff import TakeoffJunction, takeoff_junction
 from kinegami.validation import check_in_range, check_int, check_radius
@@ -37,6 +47,8 @@ __all__ = [
     "TakeoffPlacement",
     "hole_name",
     "place_takeoffs",
+    "takeoff_body",
+    "takeoff_overlap",
 ]
 
 #: How a branching joint's children are joined: a printed connector, folded take-offs, or
@@ -46,7 +58,9 @@ JUNCTION_KINDS = ("connector", "takeoff", "auto")
 #: Candidates kept per branch for the joint search (the best by overlap, then length).
 CANDIDATES_PER_BRANCH = 6
 #: Largest number of combinations searched jointly; beyond it branches are placed one by one.
-MAX_COMBINATIONS = 256
+MAX_COMBINATIONS = 20000
+#: How many of the best-ranked combinations are measured together.
+EVALUATED_SETS = 48
 #: Overlap depths closer than this many r count as equal when placements are compared.
 DEPTH_TOLERANCE = 1e-6
 
@@ -96,7 +110,8 @@ class TakeoffPlacement:
         trunk tube module's own coordinates.
     frame : the take-off frame T (4x4 world Dubins frame: x along the branch, y = s).
     link : the branch's first link, from T to the child's proximal Dubins frame.
-    depth : the deepest overlap of the tree with this branch's new link (units of r, >= 0).
+    depth : the deepest overlap of the folded body with this branch's new link (and the
+        take-offs placed before; units of r, >= 0).
     """
 
     child: int
@@ -186,14 +201,114 @@ def _depth(overlap) -> float:
     return 0.0 if overlap is None else max(0.0, -float(overlap.clearance))
 
 
+#: A take-off as the folded body needs it: (trunk child, arc length along the trunk's link of the
+#: take-off point O, branch child, the branch's first link from T).
+BodyTakeoff = tuple[int, float, int, LinkCSC]
+
+
+def takeoff_body(tree, takeoffs: Sequence[BodyTakeoff], cache: dict | None = None):
+    """The folded body with take-offs as a tree: ``(joints, links, parents, original)``.
+
+    Every trunk link with take-offs is cut at each take-off point O (arc length ``sigma``
+    along it) by a zero-length :class:`~kinegami.joints.Waypoint` whose Dubins frame is the
+    link's frame there; the branches leaving at O are its children, with their take-off links;
+    the rest of the trunk's link goes on to the trunk child. The cut pieces are the same CSC
+    path. Nodes are in a topological order; ``original[k]`` is the tree index of node k (for
+    a waypoint: the trunk child whose link it cuts). ``cache`` (a dict) keeps the cut pieces
+    between calls on the same tree.
+    """
+    cache = {} if cache is None else cache
+
+    def piece(k: int, start: np.ndarray, end: np.ndarray, key: tuple) -> LinkCSC:
+        found = cache.get((k,) + key)
+        if found is None:
+            found = cache[(k,) + key] = LinkCSC(r, start, end, tree.maxAnglePerElbow)
+        return found
+
+    n, r = tree.numSides, tree.r
+    parents_in = tree.Parents
+    cuts: dict[int, list[float]] = {}
+    branch_at: dict[int, tuple[int, float]] = {}
+    new_link: dict[int, LinkCSC] = {}
+    for trunk, sigma, child, link in takeoffs:
+        if not any(abs(sigma - s) <= 1e-9 * r for s in cuts.get(trunk, [])):
+            cuts.setdefault(trunk, []).append(float(sigma))
+        branch_at[child] = (trunk, float(sigma))
+        new_link[child] = link
+    for values in cuts.values():
+        values.sort()
+    order: list[tuple[str, int, float]] = []  # ("joint", k, 0) or ("cut", trunk, sigma)
+    for k in range(len(tree.Joints)):
+        order.append(("joint", k, 0.0))
+        for t in tree.Children[k]:
+            for sigma in cuts.get(t, []):
+                order.append(("cut", t, sigma))
+    position = {(kind, k, s): i for i, (kind, k, s) in enumerate(order)}
+    joints, links, parents, original = [], [], [], []
+    for kind, k, sigma in order:
+        if kind == "cut":
+            base = tree.Links[k]
+            F = csc_transported_frame(base.path, base.start_frame, sigma)
+            joints.append(Waypoint(n, r, F, pathIndex=0))
+            before = [s for s in cuts[k] if s < sigma]
+            parent = (position[("cut", k, before[-1])] if before
+                      else position[("joint", parents_in[k], 0.0)])  # fmt: skip
+            start = joints[parent].distal_dubins_frame()
+            links.append(piece(k, start, F, (before[-1] if before else None, sigma)))
+            parents.append(parent)
+            original.append(k)
+            continue
+        joints.append(tree.Joints[k])
+        original.append(k)
+        if k == 0:
+            links.append(tree.Links[0])
+            parents.append(-1)
+        elif k in branch_at:
+            trunk, s = branch_at[k]
+            links.append(new_link[k])
+            parents.append(position[("cut", trunk, s)])
+        elif k in cuts:
+            parent = position[("cut", k, cuts[k][-1])]
+            links.append(piece(k, joints[parent].distal_dubins_frame(),
+                               tree.Joints[k].proximal_dubins_frame(), (cuts[k][-1], None)))
+            parents.append(parent)
+        else:
+            links.append(tree.Links[k])
+            parents.append(position[("joint", parents_in[k], 0.0)])
+    return joints, links, parents, original
+
+
+def takeoff_overlap(tree, takeoffs: Sequence[BodyTakeoff], names=None,
+                    cache: dict | None = None) -> Overlap | None:  # fmt: skip
+    """The deepest overlap of the folded body with ``takeoffs`` (:func:`takeoff_body`, by the
+    rules of :func:`kinegami.bodies.tree_worst_overlap`), its parts named by the tree's joint
+    and link numbers (a cut trunk link's pieces as that link), or None when it is clear."""
+    if not takeoffs:
+        return tree_worst_overlap(tree.Joints, tree.Links, tree.Parents, tree.r, names=names)
+    joints, links, parents, original = takeoff_body(tree, takeoffs, cache)
+    if names is not None:
+        names = [names[k] if k < len(names) else None for k in original]
+    found = tree_worst_overlap(joints, links, parents, tree.r, names=names)
+    if found is None:
+        return None
+
+    def renamed(text: str) -> str:
+        return re.sub(r"\b(joint|link) (\d+)\b",
+                      lambda m: f"{m.group(1)} {original[int(m.group(2))]}", text)  # fmt: skip
+
+    return replace(found, first=renamed(found.first), second=renamed(found.second),
+                   elements=(-1, -1))  # fmt: skip
+
+
 def place_takeoffs(
     tree,
     joint: int,
     trunk: int,
     tube_frame: np.ndarray,
     tube_height: float,
+    tube_arc: float,
     options: TakeoffOptions,
-    links=None,
+    placed: Sequence[BodyTakeoff] = (),
 ) -> tuple[list[TakeoffPlacement] | None, str]:
     """Where every branch child of ``joint`` leaves the trunk ``trunk``'s plain tube.
 
@@ -205,8 +320,9 @@ def place_takeoffs(
         proximal end, in the convention of :meth:`TakeoffJunction.fold_trunk` (the folded form
         of the trunk's sheet gives it).
     tube_height : the tube module's height (its length along the trunk).
+    tube_arc : arc length along the trunk's link where the tube module starts.
     options : resolved :class:`TakeoffOptions`.
-    links : the tree's links with the take-offs placed so far (default: ``tree.Links``).
+    placed : the take-offs placed so far elsewhere in the tree (:data:`BodyTakeoff`).
 
     Returns
     -------
@@ -216,7 +332,8 @@ def place_takeoffs(
     if not isinstance(options, TakeoffOptions):
         raise InvalidTypeError(f"options must be TakeoffOptions, got {options!r}")
     n, r = tree.numSides, tree.r
-    links = list(tree.Links) if links is None else list(links)
+    placed = list(placed)
+    cache: dict = {}  # the trunk's cut pieces, shared by every candidate
     branches = [c for c in tree.Children[joint] if c != trunk]
     probe = takeoff_junction(n, r, 0, 0.0, stub_length=options.stub_length,
                              tab_width=options.tab_width)  # fmt: skip
@@ -243,9 +360,8 @@ def place_takeoffs(
                     link = LinkCSC(r, T, end, tree.maxAnglePerElbow)
                 except NoPathError:
                     continue
-                trial = list(links)
-                trial[c] = link
-                depth = _depth(tree_worst_overlap(tree.Joints, trial, tree.Parents, r))
+                trial = placed + [(trunk, tube_arc + y0, c, link)]
+                depth = _depth(takeoff_overlap(tree, trial, cache=cache))
                 found.append(TakeoffPlacement(c, J, T, link, depth))
         if not found:
             return None, (
@@ -255,23 +371,36 @@ def place_takeoffs(
         found.sort(key=lambda q: (round(q.depth / (DEPTH_TOLERANCE * r)), q.link.length,
                                   q.junction.face, q.junction.y0))  # fmt: skip
         candidates[c] = found
-    return _combine(tree, branches, candidates, links, W, r)
+    return _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache)
 
 
-def _combine(tree, branches, candidates, links, W, r):
-    """The best set of placements, one per branch, whose holes are apart."""
-    pools = [candidates[c][:CANDIDATES_PER_BRANCH] for c in branches]
+def _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache):
+    """The best set of placements, one per branch, whose holes are apart.
+
+    Each branch contributes its best candidates and its best one at every height; the sets
+    whose holes are apart are ranked by their worst single depth and total length, and the
+    first :data:`EVALUATED_SETS` are measured together (the depth of the tree with all their
+    links). Without such a set (or with too many), branches are placed one by one.
+    """
+    pools = []
+    for c in branches:
+        pool = list(candidates[c][:CANDIDATES_PER_BRANCH])
+        for q in candidates[c]:
+            if all(abs(q.junction.y0 - other.junction.y0) > 1e-9 * r for other in pool):
+                pool.append(q)
+        pools.append(pool)
     if math.prod(len(p) for p in pools) <= MAX_COMBINATIONS:
+        scale = DEPTH_TOLERANCE * r
+        sets = [combo for combo in itertools.product(*pools)
+                if all(_apart(a.junction, b.junction, W)
+                       for a, b in itertools.combinations(combo, 2))]  # fmt: skip
+        sets.sort(key=lambda combo: (round(max(q.depth for q in combo) / scale),
+                                     sum(q.link.length for q in combo)))  # fmt: skip
         best, best_key = None, None
-        for combo in itertools.product(*pools):
-            if not all(_apart(a.junction, b.junction, W)
-                       for a, b in itertools.combinations(combo, 2)):  # fmt: skip
-                continue
-            trial = list(links)
-            for q in combo:
-                trial[q.child] = q.link
-            depth = _depth(tree_worst_overlap(tree.Joints, trial, tree.Parents, r))
-            key = (round(depth / (DEPTH_TOLERANCE * r)), sum(q.link.length for q in combo))
+        for combo in sets[:EVALUATED_SETS]:
+            trial = placed + [(trunk, tube_arc + q.junction.y0, q.child, q.link) for q in combo]
+            depth = _depth(takeoff_overlap(tree, trial, cache=cache))
+            key = (round(depth / scale), sum(q.link.length for q in combo))
             if best_key is None or key < best_key:
                 best, best_key = combo, key
         if best is not None:
