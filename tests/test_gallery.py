@@ -8,7 +8,12 @@ and the numbers the gallery states about them.
 * the geometric claims of the gallery (axes that meet, are parallel or coincide; reference
   numbers of spec chain.md 11.5 and 11.6 at r = 10 mm; the PUMA on its DH axes, shortened);
 * every script runs as a subprocess into a temporary folder and writes its three files; the
-  scripts run concurrently (one process each, started together) so the whole file stays fast.
+  scripts run concurrently (one process each, started together) so the whole file stays fast;
+* the trees (TREE_ENTRIES): each design equals its script's tree; the algorithmic hand is the
+  joint specification of the reference (spec trees.md 3) placed by the construction; the
+  quadruped's and the gripper's geometry; the paper's hand's grasps (spec trees.md 4, numbers
+  from its fixture); each tree's script writes its 3D view and every sheet (pattern picture and
+  DXF at true size); the gallery page and the README show every entry.
 """
 
 from __future__ import annotations
@@ -28,7 +33,8 @@ import pytest
 from ezdxf import bbox
 
 from kinegami import *
-from kinegami.design import load_design, load_design_with_info
+from kinegami.bodies import link_polyline
+from kinegami.design import chain_from_dict, load_design, load_design_with_info
 from kinegami.dh import dh_joint_frames, dh_tool_frame
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -67,6 +73,28 @@ TREE_ENTRIES = {
     "quadruped": (18, 4, 774.985756),
     "gripper": (10, 2, 285.281991),
 }
+TREE_SCRIPTS = sorted(TREE_ENTRIES)
+#: The spec's reference data (trees.md 3 and 4): the joint specification of the algorithmic
+#: hand, and the paper's hand with its grasps.
+FIXTURES = ROOT.parent / "shared" / "fixtures"
+#: trees.md 3.2: the algorithmic hand by the published construction (routes side by side) and
+#: without the extra roll, in r.
+ALGORITHMIC_HAND_PUBLISHED_TOTAL = 755.9963
+ALGORITHMIC_HAND_TOLERANCE = 1e-3
+#: The table of docs/gallery.md for trees: joints, leaves (= sheets), printed junctions, total
+#: link length and the clearance at the design's states (None: it passes through itself), as
+#: printed there (design units, 2 decimals).
+TREE_TABLE = {
+    "hand": (12, 3, 1, 32.28, None),
+    "algorithmic_hand": (16, 3, 1, 754.59, 0.00),
+    "quadruped": (18, 4, 2, 774.99, 0.05),
+    "gripper": (10, 2, 1, 285.28, 0.17),
+}
+#: The quadruped: the hip yaw joints (mm) and where the feet's tips end at the standing states.
+QUADRUPED_HIPS = [(-45, -60, 0), (45, -60, 0), (-45, 60, 0), (45, 60, 0)]
+QUADRUPED_FOOT_END = (161.806359, 114.467700, -53.090951)  # |x|, |y|, z of every foot's far end
+#: The gripper: its fingertips (centres, mm) at the design's states, mirror images in x = 0.
+GRIPPER_TIP = (27.035552, 0.0, 232.70705)
 
 #: spec chain.md 11.5 and 11.6 (r = 1), and the PUMA 560 table of examples/puma.py.
 SCALE = 10.0  # the gallery's r (mm) for the chain.md examples
@@ -357,6 +385,226 @@ def test_puma_joints_on_the_dh_axes_and_shorter(designs):
     assert all(edit["propagate"] is False for edit in document["edits"])
 
 
+# --- the trees ---------------------------------------------------------------------------------
+def fixture(name: str) -> dict:
+    with open(FIXTURES / f"{name}.json", encoding="utf-8") as f:
+        return json.load(f)
+
+
+def load_tree(name: str) -> KinematicTree:
+    """The tree of examples/designs/<name>.json; a PlacementWarning fails (the paper's hand's
+    own overlap at its junction is allowed: it is tested below)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PlacementWarning)
+        warnings.simplefilter("ignore", ClearanceWarning)
+        return load_design(DESIGNS / f"{name}.json")
+
+
+@pytest.fixture(scope="module")
+def trees() -> dict[str, KinematicTree]:
+    return {name: load_tree(name) for name in TREE_ENTRIES}
+
+
+@pytest.fixture(scope="module")
+def folded_hand(trees, scripts):
+    """The paper's hand cut into sheets as its script does (examples/_common.tree_sheets):
+    (fabrication, slides)."""
+    scripts("hand")  # puts examples/ on the path for _common
+    from _common import tree_sheets
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        return tree_sheets(trees["hand"])
+
+
+@pytest.mark.parametrize("name", TREE_SCRIPTS)
+def test_tree_design_equals_script(name, trees, scripts):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PlacementWarning)
+        warnings.simplefilter("ignore", ClearanceWarning)  # the paper's hand, as designed
+        built = scripts(name).build()
+    assert isinstance(built, KinematicTree)
+    assert built.Parents == trees[name].Parents
+    assert_same_chain(trees[name], built)
+
+
+@pytest.mark.parametrize("name", sorted(TREE_TABLE))
+def test_tree_table(name, trees):
+    joints, leaves, junctions, length, clearance = TREE_TABLE[name]
+    tree = trees[name]
+    assert len(tree.Joints) == joints
+    assert sum(1 for c in tree.Children if not c) == leaves
+    assert sum(1 for c in tree.Children if len(c) > 1) == junctions
+    assert round(tree.totalPathLength(), 2) == length
+    report = tree.clearance()
+    if clearance is None:
+        assert not report.ok
+    else:
+        assert report.ok and round(report.min_clearance, 2) == clearance
+
+
+def test_algorithmic_hand_is_the_reference_specification(trees):
+    """The design's joints are the reference's (type, parameters, parent, axis line), and the
+    construction places each on its line with the growth direction of the reference."""
+    from kinegami.design.reader import check_document
+
+    reference = fixture("algorithmic_hand")
+    document = json.loads((DESIGNS / "algorithmic_hand.json").read_text(encoding="utf-8"))
+    spec = check_document(document).specification
+    assert spec.parents == tuple(j["parent"] for j in reference["joints"])
+    tree = trees["algorithmic_hand"]
+    node_of = tree.construction.node_of
+    for joint, expected, node in zip(spec.joints, reference["joints"], node_of, strict=True):
+        assert type(joint).__name__ == expected["type"]
+        for key, value in expected["params"].items():
+            mine = getattr(joint, key)
+            mine = mine() if callable(mine) else mine  # a Waypoint's pathIndex is a method
+            assert mine == pytest.approx(value, abs=1e-15), (expected["name"], key)
+        T = joint.pose_matrix
+        np.testing.assert_allclose(T[:3, 3], expected["axis_point"], atol=1e-12)
+        np.testing.assert_allclose(T[:3, 2], expected["axis_direction"], atol=1e-12)
+        # placed on its line: the same line (either sense), through the same point
+        placed = tree.Joints[node].pose_matrix
+        assert np.linalg.norm(np.cross(placed[:3, 2], T[:3, 2])) < 1e-12
+        assert np.linalg.norm(np.cross(placed[:3, 3] - T[:3, 3], T[:3, 2])) < 1e-9
+    placement = reference["placement"]
+    assert tree.construction.chosen  # the file leaves the growth direction to the construction
+    np.testing.assert_allclose(tree.construction.growth_direction,
+                               placement["growth_direction"], atol=1e-9)  # fmt: skip
+    assert tree.construction.quality == pytest.approx(placement["min_abs_dot_f"], abs=1e-9)
+    assert tree.maxAnglePerElbow == pytest.approx(placement["maxAnglePerElbow"], abs=1e-15)
+    assert tree.Parents == tuple(reference["reference"]["tree_parents"])
+
+
+def test_algorithmic_hand_with_the_published_routing_is_the_reference_tree():
+    """With "siblingAzimuth": 0 the file gives the reference total of the published
+    construction (without the extra roll), which passes through itself where the two routes
+    leave the root side by side; the default routing (the gallery's) is clear."""
+    document = json.loads((DESIGNS / "algorithmic_hand.json").read_text(encoding="utf-8"))
+    document["placement"]["siblingAzimuth"] = 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        published = chain_from_dict(document)
+    assert published.totalPathLength() == pytest.approx(ALGORITHMIC_HAND_PUBLISHED_TOTAL,
+                                                        abs=ALGORITHMIC_HAND_TOLERANCE)  # fmt: skip
+    report = published.clearance()
+    assert not report.ok
+    routes = {published.construction.waypoints[k][1] for k in range(2)}  # the links into W1
+    assert {int(part.split()[1].rstrip(",")) for pair in report.pairs
+            for part in (pair.first, pair.second)} == routes  # fmt: skip
+
+
+def leg_paths(tree: KinematicTree) -> list[list[int]]:
+    """Every leaf's joints from the root."""
+    paths = []
+    for leaf, children in enumerate(tree.Children):
+        if not children:
+            path = [leaf]
+            while tree.Parents[path[-1]] >= 0:
+                path.append(tree.Parents[path[-1]])
+            paths.append(path[::-1])
+    return paths
+
+
+def test_quadruped_has_four_legs_of_three_revolute_joints(trees):
+    tree = trees["quadruped"]
+    legs = leg_paths(tree)
+    assert len(legs) == 4
+    for leg, hip in zip(legs, QUADRUPED_HIPS, strict=True):
+        revolute = [k for k in leg if isinstance(tree.Joints[k], RevoluteJoint)]
+        assert len(revolute) == 3 and isinstance(tree.Joints[leg[-1]], EndTip)
+        assert all(isinstance(tree.Joints[k], Waypoint) for k in leg[: leg.index(revolute[0])])
+        yaw, pitch, knee = (axis_line(tree.Joints[k]) for k in revolute)
+        np.testing.assert_allclose(yaw[0], hip, atol=1e-9)
+        np.testing.assert_allclose(yaw[1], (0, 0, 1), atol=1e-12)  # the hip yaw is vertical
+        for _, z in (pitch, knee):  # hip pitch and knee: horizontal, parallel
+            assert abs(z[2]) < 1e-12
+        assert abs(abs(pitch[1] @ knee[1]) - 1) < 1e-12
+        assert np.linalg.norm(np.cross(knee[0] - pitch[0], pitch[1])) > 50  # a thigh between
+
+
+def test_quadruped_stands_on_four_feet_below_its_body(trees):
+    tree = trees["quadruped"]
+    ends = []
+    for leg in leg_paths(tree):
+        foot = tree.Joints[leg[-1]]
+        ends.append(foot.pose_matrix[:3, 3] + foot.pose_matrix[:3, 2] * foot.neutralLength / 2)
+        knee = tree.Joints[leg[-2]].pose_matrix[:3, 3]
+        assert knee[2] > 0  # the knees above the body, the feet below: a standing spider
+    ends = np.array(ends)
+    np.testing.assert_allclose(np.abs(ends), np.tile(np.abs(QUADRUPED_FOOT_END), (4, 1)),
+                               atol=1e-6)  # fmt: skip
+    assert sorted(np.sign(ends[:, :2]).tolist()) == [[-1, -1], [-1, 1], [1, -1], [1, 1]]
+    # the feet reach lowest: every link's centreline ends above the feet's far ends
+    lowest = min(float(link_polyline(link)[:, 2].min()) for link in tree.Links[1:])
+    assert lowest > ends[0, 2] + 0.5 * tree.r
+    assert tree.clearance().ok
+
+
+def test_gripper_wrist_and_fingers(trees):
+    tree = trees["gripper"]
+    joints = tree.Joints
+    assert isinstance(joints[0], StartTip)
+    fingers = leg_paths(tree)
+    assert len(fingers) == 2
+    wrist = [k for k in fingers[0] if isinstance(joints[k], RevoluteJoint)][:2]
+    assert wrist == [k for k in fingers[1] if isinstance(joints[k], RevoluteJoint)][:2]
+    (_, zp), (_, zy) = (axis_line(joints[k]) for k in wrist)
+    mount = axis_line(joints[0])[1]
+    np.testing.assert_allclose([zp @ zy, zp @ mount, zy @ mount], 0, atol=1e-12)  # orthogonal
+    axes = []
+    for finger in fingers:
+        own = [k for k in finger if isinstance(joints[k], RevoluteJoint)][2:]
+        assert len(own) == 2
+        axes += [axis_line(joints[k])[1] for k in own]
+    for z in axes[1:]:  # every finger joint about the same direction: they close in a plane
+        assert np.linalg.norm(np.cross(z, axes[0])) < 1e-12
+    left, right = (joints[finger[-1]].pose_matrix[:3, 3] for finger in fingers)
+    np.testing.assert_allclose(left, np.multiply(GRIPPER_TIP, (-1, 1, 1)), atol=1e-6)
+    np.testing.assert_allclose(right, GRIPPER_TIP, atol=1e-6)
+    assert tree.clearance().ok
+
+
+@pytest.mark.parametrize("grasp", ["spherical", "cylindrical", "pinch"])
+def test_hand_grasps_are_the_references(grasp, trees, scripts, folded_hand):
+    """The script's grasps are the reference's states; in them the fingertips and the ball are
+    the reference's. As folded (the palm slid so that its socket fits) the spherical and
+    cylindrical grasps are clear; the pinch folds the thumb onto the palm (its first joint turned
+    by pi/2 right after the palm's -pi/2), which the tube cannot do without passing through
+    itself: its only overlaps are between the palm and the thumb."""
+    import copy
+
+    reference = fixture("hand")["reference"]["grasps"][grasp]
+    hand = scripts("hand")
+    states = hand.POSES[grasp]
+    np.testing.assert_allclose(states, reference["states"], rtol=0, atol=1e-12)
+    names = list(hand.JOINT_NAMES)
+    tree = copy.copy(trees["hand"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        assert tree.setJointStates(states)
+    for name, origin in reference["fingertip_origins"].items():
+        np.testing.assert_allclose(tree.Joints[names.index(name)].pose_matrix[:3, 3], origin,
+                                   atol=1e-6)  # fmt: skip
+    assert tree.recomputeBoundingBall().r == pytest.approx(
+        reference["bounding_ball_radius_recomputed"], abs=1e-6
+    )
+    fabrication, slides = folded_hand
+    assert [joint for joint, _ in slides] == [names.index("palm")]
+    folded = copy.copy(fabrication.tree)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        assert folded.setJointStates(states)
+    report = folded.clearance()
+    if grasp == "pinch":
+        thumb = {"joint 1", "joint 2", "link 1", "link 3"}  # palm, thumb0 and the links into them
+        parts = {" ".join(part.split()[:2]).rstrip(",") for pair in report.pairs
+                 for part in (pair.first, pair.second)}  # fmt: skip
+        assert not report.ok and parts <= thumb, str(report)
+    else:
+        assert report.ok, str(report)
+
+
 # --- the scripts, run as programs -------------------------------------------------------------
 @pytest.fixture(scope="module")
 def script_runs(tmp_path_factory):
@@ -364,7 +612,7 @@ def script_runs(tmp_path_factory):
     the tests. Returns name -> (process, output folder)."""
     env = source_env()
     runs = {}
-    for name in SCRIPTS:
+    for name in [*SCRIPTS, *TREE_SCRIPTS]:
         folder = tmp_path_factory.mktemp("gallery") / name
         process = subprocess.Popen(
             [sys.executable, str(EXAMPLES / f"{name}.py"), str(folder)],
@@ -402,6 +650,50 @@ def test_script_writes_its_files(name, script_runs, designs):
     assert size.y == pytest.approx(pattern.height, rel=1e-6)
 
 
+@pytest.mark.parametrize("name", TREE_SCRIPTS)
+def test_tree_script_writes_its_files(name, script_runs, trees, scripts):
+    """A tree's script writes its 3D view, every sheet's pattern picture and DXF (the sheets
+    ``kinegami build`` cuts: the DXF is the sheet at true size) and a view of every pose."""
+    from _common import tree_sheets
+
+    process, folder = script_runs[name]
+    out, err = process.communicate(timeout=300)
+    assert process.returncode == 0, err
+    leaves = TREE_ENTRIES[name][1]
+    poses = getattr(scripts(name), "POSES", {})
+    sheets = [folder / f"{name}_sheet_{k}{suffix}" for k in range(leaves)
+              for suffix in ("_pattern.png", ".dxf")]  # fmt: skip
+    files = [folder / f"{name}.png", *sheets, *(folder / f"{name}_{pose}.png" for pose in poses)]
+    assert sorted(folder.iterdir()) == sorted(files)  # and no temporary file left over
+    for path in files:
+        assert str(path) in out
+        if path.suffix == ".png":
+            assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    units = json.loads((DESIGNS / f"{name}.json").read_text(encoding="utf-8"))["units"]
+    mm = {"mm": 1.0, "cm": 10.0}[units]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        fabrication, _ = tree_sheets(trees[name])
+    assert len(fabrication.sheets) == leaves
+    for sheet in fabrication.sheets:
+        pattern = sheet.pattern
+        size = bbox.extents(ezdxf.readfile(folder / f"{name}_sheet_{sheet.index}.dxf")
+                            .modelspace()).size  # fmt: skip
+        assert size.x == pytest.approx((pattern.width + pattern.width / pattern.numSides) * mm,
+                                       rel=1e-6)  # fmt: skip
+        assert size.y == pytest.approx(pattern.height * mm, rel=1e-6)
+
+
+def test_hand_script_prints_the_grasps(script_runs):
+    process, _ = script_runs["hand"]
+    out, err = process.communicate(timeout=300)
+    assert process.returncode == 0, err
+    for grasp in ("spherical", "cylindrical"):
+        line = next(line for line in out.splitlines() if line.startswith(f"{grasp} grasp"))
+        assert "middleEnd" in line and line.endswith("as folded: clear: minimum clearance 0.00347")
+    assert "joint 1 slid -3.00 cm along its axis" in out
+
+
 def test_script_rejects_extra_arguments(tmp_path):
     result = subprocess.run(
         [sys.executable, str(EXAMPLES / "planar_joint.py"), "a", "b"],
@@ -435,6 +727,20 @@ def test_make_gallery_writes_both_pictures(tmp_path):
         "planar_joint_pattern.png",
     ]
     assert "1 gallery entries" in result.stdout
+
+
+def test_make_gallery_draws_a_trees_sheets_and_poses(tmp_path):
+    result = subprocess.run(
+        [sys.executable, str(EXAMPLES / "make_gallery.py"), "hand", "--output", str(tmp_path)],
+        capture_output=True, text=True, cwd=tmp_path, env=source_env(),
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["hand.png", *(f"hand_sheet_{k}_pattern.png" for k in range(3)),
+         *(f"hand_{grasp}.png" for grasp in ("spherical", "cylindrical", "pinch"))]
+    )  # fmt: skip
+    assert "1 gallery entries" in result.stdout
+    assert result.stderr == ""  # no warning: the hand's overlap is the gallery's to state
 
 
 def test_make_gallery_unknown_name(tmp_path):
