@@ -390,8 +390,11 @@ def _write_tree_pictures(fabrication, folder: Path, stem: str) -> list[Path]:
             plt.close(fig)
         return write_atomic(path, buffer.getvalue())
 
-    # the connectors in the 3D view too, when they can be made here
-    view = fabrication.tree.show(block=False, showJunctions=_importable("manifold3d"))
+    # the connectors in the 3D view too, when they can be made here (not with take-offs: the
+    # view draws the tree's own links and every junction as a connector)
+    view = fabrication.tree.show(
+        block=False, showJunctions=_importable("manifold3d") and not fabrication.takeoffs
+    )
     written = [save(view[0], folder / f"{stem}_3d.png")]
     for sheet in fabrication.sheets:
         fig, _ = sheet.pattern.show()
@@ -482,7 +485,7 @@ def _takeoff_summary(fabrication, info) -> list[str]:
             f"new link {lengths.mm(t.link.length)}"
         )
     if fabrication.takeoffs:
-        overlap = fabrication.overlap()
+        overlap = fabrication.overlap(names=_joint_names(fabrication.tree))
         body = "clear" if overlap is None else (
             f"{lengths.mm(overlap.clearance)}: self-intersects ({overlap.first} and "
             f"{overlap.second})"
