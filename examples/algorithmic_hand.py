@@ -5,11 +5,11 @@ a root waypoint, the palm joint and a two-joint thumb, a two-joint pointer and a
 middle finger, each ending in a fingertip; the revolute joints are extended ones (a short
 straight tube on each side). It is written as a *joint specification*: each pose only says on
 which line the joint's axis lies. ``from_specification`` chooses everything else: a growth
-direction n (here (1/2, 1/sqrt 2, 1/2), which keeps every axis at least 60 degrees from
-orthogonal to it), where on its line each joint sits (just beyond a cylinder along n that holds
+direction n (here (1/2, 1/sqrt 2, 1/2), which keeps every axis within 60 degrees of it),
+where on its line each joint sits (just beyond a cylinder along n that holds
 everything built before it), its roll and the sign of its axis, and two waypoints that route
 each later finger of the root out of the cylinder. That guarantees that every link exists, but
-not a small robot: the hand comes out at 754.59 cm of links in a ball of radius 116.3 cm,
+not a small robot: the hand comes out at 754.59 cm of links in a ball of radius about 116 cm,
 against 32.28 cm for the hand placed by hand. The routes of the two later fingers leave the
 root 0.5 rad apart about n (kinegami's default); the published construction, which routes them
 side by side, gives 755.9963 cm and a tree that passes through itself.

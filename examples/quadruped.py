@@ -6,8 +6,8 @@ spine, a hip pitch joint 30 mm further out and a knee 60 mm beyond it (both abou
 axes along the body), and a foot (end tip) 80 mm beyond the knee. Every joint is placed exactly
 on its axis (``safe=False`` with fixed position and orientation), so the legs are built
 straight; joint states then make it stand: each leg splayed 25 degrees towards its end of the
-body, thighs raised 20 degrees and knees bent 80 degrees, which puts the feet 47 mm below the
-body. Its left is -x (it faces +y).
+body, thighs raised 20 degrees and knees bent 80 degrees, which puts the knees above the body
+and the feet's ends 53 mm below it. Its left is -x (it faces +y).
 
 The tree has four leaves, so it is folded from four sheets: the spine and the front left leg
 in one piece, and one sheet per other leg, starting in the printed junctions at the two body

@@ -22,6 +22,7 @@ import importlib.util
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 import warnings
@@ -603,6 +604,39 @@ def test_hand_grasps_are_the_references(grasp, trees, scripts, folded_hand):
         assert not report.ok and parts <= thumb, str(report)
     else:
         assert report.ok, str(report)
+
+
+# --- the gallery page and the README ---------------------------------------------------------
+def anchors(markdown: str) -> set[str]:
+    """GitHub's anchors of the headings of a markdown text."""
+    headings = re.findall(r"^#+ (.+)$", markdown, flags=re.M)
+    return {re.sub(r"[^\w\- ]", "", h.strip().lower()).replace(" ", "-") for h in headings}
+
+
+def test_the_gallery_page_shows_every_entry_and_only_existing_pictures(scripts):
+    page = (ROOT / "docs" / "gallery.md").read_text(encoding="utf-8")
+    shown = set(re.findall(r'src="images/gallery/([^"]+)"', page))
+    on_disk = {p.name for p in (ROOT / "docs" / "images" / "gallery").glob("*.png")}
+    assert shown == on_disk  # every picture shown exists, and every picture is shown
+    for name in ENTRIES:
+        assert {f"{name}.png", f"{name}_pattern.png"} <= shown
+    for name, (_, leaves, _) in TREE_ENTRIES.items():
+        poses = getattr(scripts(name), "POSES", {})
+        assert {f"{name}.png", *(f"{name}_sheet_{k}_pattern.png" for k in range(leaves)),
+                *(f"{name}_{pose}.png" for pose in poses)} <= shown  # fmt: skip
+        assert f"kinegami build examples/designs/{name}.json" in page
+        assert f"python examples/{name}.py" in page
+
+
+def test_the_readme_grid_shows_every_entry_and_links_to_its_section():
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    page_anchors = anchors((ROOT / "docs" / "gallery.md").read_text(encoding="utf-8"))
+    links = re.findall(r'\[<img src="docs/images/gallery/([^"]+)\.png"[^]]*\]\(docs/gallery\.md'
+                       r"#([\w-]+)\)", readme)  # fmt: skip
+    assert {picture for picture, _ in links} >= {*ENTRIES, *TREE_ENTRIES}
+    for picture, anchor in links:
+        assert (ROOT / "docs" / "images" / "gallery" / f"{picture}.png").is_file()
+        assert anchor in page_anchors, anchor
 
 
 # --- the scripts, run as programs -------------------------------------------------------------
