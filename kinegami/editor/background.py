@@ -1,8 +1,11 @@
-"""Work the editor does after a pause rather than on every change: :class:`Debounced`.
+"""Work the editor does after a pause rather than on every change: :class:`Debounced`, and
+:class:`ProcessWorker` for work too slow to share the server's process.
 
 A drag or an animation changes the document many times a second. What is not needed for each
 step (the crease-pattern drawing, the autosave) is triggered on every change and runs once, in
-a background thread, when no change came for ``delay`` seconds. See docs/editor.md.
+a background thread, when no change came for ``delay`` seconds. Fitting a tree's junctions
+takes seconds of pure Python; it runs in a worker process, so that it holds neither a tab's
+lock nor the interpreter lock meanwhile. See docs/editor.md.
 """
 
 from __future__ import annotations
@@ -10,8 +13,9 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
+from typing import Any
 
-__all__ = ["Debounced"]
+__all__ = ["Debounced", "ProcessWorker"]
 
 
 class Debounced:
@@ -89,3 +93,62 @@ class Debounced:
                     self._func()
             except Exception as error:  # noqa: BLE001 - kept for the owner; the thread goes on
                 self.error = error
+
+
+class ProcessWorker:
+    """Runs functions in a separate process, started on first use and shared by its callers.
+
+    ``run(func, *args)`` sends ``func`` (by reference) and ``args`` (pickled) to the process
+    and waits for its result, or its exception, raised again here. The process is a fresh
+    interpreter (``"spawn"``, not a fork of the threaded server), so its warnings filters are
+    its own: ``warnings.catch_warnings``, which the library uses, changes them for the whole
+    process and is not thread-safe. A process that died is started again once.
+    """
+
+    def __init__(self, processes: int = 1):
+        self._processes = int(processes)
+        self._lock = threading.Lock()
+        self._executor = None
+        self._closed = False
+        #: How many calls ran in the process (tests read it).
+        self.calls = 0
+
+    def _pool(self):
+        import concurrent.futures
+        import multiprocessing
+
+        with self._lock:
+            if self._closed:
+                raise RuntimeError("the worker process was closed")
+            if self._executor is None:
+                self._executor = concurrent.futures.ProcessPoolExecutor(
+                    self._processes, mp_context=multiprocessing.get_context("spawn")
+                )
+            return self._executor
+
+    def run(self, func: Callable[..., Any], *args) -> Any:
+        """``func(*args)`` computed in the worker process."""
+        from concurrent.futures.process import BrokenProcessPool
+
+        for attempt in range(2):
+            pool = self._pool()
+            try:
+                result = pool.submit(func, *args).result()
+            except BrokenProcessPool:
+                with self._lock:
+                    if self._executor is pool:
+                        self._executor = None
+                pool.shutdown(wait=False)
+                if attempt:
+                    raise
+                continue
+            self.calls += 1
+            return result
+        raise AssertionError("unreachable")  # pragma: no cover
+
+    def close(self) -> None:
+        """Stop the process (a call in progress is abandoned)."""
+        with self._lock:
+            executor, self._executor, self._closed = self._executor, None, True
+        if executor is not None:
+            executor.shutdown(wait=False, cancel_futures=True)

@@ -37,6 +37,7 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
+from kinegami.tree import KinematicTree
 from kinegami.validation import shown
 
 __all__ = [
@@ -44,6 +45,7 @@ __all__ = [
     "Outcome",
     "Command",
     "AddJoint",
+    "AddBranch",
     "DeleteJoint",
     "SlideJoint",
     "RollJoint",
@@ -55,6 +57,7 @@ __all__ = [
     "SetJointStates",
     "Compact",
     "SetOptions",
+    "FitJunctions",
     "ReplaceDocument",
     "JOINT_TYPES",
     "PLACEMENTS",
@@ -237,7 +240,7 @@ class _Run:
             self.warnings[:] = [clearance[-1]]
         return result
 
-    def clear_warning(self, chain: KinematicChain) -> tuple[str, ...]:
+    def clear_warning(self, chain) -> tuple[str, ...]:
         """The collected warnings that still hold for ``chain`` (it passes through itself)."""
         if not self.warnings:
             return ()
@@ -247,17 +250,33 @@ class _Run:
 _FIXED = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
 
 
-def _rebuilt(run: _Run, chain: KinematicChain, joints: Sequence[Joint], keep: int = 0,
-             maxAnglePerElbow: float | None = None) -> KinematicChain:  # fmt: skip
-    """A chain of ``joints`` at their exact poses and states: the first ``keep`` joints are
-    those of ``chain`` (its first ``keep`` links kept as they are when ``keep`` > 0 and
-    ``keep`` joints are left in the fork), the others appended at fixed poses."""
+def _is_tree(chain) -> bool:
+    return isinstance(chain, KinematicTree)
+
+
+def _attach(new, parent: int, joint: Joint, **options):
+    """Add ``joint`` to ``new`` as a child of joint ``parent``: a chain appends it (``parent``
+    is then its last joint), a tree adds it with ``addJoint``. Returns the new joint's index
+    (or None/False with a PlacementWarning, as the chain does)."""
+    if _is_tree(new):
+        return new.addJoint(parent, joint, **options)
+    return new.append(joint, **options)
+
+
+def _rebuilt(run: _Run, chain, joints: Sequence[Joint], keep: int = 0,
+             maxAnglePerElbow: float | None = None,
+             parents: Sequence[int] | None = None):  # fmt: skip
+    """A chain (or tree) of ``joints`` at their exact poses and states: the first ``keep``
+    joints are those of ``chain`` (its first ``keep`` links kept as they are when ``keep`` > 0
+    and ``keep`` joints are left in the fork), the others added at fixed poses, joint k as a
+    child of ``parents[k]`` (default: the chain's or tree's parents)."""
+    parents = chain.Parents if parents is None else parents
     if keep >= len(chain.Joints) and maxAnglePerElbow is None:
         new = fork_chain(chain)
         start = len(chain.Joints)
     elif keep > 0 and maxAnglePerElbow is None:
         new = fork_chain(chain)
-        for _ in range(len(chain.Joints) - keep):
+        for _ in range(len(chain.Joints) - keep):  # a tree's last joint is always a leaf
             run("re-linking the chain", lambda: new.delete(-1))
         start = keep
     else:
@@ -265,16 +284,17 @@ def _rebuilt(run: _Run, chain: KinematicChain, joints: Sequence[Joint], keep: in
         if isinstance(root, EndTip):
             _fail("a chain whose first joint is an EndTip cannot be rebuilt; add a joint first")
         angle = chain.maxAnglePerElbow if maxAnglePerElbow is None else maxAnglePerElbow
+        kind = KinematicTree if _is_tree(chain) else KinematicChain
         new = run(
             "rebuilding the chain",
-            lambda: KinematicChain(root, angle, requireClearance=chain.requireClearance),
+            lambda: kind(root, angle, requireClearance=chain.requireClearance),
         )
         start = 1
     for k in range(start, len(joints)):
         joint = joints[k]
         run(
             f"re-linking joint {k} ({type(joint).__name__})",
-            lambda j=joint: new.append(j, **_FIXED),
+            lambda j=joint, p=parents[k]: _attach(new, p, j, **_FIXED),
         )
     return new
 
@@ -354,14 +374,62 @@ class Command(abc.ABC):
         return self.label
 
 
+#: How each placement is asked of the chain's append or the tree's addJoint.
+_PLACEMENT_OPTIONS = {
+    "safe": {"safe": True},
+    "compact": {"safe": False},
+    "pose": {"safe": False, "fixedPosition": True, "fixedOrientation": True},
+}
+
+
+def _children(chain, j: int) -> list[int]:
+    return [k for k, p in enumerate(chain.Parents) if p == j]
+
+
+def _joint_list(indices) -> str:
+    return ", ".join(str(k) for k in indices)
+
+
+@dataclass(frozen=True)
+class _NewJoint:
+    """The checked fields of a command that adds a joint (AddJoint, AddBranch)."""
+
+    joint: Joint
+    parent: int
+    relative: bool
+    options: dict
+    name: str | None
+
+
+def _new_joint_of(command, document: Document, ref, what: str) -> _NewJoint:
+    chain = document.chain
+    if command.placement not in PLACEMENTS:
+        _fail(f"placement must be one of {', '.join(PLACEMENTS)}, got {shown(command.placement)}")
+    relative = _flag("relative", command.relative)
+    parent = len(chain.Joints) - 1 if ref is None else resolve_joint(document, ref, what)
+    pose = _pose("pose", command.pose, chain.r)
+    joint = _new_joint(command.kind, command.parameters, pose, chain.numSides, chain.r)
+    name = _check_name(document, command.name)
+    if isinstance(joint, StartTip):
+        noun = "tree" if _is_tree(chain) else "chain"
+        _fail(f"a StartTip can only be the first joint of a {noun}, which already has one")
+    if isinstance(chain.Joints[parent], EndTip):
+        ends = "ends the chain" if not _is_tree(chain) else "is a leaf of the tree"
+        _fail(f"nothing can follow {_label(document, parent)}: an EndTip {ends}")
+    return _NewJoint(joint, parent, relative, _PLACEMENT_OPTIONS[command.placement], name)
+
+
 @dataclass(frozen=True)
 class AddJoint(Command):
     """Add a joint after joint ``after`` (default: the last one), placed as ``append`` does.
 
+    On a tree the new joint becomes the child of joint ``after`` and takes over ``after``'s
+    children (inserted between them); :class:`AddBranch` adds a joint beside them instead.
+
     Parameters
     ----------
     kind : the joint type, one of :data:`JOINT_TYPES` (not a StartTip: only the root is one, and
-        an EndTip only at the end).
+        an EndTip only at the end, or on a tree after a leaf).
     parameters : its parameters (defaults: totalBendingAngle pi, numSinkLayers 1, tubeLength 2r,
         neutralLength 3r, numLayers 3, coneAngle pi/4, pathIndex 2, length 1.5r).
     pose : its Pose, a 4x4 rigid transform (default the identity); relative to joint
@@ -389,49 +457,40 @@ class AddJoint(Command):
     def apply(self, document: Document) -> Outcome:
         chain = document.chain
         run = _Run()
-        if self.placement not in PLACEMENTS:
-            _fail(f"placement must be one of {', '.join(PLACEMENTS)}, got {shown(self.placement)}")
-        relative = _flag("relative", self.relative)
-        after = (
-            len(chain.Joints) - 1
-            if self.after is None
-            else resolve_joint(document, self.after, "after")
-        )
-        pose = _pose("pose", self.pose, chain.r)
-        joint = _new_joint(self.kind, self.parameters, pose, chain.numSides, chain.r)
-        name = _check_name(document, self.name)
-        if isinstance(joint, StartTip):
-            _fail("a StartTip can only be the first joint of a chain, which already has one")
-        if isinstance(chain.Joints[after], EndTip):
-            _fail(f"nothing can follow {_label(document, after)}: an EndTip ends the chain")
-        rest = chain.Joints[after + 1 :]
-        if isinstance(joint, EndTip) and rest:
+        spec = _new_joint_of(self, document, self.after, "after")
+        joint, after = spec.joint, spec.parent
+        parents = chain.Parents
+        if isinstance(joint, EndTip) and _children(chain, after):
+            if _is_tree(chain):
+                _fail(
+                    f"an EndTip can only be a leaf; after={after} has children (joints "
+                    f"{_joint_list(_children(chain, after))}), which the new joint would take "
+                    "over: add the EndTip as a branch, or after a leaf"
+                )
             _fail(
                 f"an EndTip can only be the last joint; after={after} is followed by "
-                f"{len(rest)} joint(s)"
+                f"{len(chain.Joints) - after - 1} joint(s)"
             )
-        options = {
-            "safe": {"safe": True},
-            "compact": {"safe": False},
-            "pose": {"safe": False, "fixedPosition": True, "fixedOrientation": True},
-        }[self.placement]
         new = _rebuilt(run, chain, chain.Joints[: after + 1], keep=after + 1)
         index = run(
             f"adding the {self.kind}",
-            lambda: new.append(joint, relative=relative, **options),
+            lambda: _attach(new, after, joint, relative=spec.relative, **spec.options),
         )
         added = index - after
-        names = [*document.names[: after + 1], *(None,) * (added - 1), name]
+        names = [*document.names[: after + 1], *(None,) * (added - 1), spec.name]
         sources: list = [*range(after + 1), *(None,) * added]
+        where = list(range(after + 1))  # each old joint's index in the new chain or tree
         notes = []
-        for k, later in enumerate(rest, start=after + 1):
+        for k in range(after + 1, len(chain.Joints)):
+            later = chain.Joints[k]
+            p = index if parents[k] == after else where[parents[k]]
             what = f"re-linking joint {k} ({type(later).__name__}) after the new joint"
             try:
-                run(what, lambda j=later: new.append(j, **_FIXED))
+                run(what, lambda j=later, p=p: _attach(new, p, j, **_FIXED))
                 source = k
             except CommandError as fixed:
                 try:  # no link reaches it where it is: place it again on its axis
-                    run(what, lambda j=later: new.append(j, relative=False, safe=True))
+                    run(what, lambda j=later, p=p: _attach(new, p, j, relative=False, safe=True))
                 except CommandError:
                     raise fixed from None
                 source = None
@@ -443,13 +502,70 @@ class AddJoint(Command):
             count = len(new.Joints) - len(names)
             names += [None] * (count - 1) + [document.names[k]]
             sources += [None] * (count - 1) + [source]
+            where.append(len(new.Joints) - 1)
         return Outcome(document.replaced(chain=new, names=tuple(names)), index,
                        (*notes, *run.clear_warning(new)), tuple(sources))  # fmt: skip
 
 
 @dataclass(frozen=True)
+class AddBranch(Command):
+    """Add a joint as a new child of joint ``parent`` (default: the last one), beside the
+    children it has: a branch. Placed as ``KinematicTree.addJoint`` places it (docs/trees.md).
+
+    On a chain, a child of the last joint is simply appended (the chain stays a chain); a child
+    of any other joint makes a branch, and the document's chain becomes a
+    :class:`~kinegami.tree.KinematicTree` (the same joints and links, bit for bit, joint i the
+    child of joint i - 1). Nothing else moves: the new joint and the waypoints safe placement
+    adds before it take the next indices.
+
+    Parameters
+    ----------
+    kind, parameters, pose, placement, relative, name : as for :class:`AddJoint` (the pose is
+        relative to joint ``parent``'s Pose when ``relative``).
+    parent : the joint it is added to (index or name).
+    """
+
+    kind: str
+    parameters: Mapping = field(default_factory=dict)
+    pose: Any = None
+    parent: int | str | None = None
+    placement: str = "safe"
+    relative: bool = True
+    name: str | None = None
+
+    label: ClassVar[str] = "add branch"
+
+    def describe(self) -> str:
+        return f"add {self.kind} as a branch of joint {self.parent!r}"
+
+    def apply(self, document: Document) -> Outcome:
+        chain = document.chain
+        spec = _new_joint_of(self, document, self.parent, "parent")
+        parent = spec.parent
+        n = len(chain.Joints)
+        if not _is_tree(chain) and parent == n - 1:  # no branch: the chain grows
+            return AddJoint(self.kind, self.parameters, self.pose, parent, self.placement,
+                            self.relative, self.name).apply(document)  # fmt: skip
+        run = _Run()
+        if _is_tree(chain):
+            new = fork_chain(chain)
+        else:
+            new = run("making the chain a tree", lambda: KinematicTree.from_chain(chain))
+        index = run(
+            f"adding the {self.kind} to {_label(document, parent)}",
+            lambda: new.addJoint(parent, spec.joint, relative=spec.relative, **spec.options),
+        )
+        added = index - (n - 1)
+        names = (*document.names, *(None,) * (added - 1), spec.name)
+        sources = (*range(n), *(None,) * added)
+        return Outcome(document.replaced(chain=new, names=names), index, run.clear_warning(new),
+                       sources)  # fmt: skip
+
+
+@dataclass(frozen=True)
 class DeleteJoint(Command):
-    """Remove a joint; its neighbours are joined by a new link."""
+    """Remove a joint with at most one child; its parent and its child (if any) are joined by
+    a new link (the root can go when it has exactly one child, which becomes the root)."""
 
     joint: int | str
 
@@ -459,16 +575,24 @@ class DeleteJoint(Command):
         return f"delete joint {self.joint!r}"
 
     def apply(self, document: Document) -> Outcome:
+        chain = document.chain
         j = resolve_joint(document, self.joint)
-        if len(document.chain.Joints) == 1:
+        if len(chain.Joints) == 1:
             _fail("the chain's only joint cannot be deleted: a chain keeps at least one joint")
+        kids = _children(chain, j)
+        if len(kids) > 1:
+            _fail(
+                f"{_label(document, j)} has {len(kids)} children (joints {_joint_list(kids)}): "
+                "only a joint with at most one child can be deleted; delete all its branches "
+                "but one first"
+            )
         run = _Run()
-        new = fork_chain(document.chain)
+        new = fork_chain(chain)
         run(f"deleting {_label(document, j)}", lambda: new.delete(j))
         names = document.names[:j] + document.names[j + 1 :]
-        n = len(document.chain.Joints)
+        n = len(chain.Joints)
         sources = tuple(k for k in range(n) if k != j)
-        return Outcome(document.replaced(chain=new, names=names), max(j - 1, 0),
+        return Outcome(document.replaced(chain=new, names=names), max(chain.Parents[j], 0),
                        run.clear_warning(new), sources)  # fmt: skip
 
 
@@ -708,10 +832,21 @@ class SetJointStates(Command):
                        tuple(range(n)))  # fmt: skip
 
 
+def _kept_by_compact(chain) -> list[int]:
+    """The joints compaction keeps (the others are waypoints it may move, add or drop): every
+    joint that is not a waypoint; in a tree also the root and the waypoints where it branches."""
+    if not _is_tree(chain):
+        return [i for i, joint in enumerate(chain.Joints) if type(joint) is not Waypoint]
+    children = chain.Children
+    return [i for i, joint in enumerate(chain.Joints)
+            if i == 0 or type(joint) is not Waypoint or len(children[i]) > 1]  # fmt: skip
+
+
 @dataclass(frozen=True)
 class Compact(Command):
-    """Replace the chain by a shorter one with the same kinematics and no collisions
-    (:func:`kinegami.optimize.compact`, docs/clearance.md); names follow their joints."""
+    """Replace the chain (or tree) by a shorter one with the same kinematics and no collisions
+    (:func:`kinegami.optimize.compact`, docs/clearance.md; a tree's sockets fit afterwards);
+    names follow their joints. ``motion`` is for chains only."""
 
     seed: int = 0
     motion: bool = False
@@ -735,8 +870,7 @@ class Compact(Command):
                 starts=self.starts,
             ),
         )  # fmt: skip
-        old_kept = [i for i, joint in enumerate(chain.Joints) if type(joint) is not Waypoint]
-        new_kept = [i for i, joint in enumerate(new.Joints) if type(joint) is not Waypoint]
+        old_kept, new_kept = _kept_by_compact(chain), _kept_by_compact(new)
         old_types = [type(chain.Joints[i]) for i in old_kept]
         new_types = [type(new.Joints[i]) for i in new_kept]
         if old_types != new_types:  # pragma: no cover - compact keeps the joints
@@ -815,8 +949,9 @@ class SetOptions(Command):
                 if require:
                     report = new.clearance()
                     if not report.ok:
+                        noun = "tree" if _is_tree(new) else "chain"
                         _fail(
-                            "requireClearance cannot be turned on: the chain passes through "
+                            f"requireClearance cannot be turned on: the {noun} passes through "
                             f"itself ({report.pairs[0]})"
                         )
                 new = fork_chain(new) if new is chain else new
@@ -825,6 +960,28 @@ class SetOptions(Command):
             changes["chain"] = new
         return Outcome(document.replaced(**changes), None, run.clear_warning(new),
                        tuple(range(len(new.Joints))))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class FitJunctions(Command):
+    """Slide the branch children of a tree whose printed junction socket would not fit on
+    their link, along their axes (:func:`kinegami.tree.sheets.fit_junctions`: the kinematics
+    stay, no new collision): what ``kinegami build`` does before it makes the sheets."""
+
+    label: ClassVar[str] = "fit junctions"
+
+    def apply(self, document: Document) -> Outcome:
+        from kinegami.tree.sheets import fit_junctions
+
+        if not document.is_tree:
+            _fail("fit junctions: a chain has no junctions (a tree has one at every joint "
+                  "with several children)")  # fmt: skip
+        run = _Run()
+        fitted, moves = run("fit junctions", lambda: fit_junctions(document.chain))
+        if not moves:
+            _fail("fit junctions: every junction's socket fits already; nothing to slide")
+        return Outcome(document.replaced(chain=fitted), moves[0][0], run.clear_warning(fitted),
+                       tuple(range(len(fitted.Joints))))  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -1,9 +1,11 @@
-"""The editor's document: a design (chain, joint names, options, file metadata) as a value.
+"""The editor's document: a design (chain or tree, joint names, options, file metadata) as a
+value.
 
 A :class:`Document` never changes once made: commands build a new one (see
 :mod:`kinegami.editor.commands`), so undo keeps the old one and gives it back bit for bit. Its
-chain is a private copy that nothing edits in place; its clearance report, joint table and
-design text are computed on first use and kept. See docs/editor.md.
+chain (a :class:`~kinegami.chain.KinematicChain` or a :class:`~kinegami.tree.KinematicTree`)
+is a private copy that nothing edits in place; its clearance report, joint table and design
+text are computed on first use and kept. See docs/editor.md.
 """
 
 from __future__ import annotations
@@ -40,15 +42,17 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
+from kinegami.tree import KinematicTree
 
 __all__ = ["Document", "JointRow", "joint_parameters", "fork_chain"]
 
 
-def fork_chain(chain: KinematicChain) -> KinematicChain:
-    """A copy of ``chain`` that can be edited without touching ``chain``.
+def fork_chain(chain: KinematicChain | KinematicTree) -> KinematicChain | KinematicTree:
+    """A copy of ``chain`` (a chain or a tree) that can be edited without touching ``chain``.
 
-    Joints and links are immutable values and every chain operation replaces the chain's lists
-    rather than changing them, so a shallow copy shares them safely (and costs microseconds).
+    Joints and links are immutable values and every chain or tree operation replaces the lists
+    (joints, links, a tree's parents) rather than changing them, so a shallow copy shares them
+    safely (and costs microseconds).
     """
     return copy.copy(chain)
 
@@ -85,13 +89,15 @@ class JointRow:
 
     Attributes
     ----------
-    index : the joint's index in the chain (what commands use).
+    index : the joint's index in the chain or tree (what commands use).
     type : the joint's class name (``"RevoluteJoint"``, ...).
     name : its name in the design, or None.
     pose : the joint's Pose as a read-only 4x4 array (world coordinates, z = axis of motion).
     state : its state (radians for revolute joints, a length for prismatic ones, else 0).
     state_range : the closed interval of its states.
     parameters : its constructor parameters (see :func:`joint_parameters`).
+    parent : the index of its parent (-1 for the root; in a chain, index - 1).
+    children : the indices of its children (in a chain, the next joint, if any).
     """
 
     index: int
@@ -101,6 +107,8 @@ class JointRow:
     state: float
     state_range: tuple[float, float]
     parameters: dict
+    parent: int = -1
+    children: tuple[int, ...] = ()
 
     @property
     def movable(self) -> bool:
@@ -116,11 +124,12 @@ def _check_text(key: str, value) -> str | None:
 
 @dataclass(frozen=True, eq=False)
 class Document:
-    """A design as the editor holds it: the built chain and what a design file adds to it.
+    """A design as the editor holds it: the built chain or tree and what a design file adds.
 
     Attributes
     ----------
-    chain : the built chain (a private copy: never edit it; commands make new documents).
+    chain : the built KinematicChain or KinematicTree (a private copy: never edit it; commands
+        make new documents). :attr:`is_tree` says which.
     names : one name (or None) per joint of ``chain``.
     name, description : the design's texts (None when absent).
     units : the length unit ("mm", "cm", "m" or "in").
@@ -131,7 +140,7 @@ class Document:
     the joints' states are the chain's.
     """
 
-    chain: KinematicChain
+    chain: KinematicChain | KinematicTree
     names: tuple
     name: str | None = None
     description: str | None = None
@@ -139,9 +148,10 @@ class Document:
     twistPortion: float | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.chain, KinematicChain):
+        if not isinstance(self.chain, KinematicChain | KinematicTree):
             raise InvalidTypeError(
-                f"chain must be a KinematicChain, got {type(self.chain).__name__}"
+                "chain must be a KinematicChain or a KinematicTree, got "
+                f"{type(self.chain).__name__}"
             )
         names = tuple(self.names)
         if len(names) != len(self.chain.Joints):
@@ -160,7 +170,7 @@ class Document:
     @classmethod
     def from_chain(
         cls,
-        chain: KinematicChain,
+        chain: KinematicChain | KinematicTree,
         names=None,
         *,
         name: str | None = None,
@@ -168,12 +178,15 @@ class Document:
         units: str = "mm",
         twistPortion: float | None = None,
     ) -> Document:
-        """A document holding a copy of ``chain`` (later edits of ``chain`` do not reach it).
+        """A document holding a copy of ``chain``, a chain or a tree (later edits of ``chain``
+        do not reach it).
 
         ``names`` defaults to the joint names the design loader remembers for ``chain``.
         """
-        if not isinstance(chain, KinematicChain):
-            raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
+        if not isinstance(chain, KinematicChain | KinematicTree):
+            raise InvalidTypeError(
+                f"chain must be a KinematicChain or a KinematicTree, got {type(chain).__name__}"
+            )
         if names is None:
             origin = origin_of(chain)
             names = origin.names if origin is not None else (None,) * len(chain.Joints)
@@ -220,18 +233,29 @@ class Document:
 
     # --- derived values (computed once) -------------------------------------------------------
     @property
+    def is_tree(self) -> bool:
+        """Whether the design is a tree (its chain is a KinematicTree; folded from a sheet per
+        leaf) rather than a chain."""
+        return isinstance(self.chain, KinematicTree)
+
+    @property
     def twist_portion(self) -> float:
         """The twist portion the crease pattern uses (``twistPortion`` or the default 0.2)."""
         return DEFAULT_TWIST_PORTION if self.twistPortion is None else float(self.twistPortion)
 
     @cached_property
     def clearance(self):
-        """The chain's ClearanceReport at its states (docs/clearance.md)."""
+        """The chain's (or tree's) ClearanceReport at its states (docs/clearance.md)."""
         return self.chain.clearance()
 
     @cached_property
     def joint_table(self) -> tuple[JointRow, ...]:
-        """One :class:`JointRow` per joint, in chain order."""
+        """One :class:`JointRow` per joint, in index order."""
+        parents = self.chain.Parents
+        children: list[list[int]] = [[] for _ in parents]
+        for k, p in enumerate(parents):
+            if p >= 0:
+                children[p].append(k)
         rows = []
         for i, joint in enumerate(self.chain.Joints):
             lo, hi = joint.stateRange()
@@ -239,6 +263,7 @@ class Document:
                 JointRow(
                     i, type(joint).__name__, self.names[i], joint.pose_matrix,
                     float(joint.state), (float(lo), float(hi)), joint_parameters(joint),
+                    int(parents[i]), tuple(children[i]),
                 )
             )  # fmt: skip
         return tuple(rows)
@@ -248,7 +273,8 @@ class Document:
         """The design document (a JSON-ready dict) that loads as this document.
 
         Raises InvalidParameterError when the chain cannot be written as a design (see
-        ``kinegami.design.design_to_dict``).
+        ``kinegami.design.design_to_dict``). A tree is written as version 2 with every joint's
+        ``parent``: its name when it has one, else its entry's index.
         """
         with warnings.catch_warnings():  # the writer's state-0 copy may pass through itself
             warnings.simplefilter("ignore", ClearanceWarning)
@@ -261,11 +287,22 @@ class Document:
             )
         entries = document["joints"]
         offset = len(entries) - len(self.names)  # 1 when the root is an EndTip (see writer)
+        parents = self.chain.Parents if self.is_tree else None
         for i, label in enumerate(self.names):
             entry = entries[i + offset]
             entry.pop("name", None)
+            head = {"type": entry.pop("type")}
             if label is not None:
-                entries[i + offset] = {"type": entry.pop("type"), "name": label, **entry}
+                head["name"] = label
+            if parents is not None and "parent" in entry:
+                # the writer names parents by the loader's names, which edits may have changed
+                entry.pop("parent")
+                p = parents[i]
+                if p < 0:  # an EndTip root, written after a waypoint root that an edit deletes
+                    head["parent"] = 0
+                else:
+                    head["parent"] = self.names[p] if self.names[p] is not None else p + offset
+            entries[i + offset] = {**head, **entry}
         return document
 
     @cached_property

@@ -22,8 +22,9 @@ from kinegami.chain import KinematicChain
 from kinegami.editor import commands as cmd
 from kinegami.editor.commands import Command, CommandError, Outcome
 from kinegami.editor.document import Document, JointRow, joint_parameters
-from kinegami.editor.patterns import PatternCache, link_shape_key
+from kinegami.editor.patterns import PatternCache, TreeSheets, link_shape_key, tree_sheets
 from kinegami.errors import InvalidTypeError, KinegamiError
+from kinegami.tree import KinematicTree
 
 __all__ = ["EditorModel", "CommandResult", "Change"]
 
@@ -215,8 +216,9 @@ class EditorModel:
 
     Parameters
     ----------
-    document : the document to edit: a :class:`Document`, a KinematicChain (copied), or None
-        for the starter design of ``kinegami new`` (kinegami/design/starter.json).
+    document : the document to edit: a :class:`Document`, a KinematicChain or KinematicTree
+        (copied), or None for the starter design of ``kinegami new``
+        (kinegami/design/starter.json).
     path : the design file it belongs to (where :meth:`save` writes by default).
 
     Examples
@@ -228,17 +230,17 @@ class EditorModel:
     (True, False)
     """
 
-    def __init__(self, document: Document | KinematicChain | None = None,
+    def __init__(self, document: Document | KinematicChain | KinematicTree | None = None,
                  path: str | os.PathLike | None = None):  # fmt: skip
         if document is None:
             from kinegami.design.starter import starter_text
 
             document = Document.loads(starter_text())
-        elif isinstance(document, KinematicChain):
+        elif isinstance(document, KinematicChain | KinematicTree):
             document = Document.from_chain(document)
         elif not isinstance(document, Document):
             raise InvalidTypeError(
-                f"document must be a Document, a KinematicChain or None, got "
+                f"document must be a Document, a KinematicChain, a KinematicTree or None, got "
                 f"{type(document).__name__}"
             )
         self._document = document
@@ -268,9 +270,14 @@ class EditorModel:
         return self._document
 
     @property
-    def chain(self) -> KinematicChain:
-        """The current chain (read it; change it only through commands)."""
+    def chain(self) -> KinematicChain | KinematicTree:
+        """The current chain or tree (read it; change it only through commands)."""
         return self._document.chain
+
+    @property
+    def is_tree(self) -> bool:
+        """Whether the current design is a tree (see :meth:`sheets`)."""
+        return self._document.is_tree
 
     @property
     def path(self) -> Path | None:
@@ -320,13 +327,21 @@ class EditorModel:
 
     # --- derived values -----------------------------------------------------------------------
     def clearance(self):
-        """The current chain's ClearanceReport (computed once per document)."""
+        """The current chain's (or tree's) ClearanceReport (computed once per document)."""
         return self._document.clearance
+
+    def _chain_only(self, what: str) -> None:
+        if self._document.is_tree:
+            raise InvalidTypeError(
+                f"{what}: a tree is folded from several sheets, one per leaf; use sheets()"
+            )
 
     def pattern(self):
         """The current chain's crease pattern (a TubularPattern, equal to
         ``chain.creasePattern(twistPortion)``), computed once per document and built from
-        the parts the last pattern shares with it."""
+        the parts the last pattern shares with it. A tree has a sheet per leaf instead
+        (:meth:`sheets`; InvalidTypeError here)."""
+        self._chain_only("pattern")
         document = self._document
         cached = document.__dict__.get("_pattern")
         if cached is None:
@@ -337,7 +352,9 @@ class EditorModel:
     def joint_modules(self) -> tuple[range, ...]:
         """Per joint, which records of ``pattern().modules`` (and of its ``module_vertices``)
         are the joint's own modules: a range of indices, empty for a joint without a pattern
-        of its own (a waypoint). Computed once per document."""
+        of its own (a waypoint). Computed once per document. Chains only (a tree's joints are
+        in :attr:`TreeSheets.places <kinegami.editor.patterns.TreeSheets.places>`)."""
+        self._chain_only("joint_modules")
         document = self._document
         cached = document.__dict__.get("_joint_modules")
         if cached is None:
@@ -345,8 +362,31 @@ class EditorModel:
             document.__dict__["_joint_modules"] = cached
         return cached
 
+    def sheets(self, document: Document | None = None, fit: Callable | None = None) -> TreeSheets:
+        """The sheets of the current tree (or of ``document``, a tree's), one per leaf, with
+        its junctions, as ``kinegami build`` makes them (the tree fitted by
+        :func:`~kinegami.tree.sheets.fit_junctions` first, or by ``fit``, which computes the
+        same elsewhere): a :class:`~kinegami.editor.patterns.TreeSheets`. Computed once per
+        document (a failure too: the same error is raised again); any thread may ask.
+        InvalidTypeError for a chain (its one sheet is :meth:`pattern`)."""
+        document = self._document if document is None else document
+        if not document.is_tree:
+            raise InvalidTypeError("sheets: a chain is folded from one sheet; use pattern()")
+        cached = document.__dict__.get("_sheets")
+        if cached is None:
+            try:
+                cached = tree_sheets(document.chain, document.twist_portion, document.names,
+                                     document.units, fit=fit)  # fmt: skip
+            except (KinegamiError, ValueError) as error:
+                cached = error
+            document.__dict__["_sheets"] = cached
+        if isinstance(cached, Exception):
+            raise cached
+        return cached
+
     def joint_table(self) -> tuple[JointRow, ...]:
-        """One row per joint: index, type, name, pose, state, state range, parameters."""
+        """One row per joint: index, type, name, pose, state, state range, parameters, parent
+        and children."""
         return self._document.joint_table
 
     def to_design_text(self) -> str:
@@ -551,6 +591,20 @@ class EditorModel:
         after = self._target(after)
         return self.apply(cmd.AddJoint(kind, parameters or {}, pose, after, placement,
                                        relative, name))  # fmt: skip
+
+    def add_branch(self, kind: str, parameters=None, pose=None, *, parent=None,
+                   placement: str = "safe", relative: bool = True,
+                   name: str | None = None) -> CommandResult:  # fmt: skip
+        """Add a joint as a new child of ``parent`` (default: the selected joint, else the
+        last one), beside its children; see :class:`~kinegami.editor.commands.AddBranch`."""
+        parent = self._target(parent)
+        return self.apply(cmd.AddBranch(kind, parameters or {}, pose, parent, placement,
+                                        relative, name))  # fmt: skip
+
+    def fit_junctions(self) -> CommandResult:
+        """Slide the tree's joints whose junction socket does not fit (see
+        :class:`~kinegami.editor.commands.FitJunctions`)."""
+        return self.apply(cmd.FitJunctions())
 
     def delete(self, joint=None) -> CommandResult:
         """Delete a joint (default: the selected one)."""

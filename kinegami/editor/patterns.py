@@ -10,19 +10,26 @@ leaves the rest of the modules as they were, so :class:`PatternCache` keeps
   parts with it starts from the composite of those k parts.
 
 The result is the pattern ``chain.creasePattern(twistPortion)`` returns, bit for bit
-(``concatenate`` of a composite and more modules equals the fold of all of them). See
+(``concatenate`` of a composite and more modules equals the fold of all of them).
+
+A tree is folded from a sheet per leaf: :func:`tree_sheets` makes them as ``kinegami build``
+does and says which sheet carries each joint and which of its records are the joint's own. See
 docs/editor.md.
 """
 
 from __future__ import annotations
 
 from collections import OrderedDict
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 from kinegami.chain import KinematicChain
 from kinegami.links import LinkCSC
 from kinegami.pattern import TubularPattern
 
-__all__ = ["PatternCache", "link_shape_key", "joint_records"]
+__all__ = ["PatternCache", "link_shape_key", "joint_records", "TreeSheets", "tree_sheets",
+           "sheet_records"]  # fmt: skip
 
 
 def _arc_key(arc) -> tuple:
@@ -117,3 +124,91 @@ class PatternCache:
             composites.append(TubularPattern.concatenate([composites[-1], *part]))
         self._tube, self._parts, self._composites = tube, parts, composites
         return composites[-1]
+
+
+# --- trees: a sheet per leaf ------------------------------------------------------------------
+def _record_count(pattern, first: bool) -> int:
+    """How many module records ``pattern`` adds to a composite (all of the first pattern's;
+    none of a later empty one's)."""
+    return len(pattern.modules) if first or not pattern.isEmpty else 0
+
+
+def sheet_records(tree, sheet, twistPortion: float = 0.2,
+                  cache: PatternCache | None = None) -> tuple[range, ...]:  # fmt: skip
+    """Per joint of ``sheet`` (a :class:`~kinegami.tree.sheets.TreeSheet` of ``tree``), the
+    indices of its own records in ``sheet.pattern.modules``.
+
+    A sheet is the composite of, for each of its joints in order, the modules of the link into
+    it and the joint's pattern; its first joint's link is only the part beyond the junction's
+    socket (sheet 0 starts with the root's pattern alone). The records are counted from the
+    sheet's end, so that part's modules need not be built again.
+    """
+    cache = PatternCache() if cache is None else cache
+    n = tree.numSides
+    end = len(sheet.pattern.modules)
+    records: list[range] = []
+    for k in reversed(sheet.joints[1:]):
+        own = _record_count(tree.Joints[k].pattern, False)
+        records.append(range(end - own, end))
+        end -= own
+        for module in cache.link_modules(tree.Links[k], n, twistPortion):
+            end -= _record_count(module, False)
+    first = tree.Joints[sheet.joints[0]]
+    if sheet.junction is None:  # the root's pattern is the whole first part
+        records.append(range(0, end))
+    else:
+        own = _record_count(first.pattern, False)
+        records.append(range(end - own, end))
+    return tuple(reversed(records))
+
+
+@dataclass(frozen=True)
+class TreeSheets:
+    """A tree's sheets as the editor shows and downloads them (docs/trees.md, Fabrication).
+
+    Attributes
+    ----------
+    fabrication : the :class:`~kinegami.tree.sheets.TreeFabrication` (sheets and junctions)
+        of the tree after :func:`~kinegami.tree.sheets.fit_junctions`, as ``kinegami build``
+        makes it.
+    slides : ``(joint, distance)`` of every slide the fit made (lengths in the tree's units;
+        empty when every socket fits as designed).
+    labels : per sheet, its label (joints by name, lengths in mm; what the DXF, SVG and PDF
+        carry).
+    places : per joint, ``(sheet, records)``: the sheet that carries it and the indices of its
+        own records in that sheet's ``pattern.modules``.
+    """
+
+    fabrication: Any
+    slides: tuple
+    labels: tuple[str, ...]
+    places: tuple[tuple[int, range], ...]
+
+    @property
+    def sheets(self) -> tuple:
+        """The :class:`~kinegami.tree.sheets.TreeSheet` of every leaf."""
+        return self.fabrication.sheets
+
+
+def tree_sheets(tree, twistPortion: float = 0.2, names=None, units: str = "mm",
+                cache: PatternCache | None = None,
+                fit: Callable | None = None) -> TreeSheets:  # fmt: skip
+    """The :class:`TreeSheets` of ``tree`` (a KinematicTree): fitted and fabricated as
+    ``kinegami build`` does (raises InvalidParameterError when some socket cannot be made to
+    fit; the message names the joint).
+
+    ``fit`` replaces :func:`~kinegami.tree.sheets.fit_junctions` (``fit(tree) -> (fitted,
+    slides)``; the view runs it in a worker process); ``cache`` gives the links' modules.
+    """
+    from kinegami.export.tree_build import sheet_labels
+    from kinegami.tree.sheets import fabricate, fit_junctions
+
+    fitted, slides = (fit_junctions if fit is None else fit)(tree)
+    fabrication = fabricate(fitted, twistPortion=twistPortion)
+    labels = tuple(sheet_labels(fabrication, names, units))
+    places: list = [None] * len(fitted.Joints)
+    for sheet in fabrication.sheets:
+        for joint, records in zip(sheet.joints, sheet_records(fitted, sheet, twistPortion, cache),
+                                  strict=True):  # fmt: skip
+            places[joint] = (sheet.index, records)
+    return TreeSheets(fabrication, tuple(slides), labels, tuple(places))

@@ -21,6 +21,7 @@ import threading
 from pathlib import Path
 
 from kinegami.editor.autosave import Autosaver, Recovery, autosave_path, find_recovery
+from kinegami.editor.background import ProcessWorker
 from kinegami.editor.commands import ReplaceDocument
 from kinegami.editor.document import Document
 from kinegami.editor.model import EditorModel
@@ -78,6 +79,8 @@ class EditorServer:
         #: tab until one recovers or discards it), or None.
         self.recovery: Recovery | None = find_recovery(self.path) if self.autosave else None
         self.recover = bool(recover)
+        #: Fits trees' junctions for the tabs' pattern panels (a process started on first use).
+        self.worker = ProcessWorker()
         if port == 0:
             port = _free_port(host)
         with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the CLI prints its own
@@ -119,7 +122,7 @@ class EditorServer:
             recovery = None
         return EditorView(
             target, model, autosave_for=self.autosaver if self.autosave else None,
-            recovery=recovery, on_recovery=self._recovered,
+            recovery=recovery, on_recovery=self._recovered, worker=self.worker,
         )  # fmt: skip
 
     def _recovered(self, choice: str) -> None:
@@ -146,6 +149,7 @@ class EditorServer:
             view.close()
         for saver in savers:
             saver.close()
+        self.worker.close()
         with contextlib.redirect_stdout(io.StringIO()):
             self.server.stop()
 

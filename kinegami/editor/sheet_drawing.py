@@ -5,9 +5,10 @@ mountain, valley, boundary and cut lines and the glue tab, coloured as the patte
 (:data:`kinegami.viz.pattern_plot.PATTERN_PLOT_DEFAULTS`), with the sheet's size in
 millimetres. :func:`sheet_html` lays it out for the view's pattern panel: the whole sheet and,
 when a joint is selected, a close-up of its modules, both with the joint's part of the sheet
-highlighted. The sheet is drawn lying down: the tube's axis runs left to right (the proximal
-end at the left) and the way around the tube runs bottom to top. No web framework here: the
-view puts the text in a viser HTML element. See docs/editor.md.
+highlighted; :func:`sheets_html` does the same for a tree's sheets, one per leaf. The sheet is
+drawn lying down: the tube's axis runs left to right (the proximal end at the left) and the way
+around the tube runs bottom to top. No web framework here: the view puts the text in a viser
+HTML element. See docs/editor.md.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["SheetLines", "sheet_lines", "sheet_html", "joint_span"]
+__all__ = ["SheetLines", "sheet_lines", "sheet_html", "sheets_html", "joint_span"]
 
 #: How the highlighted part of the sheet is filled (the 3D view's selection colour).
 HIGHLIGHT = "#fab428"
@@ -176,35 +177,77 @@ def _legend(colours: dict) -> str:
                     swatch(HIGHLIGHT, "selected joint")])  # fmt: skip
 
 
+def _size_line(lines: SheetLines, title: str = "Sheet") -> str:
+    around, along = lines.size_mm
+    c = lines.counts
+    return (f'<div class="kinegami-sheet-size"><b>{html.escape(title)} {along:.1f} x '
+            f'{around:.1f} mm</b> (along x around the tube; cut outline) &middot; {c["M"]} '
+            f'mountain, {c["V"]} valley folds</div>')  # fmt: skip
+
+
+def _whole(lines: SheetLines, highlight: str, label: str) -> str:
+    umin, vmin, umax, vmax = lines.bounds
+    stretched = (vmax - vmin) < MIN_STRIP_ASPECT * (umax - umin)
+    title = "whole sheet, proximal end at the left" + (" (not to scale)" if stretched else "")
+    return f"<div>{title}</div>" + _svg(
+        (umin, vmin, umax - umin, vmax - vmin), lines.group + highlight, label, stretch=stretched
+    )
+
+
+def _close_up(lines: SheetLines, span: tuple[float, float], highlight: str, joint) -> str:
+    umin, vmin, umax, vmax = lines.bounds
+    margin = CLOSE_UP_MARGIN * (vmax - vmin)
+    u0 = max(umin, span[0] - lines.y0 - margin)
+    u1 = min(umax, span[1] - lines.y0 + margin)
+    content = f'<use href="#{lines.group_id}"/>' + highlight
+    return (f'<div style="margin-top:0.4em">close-up: {html.escape(joint or "")}</div>'
+            + _svg((u0, vmin, max(u1 - u0, 1e-9), vmax - vmin), content,
+                   "crease pattern, selected joint"))  # fmt: skip
+
+
 def sheet_html(lines: SheetLines, span: tuple[float, float] | None = None,
                joint: str | None = None) -> str:  # fmt: skip
     """The pattern panel: the sheet's size and line counts, the whole sheet, and for a
     selected joint (``span``: its pattern y range, ``joint``: its label) a close-up."""
-    umin, vmin, umax, vmax = lines.bounds
-    around, along = lines.size_mm
-    c = lines.counts
-    colours = _colours()
     highlight = _highlight(lines, span)
     parts = [
         '<div class="kinegami-pattern" style="font-size:0.8em;line-height:1.4">',
-        f'<div class="kinegami-sheet-size"><b>Sheet {along:.1f} x {around:.1f} mm</b> '
-        f"(along x around the tube; cut outline) &middot; {c['M']} mountain, {c['V']} valley "
-        "folds</div>",
-        f'<div style="margin:0.2em 0">{_legend(colours)}</div>',
+        _size_line(lines),
+        f'<div style="margin:0.2em 0">{_legend(_colours())}</div>',
+        _whole(lines, highlight, "crease pattern, whole sheet"),
     ]
-    stretched = (vmax - vmin) < MIN_STRIP_ASPECT * (umax - umin)
-    title = "whole sheet, proximal end at the left" + (" (not to scale)" if stretched else "")
-    parts.append(f"<div>{title}</div>")
-    parts.append(_svg((umin, vmin, umax - umin, vmax - vmin), lines.group + highlight,
-                      "crease pattern, whole sheet", stretch=stretched))  # fmt: skip
     if span is not None:
-        margin = CLOSE_UP_MARGIN * (vmax - vmin)
-        u0 = max(umin, span[0] - lines.y0 - margin)
-        u1 = min(umax, span[1] - lines.y0 + margin)
-        content = f'<use href="#{lines.group_id}"/>' + highlight
-        parts.append(f'<div style="margin-top:0.4em">close-up: {html.escape(joint or "")}</div>')
-        parts.append(_svg((u0, vmin, max(u1 - u0, 1e-9), vmax - vmin), content,
-                          "crease pattern, selected joint"))  # fmt: skip
+        parts.append(_close_up(lines, span, highlight, joint))
+    elif joint is not None:
+        parts.append(f"<div>{html.escape(joint)}</div>")
+    parts.append("</div>")
+    return "".join(parts)
+
+
+def sheets_html(sheets, selected: int | None = None, span: tuple[float, float] | None = None,
+                joint: str | None = None, notes=()) -> str:  # fmt: skip
+    """The pattern panel of a tree: ``sheets`` is one ``(lines, label)`` per sheet (a
+    :class:`SheetLines` and the sheet's label), each drawn whole with its size; ``notes`` are
+    lines of text above them (the junctions, the slides that fit them). For a selected joint,
+    ``selected`` is the sheet that carries it, ``span`` its pattern y range there and
+    ``joint`` its label: that sheet is highlighted and a close-up follows the sheets."""
+    parts = [
+        '<div class="kinegami-pattern" style="font-size:0.8em;line-height:1.4">',
+        f"<div><b>{len(sheets)} sheets</b>, one per leaf of the tree</div>",
+        f'<div style="margin:0.2em 0">{_legend(_colours())}</div>',
+    ]
+    parts += [f'<div class="kinegami-sheet-note">{html.escape(note)}</div>' for note in notes]
+    for k, (lines, label) in enumerate(sheets):
+        highlight = _highlight(lines, span) if k == selected else ""
+        parts.append('<div class="kinegami-sheet" style="margin-top:0.6em">')
+        parts.append(_size_line(lines, f"Sheet {k}:"))
+        parts.append(f'<div class="kinegami-sheet-label">{html.escape(label)}</div>')
+        parts.append(_whole(lines, highlight, f"crease pattern, sheet {k}"))
+        parts.append("</div>")
+    if selected is not None and span is not None:
+        lines = sheets[selected][0]
+        parts.append(_close_up(lines, span, _highlight(lines, span),
+                               f"{joint or ''} (sheet {selected})"))  # fmt: skip
     elif joint is not None:
         parts.append(f"<div>{html.escape(joint)}</div>")
     parts.append("</div>")

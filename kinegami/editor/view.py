@@ -15,6 +15,7 @@ import functools
 import io
 import itertools
 import math
+import tempfile
 import threading
 import time
 import zipfile
@@ -26,19 +27,25 @@ from typing import Any
 import numpy as np
 
 from kinegami.editor import sheet_drawing
-from kinegami.editor.background import Debounced
+from kinegami.editor.background import Debounced, ProcessWorker
 from kinegami.editor.commands import ReplaceDocument, RollJoint, SetJointStates, SlideJoint
 from kinegami.editor.document import Document
 from kinegami.editor.model import Change, CommandResult, EditorModel
-from kinegami.errors import KinegamiError
+from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
 
-__all__ = ["EditorView", "DOWNLOADS", "MAX_UPLOAD_BYTES", "gallery", "download_data"]
+__all__ = ["EditorView", "DOWNLOADS", "SHEET_FORMATS", "MAX_UPLOAD_BYTES", "gallery",
+           "download_data"]  # fmt: skip
 
 #: The largest design file a browser may upload (bytes).
 MAX_UPLOAD_BYTES = 16 * 1024 * 1024
 #: Download buttons: label -> file suffix (through the export registry).
 DOWNLOADS = {"DXF": ".dxf", "SVG": ".svg", "FOLD": ".fold", "PDF": ".pdf", "STL": ".stl",
              "URDF": ".urdf"}  # fmt: skip
+#: What a tree's downloads are made of (kinegami.export.tree_build.write_tree_files formats):
+#: a sheet each for these suffixes, every sheet in one PDF, the junction connectors.
+SHEET_FORMATS = {".dxf": "dxf", ".svg": "svg", ".fold": "fold"}
+#: The Sheet menu's entry for every sheet at once (a zip).
+ALL_SHEETS = "all sheets (zip)"
 GALLERY_DIR = Path(__file__).resolve().parents[2] / "examples" / "designs"
 
 JOINT_COLOR = (70, 140, 220)
@@ -62,25 +69,82 @@ def gallery(folder: Path = GALLERY_DIR) -> dict[str, Path]:
     return {p.stem: p for p in sorted(folder.glob("*.json"))}
 
 
-def download_data(model: EditorModel, suffix: str) -> tuple[str, bytes]:
+def download_data(model: EditorModel, suffix: str, sheet: int | None = None,
+                  sheets=None) -> tuple[str, bytes]:  # fmt: skip
     """(file name, bytes) of the current design in the format of ``suffix`` (``.json``: the
-    design file; ``.urdf``: a zip of the URDF and its meshes). Raises the registry's errors."""
+    design file; ``.urdf``: a zip of the URDF and its meshes). Raises the registry's errors.
+
+    For a tree, ``.dxf``, ``.svg`` and ``.fold`` give sheet ``sheet`` (None: every sheet, in a
+    zip), ``.pdf`` every sheet and ``"junctions"`` the printed junction connectors (STL and
+    3MF, in a zip): the files ``kinegami build`` writes
+    (:func:`kinegami.export.tree_build.write_tree_files`) of ``sheets`` (default:
+    ``model.sheets()``). STL and URDF are the tree as drawn, through the registry.
+    """
     from kinegami.export.registry import FORMATS
 
     stem = _file_stem(model)
     if suffix == ".json":
         return f"{stem}.json", model.to_design_text().encode()
+    if model.is_tree and (suffix in SHEET_FORMATS or suffix in (".pdf", "junctions")):
+        return _tree_files(model, suffix, sheet, model.sheets() if sheets is None else sheets,
+                           stem)  # fmt: skip
+    if suffix == "junctions":
+        raise InvalidTypeError("junctions: a chain has none (a tree has one at every joint with "
+                               "several children)")  # fmt: skip
     fmt = FORMATS[suffix]
     name = f"{stem}{suffix}"
     subject = model.chain if fmt.accepts == "chain" else model.pattern()
     data = fmt.render(subject, Path(name))
     if fmt.kind == "files":
-        buffer = io.BytesIO()
-        with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
-            for path, content in sorted(data.items()):
-                archive.writestr(str(path), content)
-        return f"{stem}_urdf.zip", buffer.getvalue()
+        return f"{stem}_urdf.zip", _zipped(data)
     return name, data.encode() if isinstance(data, str) else bytes(data)
+
+
+def _zipped(files) -> bytes:
+    """A zip of ``{relative path: bytes or text}``."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        for path, content in sorted(files.items()):
+            archive.writestr(str(path), content)
+    return buffer.getvalue()
+
+
+def _tree_files(model: EditorModel, suffix: str, sheet: int | None, sheets,
+                stem: str) -> tuple[str, bytes]:  # fmt: skip
+    """A tree's sheets, PDF or junctions as ``kinegami build`` writes them (written into a
+    private temporary folder, read back and removed)."""
+    import dataclasses
+
+    from kinegami.export.tree_build import write_tree_files
+
+    fabrication = sheets.fabrication
+    fmt = SHEET_FORMATS.get(suffix, suffix.lstrip("."))
+    if sheet is not None:
+        if fmt not in SHEET_FORMATS.values():
+            raise InvalidParameterError(f"sheet: only DXF, SVG and FOLD are made per sheet, not "
+                                        f"{suffix!r}")  # fmt: skip
+        if (
+            isinstance(sheet, bool)
+            or not isinstance(sheet, int)
+            or not (0 <= sheet < len(fabrication.sheets))
+        ):
+            raise InvalidParameterError(f"sheet must be in [0, {len(fabrication.sheets) - 1}] "
+                                        f"(the tree's sheets), got {sheet!r}")  # fmt: skip
+        fabrication = dataclasses.replace(fabrication, sheets=(fabrication.sheets[sheet],))
+    if fmt == "junctions" and not fabrication.junctions:
+        raise InvalidParameterError("junctions: this tree has none (no joint has several "
+                                    "children)")  # fmt: skip
+    document = model.document
+    with tempfile.TemporaryDirectory(prefix="kinegami-edit-") as folder:
+        written = write_tree_files(fabrication, folder, stem, [fmt], units=document.units,
+                                   twistPortion=document.twist_portion,
+                                   names=document.names)  # fmt: skip
+        files = {path.name: path.read_bytes() for path in written if path.is_file()}
+    if len(files) == 1:
+        ((name, data),) = files.items()
+        return name, data
+    label = "junctions" if fmt == "junctions" else f"sheets_{fmt}"
+    return f"{stem}_{label}.zip", _zipped(files)
 
 
 def _file_stem(model: EditorModel) -> str:
@@ -155,12 +219,16 @@ class EditorView:
         offer back in a dialog; ``on_recovery(choice)`` is called with ``"recover"`` or
         ``"discard"`` once the user chose.
     pattern_delay : seconds without a change before the crease-pattern panel is drawn again.
+    worker : a :class:`~kinegami.editor.background.ProcessWorker` that fits a tree's junctions
+        for the pattern panel (seconds of work) away from the tab's lock and the interpreter
+        lock; None: fitted in the panel's thread, holding the tab's lock.
     """
 
     def __init__(self, target: Any, model: EditorModel | None = None, *,
                  autosave_for: Callable | None = None, recovery=None,
                  on_recovery: Callable[[str], None] | None = None,
-                 pattern_delay: float = PATTERN_DELAY):  # fmt: skip
+                 pattern_delay: float = PATTERN_DELAY,
+                 worker: ProcessWorker | None = None):  # fmt: skip
         self.target = target
         self.scene = target.scene
         self.gui = target.gui
@@ -189,6 +257,8 @@ class EditorView:
         self._closed = False
         self._pattern_lines = None  # (pattern, units, SheetLines) last drawn
         self._pattern_key = None
+        self._worker = worker
+        self._sheet_lines: dict = {}  # id of a tree sheet's pattern -> (pattern, SheetLines)
         self._pattern_redraw = Debounced(self.redraw_pattern, pattern_delay,
                                          name="kinegami-pattern")  # fmt: skip
         self._build_panel()
@@ -598,6 +668,12 @@ class EditorView:
             self._kind = gui.add_dropdown("New joint", JOINT_KINDS)
             add = gui.add_button("Add joint after selected")
             add.on_click(lambda _: self.act(lambda: self.model.add_joint(str(self._kind.value))))
+            branch = gui.add_button(
+                "Add branch at selected",
+                hint="a new child of the selected joint, beside its children (on a chain, "
+                "a branch makes it a tree)",
+            )  # fmt: skip
+            branch.on_click(lambda _: self.add_branch(str(self._kind.value)))
             delete = gui.add_button("Delete selected joint", color="red")
             delete.on_click(lambda _: self.act(self.model.delete))
         self._config = gui.add_folder("Configuration")
@@ -611,6 +687,12 @@ class EditorView:
             self._clearance = gui.add_markdown("")
             compact = gui.add_button("Compact")
             compact.on_click(lambda _: self.act(lambda: self.model.compact(time_limit=30.0)))
+            self._fit = gui.add_button(
+                "Fit junctions", visible=self.model.is_tree,
+                hint="slide the joints whose junction socket does not fit along their axes, "
+                "as kinegami build does (the kinematics stay)",
+            )  # fmt: skip
+            self._fit.on_click(lambda _: self.act(self.model.fit_junctions))
         with gui.add_folder("File"):
             self._save_file = gui.add_button(
                 "Save to " + (self.model.path.name if self.model.path else "file"),
@@ -620,9 +702,18 @@ class EditorView:
             self._save_file.on_click(lambda _: self.save_file())
             save = gui.add_button("Save design (download)")
             save.on_click(lambda _: self.download(".json"))
+            self._sheet = gui.add_dropdown(
+                "Sheet", self._sheet_options(), visible=self.model.is_tree,
+                hint="which sheet of the tree Download DXF, SVG and FOLD give",
+            )  # fmt: skip
             for label, suffix in DOWNLOADS.items():
                 button = gui.add_button(f"Download {label}")
                 button.on_click(lambda _, s=suffix: self.download(s))
+            self._junctions = gui.add_button(
+                "Download junctions (STL/3MF)", visible=self.model.is_tree,
+                hint="the printed connector of every junction, in mm (a zip)",
+            )  # fmt: skip
+            self._junctions.on_click(lambda _: self.download("junctions"))
             names = tuple(gallery()) or ("(none)",)
             self._example = gui.add_dropdown("Example", names)
             open_example = gui.add_button("Open example")
@@ -637,7 +728,9 @@ class EditorView:
         return self.model.redo()
 
     def _labels(self) -> tuple[str, ...]:
+        tree = self.model.is_tree
         return tuple(f"{row.index}: {row.type}" + (f" '{row.name}'" if row.name else "")
+                     + (f" (on {row.parent})" if tree and row.parent >= 0 else "")
                      for row in self.model.joint_table())  # fmt: skip
 
     @_locked
@@ -661,8 +754,28 @@ class EditorView:
             self._joint_info.content = self._joint_text()
             self._clearance.content = self._clearance_text
             self._update_sliders(structure)
+            tree = self.model.is_tree
+            for widget in (self._fit, self._sheet, self._junctions):
+                if widget.visible != tree:
+                    widget.visible = tree
+            options = self._sheet_options()
+            if tuple(self._sheet.options) != options:
+                self._sheet.options = options
         finally:
             self._syncing = False
+
+    def _sheet_options(self) -> tuple[str, ...]:
+        """The Sheet menu: every sheet at once, then one entry per sheet (one per leaf)."""
+        if not self.model.is_tree:
+            return (ALL_SHEETS,)
+        leaves = sum(1 for row in self.model.joint_table() if not row.children)
+        return (ALL_SHEETS, *(f"sheet {k}" for k in range(leaves)))
+
+    @_locked
+    def add_branch(self, kind: str) -> CommandResult:
+        """Add a joint of type ``kind`` as a new child of the selected joint (the Add branch
+        button)."""
+        return self.act(lambda: self.model.add_branch(kind))
 
     def _joint_text(self) -> str:
         selected = self.model.selected
@@ -671,6 +784,10 @@ class EditorView:
         row = self.model.joint_table()[selected]
         lines = [f"**{selected}: {row.type}** {row.name or ''}", "", f"state {row.state:.4g} in "
                  f"[{row.state_range[0]:.4g}, {row.state_range[1]:.4g}]", ""]  # fmt: skip
+        if self.model.is_tree:
+            kids = ", ".join(map(str, row.children)) or "none (a leaf)"
+            parent = "none (the root)" if row.parent < 0 else str(row.parent)
+            lines[3:3] = [f"parent {parent}; children {kids}", ""]
         lines += [f"- {k}: {v:.4g}" if isinstance(v, float) else f"- {k}: {v}"
                   for k, v in row.parameters.items()]  # fmt: skip
         return "\n".join(lines)
@@ -717,7 +834,11 @@ class EditorView:
         """Send the design (``.json``) or an export to the browser; returns (name, data)."""
         self.stop_animation()
         try:
-            name, data = download_data(self.model, suffix)
+            sheet = None
+            if self.model.is_tree and suffix in SHEET_FORMATS and self._sheet.value != ALL_SHEETS:
+                sheet = int(str(self._sheet.value).split()[-1])
+            sheets = self._sheets(self.model, self.model.document) if self.model.is_tree else None
+            name, data = download_data(self.model, suffix, sheet, sheets)
         except Exception as error:  # noqa: BLE001 - any exporter failure is shown, not raised
             self._say(f"**Download failed:** {error}")
             return None
@@ -784,27 +905,132 @@ class EditorView:
         """The crease-pattern panel's HTML (an inline SVG of the sheet)."""
         return self._pattern_html.content
 
-    @_locked
     def redraw_pattern(self) -> bool:
         """Draw the crease-pattern panel if the pattern, its units or the selection changed
         since it was last drawn (the view calls it after a pause; see :meth:`flush`).
+        Returns whether it sent a new drawing. A tree's panel shows its sheets
+        (:meth:`redraw_sheets`)."""
+        with self.lock:
+            if self._closed:
+                return False
+            if not self.model.is_tree:
+                return self._redraw_chain_pattern()
+            model, document = self.model, self.model.document
+        return self.redraw_sheets(model, document)
+
+    def _remote_fit(self, tree):
+        from kinegami.tree.sheets import fit_junctions
+
+        return self._worker.run(fit_junctions, tree)
+
+    def _sheets(self, model: EditorModel, document: Document):
+        """``model.sheets(document)``, fitted by the worker process when the view has one
+        (without holding the tab's lock), else here under the lock."""
+        if self._worker is not None:
+            try:
+                return model.sheets(document, fit=self._remote_fit)
+            except (KinegamiError, ValueError):
+                raise
+            except Exception:  # noqa: BLE001, S110 - the worker process failed: fit here instead
+                pass
+        with self.lock:
+            return model.sheets(document)
+
+    def redraw_sheets(self, model: EditorModel | None = None,
+                      document: Document | None = None) -> bool:  # fmt: skip
+        """Draw a tree's sheets in the crease-pattern panel (``document``: the document to draw,
+        default the current one; nothing is drawn when another has replaced it meanwhile).
         Returns whether it sent a new drawing."""
-        if self._closed:
+        if model is None or document is None:
+            with self.lock:
+                model, document = self.model, self.model.document
+        try:
+            sheets = self._sheets(model, document)
+        except (KinegamiError, ValueError) as error:
+            sheets = error
+        with self.lock:
+            if self._closed or self.model is not model or model.document is not document:
+                return False  # a later change has triggered another drawing
+            if isinstance(sheets, Exception):
+                return self._show_pattern_error(sheets)
+            return self._draw_sheets(model, document, sheets)
+
+    def _show_pattern_error(self, error: Exception) -> bool:
+        key = ("error", str(error))
+        if key == self._pattern_key:
             return False
+        self._pattern_key = key
+        self._pattern_html.content = (
+            f"<div><b>No crease pattern:</b> {sheet_drawing.html.escape(str(error))}</div>"
+        )
+        self.pattern_draws += 1
+        return True
+
+    def _joint_label(self, index: int) -> str:
+        row = self.model.joint_table()[index]
+        return f"joint {index} ({row.type}" + (f" '{row.name}'" if row.name else "") + ")"
+
+    def _draw_sheets(self, model: EditorModel, document: Document, sheets) -> bool:
+        units = document.units
+        drawn = {}
+        entries = []
+        for sheet, label in zip(sheets.sheets, sheets.labels, strict=True):
+            key = (id(sheet.pattern), units)
+            cached = self._sheet_lines.get(key)
+            if cached is None or cached[0] is not sheet.pattern:
+                cached = (sheet.pattern, sheet_drawing.sheet_lines(sheet.pattern, units))
+            drawn[key] = cached
+            entries.append((cached[1], label))
+        self._sheet_lines = drawn  # only the current sheets' drawings are kept
+        notes = [self._junction_note(document, sheets, junction)
+                 for junction in sheets.fabrication.junctions]  # fmt: skip
+        notes += [self._slide_note(document, joint, slide) for joint, slide in sheets.slides]
+        selected = model.selected
+        where = span = label = None
+        if selected is not None and selected < len(sheets.places):
+            where, records = sheets.places[selected]
+            span = sheet_drawing.joint_span(sheets.sheets[where].pattern, records)
+            label = self._joint_label(selected)
+            if not len(records):
+                label += ": no modules of its own; the line marks where its links meet"
+        content = sheet_drawing.sheets_html(entries, where, span, label, notes)
+        key = ("sheets", content)
+        if key == self._pattern_key:
+            return False
+        self._pattern_key = key
+        self._pattern_html.content = content
+        self.pattern_draws += 1
+        return True
+
+    def _junction_note(self, document: Document, sheets, junction) -> str:
+        def joint(k: int) -> str:
+            name = document.names[k]
+            return f"{k} '{name}'" if name else str(k)
+
+        kids = ", ".join(joint(c) for c in junction.children)
+        return (f"Junction {junction.index} (a printed connector) at joint "
+                f"{joint(junction.joint)}: children {kids}; the sheet of {joint(junction.trunk)} "
+                "runs through it")  # fmt: skip
+
+    def _slide_note(self, document: Document, joint: int, slide: float) -> str:
+        from kinegami.export._options import UNITS_IN_MM
+
+        name = document.names[joint]
+        what = f"joint {joint}" + (f" '{name}'" if name else "")
+        mm = slide * UNITS_IN_MM[document.units]
+        return (
+            f"The sheets are of the tree with {what} slid {mm:.1f} mm along its axis, so "
+            "that its socket fits (as kinegami build does; the kinematics stay): Fit "
+            "junctions makes that slide in the design"
+        )
+
+    def _redraw_chain_pattern(self) -> bool:
         model = self.model
         units = model.document.units
         try:
             pattern = model.pattern()
         except (KinegamiError, ValueError) as error:
-            key = ("error", str(error))
-            if key != self._pattern_key:
-                self._pattern_key = key
-                self._pattern_html.content = (
-                    f"<div><b>No crease pattern:</b> {sheet_drawing.html.escape(str(error))}</div>"
-                )
-                self.pattern_draws += 1
-                return True
-            return False
+            return self._show_pattern_error(error)
         cached = self._pattern_lines
         if cached is None or cached[0] is not pattern or cached[1] != units:
             cached = (pattern, units, sheet_drawing.sheet_lines(pattern, units))
@@ -815,8 +1041,7 @@ class EditorView:
         if selected is not None:
             records = model.joint_modules()[selected]
             span = sheet_drawing.joint_span(pattern, records)
-            row = model.joint_table()[selected]
-            label = f"joint {selected} ({row.type}" + (f" '{row.name}'" if row.name else "") + ")"
+            label = self._joint_label(selected)
             if not len(records):
                 label += ": no modules of its own; the line marks where its links meet"
         key = (id(lines), span, label)

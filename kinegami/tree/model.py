@@ -20,7 +20,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from kinegami.bodies import link_polyline, tree_worst_overlap
-from kinegami.chain import RADIAL_VARIANTS, _JointAssembly
+from kinegami.chain import RADIAL_VARIANTS, KinematicChain, _JointAssembly
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
 from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube
 from kinegami.validation import check_real
@@ -115,6 +115,20 @@ class KinematicTree(_JointAssembly):
             placed.append(joint)
             links.append(link)
         tree._accept("from_joints", placed, links, ball, parents)
+        return tree
+
+    @classmethod
+    def from_chain(cls, chain) -> KinematicTree:
+        """The tree that is ``chain``: the same joints, links and ball (shared: they are
+        immutable values), joint i the child of joint i - 1, the same options. Nothing is solved
+        again, so every joint, link and the ball are the chain's bit for bit; ``chain`` is not
+        changed. A chain whose root is an EndTip (left by deleting its first joint) has no
+        tree: InvalidParameterError, as for ``KinematicTree(EndTip(...))``."""
+        if not isinstance(chain, KinematicChain):
+            raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
+        tree = cls(chain.Joints[0], chain.maxAnglePerElbow, chain.requireClearance)
+        tree._commit(list(chain.Joints), list(chain.Links), chain.boundingBall,
+                     list(chain.Parents))  # fmt: skip
         return tree
 
     # --- published read-only views -----------------------------------------------------------
