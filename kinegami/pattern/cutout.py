@@ -25,6 +25,7 @@ Lengths are in the pattern's unit (that of r).
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -404,6 +405,22 @@ class CutPattern:
     def hole_polygons(self) -> list[np.ndarray]:
         """Each hole's polygon in sheet coordinates (x continuous, centre in [0, W))."""
         return list(self.regions().holes[1::3])
+
+    def validate(self):
+        """Every problem found (a :class:`~kinegami.pattern.ValidationReport`): those of the
+        crease pattern, and holes that overlap each other."""
+        from kinegami.pattern.tubular import ValidationReport
+
+        problems = list(self.pattern.validate().problems)
+        polygons = self.regions().holes
+        for i, j in itertools.combinations(range(len(self.holes)), 2):
+            first = polygons[3 * i + 1]
+            for other in polygons[3 * j : 3 * j + 3]:
+                if (points_in_polygon(other, first).any()
+                        or points_in_polygon(first, other).any()):  # fmt: skip
+                    problems.append(f"holes {self.holes[i].name} and {self.holes[j].name} overlap")
+                    break
+        return ValidationReport(tuple(problems))
 
     # --- drawing -------------------------------------------------------------------------
 
