@@ -675,13 +675,53 @@ def _clean_mesh(mf, n, D, links, sockets, parent_side, opts, r):
         solid = _connector_solid(mf, n, D, links, sockets, parent_side, opts, r, overlap * r)
         mesh = _to_trimesh(solid)
         if mesh.is_watertight and mesh.is_volume:
-            return mesh
+            merged = _single_precision_safe(mesh)
+            if merged is not None:
+                return merged
     raw = solid.to_mesh64()
     return trimesh.Trimesh(
         vertices=np.asarray(raw.vert_properties, dtype=float)[:, :3],
         faces=np.asarray(raw.tri_verts, dtype=np.int64),
         process=False,
     )
+
+
+#: Vertices closer than this share one position (relative to the mesh's largest coordinate):
+#: STL stores single precision (about 6e-8 relative), where they would merge anyway.
+_MERGE_RELATIVE = 1e-6
+
+
+def _single_precision_safe(mesh):
+    """``mesh`` with the vertices that single precision cannot tell apart merged (clusters
+    within _MERGE_RELATIVE of the largest coordinate), and its degenerate faces dropped, if it
+    is still a watertight volume whose vertices stay distinct in 32-bit floats; else None. So
+    the file a slicer reads (STL: 32-bit floats) is as watertight as the mesh built here."""
+    import trimesh
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    tol = _MERGE_RELATIVE * max(1.0, float(np.abs(vertices).max()))
+    pairs = cKDTree(vertices).query_pairs(tol, output_type="ndarray")
+    faces = np.asarray(mesh.faces)
+    if len(pairs):
+        count = len(vertices)
+        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), (count, count))
+        _, label = connected_components(graph, directed=False)
+        keep = np.unique(label, return_index=True)[1]  # the first vertex of every cluster
+        vertices = vertices[keep]
+        faces = label[faces]
+        faces = faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2])
+                      & (faces[:, 0] != faces[:, 2])]  # fmt: skip
+    merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+    merged.remove_unreferenced_vertices()
+    if not (merged.is_watertight and merged.is_volume):
+        return None
+    rounded = merged.vertices.astype(np.float32)
+    if len(np.unique(rounded, axis=0)) != len(rounded):
+        return None
+    return merged
 
 
 def _connector_solid(mf, n, D, links, sockets, parent_side, opts, r, overlap):

@@ -117,7 +117,9 @@ def test_the_junction_connectors_are_watertight(name, builds):
         # in mm: the connector's volume (units of the design) times the unit's mm cubed
         expected = fabrication.connector(k).volume * UNITS_IN_MM[units] ** 3
         assert printed.volume == pytest.approx(expected, rel=1e-6)
+        # STL stores 32-bit floats: vertices the connector keeps apart must stay apart there
         stl = trimesh.load(out / f"{name}_junction_{k}.stl")
+        assert stl.is_watertight and stl.is_volume, (name, k)
         assert stl.volume == pytest.approx(expected, rel=1e-4)
 
 
