@@ -1,4 +1,5 @@
-"""Shared helpers of the editor tests: example documents and an exact document snapshot."""
+"""Shared helpers of the editor tests: example documents, the trees' reference numbers and an
+exact document snapshot."""
 
 from __future__ import annotations
 
@@ -8,11 +9,28 @@ from kinegami.editor import Document, EditorModel
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE1 = ROOT / "examples" / "designs" / "example1.json"
+#: The paper's hand (12 joints, 3 leaves; the fingers leave the root waypoint) and a two-finger
+#: gripper (10 joints, 2 leaves; the fingers leave the palm, joint 3).
+HAND = ROOT / "examples" / "designs" / "hand.json"
+GRIPPER = ROOT / "examples" / "designs" / "gripper.json"
+
+#: What the editor shows of the paper's hand: its parents, its sheets (one per leaf: the middle
+#: finger's continues the root's, then the pointer's and the thumb's), the one junction at the
+#: root, and the slide kinegami build makes so that the palm's socket fits (joint 1 by -3 r).
+HAND_PARENTS = (-1, 0, 1, 2, 3, 0, 5, 6, 0, 8, 9, 10)
+HAND_SHEET_JOINTS = ((0, 8, 9, 10, 11), (5, 6, 7), (1, 2, 3, 4))
+HAND_SLIDES = ((1, -3.0),)
+HAND_JUNCTION = (0, (1, 5, 8), 8)  # (joint, children, trunk)
 
 
 def example_model() -> EditorModel:
     """A model editing a copy-free load of examples/designs/example1.json (7 joints, named)."""
     return EditorModel.open(EXAMPLE1)
+
+
+def hand_model() -> EditorModel:
+    """A model editing examples/designs/hand.json (the paper's hand, every joint named)."""
+    return EditorModel.open(HAND)
 
 
 def snapshot(document: Document) -> tuple:
@@ -25,6 +43,8 @@ def snapshot(document: Document) -> tuple:
     chain = document.chain
     return (
         text,
+        type(chain).__name__,
+        tuple(chain.Parents),
         tuple(type(j).__name__ for j in chain.Joints),
         tuple(j.pose_matrix.tobytes() for j in chain.Joints),
         tuple(float(j.state) for j in chain.Joints),
