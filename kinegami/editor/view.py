@@ -787,7 +787,7 @@ class EditorView:
         if self.model.is_tree:
             kids = ", ".join(map(str, row.children)) or "none (a leaf)"
             parent = "none (the root)" if row.parent < 0 else str(row.parent)
-            lines[3:3] = [f"parent {parent}; children {kids}", ""]
+            lines[4:4] = [f"parent {parent}; children {kids}", ""]
         lines += [f"- {k}: {v:.4g}" if isinstance(v, float) else f"- {k}: {v}"
                   for k, v in row.parameters.items()]  # fmt: skip
         return "\n".join(lines)

@@ -14,7 +14,7 @@ from pathlib import Path
 import headless_chromium
 import pytest
 
-from .helpers import EXAMPLE1
+from .helpers import EXAMPLE1, HAND
 
 pytestmark = pytest.mark.browser
 
@@ -208,3 +208,61 @@ def test_dxf_download_reads_back_with_ezdxf(tab, tmp_path):
     doc = ezdxf.readfile(target)
     assert len(doc.modelspace()) > 0
     page.screenshot(path=tmp_path / "6_downloaded.png")
+
+
+# --- a tree: the paper's hand --------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def hand_server(browser):
+    from kinegami.editor.server import EditorServer
+
+    server = EditorServer(HAND, port=0, autosave=False)
+    yield server
+    server.stop()
+
+
+def test_the_hand_gets_a_branch_and_a_sheet_downloads(browser, hand_server, tmp_path):
+    """The paper's hand in a tab: drawn in 3D with its three sheets in the pattern panel; a
+    joint picked in the Joint list gets a branch (Add branch at selected), the panel shows a
+    fourth sheet, and Download DXF of that sheet gives a labelled file ezdxf reads."""
+    import ezdxf
+
+    before = set(hand_server.views)
+    page = browser.new_page(viewport={"width": 1600, "height": 900}, accept_downloads=True)
+    page.set_default_timeout(TIMEOUT * 1000)
+    try:
+        page.goto(hand_server.url)
+        new = wait_for(lambda: set(hand_server.views) - before, "the tab's editor view")
+        view = hand_server.views[new.pop()]
+        page.wait_for_selector("canvas")
+        page.locator("svg[aria-label='crease pattern, sheet 2']").wait_for()
+        assert page.locator("svg[aria-label='crease pattern, sheet 3']").count() == 0
+        close = page.locator(".mantine-Notification-closeButton")
+        if close.count():
+            close.first.click()
+        time.sleep(2.0)  # let the software renderer draw the meshes
+        shot = tmp_path / "7_hand.png"
+        page.screenshot(path=shot)
+        assert drawn_pixels(shot, page.locator("canvas").first.bounding_box()) > 5000
+
+        page.get_by_role("combobox", name="Joint", exact=True).click()
+        page.get_by_role("option", name="6: RevoluteJoint 'pointer2' (on 5)").click()
+        wait_for(lambda: view.model.selected == 6, "joint 6 selected on the server")
+        page.get_by_role("button", name="Add branch at selected").click()
+        wait_for(lambda: len(view.model.chain.Children[6]) == 2, "the branch on the server")
+        assert view.model.undo_labels == ("add RevoluteJoint as a branch of joint 6",)
+        page.locator("svg[aria-label='crease pattern, sheet 3']").wait_for()
+        time.sleep(1.0)
+        page.screenshot(path=tmp_path / "8_branch.png")
+
+        page.get_by_role("combobox", name="Sheet", exact=True).click()
+        page.get_by_role("option", name="sheet 3", exact=True).click()
+        with page.expect_download() as info:
+            page.get_by_role("button", name="Download DXF").click()
+        target = tmp_path / info.value.suggested_filename
+        info.value.save_as(target)
+        assert target.name == "Three-finger_hand_sheet_3.dxf"
+        texts = [e.dxf.text for e in ezdxf.readfile(target).modelspace() if e.dxftype() == "TEXT"]
+        assert any(t.startswith("sheet 3:") for t in texts), texts
+        page.screenshot(path=tmp_path / "9_downloaded.png")
+    finally:
+        page.close()
