@@ -896,8 +896,10 @@ def tree_pair_distances(
                 d = _polyline_distance(ends, line)
                 along[rows_k, 0], along[rows_k, 1] = d[: rows_k.size], d[rows_k.size :]
         rest = np.full(q.size, np.inf)
-        # the part of one row beyond its junction, against the whole other row (both ways)
-        for mine, other in ((i[q], j[q]), (j[q], i[q])):
+        rest_s, rest_t = s[q].copy(), t[q].copy()
+        # the part of one row beyond its junction, against the whole other row (both ways);
+        # the closest points are those of the parts tested (parameters along the whole rows)
+        for first_is_mine, (mine, other) in ((True, (i[q], j[q])), (False, (j[q], i[q]))):
             e = extent[top[node[mine]]]
             d0, d1 = along[mine, 0], along[mine, 1]
             beyond = np.maximum(d0, d1) > e
@@ -908,9 +910,26 @@ def tree_pair_distances(
             cut = p0 + u[:, None] * (p1 - p0)
             lo = np.where((d1 < d0)[:, None], p0, cut)
             hi = np.where((d1 < d0)[:, None], cut, p1)
-            dd, _, _ = segment_distances(lo, hi, a[other], b[other])
-            rest = np.minimum(rest, np.where(beyond, dd, np.inf))
+            dd, ss, tt = segment_distances(lo, hi, a[other], b[other])
+            dd = np.where(beyond, dd, np.inf)
+            # ss runs along [lo, hi]: the same point as a parameter along the whole row
+            point = lo + ss[:, None] * (hi - lo)
+            axis = p1 - p0
+            length2 = np.einsum("ij,ij->i", axis, axis)
+            along_row = np.einsum("ij,ij->i", point - p0, axis) / np.where(
+                length2 > 0, length2, 1.0
+            )
+            along_row = np.clip(np.where(length2 > 0, along_row, 0.0), 0.0, 1.0)
+            better = dd < rest
+            rest = np.where(better, dd, rest)
+            if first_is_mine:
+                rest_s = np.where(better, along_row, rest_s)
+                rest_t = np.where(better, tt, rest_t)
+            else:
+                rest_s = np.where(better, tt, rest_s)
+                rest_t = np.where(better, along_row, rest_t)
         dist[q] = rest
+        s[q], t[q] = rest_s, rest_t
     return i, j, dist, s, t, rows, a, b
 
 

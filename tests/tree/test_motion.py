@@ -148,3 +148,36 @@ def test_kinegami_check_motion_sweeps_a_tree(capsys):
     assert data["motion"]["samples"] == 30
     assert 0 <= data["motion"]["colliding"] <= 30
     assert math.isclose(data["motion"]["colliding_fraction"], data["motion"]["colliding"] / 30)
+
+
+# --- closest points of pairs that leave one junction ---------------------------------------------
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    gap=st.floats(0.0, 1.9),
+    height=st.floats(8.0, 16.0),
+    lean=st.floats(-0.3, 0.3),
+)
+def test_the_points_of_every_reported_pair_realise_its_clearance(gap, height, lean):
+    """Two sibling tubes leaving the root together: within the junction (up to 5 r) they may
+    touch; beyond it they overlap, and the reported parts and closest points are those beyond
+    it (they were those of the whole rows: 'first elbow and first elbow' at the root)."""
+    from spatialmath import SE3
+
+    from kinegami import EndTip, KinematicTree, Waypoint
+
+    tree = KinematicTree(Waypoint(4, 1, SE3()))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        for side in (-1, 1):
+            pose = SE3.Trans(side * gap / 2, 0, height) * SE3.Ry(side * lean)
+            tree.addJoint(0, EndTip(4, 1, pose, 1.5), safe=False, fixedPosition=True,
+                          fixedOrientation=True)  # fmt: skip
+    report = tree.clearance()
+    assert not report.ok  # closer than 2 r beyond the junction
+    for pair in (*report.pairs, report.closest):
+        p, o = map(np.array, pair.points)
+        assert abs(np.linalg.norm(p - o) - 2.0 - pair.clearance) < 1e-9, pair
+        if node_of(pair.elements[0]) != node_of(pair.elements[1]):  # the two branches
+            assert min(p[2], o[2]) > 4.0, pair  # beyond the junction, not at the root
