@@ -1,11 +1,13 @@
 """``kinegami build`` of a tree (docs/trees.md): a sheet per leaf, the junction connectors, the
-whole tree; the defaults when an optional library is missing; clean failures."""
+whole tree; the defaults when an optional library is missing; clean failures; folded take-off
+junctions (``--junctions takeoff``)."""
 
 from __future__ import annotations
 
 import json
 import sys
 
+import numpy as np
 import pytest
 
 from .helpers import ROOT, main_in_process
@@ -119,4 +121,125 @@ def test_an_unknown_tree_format_is_a_one_line_error(tmp_path, capsys):
     assert main_in_process("build", HAND, "-o", tmp_path, "--formats", "dxf,gcode") == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "gcode" in err[0] and "junctions" in err[0], err
+    assert list(tmp_path.iterdir()) == []
+
+
+# --- folded take-off junctions (--junctions takeoff) -------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def takeoff_build(tmp_path_factory):
+    """The paper's hand built with take-offs: (exit code, folder, stdout)."""
+    import contextlib
+    import io
+
+    out = tmp_path_factory.mktemp("hand_takeoff")
+    stdout = io.StringIO()
+    with contextlib.redirect_stdout(stdout):
+        code = main_in_process("build", HAND, "-o", out, "--junctions", "takeoff",
+                               "--formats", "dxf,svg,fold,pdf,junctions")  # fmt: skip
+    return code, out, stdout.getvalue()
+
+
+@pytest.fixture(scope="module")
+def takeoff_fabrication():
+    """The same fabrication in-process (the hand as the design file gives it; lengths in r)."""
+    import warnings
+
+    from kinegami.design import load_design_with_info
+    from kinegami.errors import ClearanceWarning
+    from kinegami.tree.sheets import fabricate
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        tree, info = load_design_with_info(HAND)
+    return fabricate(tree, junction="takeoff", twistPortion=info.twistPortion)
+
+
+MM = 10.0  # the hand's r = 1 cm
+
+
+def test_a_takeoff_build_writes_every_sheet_and_no_connector(takeoff_build):
+    code, out, _ = takeoff_build
+    assert code == 0
+    assert names(out) == SHEET_FILES | {"hand.pdf"}  # no connector to print
+    assert _pdf_pages(out / "hand.pdf") == 3
+
+
+def test_the_takeoff_summary_lists_where_each_branch_leaves(takeoff_build):
+    _, _, text = takeoff_build
+    assert "junctions: 0 (printed connectors)" in text
+    assert "take-offs: 2 (folded)" in text
+    assert "take-off A: joint 1 leaves joint 8's link through face 0" in text
+    assert "take-off B: joint 5 leaves joint 8's link through face 2" in text
+    assert "hole A in sheet 0, sheet 2 starts with its skirt (4 glue tabs)" in text
+    assert "folded body with the take-off links:" in text
+    assert "cut out hole A (sheet 2's skirt glues in)" in text
+    assert "note: joint 1 slid" not in text  # nothing to fit: the palm's tube leaves link 8
+
+
+def _dxf_lines(path, layer):
+    import ezdxf
+
+    doc = ezdxf.readfile(path)
+    lines = [[(e.dxf.start.x, e.dxf.start.y), (e.dxf.end.x, e.dxf.end.y)]
+             for e in doc.modelspace().query(f"LINE[layer=='{layer}']")]  # fmt: skip
+    return np.array(lines), [e.dxf.text for e in doc.modelspace().query("TEXT")]
+
+
+def _on_lines(points, lines, tol=1e-6):
+    a, c = lines[None, :, 0], lines[None, :, 1]
+    d = c - a
+    t = np.clip(((points[:, None] - a) * d).sum(-1) / np.maximum((d * d).sum(-1), 1e-300), 0, 1)
+    return np.linalg.norm(a + t[..., None] * d - points[:, None], axis=-1).min(axis=1) <= tol
+
+
+def _samples(lines):
+    f = np.array([0.1, 0.5, 0.9])[None, :, None]
+    return (lines[:, :1] + f * (lines[:, 1:] - lines[:, :1])).reshape(-1, 2)
+
+
+def test_the_takeoff_dxf_cuts_the_holes_and_the_tabs_and_labels_them(takeoff_build,
+                                                                    takeoff_fabrication):
+    pytest.importorskip("ezdxf")
+    _, out, _ = takeoff_build
+    trunk = takeoff_fabrication.sheets[0].pattern
+    cuts, texts = _dxf_lines(out / "hand_sheet_0.dxf", "Cut")
+    for hole in trunk.hole_polygons():
+        edges = np.stack([hole, np.roll(hole, -1, axis=0)], axis=1) * MM
+        assert _on_lines(_samples(edges), cuts).all()
+    assert "cut out hole A" in texts[0] and "hole B" in texts[0]
+    for k in (1, 2):
+        sheet = takeoff_fabrication.sheets[k]
+        cuts, texts = _dxf_lines(out / f"hand_sheet_{k}.dxf", "Cut")
+        tabs = sheet.pattern.regions().tab_outline_segments()
+        W, b = sheet.pattern.width, sheet.pattern.sideLength
+        inside = (tabs[:, :, 0] > -0.5 * b - 1e-9) & (tabs[:, :, 0] < W + 0.5 * b + 1e-9)
+        tabs = tabs[inside.all(axis=1)]
+        assert _on_lines(_samples(tabs * MM), cuts).all()
+        assert f"glue them inside hole {sheet.takeoff} of sheet 0" in texts[0]
+        assert sheet.takeoff in (out / f"hand_sheet_{k}.svg").read_text()
+
+
+def test_the_takeoff_fold_files_meet_in_the_world(takeoff_build, takeoff_fabrication):
+    """The branch sheets' FOLD files, folded, put their fish-mouths on the trunk sheet's hole
+    vertices (the files' folded forms are in the tree's world frame, mm)."""
+    _, out, _ = takeoff_build
+    data = {k: json.loads((out / f"hand_sheet_{k}.fold").read_text()) for k in range(3)}
+    trunk = np.array(data[0]["file_frames"][0]["vertices_coords"])
+    for t in takeoff_fabrication.takeoffs:
+        sheet = data[t.branch_sheet]
+        flat = np.array(sheet["vertices_coords"])
+        folded = np.array(sheet["file_frames"][0]["vertices_coords"])
+        fm = (t.junction.fish_mouth - [0.0, t.junction.skirt_base]) * MM
+        at = [int(np.argmin(np.hypot(*(flat - p).T))) for p in fm]
+        gap = np.linalg.norm(folded[at][:, None] - trunk[None], axis=2).min(axis=1)
+        assert gap.max() <= 1e-6  # mm; measured 1e-13
+
+
+def test_an_unknown_junction_kind_is_a_one_line_error(tmp_path, capsys):
+    assert main_in_process("build", HAND, "-o", tmp_path, "--junctions", "glue") == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--junctions" in err[0] and "'glue'" in err[0], err
+    assert "connector, takeoff, auto" in err[0]
     assert list(tmp_path.iterdir()) == []
