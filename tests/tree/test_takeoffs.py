@@ -28,7 +28,7 @@ from .helpers import hand_tree
 HAND_SHEETS = [(0, 8, 9, 10, 11), (5, 6, 7), (1, 2, 3, 4)]
 #: Agreement of the two folded nets and of frames, in units of r (measured: 1e-15).
 TOL = 1e-9
-FIXED = {"safe": False, "fixedPosition": True, "fixedOrientation": True}
+FIXED = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}
 
 
 @pytest.fixture(scope="module")
