@@ -10,12 +10,16 @@ For joints near the start, middle and end, with and without propagation, 11 step
 * the pause after it: the crease pattern and its drawing (:meth:`EditorView.flush`);
 * a slide as a command (the drag's end, or the Slide buttons), pattern deferred likewise.
 
-Prints the medians in milliseconds and the meshes each step sent. See docs/editor.md (The
-browser view).
+Prints the medians in milliseconds and the meshes each step sent. Then the same for a tree,
+the paper's hand (examples/designs/hand.json), on a server with its worker process: the pause
+after a step there draws the tree's sheets, whose junctions the worker fits first (as designed,
+and after Fit junctions has made the slides in the design). See docs/editor.md (The browser
+view, Trees).
 """
 
 from __future__ import annotations
 
+import math
 import statistics
 import time
 
@@ -24,7 +28,7 @@ from kinegami.editor.model import EditorModel
 
 
 def _median_ms(values) -> float:
-    return statistics.median(values) * 1e3
+    return statistics.median(values) * 1e3 if values else math.nan
 
 
 def main() -> None:
@@ -68,6 +72,66 @@ def main() -> None:
                       f"{_median_ms(drags):5.1f} | pattern {_median_ms(pauses):5.1f} | "
                       f"command {_median_ms(commands):5.1f} "
                       f"({statistics.median(sent):g} meshes)")  # fmt: skip
+    finally:
+        server.stop()
+    trees()
+
+
+def trees(steps: int = 5) -> None:
+    """The paper's hand: drag step, sheets after the pause, slide command (median ms)."""
+    from pathlib import Path
+
+    from kinegami.editor.server import EditorServer
+
+    hand = Path(__file__).resolve().parents[2] / "examples" / "designs" / "hand.json"
+    server = EditorServer(hand, port=0, autosave=False)
+    try:
+        view = server.new_view(server.server)
+        view.flush()  # starts the worker process
+        print("the paper's hand (12 joints, 3 sheets), median ms: live drag step | sheets after "
+              "the pause | slide command (meshes sent per step)")  # fmt: skip
+        for fitted in (False, True):
+            if fitted:
+                view.act(view.model.fit_junctions)
+                view.flush()
+            for joint in (1, 5, 9):
+                for propagate in (True, False):
+                    view.model.propagate = propagate
+                    view.act(lambda j=joint: view.model.select(j))
+                    view.flush()
+                    pose = view.model.chain.Joints[joint].pose_matrix.copy()
+                    drags, pauses, commands, sent = [], [], [], []
+                    for k in range(steps):
+                        target = pose[:3, 3] + (0.05 if k % 2 == 0 else 0.1) * pose[:3, 2]
+                        before = view.meshes_sent
+                        t0 = time.perf_counter()
+                        result = view.drag_preview(target, view._gizmo.wxyz)
+                        t1 = time.perf_counter()
+                        view.flush()
+                        t2 = time.perf_counter()
+                        if result is not None and result.ok:
+                            drags.append(t1 - t0)
+                            pauses.append(t2 - t1)
+                            sent.append(view.meshes_sent - before)
+                    state = "after Fit junctions" if fitted else "as designed"
+                    if not drags:
+                        print(f"  {state:19}, joint {joint}, propagate={propagate!s:5}: refused "
+                              f"({result.reason})")  # fmt: skip
+                        continue
+                    view.drag_to(pose[:3, 3], view._gizmo.wxyz)
+                    view.flush()
+                    for k in range(steps):
+                        t0 = time.perf_counter()
+                        result = view.act(lambda k=k, j=joint, p=propagate: view.model.slide(
+                            j, 0.05 if k % 2 == 0 else -0.05, propagate=p))  # fmt: skip
+                        t1 = time.perf_counter()
+                        view.flush()
+                        if result.ok:
+                            commands.append(t1 - t0)
+                    print(f"  {state:19}, joint {joint}, propagate={propagate!s:5}: drag "
+                          f"{_median_ms(drags):5.1f} | sheets {_median_ms(pauses):6.1f} | "
+                          f"command {_median_ms(commands):5.1f} "
+                          f"({statistics.median(sent):g} meshes)")  # fmt: skip
     finally:
         server.stop()
 

@@ -61,7 +61,7 @@ commands = st.one_of(
 actions = st.one_of(commands, commands, st.sampled_from(["undo", "redo"]))
 
 
-@settings(deadline=None, max_examples=50, suppress_health_check=[HealthCheck.too_slow])
+@settings(deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.sampled_from([GRIPPER, EXAMPLE1]), st.lists(actions, min_size=1, max_size=8))
 def test_random_command_sequences_on_trees_undo_and_redo_exactly(path, sequence):
     model = EditorModel.open(path)
