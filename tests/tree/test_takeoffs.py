@@ -286,3 +286,31 @@ def test_bad_takeoff_options_are_named(hand, options, error, words):
 def test_hole_names_run_past_z():
     assert [hole_name(k) for k in (0, 1, 25, 26, 27, 51, 52)] == [
         "A", "B", "Z", "AA", "AB", "AZ", "BA"]  # fmt: skip
+
+
+def test_a_branch_sheet_can_hold_the_hole_of_the_next_takeoff():
+    """A branch that starts with a skirt branches again: its own sheet gets the next hole, and
+    both pairs of nets meet."""
+    n = 6
+    tree = KinematicTree(Waypoint(n, 1, SE3()))
+    up = tree.addJoint(0, RevoluteJoint(n, 1, math.pi, SE3.Trans(0, 0, 9) * SE3.Ry(-math.pi / 2)),
+                       **FIXED)  # fmt: skip
+    tree.addJoint(up, EndTip(n, 1, SE3.Trans(0, 0, 13), 1), **FIXED)
+    side = tree.addJoint(0, RevoluteJoint(n, 1, math.pi, SE3.Trans(5, 0, 4) * SE3.Rx(math.pi / 2)),
+                         **FIXED)  # fmt: skip
+    far = tree.addJoint(side, RevoluteJoint(n, 1, math.pi,
+                                            SE3.Trans(14, 0, 4) * SE3.Rx(math.pi / 2)), **FIXED)
+    tree.addJoint(far, EndTip(n, 1, SE3.Trans(18, 0, 4) * SE3.Ry(math.pi / 2), 1), **FIXED)
+    tree.addJoint(side, EndTip(n, 1, SE3.Trans(10, 5, 6) * SE3.Rx(-math.pi / 2), 1), **FIXED)
+    made = fabricate(tree, junction="takeoff", trunks={0: 1})
+    assert [s.joints for s in made.sheets] == [(0, 1, 2), (3, 4, 5), (6,)]
+    middle = made.sheets[1]
+    assert middle.takeoff == "A" and middle.holes == (("B", 2),)
+    assert middle.pattern.skirt is not None and [h.name for h in middle.pattern.holes] == ["B"]
+    assert "cut out hole B (sheet 2's skirt glues in)" in middle.label(tree)
+    assert made.overlap() is None
+    graphs = {s.index: sheet_graph(s.pattern) for s in made.sheets}
+    for t in made.takeoffs:
+        X = fish_mouth_points(graphs[t.branch_sheet], t.junction)
+        trunk = graphs[t.sheet].vertices_3d
+        assert np.linalg.norm(X[:, None] - trunk[None], axis=2).min(1).max() <= TOL
