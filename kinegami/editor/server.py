@@ -18,6 +18,7 @@ import contextlib
 import io
 import os
 import threading
+import warnings
 from pathlib import Path
 
 from kinegami.editor.autosave import Autosaver, Recovery, autosave_path, find_recovery
@@ -26,7 +27,7 @@ from kinegami.editor.commands import ReplaceDocument
 from kinegami.editor.document import Document
 from kinegami.editor.model import EditorModel
 from kinegami.editor.view import EditorView, gallery
-from kinegami.errors import ExporterUnavailableError
+from kinegami.errors import ClearanceWarning, ExporterUnavailableError
 
 __all__ = ["EditorServer", "LOCAL_HOSTS", "starting_document"]
 
@@ -36,10 +37,14 @@ LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
 
 def starting_document(design: str | os.PathLike | None = None) -> Document:
     """The document each new tab starts from: the design file, else the starter design of
-    ``kinegami new`` (a start tip and a few joints). Raises DesignError for a bad file."""
+    ``kinegami new`` (a start tip and a few joints). Raises DesignError for a bad file. A
+    design that passes through itself is loaded without printing the loader's
+    ClearanceWarnings: the editor's clearance panel reports it."""
     if design is None:
         return EditorModel().document
-    return Document.load(design)
+    with warnings.catch_warnings():  # on start, before the server's threads run
+        warnings.simplefilter("ignore", ClearanceWarning)
+        return Document.load(design)
 
 
 def _viser():
@@ -77,7 +82,9 @@ class EditorServer:
         self._autosavers: dict[Path, Autosaver] = {}
         #: The autosave found on start that is newer than the design (offered to each new
         #: tab until one recovers or discards it), or None.
-        self.recovery: Recovery | None = find_recovery(self.path) if self.autosave else None
+        with warnings.catch_warnings():  # the recovered document's clearance is shown too
+            warnings.simplefilter("ignore", ClearanceWarning)
+            self.recovery: Recovery | None = find_recovery(self.path) if self.autosave else None
         self.recover = bool(recover)
         #: Fits trees' junctions for the tabs' pattern panels (a process started on first use).
         self.worker = ProcessWorker()
