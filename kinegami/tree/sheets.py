@@ -495,6 +495,9 @@ def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes) -> Tr
                     link = tree.Links[t]
                     link_modules = link.pattern_modules(n, twistPortion)
                     at = next(i for i, m in enumerate(link_modules) if m.modules[0].kind == "tube")
+                    if link_modules[at].isEmpty:  # a link without a straight part
+                        reasons.append(f"trunk {t}: its link has no straight part")
+                        continue
                     index = _record_count(modules + link_modules[:at])
                     prefix = TubularPattern.concatenate(modules + link_modules[: at + 1])
                     form = unsnapped_form(prefix, frame=frame)

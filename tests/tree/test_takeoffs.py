@@ -314,3 +314,14 @@ def test_a_branch_sheet_can_hold_the_hole_of_the_next_takeoff():
         X = fish_mouth_points(graphs[t.branch_sheet], t.junction)
         trunk = graphs[t.sheet].vertices_3d
         assert np.linalg.norm(X[:, None] - trunk[None], axis=2).min(1).max() <= TOL
+
+
+def test_a_trunk_without_a_straight_part_holds_no_hole():
+    """Two links that are only arcs: neither can be the trunk of a take-off."""
+    tree = KinematicTree(Waypoint(4, 1, SE3()))
+    tree.addJoint(0, EndTip(4, 1, SE3.Trans(1.5, 0, 1) * SE3.Ry(math.pi / 2), 1), **FIXED)
+    tree.addJoint(0, EndTip(4, 1, SE3.Trans(-1.5, 0, 1) * SE3.Ry(-math.pi / 2), 1), **FIXED)
+    assert all(link.path.tMag < 1e-9 for link in tree.Links[1:])
+    with pytest.raises(InvalidParameterError, match=r"junction at joint 0: .*trunk 1: its link has "
+                       r"no straight part; trunk 2: its link has no straight part"):  # fmt: skip
+        fabricate(tree, junction="takeoff")
