@@ -578,7 +578,8 @@ class DeleteJoint(Command):
         chain = document.chain
         j = resolve_joint(document, self.joint)
         if len(chain.Joints) == 1:
-            _fail("the chain's only joint cannot be deleted: a chain keeps at least one joint")
+            noun = "tree" if _is_tree(chain) else "chain"
+            _fail(f"the {noun}'s only joint cannot be deleted: a {noun} keeps at least one joint")
         kids = _children(chain, j)
         if len(kids) > 1:
             _fail(

@@ -14,7 +14,7 @@ import pytest
 pytest.importorskip("viser")
 
 from kinegami.editor.server import EditorServer  # noqa: E402
-from kinegami.editor.view import ALL_SHEETS, download_data  # noqa: E402
+from kinegami.editor.view import ALL_SHEETS, COLLIDING_COLOR, download_data  # noqa: E402
 from kinegami.export.mesh import chain_parts  # noqa: E402
 
 from .helpers import EXAMPLE1, HAND, HAND_SHEET_JOINTS  # noqa: E402
@@ -46,6 +46,27 @@ def test_the_joint_list_names_each_parent(view):
     assert labels[0] == "0: Waypoint 'root'"
     view.act(lambda: view.model.select("root"))
     assert "children 1, 5, 8" in view._joint_info.content
+
+
+def test_the_hands_colliding_parts_are_red(view):
+    (pair,) = view.model.clearance().pairs  # the palm's joint and the pointer's first link
+    assert pair.elements == (2, 9)
+    assert view.colour_of("joint", 1) == COLLIDING_COLOR
+    assert view.colour_of("link", 5) == COLLIDING_COLOR
+    assert "self-intersecting" in view._clearance.content
+
+
+def test_animate_sweeps_the_trees_joints_and_gives_the_states_back(view):
+    import time
+
+    base = view.model.document
+    assert view.animate(period=0.5, fps=40.0)
+    end = time.monotonic() + 20.0
+    while view.animation_frames < 5:
+        assert time.monotonic() < end, "timed out"
+        time.sleep(0.02)
+    assert view.stop_animation()
+    assert view.model.document is base and not view.model.can_undo
 
 
 def test_the_tree_widgets_are_shown(view):
