@@ -760,7 +760,9 @@ class EditorView:
                     widget.visible = tree
             options = self._sheet_options()
             if tuple(self._sheet.options) != options:
+                value = self._sheet.value
                 self._sheet.options = options
+                self._sheet.value = value if value in options else ALL_SHEETS
         finally:
             self._syncing = False
 
@@ -834,10 +836,11 @@ class EditorView:
         """Send the design (``.json``) or an export to the browser; returns (name, data)."""
         self.stop_animation()
         try:
-            sheet = None
-            if self.model.is_tree and suffix in SHEET_FORMATS and self._sheet.value != ALL_SHEETS:
-                sheet = int(str(self._sheet.value).split()[-1])
-            sheets = self._sheets(self.model, self.model.document) if self.model.is_tree else None
+            sheet = sheets = None
+            if self.model.is_tree and (suffix in SHEET_FORMATS or suffix in (".pdf", "junctions")):
+                if suffix in SHEET_FORMATS and self._sheet.value != ALL_SHEETS:
+                    sheet = int(str(self._sheet.value).split()[-1])
+                sheets = self._sheets(self.model, self.model.document)
             name, data = download_data(self.model, suffix, sheet, sheets)
         except Exception as error:  # noqa: BLE001 - any exporter failure is shown, not raised
             self._say(f"**Download failed:** {error}")

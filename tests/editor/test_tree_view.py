@@ -158,6 +158,9 @@ def test_a_branch_sends_only_the_new_parts(view):
     expected = sum(1 for part in chain_parts(tree) if part.index in new)
     assert view.meshes_sent - before == expected
     assert tuple(view._sheet.options)[-1] == "sheet 3"
+    view._sheet.value = "sheet 3"
+    view.act(view._undo)  # the fourth sheet is gone: the menu falls back to every sheet
+    assert tuple(view._sheet.options)[-1] == "sheet 2" and view._sheet.value == ALL_SHEETS
 
 
 def test_a_branch_turns_a_chains_view_into_a_trees():
@@ -172,6 +175,8 @@ def test_a_branch_turns_a_chains_view_into_a_trees():
         assert "No crease pattern:" in view.pattern_html
         assert "cannot be made with printed junctions" in view.pattern_html
         assert view.download(".dxf") is None and "Download failed" in view.message
+        assert view.download(".stl")[0].endswith(".stl")  # the tree as drawn still downloads
+        assert view.download(".json")[0].endswith(".json")
         view.act(view._undo)
         assert not view.model.is_tree and not view._sheet.visible
         view.flush()
