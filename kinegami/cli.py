@@ -390,10 +390,13 @@ def _write_tree_pictures(fabrication, folder: Path, stem: str) -> list[Path]:
             plt.close(fig)
         return write_atomic(path, buffer.getvalue())
 
-    # the connectors in the 3D view too, when they can be made here (not with take-offs: the
-    # view draws the tree's own links and every junction as a connector)
-    view = fabrication.tree.show(
-        block=False, showJunctions=_importable("manifold3d") and not fabrication.takeoffs
+    # the tree as folded (take-off branches from their faces), and the connectors too when
+    # they can be made here (not with take-offs: showJunctions makes every junction a connector)
+    view = fabrication.folded_tree().show(
+        block=False,
+        showJunctions=_importable("manifold3d")
+        and _importable("trimesh")
+        and not fabrication.takeoffs,
     )
     written = [save(view[0], folder / f"{stem}_3d.png")]
     for sheet in fabrication.sheets:
@@ -575,6 +578,9 @@ def cmd_build(args: argparse.Namespace) -> int:
     chain, info = _load(args.design)
     if _is_tree(chain):
         return _build_tree(args, chain, info, stem, out)
+    if args.junctions is not None:
+        _note(args.command, f"--junctions {args.junctions} ignored: {args.design} is a chain "
+                            "(junctions join the sheets of a tree)")  # fmt: skip
     formats = _parse_formats(",".join(DEFAULT_FORMATS) if args.formats is None else args.formats)
     job = BuildJob(chain, info)
     _check_pattern(job)

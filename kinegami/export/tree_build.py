@@ -78,7 +78,7 @@ def write_tree_files(
         )
     folder = Path(folder)
     labels = sheet_labels(fabrication, names, units)
-    tree = fabrication.tree
+    folded = fabrication.folded_tree()
     written: list[Path] = []
     for fmt in formats:
         if fmt in ("dxf", "svg", "fold"):
@@ -106,9 +106,9 @@ def write_tree_files(
                         registry.import_library("networkx", "3MF connectors", "print")
                     path = folder / f"{stem}_junction_{junction.index}.{suffix}"
                     written.append(write_atomic(path, mesh.export(file_type=suffix)))
-        else:  # the whole tree: stl, obj, urdf
+        else:  # the whole tree as folded (take-off branches from their faces): stl, obj, urdf
             path = folder / f"{stem}.{fmt}"
-            registry.export(tree, path, units=units, twistPortion=twistPortion)
+            registry.export(folded, path, units=units, twistPortion=twistPortion)
             written.append(path)
             if fmt == "urdf":
                 written.append(folder / f"{stem}_meshes")

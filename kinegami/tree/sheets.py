@@ -197,6 +197,20 @@ class TreeFabrication:
         body = [(t.trunk, t.arc, t.child, t.link) for t in self.takeoffs]
         return takeoff_overlap(self.tree, body, names=names)
 
+    def folded_tree(self) -> KinematicTree:
+        """The tree as it is folded: :attr:`tree` itself, or, with take-offs, the tree whose
+        take-off branches leave through their trunk's face (their :attr:`links`), every trunk
+        link cut at its take-off points by a zero-length waypoint
+        (:func:`~kinegami.tree.takeoffs.takeoff_body`). What the whole-tree STL, OBJ and URDF
+        and the 3D picture of ``kinegami build`` show."""
+        if not self.takeoffs:
+            return self.tree
+        from kinegami.tree.takeoffs import takeoff_body
+
+        body = [(t.trunk, t.arc, t.child, t.link) for t in self.takeoffs]
+        joints, links, parents, _ = takeoff_body(self.tree, body)
+        return KinematicTree._from_parts(joints, links, parents, self.tree.maxAnglePerElbow)
+
     def connector(self, k: int):
         """The printed connector of junction ``k`` as a watertight trimesh (world frame, units
         of r; needs manifold3d, ``pip install 'kinegami[print]'``)."""

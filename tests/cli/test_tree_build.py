@@ -243,3 +243,12 @@ def test_an_unknown_junction_kind_is_a_one_line_error(tmp_path, capsys):
     assert len(err) == 1 and "--junctions" in err[0] and "'glue'" in err[0], err
     assert "connector, takeoff, auto" in err[0]
     assert list(tmp_path.iterdir()) == []
+
+
+def test_junctions_on_a_chain_is_a_note_not_silence(tmp_path, capsys):
+    chain = ROOT / "examples" / "designs" / "example1.json"
+    assert main_in_process("build", chain, "-o", tmp_path, "--formats", "dxf",
+                           "--junctions", "takeoff") == 0  # fmt: skip
+    err = capsys.readouterr().err
+    assert "--junctions takeoff ignored" in err and "is a chain" in err
+    assert names(tmp_path) == {"example1.dxf"}

@@ -289,3 +289,16 @@ def test_random_trees_forward_kinematics(tmp_path_factory, tree, seed):
     ]
     configurations = random_configurations(tree, 3, seed=seed)
     assert fk_error(robot, tree, configurations) <= FK_TOL * max(1.0, tree.r)
+
+
+def test_the_folded_tree_with_takeoffs_is_a_valid_robot(tmp_path, hand):
+    """kinegami build --junctions takeoff writes the URDF of the tree as folded: the take-off
+    branches leave their trunk's face (each trunk link cut there by a fixed waypoint)."""
+    from kinegami.tree.sheets import fabricate
+
+    folded = fabricate(hand, junction="takeoff").folded_tree()
+    assert len(folded.Joints) > len(hand.Joints)
+    robot = load(export(folded, tmp_path / "folded.urdf"))
+    assert fk_error(robot, folded, random_configurations(folded, 3, seed=5)) < 1e-9
+    # the same joints move as in the tree
+    assert len(movable(folded)) == len(movable(hand))

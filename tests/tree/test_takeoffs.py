@@ -325,3 +325,54 @@ def test_a_trunk_without_a_straight_part_holds_no_hole():
     with pytest.raises(InvalidParameterError, match=r"junction at joint 0: .*trunk 1: its link has "
                        r"no straight part; trunk 2: its link has no straight part"):  # fmt: skip
         fabricate(tree, junction="takeoff")
+
+
+# --- the tree as folded (what the whole-tree STL, OBJ, URDF and the 3D picture show) ----------
+
+
+def test_the_folded_tree_of_printed_connectors_is_the_tree(hand):
+    from kinegami.tree.sheets import fit_junctions
+
+    fitted, _ = fit_junctions(hand)
+    fabrication = fabricate(fitted)
+    assert fabrication.folded_tree() is fabrication.tree
+
+
+def test_the_folded_tree_has_the_takeoff_links(made, hand):
+    folded = made.folded_tree()
+    tree = made.tree
+    assert isinstance(folded, KinematicTree)
+    # every joint of the tree, in order, at its pose; plus one zero-length waypoint per cut
+    where = [next(i for i, j in enumerate(folded.Joints) if j is joint) for joint in tree.Joints]
+    assert where == sorted(where)
+    cuts = [i for i in range(len(folded.Joints)) if i not in where]
+    assert len(cuts) == len({(t.trunk, round(t.arc, 9)) for t in made.takeoffs})
+    for i in cuts:
+        assert isinstance(folded.Joints[i], Waypoint) and folded.Joints[i].neutralLength == 0.0
+    for takeoff in made.takeoffs:
+        k = where[takeoff.child]
+        link = folded.Links[k]
+        assert link is takeoff.link
+        # it ends at the child's proximal Dubins frame, starts at the take-off point on the
+        # trunk's link, and its parent is the waypoint that cuts the trunk's link there
+        assert_allclose(link.end_frame, tree.Joints[takeoff.child].proximal_dubins_frame(),
+                        atol=1e-9)  # fmt: skip
+        trunk = tree.Links[takeoff.trunk]
+        F = csc_transported_frame(trunk.path, trunk.start_frame, takeoff.arc)
+        assert_allclose(link.start_frame, takeoff.frame, atol=1e-12)
+        # on the trunk's face there: an apothem from its axis, square to it
+        offset = link.start_frame[:3, 3] - F[:3, 3]
+        assert abs(np.linalg.norm(offset) - tree.r * math.cos(math.pi / tree.numSides)) < 1e-9
+        assert abs(offset @ F[:3, 0]) < 1e-9
+        assert folded.Parents[k] in cuts
+    # the trunk links are cut, not changed: their pieces add up to the whole
+    for trunk in {t.trunk for t in made.takeoffs}:
+        pieces, node = 0.0, where[trunk]
+        while True:
+            pieces += folded.Links[node].path.length
+            node = folded.Parents[node]
+            if node not in cuts:
+                break
+        assert abs(pieces - tree.Links[trunk].path.length) < 1e-9
+    new = sum(t.link.path.length - tree.Links[t.child].path.length for t in made.takeoffs)
+    assert abs(folded.totalPathLength() - tree.totalPathLength() - new) < 1e-9
