@@ -221,7 +221,12 @@ class KinematicTree(_JointAssembly):
         away = away - float(away @ d1) * d1
         away /= float(np.linalg.norm(away))
         side = np.cross(d1, away)
-        for escape in (away, side, -side, -away):
+        # away first, then sideways, then back; then the diagonals between them (a parent with
+        # three or more children may have the four main directions taken)
+        diagonals = [
+            (a * away + b * side) / np.sqrt(2.0) for a, b in ((1, 1), (1, -1), (-1, 1), (-1, -1))
+        ]
+        for escape in (away, side, -side, -away, *diagonals):
             for variant in RADIAL_VARIANTS:
                 yield {**variant, "escape": escape}
         yield from super()._radial_variants(distal, k, p)

@@ -307,7 +307,8 @@ def test_safe_siblings_do_not_overlap():
 @settings(max_examples=10)
 @given(st.lists(st.tuples(st.floats(-math.pi, math.pi), st.floats(-1, 1)), min_size=2, max_size=4))
 def test_safe_siblings_are_clear(children):
-    """Any number of children added safely to one joint: the tree stays clear."""
+    """Up to four children added safely to one joint: each is placed and the tree stays clear
+    (four identical ones needed the diagonal escapes: the fourth was refused)."""
     tree = KinematicTree(Waypoint(4, 1, SE3()), requireClearance=True)
     with warnings.catch_warnings():
         warnings.simplefilter("error", ClearanceWarning)
@@ -316,6 +317,16 @@ def test_safe_siblings_are_clear(children):
             assert tree.addJoint(0, RevoluteJoint(4, 1, math.pi, pose)) is not None
     assert tree.clearance().ok
     assert len(tree.Children[0]) == len(children)
+
+
+def test_four_identical_safe_siblings_are_placed_and_clear():
+    tree = KinematicTree(Waypoint(4, 1, SE3()), requireClearance=True)
+    pose = SE3.Trans(3, 0, 4) * SE3.Ry(math.pi / 2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ClearanceWarning)
+        for _ in range(4):
+            assert tree.addJoint(0, RevoluteJoint(4, 1, math.pi, pose)) is not None
+    assert tree.clearance().ok and len(tree.Children[0]) == 4
 
 
 # --- delete ------------------------------------------------------------------------------------
