@@ -77,7 +77,7 @@ class Junction:
     children : its children (tree indices, in order).
     trunk : the child whose sheet runs through the connector.
     sockets : one :class:`~kinegami.tree.connector.JunctionSocket` per child, in ``children``
-        order (lengths along each child's link, units of r).
+        order (lengths along each child's link, in the tree's length units, those of r).
     parent_side : how the connector meets the joint behind it (``"base"`` for the root,
         ``"flange"`` otherwise; docs/junctions.md).
     """
@@ -134,8 +134,9 @@ class TreeSheet:
 
     def label(self, tree: KinematicTree, names=None, length=None) -> str:
         """One line for the drawings: the sheet, its joints, where it starts, where it is glued
-        (``names``: the joint names; ``length``: formats a length, default in units of r)."""
-        length = (lambda v: f"{v:.3g} r") if length is None else length
+        (``names``: the joint names; ``length``: formats a length given in the tree's length
+        units; default: as a multiple of r)."""
+        length = (lambda v: f"{v / tree.r:.3g} r") if length is None else length
 
         def joint(k: int) -> str:
             if names is not None and k < len(names) and names[k]:
@@ -232,7 +233,8 @@ class TreeFabrication:
 
 
 def _downstream(tree: KinematicTree) -> list[float]:
-    """Per joint: the longest path (link into it, itself, then on to a leaf), units of r."""
+    """Per joint: the longest path (link into it, itself, then on to a leaf), in the tree's
+    length units."""
     children = tree.Children
     longest = [0.0] * len(tree.Joints)
     for k in range(len(tree.Joints) - 1, -1, -1):
@@ -596,7 +598,7 @@ def fit_junctions(
     A child whose socket does not fit is slid along its own axis of motion (its subtree
     follows), by the smallest of :data:`FIT_SLIDES` that makes it fit without making the tree
     pass through itself more than before: the axes, hence the kinematics, stay as they were.
-    ``tree`` is not changed. Returns ``(tree, [(joint, slide in units of r), ...])``.
+    ``tree`` is not changed. Returns ``(tree, [(joint, slide in the tree's length units), ...])``.
 
     Raises
     ------

@@ -187,3 +187,24 @@ def test_sheet_start_frames_lie_on_their_links():
         d = np.linalg.norm(socket.frame[:3, 3] - link.start_frame[:3, 3])
         assert d <= socket.sheet_start + 1e-9
         assert_allclose(np.linalg.det(socket.frame[:3, :3]), 1.0, atol=1e-12)
+
+
+def test_default_labels_give_lengths_as_multiples_of_r():
+    """A tree in mm with r = 10 mm: the label's "x r along its link" is start_arc / r (it
+    printed the length in mm followed by "r")."""
+    import re
+    from pathlib import Path
+
+    from kinegami.design import load_design
+    from kinegami.tree.sheets import fit_junctions
+
+    design = Path(__file__).resolve().parents[2] / "examples" / "designs" / "quadruped.json"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        tree, _ = fit_junctions(load_design(design))
+    assert tree.r == 10.0
+    made = fabricate(tree)
+    for sheet in made.sheets[1:]:
+        found = re.search(r"([0-9.]+) r along its link", sheet.label(tree))
+        assert found, sheet.label(tree)
+        assert abs(float(found.group(1)) - sheet.start_arc / tree.r) < 0.01
