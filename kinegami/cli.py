@@ -390,14 +390,10 @@ def _write_tree_pictures(fabrication, folder: Path, stem: str) -> list[Path]:
             plt.close(fig)
         return write_atomic(path, buffer.getvalue())
 
-    # the tree as folded (take-off branches from their faces), and the connectors too when
-    # they can be made here (not with take-offs: showJunctions makes every junction a connector)
-    view = fabrication.folded_tree().show(
-        block=False,
-        showJunctions=_importable("manifold3d")
-        and _importable("trimesh")
-        and not fabrication.takeoffs,
-    )
+    # the tree as folded (take-off branches from their faces) with its connectors, when they
+    # can be made here
+    view = fabrication.show(block=False, showJunctions=_importable("manifold3d")
+                            and _importable("trimesh"))  # fmt: skip
     written = [save(view[0], folder / f"{stem}_3d.png")]
     for sheet in fabrication.sheets:
         fig, _ = sheet.pattern.show()

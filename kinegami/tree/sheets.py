@@ -212,6 +212,13 @@ class TreeFabrication:
         joints, links, parents, _ = takeoff_body(self.tree, body)
         return KinematicTree._from_parts(joints, links, parents, self.tree.maxAnglePerElbow)
 
+    def show(self, **options):
+        """Draw the tree as it is made: :meth:`folded_tree` with this fabrication's printed
+        connectors; returns (figure, axes). Options as for ``KinematicTree.show``."""
+        from kinegami.viz.chain_plot import show_fabrication
+
+        return show_fabrication(self, **options)
+
     def connector(self, k: int):
         """The printed connector of junction ``k`` as a watertight trimesh (world frame, units
         of r; needs manifold3d, ``pip install 'kinegami[print]'``)."""

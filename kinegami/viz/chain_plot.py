@@ -38,7 +38,13 @@ if TYPE_CHECKING:  # pragma: no cover
     from kinegami.chain import KinematicChain
     from kinegami.tree.model import KinematicTree
 
-__all__ = ["show_chain", "resolve_chain_options", "ARTIST_GIDS", "CHAIN_PLOT_OPTIONS"]
+__all__ = [
+    "show_chain",
+    "show_fabrication",
+    "resolve_chain_options",
+    "ARTIST_GIDS",
+    "CHAIN_PLOT_OPTIONS",
+]
 
 #: Names of all options accepted by ``show_chain`` (and ``KinematicChain.show``).
 CHAIN_PLOT_OPTIONS = tuple(style.CHAIN_PLOT_DEFAULTS)
@@ -305,6 +311,11 @@ def _draw_junctions(scene, chain, opts):
     except KinegamiError as error:
         warnings.warn(f"showJunctions: the junctions are not drawn: {error}", stacklevel=4)
         return
+    _draw_meshes(scene, meshes, opts)
+
+
+def _draw_meshes(scene, meshes, opts):
+    """Junction connector meshes (trimeshes, world frame), shaded, as the ``junctions`` artist."""
     faces = [mesh.vertices[mesh.faces] for mesh in meshes]
     scene.polygons(np.concatenate(faces), "junctions", opts["junctionColor"],
                    min(1.0, opts["surfaceOpacity"] + 0.3), shade=True)  # fmt: skip
@@ -558,7 +569,33 @@ def show_chain(chain: KinematicChain | KinematicTree, **options) -> tuple[Figure
     >>> fig.savefig("chain.png")  # doctest: +SKIP
     >>> fig, ax = hand.show(showCollisions=True)  # a KinematicTree  # doctest: +SKIP
     """
+    return _show(chain, resolve_chain_options(options))
+
+
+def show_fabrication(fabrication, **options) -> tuple[Figure, Axes3D]:
+    """Draw a tree as it is made (:meth:`kinegami.tree.sheets.TreeFabrication.show`): the tree as
+    folded (take-off branches leaving their trunk's face) and this fabrication's own printed
+    connectors, whichever kind each junction is. ``options`` as for :func:`show_chain`
+    (``showJunctions`` defaults to True here)."""
+    import warnings
+
+    from kinegami.errors import KinegamiError
+
+    options = {"showJunctions": True, **options}
     opts = resolve_chain_options(options)
+    meshes = []
+    if opts["showJunctions"] and fabrication.junctions:
+        try:
+            meshes = [fabrication.connector(k) for k in range(len(fabrication.junctions))]
+        except KinegamiError as error:
+            warnings.warn(f"showJunctions: the junctions are not drawn: {error}", stacklevel=3)
+    opts["showJunctions"] = False  # drawn from these meshes, not made again
+    return _show(fabrication.folded_tree(), opts, meshes)
+
+
+def _show(chain, opts, junction_meshes=()) -> tuple[Figure, Axes3D]:
+    """:func:`show_chain` with resolved options, plus ``junction_meshes`` (trimeshes) drawn as
+    the junctions."""
     import matplotlib.pyplot as plt
 
     ax = opts["ax"]
@@ -593,6 +630,8 @@ def show_chain(chain: KinematicChain | KinematicTree, **options) -> tuple[Figure
         _draw_ground_plane(scene, chain, opts)
     if opts["showJunctions"]:
         _draw_junctions(scene, chain, opts)
+    if junction_meshes:
+        _draw_meshes(scene, junction_meshes, opts)
     if opts["showCollisions"]:
         title = _draw_collisions(scene, chain)
         # inside the figure when the axes fill it (no axis grids)

@@ -418,3 +418,41 @@ def test_a_connector_that_cannot_be_made_is_left_out_with_a_warning():
     assert "junctions" not in _collection_gids(ax)
     assert "joint-bodies" in _collection_gids(ax)
     plt.close(fig)
+
+
+def test_a_fabrication_shows_its_folded_tree_and_only_its_own_connectors():
+    """``TreeFabrication.show``: the quadruped with ``junction="auto"`` has a take-off at the
+    body and a printed connector at joint 9: the view draws the take-off links and that one
+    connector (``showJunctions`` alone would have made both junctions connectors)."""
+    pytest.importorskip("manifold3d")
+    import warnings
+    from pathlib import Path
+
+    from kinegami import ClearanceWarning
+    from kinegami.design import load_design
+    from kinegami.tree.sheets import fabricate, fit_junctions
+
+    design = Path(__file__).resolve().parents[2] / "examples/designs/quadruped.json"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        tree, _ = fit_junctions(load_design(design))
+        made = fabricate(tree, junction="auto")
+    assert made.takeoffs and len(made.junctions) == 1
+    fig, ax = made.show()
+    try:
+        fig.canvas.draw()
+        [junctions] = [c for c in ax.collections if c.get_gid() == "junctions"]
+        assert len(junctions.get_paths()) == len(made.connector(0).faces)
+        # the centrelines drawn are the folded tree's: one more node per take-off cut
+        [path] = [line for line in ax.lines if line.get_gid() == "link-path"]
+        drawn = np.asarray(path.get_data_3d()).T
+        folded = made.folded_tree()
+        assert len(folded.Joints) > len(tree.Joints)
+        for takeoff in made.takeoffs:  # each take-off link starts on its trunk's face
+            start = takeoff.frame[:3, 3]
+            assert np.nanmin(np.linalg.norm(drawn - start, axis=1)) < 1e-9
+    finally:
+        plt.close(fig)
+    fig, ax = made.show(showJunctions=False)
+    assert "junctions" not in _collection_gids(ax)
+    plt.close(fig)
