@@ -41,10 +41,10 @@ class KinematicTree(_JointAssembly):
     Examples
     --------
     >>> tree = KinematicTree(Waypoint(4, 1, SE3()))
-    >>> tree.addJoint(0, RevoluteJoint(4, 1, np.pi, SE3.Trans(3, 0, 4) * SE3.Ry(np.pi / 2)),
+    >>> tree.addJoint(0, RevoluteJoint(4, 1, np.pi, SE3.Trans(4, 0, 4) * SE3.Ry(np.pi / 2)),
     ...               safe=False, fixedPosition=True, fixedOrientation=True)
     1
-    >>> tree.addJoint(0, RevoluteJoint(4, 1, np.pi, SE3.Trans(-3, 0, 4) * SE3.Ry(np.pi / 2)),
+    >>> tree.addJoint(0, RevoluteJoint(4, 1, np.pi, SE3.Trans(-4, 0, 4) * SE3.Ry(np.pi / 2)),
     ...               safe=False, fixedPosition=True, fixedOrientation=True)
     2
     >>> tree.Parents, tree.Children
