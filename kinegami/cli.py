@@ -281,6 +281,32 @@ def _angle_span(low: float, high: float) -> str:
     return f"{math.degrees(low):.1f} to {math.degrees(high):.1f} deg"
 
 
+def _junction_note(tree, report) -> str:
+    """For a clear tree whose closest parts are two tubes leaving the same branching joint:
+    "; closest where the tubes leaving joint J come out of its junction" (they touch there by
+    construction: the junction covers them up to where they are 2r apart), else ""."""
+    from kinegami.joints import Waypoint
+
+    pair = report.closest
+    if not report.ok or pair is None or any(e < 1 or e % 2 == 0 for e in pair.elements):
+        return ""
+
+    def top(k: int) -> int | None:  # the child of a branching joint whose tube k continues
+        while k > 0:
+            parent = tree.Parents[k]
+            if len(tree.Children[parent]) > 1:
+                return k
+            if not isinstance(tree.Joints[parent], Waypoint):
+                return None
+            k = parent
+        return None
+
+    a, b = (top((e + 1) // 2) for e in pair.elements)
+    if a is None or b is None or a == b or tree.Parents[a] != tree.Parents[b]:
+        return ""
+    return f"; closest where the tubes leaving joint {tree.Parents[a]} come out of its junction"
+
+
 def _clearance_summary(report, lengths: _Lengths, own_units: bool = False) -> str:
     """The build summary's clearance: "9.9 mm (clear)" or "-0.35 mm: self-intersects (A and
     B)", in mm like the other sizes of the summary (``own_units``: and in the design's unit,
@@ -414,14 +440,15 @@ def _tree_summary(tree, info, design: str, fabrication, moves) -> list[str]:
     links_length = tree.totalPathLength()
     names = _joint_names(tree)
     title = f"{_printable(info.name)} ({design})" if info.name else design
+    report = _clearance(tree)
     lines = [
         title,
         f"  joints: {len(tree.Joints)} ({kinds}), a tree with {len(fabrication.sheets)} leaves",
         f"  tube: {tree.numSides} sides, r = {tree.r * factor:g} mm",
         f"  total tube length: {(links_length + joints_length) * factor:.1f} mm "
         f"(links {links_length * factor:.1f} mm, joints {joints_length * factor:.1f} mm)",
-        "  clearance: " + _printable(_clearance_summary(_clearance(tree), _Lengths(tree.r,
-                                                                                 info.units))),
+        "  clearance: " + _printable(_clearance_summary(report, _Lengths(tree.r, info.units))
+                                     + _junction_note(tree, report)),
         f"  sheets: {len(fabrication.sheets)} (one per leaf)",
     ]  # fmt: skip
     labels = sheet_labels(fabrication, names, info.units)
@@ -824,7 +851,8 @@ def _check_lines(chain, info, design, report, motion, seed) -> list[str]:
         else:
             closest = report.closest
             lines.append(f"  minimum clearance: {lengths(report.min_clearance)}, between "
-                         f"{closest.first} and {closest.second}")  # fmt: skip
+                         f"{closest.first} and {closest.second}"
+                         + (_junction_note(chain, report) if _is_tree(chain) else ""))  # fmt: skip
     else:
         count = len(report.pairs)
         lines.append(f"{title}: self-intersects at its states "

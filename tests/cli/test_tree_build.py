@@ -65,6 +65,8 @@ def test_the_summary_lists_the_sheets_and_the_junctions(hand_build):
     assert "junctions: 1 (printed connectors)" in text
     assert "junction 0: at joint 0, children 1, 5, 8" in text
     assert "clearance:" in text and "(clear)" in text
+    # its closest parts touch where the junction ends (it covers them up to 2 r apart): said
+    assert "(clear); closest where the tubes leaving joint 0 come out of its junction" in text
     # the palm slides along its axis so that its socket fits, and the summary says so
     assert "note: joint 1 slid" in text
 
@@ -252,3 +254,14 @@ def test_junctions_on_a_chain_is_a_note_not_silence(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--junctions takeoff ignored" in err and "is a chain" in err
     assert names(tmp_path) == {"example1.dxf"}
+
+
+def test_check_says_when_the_closest_parts_leave_one_junction(capsys):
+    gripper = ROOT / "examples" / "designs" / "gripper.json"
+    assert main_in_process("check", gripper) == 0
+    out = capsys.readouterr().out
+    assert "clear at its states" in out
+    assert "closest where the tubes leaving joint 3 come out of its junction" in out
+    # a chain never gets the note
+    assert main_in_process("check", ROOT / "examples" / "designs" / "puma.json") == 0
+    assert "junction" not in capsys.readouterr().out
