@@ -691,44 +691,19 @@ def tree_clearance(tree, states=None, names=None) -> ClearanceReport:
         values = tuple(float(joint.state) for joint in joints)
         links = tree.Links
     else:
-        if isinstance(states, str | bytes) or not isinstance(states, Sequence | np.ndarray):
-            raise InvalidTypeError(
-                f"states must be a list of {len(joints)} joint states, got {type(states).__name__}"
-            )
-        if len(states) != len(joints):
-            raise InvalidParameterError(
-                f"states must have one state per joint ({len(joints)}), got {len(states)}"
-            )
-        checked = [check_real(f"states[{k}]", s) for k, s in enumerate(states)]
-        for k, (s, joint) in enumerate(zip(checked, joints, strict=True)):
-            lo, hi = joint.stateRange()
-            if not lo - 1e-12 <= s <= hi + 1e-12:
-                raise InvalidParameterError(
-                    f"states[{k}] = {s!r} is outside joint {k}'s state range [{lo:.6g}, {hi:.6g}]"
-                )
-        values = tuple(min(max(s, j.stateRange()[0]), j.stateRange()[1])
-                       for s, j in zip(checked, joints, strict=True))  # fmt: skip
+        ranges = np.array([joint.stateRange() for joint in joints], dtype=float)
+        values = _clipped(_checked_states(states, ranges, "states"), ranges)
         joints, links = tree._configured(values)
     r = float(tree.r)
     found = tree_pair_distances(joints, links, tree.Parents, r, reach=math.inf)
     if found is None:
         return ClearanceReport(True, math.inf, (), None, values)
-    i, j, dist, s, t, rows, a, b = found
-    clearance = dist - 2.0 * r
+    clearance = found[2] - 2.0 * r
     order = np.argsort(clearance, kind="stable")
     limit = -CONTACT_TOLERANCE * r
 
     def make(q: int) -> CollidingPair:
-        ii, jj = int(i[q]), int(j[q])
-        p = a[ii] + s[q] * (b[ii] - a[ii])
-        o = a[jj] + t[q] * (b[jj] - a[jj])
-        return CollidingPair(
-            part_label(rows[ii], float(s[q]), joints, names),
-            part_label(rows[jj], float(t[q]), joints, names),
-            float(clearance[q]),
-            (tuple(map(float, p)), tuple(map(float, o))),
-            (int(rows[ii][5]), int(rows[jj][5])),
-        )
+        return _pair_at(found, q, float(clearance[q]), joints, names)
 
     closest = make(int(order[0]))
     pairs: dict[tuple[str, str], CollidingPair] = {}
@@ -767,27 +742,16 @@ class TreeMotion:
 
     def _pair(self, values) -> CollidingPair | None:
         """The deepest overlap at the configuration ``values``, or None when it is clear."""
-        clipped = np.clip(np.asarray(values, dtype=float), self.ranges[:, 0], self.ranges[:, 1])
-        values = tuple(float(v) for v in clipped)
-        joints, links = self._tree._configured(values)
+        joints, links = self._tree._configured(_clipped(values, self.ranges))
         found = tree_pair_distances(joints, links, self._parents, self.r)
         if found is None:
             return None
-        i, j, dist, s, t, rows, a, b = found
+        dist = found[2]
         q = int(np.argmin(dist))
         clearance = float(dist[q]) - 2.0 * self.r
         if clearance >= -CONTACT_TOLERANCE * self.r:
             return None
-        ii, jj = int(i[q]), int(j[q])
-        p = a[ii] + s[q] * (b[ii] - a[ii])
-        o = a[jj] + t[q] * (b[jj] - a[jj])
-        return CollidingPair(
-            part_label(rows[ii], float(s[q]), joints, self._names),
-            part_label(rows[jj], float(t[q]), joints, self._names),
-            clearance,
-            (tuple(map(float, p)), tuple(map(float, o))),
-            (int(rows[ii][5]), int(rows[jj][5])),
-        )
+        return _pair_at(found, q, clearance, joints, self._names)
 
     def worst(self, Q: np.ndarray) -> tuple[np.ndarray, list]:
         """Deepest overlap at each configuration of ``Q`` (K, J), unchecked: ``(clearance,
@@ -834,6 +798,29 @@ class TreeMotion:
                 ends.append(good)
             out[j] = (min(ends), max(ends))
         return tuple(out)
+
+
+def _clipped(values, ranges: np.ndarray) -> tuple[float, ...]:
+    """Checked states clamped into ``ranges`` (one within 1e-12 of its range moves onto it), as
+    the tuple ``KinematicTree._configured`` takes."""
+    clipped = np.clip(np.asarray(values, dtype=float), ranges[:, 0], ranges[:, 1])
+    return tuple(float(v) for v in clipped)
+
+
+def _pair_at(found: tuple, q: int, clearance: float, joints, names) -> CollidingPair:
+    """Pair ``q`` of :func:`~kinegami.bodies.tree_pair_distances`'s result ``found`` as a
+    CollidingPair: its parts in words, ``clearance``, its closest points and elements."""
+    i, j, _, s, t, rows, a, b = found
+    ii, jj = int(i[q]), int(j[q])
+    p = a[ii] + s[q] * (b[ii] - a[ii])
+    o = a[jj] + t[q] * (b[jj] - a[jj])
+    return CollidingPair(
+        part_label(rows[ii], float(s[q]), joints, names),
+        part_label(rows[jj], float(t[q]), joints, names),
+        clearance,
+        (tuple(map(float, p)), tuple(map(float, o))),
+        (int(rows[ii][5]), int(rows[jj][5])),
+    )
 
 
 def _checked_states(states, ranges: np.ndarray, name: str) -> np.ndarray:

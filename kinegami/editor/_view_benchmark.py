@@ -31,6 +31,41 @@ def _median_ms(values) -> float:
     return statistics.median(values) * 1e3 if values else math.nan
 
 
+def _drags(view, joint: int, steps: int):
+    """``steps`` live drags of the selected ``joint`` along its axis, each followed by the pause
+    (:meth:`EditorView.flush`): (drag seconds, pause seconds, meshes sent, last result)."""
+    pose = view.model.chain.Joints[joint].pose_matrix.copy()
+    drags, pauses, sent, result = [], [], [], None
+    for k in range(steps):
+        target = pose[:3, 3] + (0.05 if k % 2 == 0 else 0.1) * pose[:3, 2]
+        before = view.meshes_sent
+        t0 = time.perf_counter()
+        result = view.drag_preview(target, view._gizmo.wxyz)
+        t1 = time.perf_counter()
+        view.flush()
+        t2 = time.perf_counter()
+        if result is not None and result.ok:
+            drags.append(t1 - t0)
+            pauses.append(t2 - t1)
+            sent.append(view.meshes_sent - before)
+    view.drag_to(pose[:3, 3], view._gizmo.wxyz)  # back where it began
+    return drags, pauses, sent, result
+
+
+def _slides(view, joint: int, propagate: bool, steps: int) -> list[float]:
+    """Seconds of ``steps`` slide commands of ``joint`` (back and forth by 0.05)."""
+    commands = []
+    for k in range(steps):
+        t0 = time.perf_counter()
+        result = view.act(lambda k=k: view.model.slide(
+            joint, 0.05 if k % 2 == 0 else -0.05, propagate=propagate))  # fmt: skip
+        t1 = time.perf_counter()
+        view.flush()
+        if result.ok:
+            commands.append(t1 - t0)
+    return commands
+
+
 def main() -> None:
     from kinegami.editor.server import EditorServer
 
@@ -45,29 +80,8 @@ def main() -> None:
             for propagate in (True, False):
                 view.model.propagate = propagate
                 view.act(lambda j=joint: view.model.select(j))
-                pose = view.model.chain.Joints[joint].pose_matrix.copy()
-                drags, pauses, commands, sent = [], [], [], []
-                for k in range(11):
-                    target = pose[:3, 3] + (0.05 if k % 2 == 0 else 0.1) * pose[:3, 2]
-                    before = view.meshes_sent
-                    t0 = time.perf_counter()
-                    result = view.drag_preview(target, view._gizmo.wxyz)
-                    t1 = time.perf_counter()
-                    view.flush()
-                    t2 = time.perf_counter()
-                    if result is not None and result.ok:
-                        drags.append(t1 - t0)
-                        pauses.append(t2 - t1)
-                        sent.append(view.meshes_sent - before)
-                view.drag_to(pose[:3, 3], view._gizmo.wxyz)  # back where it began
-                for k in range(11):
-                    t0 = time.perf_counter()
-                    result = view.act(lambda k=k, j=joint, p=propagate: view.model.slide(
-                        j, 0.05 if k % 2 == 0 else -0.05, propagate=p))  # fmt: skip
-                    t1 = time.perf_counter()
-                    view.flush()
-                    if result.ok:
-                        commands.append(t1 - t0)
+                drags, pauses, sent, _ = _drags(view, joint, 11)
+                commands = _slides(view, joint, propagate, 11)
                 print(f"  joint {joint:2d}, propagate={propagate!s:5}: drag "
                       f"{_median_ms(drags):5.1f} | pattern {_median_ms(pauses):5.1f} | "
                       f"command {_median_ms(commands):5.1f} "
@@ -94,40 +108,19 @@ def trees(steps: int = 5) -> None:
             if fitted:
                 view.act(view.model.fit_junctions)
                 view.flush()
+            state = "after Fit junctions" if fitted else "as designed"
             for joint in (1, 5, 9):
                 for propagate in (True, False):
                     view.model.propagate = propagate
                     view.act(lambda j=joint: view.model.select(j))
                     view.flush()
-                    pose = view.model.chain.Joints[joint].pose_matrix.copy()
-                    drags, pauses, commands, sent = [], [], [], []
-                    for k in range(steps):
-                        target = pose[:3, 3] + (0.05 if k % 2 == 0 else 0.1) * pose[:3, 2]
-                        before = view.meshes_sent
-                        t0 = time.perf_counter()
-                        result = view.drag_preview(target, view._gizmo.wxyz)
-                        t1 = time.perf_counter()
-                        view.flush()
-                        t2 = time.perf_counter()
-                        if result is not None and result.ok:
-                            drags.append(t1 - t0)
-                            pauses.append(t2 - t1)
-                            sent.append(view.meshes_sent - before)
-                    state = "after Fit junctions" if fitted else "as designed"
+                    drags, pauses, sent, result = _drags(view, joint, steps)
                     if not drags:
                         print(f"  {state:19}, joint {joint}, propagate={propagate!s:5}: refused "
                               f"({result.reason})")  # fmt: skip
                         continue
-                    view.drag_to(pose[:3, 3], view._gizmo.wxyz)
                     view.flush()
-                    for k in range(steps):
-                        t0 = time.perf_counter()
-                        result = view.act(lambda k=k, j=joint, p=propagate: view.model.slide(
-                            j, 0.05 if k % 2 == 0 else -0.05, propagate=p))  # fmt: skip
-                        t1 = time.perf_counter()
-                        view.flush()
-                        if result.ok:
-                            commands.append(t1 - t0)
+                    commands = _slides(view, joint, propagate, steps)
                     print(f"  {state:19}, joint {joint}, propagate={propagate!s:5}: drag "
                           f"{_median_ms(drags):5.1f} | sheets {_median_ms(pauses):6.1f} | "
                           f"command {_median_ms(commands):5.1f} "

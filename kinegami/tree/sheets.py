@@ -195,8 +195,11 @@ class TreeFabrication:
         the joints' names for the labels)."""
         from kinegami.tree.takeoffs import takeoff_overlap
 
-        body = [(t.trunk, t.arc, t.child, t.link) for t in self.takeoffs]
-        return takeoff_overlap(self.tree, body, names=names)
+        return takeoff_overlap(self.tree, self._body_takeoffs(), names=names)
+
+    def _body_takeoffs(self) -> list[tuple]:
+        """The take-offs as :func:`~kinegami.tree.takeoffs.takeoff_body` takes them."""
+        return [(t.trunk, t.arc, t.child, t.link) for t in self.takeoffs]
 
     def folded_tree(self) -> KinematicTree:
         """The tree as it is folded: :attr:`tree` itself, or, with take-offs, the tree whose
@@ -208,8 +211,7 @@ class TreeFabrication:
             return self.tree
         from kinegami.tree.takeoffs import takeoff_body
 
-        body = [(t.trunk, t.arc, t.child, t.link) for t in self.takeoffs]
-        joints, links, parents, _ = takeoff_body(self.tree, body)
+        joints, links, parents, _ = takeoff_body(self.tree, self._body_takeoffs())
         return KinematicTree._from_parts(joints, links, parents, self.tree.maxAnglePerElbow)
 
     def show(self, **options):

@@ -44,3 +44,15 @@ def hand_tree(**options) -> KinematicTree:
                               fixedPosition=True, fixedOrientation=True)  # fmt: skip
         assert index == spec["index"]
     return tree
+
+
+def quiet_hand(**options) -> KinematicTree:
+    """:func:`hand_tree` without its ClearanceWarnings (the paper's hand, as designed, has its
+    palm 0.25 r into the tube to the pointer)."""
+    import warnings
+
+    from kinegami import ClearanceWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        return hand_tree(**options)

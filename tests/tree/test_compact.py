@@ -25,19 +25,13 @@ from kinegami import (
 )
 from kinegami.optimize import compact, tube_length
 
-from .helpers import hand_tree
+from .helpers import quiet_hand
 
 RY = SE3.Ry(math.pi / 2)
 
 
 def _serial() -> concurrent.futures.Executor:
     return concurrent.futures.ThreadPoolExecutor(1)
-
-
-def quiet_hand() -> KinematicTree:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ClearanceWarning)
-        return hand_tree()
 
 
 def assert_same_kinematics(before: KinematicTree, after: KinematicTree) -> None:

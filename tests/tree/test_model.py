@@ -30,7 +30,7 @@ from kinegami import (
 )
 from kinegami.clearance import chain_clearance
 
-from .helpers import hand_tree, load_fixture
+from .helpers import hand_tree, load_fixture, quiet_hand
 
 REF = load_fixture()["reference"]
 RY = SE3.Ry(math.pi / 2)  # a revolute joint's path (its x axis) along -z
@@ -41,12 +41,6 @@ EXACT = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientat
 def hand():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ClearanceWarning)  # the palm nearly touches link 5
-        return hand_tree()
-
-
-def quiet_hand() -> KinematicTree:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ClearanceWarning)
         return hand_tree()
 
 

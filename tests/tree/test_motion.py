@@ -19,7 +19,7 @@ from kinegami import ClearanceWarning
 from kinegami.clearance import SweepReport, TreeMotion, sweep
 from kinegami.optimize import compact
 
-from .helpers import hand_tree
+from .helpers import quiet_hand
 
 ROOT = Path(__file__).resolve().parents[2]
 HAND_DESIGN = ROOT / "examples" / "designs" / "hand.json"
@@ -27,9 +27,7 @@ HAND_DESIGN = ROOT / "examples" / "designs" / "hand.json"
 
 @pytest.fixture(scope="module")
 def hand():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ClearanceWarning)
-        return hand_tree()
+    return quiet_hand()
 
 
 @pytest.fixture(scope="module")

@@ -22,7 +22,7 @@ from kinegami.pattern.folded import UVA_TO_DUBINS, unsnapped_form
 from kinegami.tree.sheets import fabricate
 from kinegami.tree.takeoffs import TakeoffOptions, hole_name, takeoff_body
 
-from .helpers import hand_tree
+from .helpers import hand_tree, quiet_hand
 
 #: The paper's hand's sheets (the same as with printed connectors: the trunk rule).
 HAND_SHEETS = [(0, 8, 9, 10, 11), (5, 6, 7), (1, 2, 3, 4)]
@@ -33,9 +33,7 @@ FIXED = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientat
 
 @pytest.fixture(scope="module")
 def hand():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ClearanceWarning)
-        return hand_tree()
+    return quiet_hand()
 
 
 @pytest.fixture(scope="module")
