@@ -524,26 +524,27 @@ def _takeoff_summary(fabrication, info) -> list[str]:
 def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> int:
     """``kinegami build`` of a tree: a sheet per leaf, the junction connectors and the whole
     tree (kinegami.export.tree_build), published as one transaction."""
-    from kinegami.export.tree_build import write_tree_files
-    from kinegami.tree.sheets import fabricate, fit_junctions
-
-    formats = _parse_tree_formats(args.formats)
-    if args.formats is None:  # the defaults: leave out what a missing optional library stops
-        needs = {"junctions": (("manifold3d", "trimesh"), "print"), "urdf": (("trimesh",), "mesh")}
-        for fmt, (modules, extra) in needs.items():
-            missing = [m for m in modules if not _importable(m)]
-            if fmt in formats and missing:
-                formats.remove(fmt)
-                _note(args.command, f"{fmt} not written: it needs {missing[0]} "
-                                    f"(pip install 'kinegami[{extra}]')")  # fmt: skip
     from kinegami.design.reader import carry_origin
     from kinegami.errors import InvalidParameterError
+    from kinegami.export.tree_build import write_tree_files
+    from kinegami.tree.sheets import fabricate, fit_junctions
     from kinegami.tree.takeoffs import JUNCTION_KINDS
 
     kind = "connector" if args.junctions is None else args.junctions
     if kind not in JUNCTION_KINDS:
         raise CommandError(f"--junctions: unknown kind {shown(kind)}; known: "
                            f"{', '.join(JUNCTION_KINDS)}")  # fmt: skip
+    formats = _parse_tree_formats(args.formats)
+    if args.formats is None:  # the defaults: leave out what a missing optional library stops
+        needs = {"urdf": (("trimesh",), "mesh")}
+        if kind != "takeoff":  # folded take-offs print no connector
+            needs["junctions"] = (("manifold3d", "trimesh"), "print")
+        for fmt, (modules, extra) in needs.items():
+            missing = [m for m in modules if not _importable(m)]
+            if fmt in formats and missing:
+                formats.remove(fmt)
+                _note(args.command, f"{fmt} not written: it needs {missing[0]} "
+                                    f"(pip install 'kinegami[{extra}]')")  # fmt: skip
     try:
         fitted, moves, fabrication = tree, [], None
         if kind != "connector":  # take-offs need no room for sockets: try the tree as it is

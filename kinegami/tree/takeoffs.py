@@ -340,8 +340,8 @@ def place_takeoffs(
     e = probe.axial_half_extent + probe.margin
     if tube_height < 2.0 * e - 1e-12 * r:
         return None, (
-            f"the plain tube of the trunk's link (to joint {trunk}) is {tube_height:.3g} r long; a "
-            f"take-off hole with its margin needs {2.0 * e:.3g} r (n = {n})"
+            f"the plain tube of the trunk's link (to joint {trunk}) is {tube_height / r:.3g} r "
+            f"long; a take-off hole with its margin needs {2.0 * e / r:.3g} r (n = {n})"
         )
     span = max(0.0, tube_height - 2.0 * e)
     count = 1 if span <= 1e-9 * r else options.heights

@@ -265,3 +265,16 @@ def test_check_says_when_the_closest_parts_leave_one_junction(capsys):
     # a chain never gets the note
     assert main_in_process("check", ROOT / "examples" / "designs" / "puma.json") == 0
     assert "junction" not in capsys.readouterr().out
+
+
+def test_takeoffs_need_no_connector_library_and_a_bad_kind_is_checked_first(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.setitem(sys.modules, "manifold3d", None)
+    assert main_in_process("build", HAND, "-o", tmp_path / "a", "--formats", "dxf",
+                           "--junctions", "takeoff") == 0  # fmt: skip
+    assert "manifold3d" not in capsys.readouterr().err  # no connector to print: no note
+    assert main_in_process("build", HAND, "-o", tmp_path / "b", "--junctions", "bogus") == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--junctions: unknown kind 'bogus'" in err[0], err
+    assert not (tmp_path / "b").exists()

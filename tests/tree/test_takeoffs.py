@@ -374,3 +374,19 @@ def test_the_folded_tree_has_the_takeoff_links(made, hand):
         assert abs(pieces - tree.Links[trunk].path.length) < 1e-9
     new = sum(t.link.path.length - tree.Links[t.child].path.length for t in made.takeoffs)
     assert abs(folded.totalPathLength() - tree.totalPathLength() - new) < 1e-9
+
+
+def test_a_takeoff_refusal_gives_lengths_in_r_for_a_tree_in_mm():
+    """The quadruped (r = 10 mm): its front trunk's plain tube is 2.11 r, a hole needs 2.5 r
+    (the message printed the millimetres followed by "r": 21.1 r and 25 r)."""
+    from pathlib import Path
+
+    from kinegami.design import load_design
+    from kinegami.tree.sheets import fit_junctions
+
+    design = Path(__file__).resolve().parents[2] / "examples" / "designs" / "quadruped.json"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        tree, _ = fit_junctions(load_design(design))
+    with pytest.raises(InvalidParameterError, match=r"is 2\.11 r long; .* needs 2\.5 r \(n = 6\)"):
+        fabricate(tree, junction="takeoff")
