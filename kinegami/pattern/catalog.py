@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from kinegami._record import Record
 from kinegami.errors import UnknownModuleKindError
 
 if TYPE_CHECKING:
@@ -50,7 +51,7 @@ def identity_unsnapped(prism: Prism, catalog: TubularPattern, params: Mapping[st
     return catalog, np.arange(catalog.numVertices)
 
 
-class ModuleKind(NamedTuple):
+class ModuleKind(Record):
     """The catalog entry of one module kind.
 
     Attributes

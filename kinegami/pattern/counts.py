@@ -8,15 +8,14 @@ compare a pattern with them.
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
+from kinegami._record import Record
 from kinegami.pattern._prism import Prism
 from kinegami.pattern.tubular import ModuleRecord
 
 __all__ = ["ModuleCounts", "expected_counts"]
 
 
-class ModuleCounts(NamedTuple):
+class ModuleCounts(Record):
     """Expected numbers of vertices, creases and (when known) mountain creases."""
 
     numVertices: int

@@ -6,10 +6,10 @@ See docs/theory/patterns.md 3.3; the fixes B6 and B9 are in its §6.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 
+from kinegami._record import Record
 from kinegami.errors import InvalidParameterError
 from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
@@ -34,7 +34,7 @@ __all__ = ["ELBOW_ANGLE_TOL", "ElbowFittingPattern", "ElbowGeometry", "elbow_geo
 ELBOW_ANGLE_TOL = 1e-6
 
 
-class ElbowGeometry(NamedTuple):
+class ElbowGeometry(Record):
     """Derived quantities of an elbow (section 3.3); lengths in units of r, angles in radians.
 
     Attributes

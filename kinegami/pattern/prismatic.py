@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 
+from kinegami._record import Record
 from kinegami.errors import InvalidParameterError
 from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
@@ -36,7 +36,7 @@ __all__ = [
 ]
 
 
-class REBOGeometry(NamedTuple):
+class REBOGeometry(Record):
     """Derived quantities of a REBO (section 3.7); lengths in units of r, angles in radians.
 
     Attributes

@@ -6,10 +6,10 @@ See docs/theory/patterns.md 3.4-3.6.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 
+from kinegami._record import Record
 from kinegami.errors import InvalidParameterError
 from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
@@ -28,7 +28,7 @@ __all__ = [
 ]
 
 
-class RevoluteGeometry(NamedTuple):
+class RevoluteGeometry(Record):
     """Derived quantities of a revolute joint or tip (sections 3.4, 3.6); lengths in units of r.
 
     Attributes

@@ -32,10 +32,11 @@ Everything is in pattern units (the unit of the tube radius r); exporters scale 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from kinegami._record import Record
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.pattern._prism import periodic_dx
 from kinegami.validation import check_bool
@@ -62,7 +63,7 @@ TOLERANCE_FACTOR = 1e-9
 _KIND_DTYPE = np.dtype("<U1")
 
 
-class Sheet(NamedTuple):
+class Sheet(Record):
     """The lines drawn on the flat sheet of a tubular pattern (docs/fabrication.md).
 
     Attributes

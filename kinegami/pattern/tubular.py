@@ -15,10 +15,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
+from kinegami._record import Record
 from kinegami.errors import InvalidParameterError, InvalidTypeError, ReadOnlyError
 from kinegami.pattern._prism import EPS_FACTOR, make_prism, periodic_dx, wrap_scalar, wrap_x
 from kinegami.validation import check_nonnegative
@@ -92,7 +93,7 @@ class FrozenParams(Mapping):
         return (FrozenParams, (self._data,))
 
 
-class _RecordFields(NamedTuple):
+class _RecordFields(Record):
     kind: str
     params: Mapping[str, Any]
 
@@ -138,7 +139,7 @@ class ModuleRecord(_RecordFields):
         return (ModuleRecord, (self.kind, self.params))
 
 
-class ValidationReport(NamedTuple):
+class ValidationReport(Record):
     """Result of :meth:`TubularPattern.validate`: every problem found (empty when fine)."""
 
     problems: tuple[str, ...] = ()
@@ -785,7 +786,7 @@ def _check_composable(
         )
 
 
-class _ComposeState(NamedTuple):
+class _ComposeState(Record):
     """What composition needs to know about the pattern built so far."""
 
     n: int
@@ -812,7 +813,7 @@ class _ComposeState(NamedTuple):
         )
 
 
-class _Step(NamedTuple):
+class _Step(Record):
     mapping: np.ndarray  # composite vertex of each of the module's vertices
     vertices: np.ndarray
     edges: np.ndarray

@@ -6,10 +6,10 @@ See docs/theory/patterns.md 3.2.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 
+from kinegami._record import Record
 from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
 from kinegami.pattern._fold import corners, mod_w, moved_copy, polygon_point, rot_axis
@@ -21,7 +21,7 @@ from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 __all__ = ["TwistFittingPattern", "TwistGeometry", "twist_geometry"]
 
 
-class TwistGeometry(NamedTuple):
+class TwistGeometry(Record):
     """Derived quantities of a twist (section 3.2); lengths in units of r, angles in radians.
 
     Attributes
