@@ -800,11 +800,15 @@ class KinematicChain(_JointAssembly):
     def creasePattern(self, twistPortion: float = 0.2):
         """The chain's tubular crease pattern (docs/fabrication.md) as a TubularPattern."""
         from kinegami.pattern import TubularPattern
+        from kinegami.pattern.catalog import build_pieces
 
         twistPortion = check_twist_portion(twistPortion)
+        # every link's modules built together (the elbows of the whole chain in one batch)
+        pieces = [link.pattern_pieces(self.numSides, twistPortion) for link in self._links[1:]]
+        built = iter(build_pieces([piece for link in pieces for piece in link]))
         modules = [self._joints[0].pattern]
-        for link, joint in zip(self._links[1:], self._joints[1:], strict=True):
-            modules += link.pattern_modules(self.numSides, twistPortion)
+        for link, joint in zip(pieces, self._joints[1:], strict=True):
+            modules.extend(next(built) for _ in link)
             modules.append(joint.pattern)
         return TubularPattern.concatenate(modules)
 

@@ -390,29 +390,32 @@ class LinkCSC(ReadOnlyAttributes):
 
     def pattern_modules(self, numSides: int, twistPortion: float) -> list:
         """The catalog modules of the link's pattern, in order (arguments already checked)."""
-        from kinegami.pattern import (
-            ElbowFittingPattern,
-            TubeFittingPattern,
-            TwistFittingPattern,
-        )
+        from kinegami.pattern.catalog import build_pieces
 
-        modules = []
+        return build_pieces(self.pattern_pieces(numSides, twistPortion))
+
+    def pattern_pieces(self, numSides: int, twistPortion: float) -> list[tuple[str, tuple]]:
+        """What :meth:`pattern_modules` builds: a (catalog kind, build arguments) pair per
+        module, in order (arguments already checked). A chain builds the pieces of all its links
+        together (kinegami.pattern.catalog.build_pieces), its elbows in one batch."""
+        pieces = []
 
         def elbows(arc: ElbowArc) -> list:
             if arc.angle <= PATTERN_MIN_ANGLE:
                 return []
-            elbow = ElbowFittingPattern(numSides, self.r, arc.elbowAngle, arc.rotationalAxisAngle)
-            return [elbow] * arc.count
+            return [("elbow", (numSides, self.r, arc.elbowAngle, arc.rotationalAxisAngle))] * (
+                arc.count
+            )
 
-        modules += elbows(self.elbows1)
+        pieces += elbows(self.elbows1)
         tube = self.path.tMag
         if self.hasTwist:
             twist_height = twistPortion * tube
-            modules.append(TwistFittingPattern(numSides, self.r, self.twistAngle, twist_height))
+            pieces.append(("twist", (numSides, self.r, self.twistAngle, twist_height)))
             tube -= twist_height
-        modules.append(TubeFittingPattern(numSides, self.r, tube))
-        modules += elbows(self.elbows2)
-        return modules
+        pieces.append(("tube", (numSides, self.r, tube)))
+        pieces += elbows(self.elbows2)
+        return pieces
 
     def __repr__(self) -> str:
         p = self.path

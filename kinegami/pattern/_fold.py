@@ -11,23 +11,14 @@ import math
 
 import numpy as np
 
-from kinegami.errors import InvalidParameterError
-from kinegami.pattern._prism import Prism, periodic_dx
-from kinegami.pattern.sheet import TOLERANCE_FACTOR
+from kinegami.errors import FoldedFormError
+from kinegami.pattern._prism import SHEET_TOLERANCE_FACTOR, Prism, periodic_dx
 from kinegami.pattern.tubular import TubularPattern
 
-try:  # one class for the whole package once kinegami.errors defines it
-    from kinegami.errors import FoldedFormError
-except ImportError:  # pragma: no cover - older kinegami.errors
-
-    class FoldedFormError(InvalidParameterError):
-        """A pattern cannot be folded (no module records, or records that do not rebuild it)."""
-
-
 #: Points of an unsnapped module closer than this many r are one vertex: they coincide to the
-#: tolerance of the flat sheet (kinegami.pattern.sheet.TOLERANCE_FACTOR), below which the sheet's
+#: tolerance of the flat sheet (SHEET_TOLERANCE_FACTOR), below which the sheet's
 #: planar graph cannot tell points apart.
-MERGE_TOLERANCE = TOLERANCE_FACTOR
+MERGE_TOLERANCE = SHEET_TOLERANCE_FACTOR
 
 
 def translation(a: float) -> np.ndarray:

@@ -16,6 +16,9 @@ from kinegami.validation import check_num_sides, check_radius
 
 #: Relative length tolerance of the reference: eps = EPS_FACTOR * b (docs/theory/patterns.md 1.1).
 EPS_FACTOR = 1e-4
+#: Length tolerance of the flat sheet, as a multiple of the tube radius r: points closer than this
+#: are one point of the sheet's planar graph (kinegami.pattern.sheet) and of the folded form.
+SHEET_TOLERANCE_FACTOR = 1e-9
 
 
 class Prism:

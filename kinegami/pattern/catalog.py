@@ -12,7 +12,7 @@ and calls :func:`register` with its entry; import that file in ``kinegami/patter
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -28,6 +28,7 @@ if TYPE_CHECKING:
 __all__ = [
     "ModuleKind",
     "UnknownModuleKindError",
+    "build_pieces",
     "cached_build",
     "find_kind",
     "kinds",
@@ -42,8 +43,6 @@ Unsnapped = Callable[["Prism", "TubularPattern", Mapping[str, Any]], tuple["Tubu
 #: (X, T): vertex positions (V, 3) in the proximal frame (e_u, e_v, e_a) and the 4x4 transform
 #: from the proximal to the distal frame.
 Fold = Callable[["Prism", "TubularPattern", Mapping[str, Any]], tuple[Any, Any]]
-
-
 
 
 def identity_unsnapped(prism: Prism, catalog: TubularPattern, params: Mapping[str, Any]):
@@ -88,25 +87,112 @@ class ModuleKind(Record):
         return self.build(numSides, r, *(params[name] for name in self.params))
 
 
-def cached_build(build: Callable[..., TubularPattern]) -> Callable[..., TubularPattern]:
+#: Patterns each cached constructor keeps (the oldest are dropped first).
+CACHE_SIZE = 1024
+
+
+class CacheInfo(Record):
+    """What a cached constructor's ``cache_info()`` returns (as ``functools.lru_cache``)."""
+
+    hits: int
+    misses: int
+    maxsize: int
+    currsize: int
+
+
+def cached_build(
+    build: Callable[..., TubularPattern] | None = None,
+    *,
+    many: Callable[[list[tuple]], list[TubularPattern]] | None = None,
+) -> Callable[..., TubularPattern]:
     """Cache a module constructor per argument values (and types): patterns are immutable
     values, so equal arguments may share one pattern. Errors are not cached; unhashable
-    arguments bypass the cache. ``cache_clear()`` empties it."""
-    cached = functools.lru_cache(maxsize=1024, typed=True)(build)
+    arguments bypass the cache. ``cache_clear()`` empties it, ``cache_info()`` says how full
+    it is.
+
+    ``many``, when given, builds the patterns of a list of (distinct, hashable) argument tuples
+    at once, equal bit for bit to ``build`` of each (the constructor's ``many(calls)`` attribute
+    uses it for the calls not in the cache, and caches their results; :func:`build_pieces`
+    calls it). Used as ``@cached_build`` or ``@cached_build(many=...)``.
+    """
+    if build is None:
+        return functools.partial(cached_build, many=many)
+    cache: dict = {}
+    hits_misses = [0, 0]
+
+    def remember(key, value) -> None:
+        if len(cache) >= CACHE_SIZE:
+            del cache[next(iter(cache))]
+        cache[key] = value
 
     @functools.wraps(build)
     def wrapper(*args, **kwargs):
+        key = (args, tuple(map(type, args)), tuple(kwargs.items())) if kwargs else (
+            args, tuple(map(type, args)))  # fmt: skip
         try:
-            hash(args)
-            if kwargs:
-                hash(tuple(kwargs.items()))
-        except TypeError:
+            value = cache[key]
+        except KeyError:
+            pass
+        except TypeError:  # an unhashable argument
             return build(*args, **kwargs)
-        return cached(*args, **kwargs)
+        else:
+            hits_misses[0] += 1
+            return value
+        hits_misses[1] += 1
+        value = build(*args, **kwargs)
+        remember(key, value)
+        return value
 
-    wrapper.cache_clear = cached.cache_clear
-    wrapper.cache_info = cached.cache_info
+    def build_many(calls: list[tuple]) -> list[TubularPattern]:
+        """``[wrapper(*args) for args in calls]``, building the missing ones in one batch."""
+        keys = []
+        missing: dict = {}
+        for args in calls:
+            key = (args, tuple(map(type, args)))
+            try:
+                if key not in cache:
+                    missing.setdefault(key, args)
+            except TypeError:
+                return [wrapper(*a) for a in calls]
+            keys.append(key)
+        if missing:
+            todo = list(missing.values())
+            built = many(todo) if many is not None and len(todo) > 1 else [build(*a) for a in todo]
+            for key, value in zip(missing, built, strict=True):
+                remember(key, value)
+            hits_misses[1] += len(missing)
+        hits_misses[0] += len(keys) - len(missing)
+        return [cache[key] for key in keys]
+
+    def cache_clear() -> None:
+        cache.clear()
+        hits_misses[:] = [0, 0]
+
+    wrapper.many = build_many
+    wrapper.cache_clear = cache_clear
+    wrapper.cache_info = lambda: CacheInfo(hits_misses[0], hits_misses[1], CACHE_SIZE, len(cache))
     return wrapper
+
+
+def build_pieces(pieces: Iterable[tuple[str, tuple]]) -> list[TubularPattern]:
+    """The pattern of every (kind, build arguments) piece, in order: the same patterns as
+    ``module_kind(kind).build(*args)`` of each, with the modules of one kind built together
+    where the kind's constructor can (its ``many``)."""
+    pieces = list(pieces)
+    calls: dict[str, dict] = {}
+    try:
+        for kind, args in pieces:
+            calls.setdefault(kind, {})[args] = None
+    except TypeError:  # an unhashable argument: no batches
+        return [module_kind(kind).build(*args) for kind, args in pieces]
+    built: dict = {}
+    for kind, unique in calls.items():
+        build = module_kind(kind).build
+        arguments = list(unique)
+        many = getattr(build, "many", None)
+        patterns = many(arguments) if many is not None else [build(*a) for a in arguments]
+        built[kind] = dict(zip(arguments, patterns, strict=True))
+    return [built[kind][args] for kind, args in pieces]
 
 
 _REGISTRY: dict[str, ModuleKind] = {}

@@ -98,13 +98,24 @@ def normalise_elbow_angles(bendingAngle: float, rotationalAxisAngle: float) -> t
 def elbow_geometry(prism: Prism, bendingAngle: float, rotationalAxisAngle: float) -> ElbowGeometry:
     """Column heights, tuck angles and collapsed columns of an elbow (section 3.3)."""
     theta, phi = normalise_elbow_angles(bendingAngle, rotationalAxisAngle)
-    r, b, eps = prism.r, prism.b, prism.eps
+    d_w = prism.r * math.tan(theta / 2.0)
+    h, H_m, tuck, collapsed, low = _column_arrays(prism, np.array([phi]), np.array([d_w]))
+    return ElbowGeometry(theta, phi, d_w, h[0], float(H_m[0]), tuck[0], collapsed[0], low[0])
+
+
+def _column_arrays(prism: Prism, phi: np.ndarray, d_w: np.ndarray) -> tuple:
+    """(h, H_m, tuck, collapsed, low) of E elbows at once, from their normalised phi and d_w
+    (shape (E,)): h, tuck, collapsed and low have shape (E, n), H_m shape (E,).
+
+    Row i is, bit for bit, what elbow i alone gives: every operation is elementwise or a
+    maximum, on contiguous arrays, so no result depends on the other rows.
+    """
+    b, eps = prism.b, prism.eps
     beta, prev, nxt, ring = prism.cached("elbow", lambda: _prism_arrays(prism))
-    d_w = r * math.tan(theta / 2.0)
-    h = d_w * (1.0 + np.sin(beta - phi))
-    H_m = max(h.tolist())
-    dh_prev = h[prev] - h
-    dh_next = h[nxt] - h
+    h = d_w[:, None] * (1.0 + np.sin(beta - phi[:, None]))
+    H_m = h.max(axis=1)
+    dh_prev = h[:, prev] - h
+    dh_next = h[:, nxt] - h
     flat = math.pi - np.arctan(dh_prev / b) - np.arctan(dh_next / b)
     # the angle at corner k of the polygon q_k = (r cos beta_k, r sin beta_k, h_k) between
     # u = q_{k+1} - q_k and w = q_{k-1} - q_k; the dot products are summed in the order
@@ -118,9 +129,10 @@ def elbow_geometry(prism: Prism, bendingAngle: float, rotationalAxisAngle: float
     # a column collapses when its tuck vertices L, M, O would lie within eps of each other:
     # h_k >= H_m - eps (section 3.3), or the offset (H_m - h_k) tan(eps_k) of O_k below eps
     # (fix B6)
-    collapsed = (h >= H_m - eps) | ((H_m - h) * np.tan(tuck) < eps)
+    below = H_m[:, None] - h
+    collapsed = (h >= H_m[:, None] - eps) | (below * np.tan(tuck) < eps)
     low = (h < eps) & ~collapsed
-    return ElbowGeometry(theta, phi, d_w, h, H_m, tuck, collapsed, low)
+    return h, H_m, tuck, collapsed, low
 
 
 class _Ring:
@@ -145,7 +157,22 @@ def _prism_arrays(prism: Prism):
     return beta, prev, nxt, ring
 
 
-@catalog.cached_build
+def _many_elbows(calls: list[tuple]) -> list[TubularPattern]:
+    """ElbowFittingPattern of every (numSides, r, bendingAngle, rotationalAxisAngle) call, the
+    calls on one prism computed together."""
+    prisms = [make_prism(numSides, r) for numSides, r, *_ in calls]
+    groups: dict[Prism, list[int]] = {}
+    for i, prism in enumerate(prisms):
+        groups.setdefault(prism, []).append(i)
+    built: list = [None] * len(calls)
+    for prism, rows in groups.items():
+        angles = [calls[i][2:] for i in rows]
+        for i, pattern in zip(rows, _elbow_patterns(prism, angles), strict=True):
+            built[i] = pattern
+    return built
+
+
+@catalog.cached_build(many=_many_elbows)
 def ElbowFittingPattern(
     numSides: int, r: float, bendingAngle: float, rotationalAxisAngle: float
 ) -> TubularPattern:
@@ -174,22 +201,54 @@ def ElbowFittingPattern(
         For a bending angle out of range, or one so small that more than two columns collapse
         at the length tolerance eps = 1e-4 b (the pattern could not be resolved).
     """
-    prism = make_prism(numSides, r)
-    geo = elbow_geometry(prism, bendingAngle, rotationalAxisAngle)
-    n = prism.numSides
-    layout = _layout(prism, geo)
-    if layout is None:
-        c = int(np.count_nonzero(geo.collapsed))
-        raise InvalidParameterError(
-            f"bendingAngle {bendingAngle!r} is too small to resolve for numSides={n}, "
-            f"r={prism.r:g}: {c} columns lie within the tolerance {prism.eps:.3g} of the midline "
-            "(at most two adjacent ones are allowed)"
+    return _elbow_patterns(make_prism(numSides, r), [(bendingAngle, rotationalAxisAngle)])[0]
+
+
+def _elbow_patterns(prism: Prism, angles: list[tuple]) -> list[TubularPattern]:
+    """The elbows of (bendingAngle, rotationalAxisAngle) pairs on one prism, computed together
+    (each equal, bit for bit, to the elbow computed alone)."""
+    n, r, W, eps = prism.numSides, prism.r, prism.W, prism.eps
+    normalised = [normalise_elbow_angles(theta, phi) for theta, phi in angles]
+    d_w = np.array([r * math.tan(theta / 2.0) for theta, _ in normalised])
+    phi = np.array([phi for _, phi in normalised])
+    h, H_m, tuck, collapsed, low = _column_arrays(prism, phi, d_w)
+    layouts = [_layout(prism, c, z) for c, z in zip(collapsed, low, strict=True)]
+    for (theta, _), layout, c in zip(angles, layouts, collapsed, strict=True):
+        if layout is None:
+            raise InvalidParameterError(
+                f"bendingAngle {theta!r} is too small to resolve for numSides={n}, r={r:g}: "
+                f"{int(np.count_nonzero(c))} columns lie within the tolerance {eps:.3g} of the "
+                "midline (at most two adjacent ones are allowed)"
+            )
+    H = 2.0 * H_m
+    offset = (H_m[:, None] - h) * np.tan(tuck)
+    E = len(angles)
+    x_source = np.empty((E, 2 * n))
+    x_source[:, :n] = prism.columns
+    x_source[:, n:] = wrap_x(prism.columns + offset, W, eps)
+    y_source = np.empty((E, 3 + 2 * n))
+    y_source[:, 0] = 0.0
+    y_source[:, 1] = H
+    y_source[:, 2] = H_m
+    y_source[:, 3 : 3 + n] = h
+    y_source[:, 3 + n :] = H[:, None] - h
+    patterns = []
+    for (theta, phi), layout, xs, ys, height in zip(
+        angles, layouts, x_source, y_source, H.tolist(), strict=True
+    ):
+        record = ModuleRecord._of(
+            "elbow", {"bendingAngle": float(theta), "rotationalAxisAngle": float(phi)}
         )
-    record = ModuleRecord._of(
-        "elbow",
-        {"bendingAngle": float(bendingAngle), "rotationalAxisAngle": float(rotationalAxisAngle)},
-    )
-    return _build_elbow(prism, geo, layout, record)
+        vertices = np.empty((layout.total, 2))
+        vertices[:, 0] = xs[layout.x_index]
+        vertices[:, 1] = ys[layout.y_index]
+        patterns.append(
+            TubularPattern._build(
+                n, r, vertices, layout.edges, layout.labels, layout.P, layout.D, np.zeros(2),
+                np.array([0.0, height]), height, (record,), 0, None, False,
+            )  # fmt: skip
+        )
+    return patterns
 
 
 class _Layout:
@@ -236,10 +295,9 @@ class _Layout:
         self.x_index, self.y_index = x_index, y_index
 
 
-def _layout(prism: Prism, geo: ElbowGeometry) -> _Layout | None:
+def _layout(prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> _Layout | None:
     """The shared layout of an elbow's columns, or None when they cannot be resolved (more
     than two collapsed columns, or two that are not adjacent)."""
-    collapsed, low = geo.collapsed, geo.low
     key = ("elbow layout", collapsed.tobytes(), low.tobytes())
 
     def make():
@@ -248,24 +306,6 @@ def _layout(prism: Prism, geo: ElbowGeometry) -> _Layout | None:
         return _Layout(prism, collapsed.copy(), low.copy()) if adjacent else None
 
     return prism.cached(key, make)
-
-
-def _build_elbow(
-    prism: Prism, geo: ElbowGeometry, layout: _Layout, record: ModuleRecord
-) -> TubularPattern:
-    x = prism.columns
-    h, H_m = geo.h, geo.H_m
-    H = 2.0 * H_m
-    offset = (H_m - h) * np.tan(geo.tuck)
-    x_source = np.concatenate([x, wrap_x(x + offset, prism.W, prism.eps)])
-    y_source = np.concatenate([[0.0, H, H_m], h, H - h])
-    vertices = np.empty((layout.total, 2))
-    vertices[:, 0] = x_source[layout.x_index]
-    vertices[:, 1] = y_source[layout.y_index]
-    return TubularPattern._build(
-        prism.numSides, prism.r, vertices, layout.edges, layout.labels, layout.P, layout.D,
-        np.zeros(2), np.array([0.0, H]), float(H), (record,), 0, None, False,
-    )  # fmt: skip
 
 
 def _build_elbow_reference(prism: Prism, geo: ElbowGeometry, record: ModuleRecord):

@@ -38,7 +38,7 @@ import numpy as np
 
 from kinegami._record import Record
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.pattern._prism import periodic_dx
+from kinegami.pattern._prism import SHEET_TOLERANCE_FACTOR, periodic_dx
 from kinegami.validation import check_bool
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -58,7 +58,7 @@ __all__ = [
 SHEET_KINDS = ("M", "V", "B", "C")
 
 #: Length tolerance of the flattening, as a multiple of the tube radius r.
-TOLERANCE_FACTOR = 1e-9
+TOLERANCE_FACTOR = SHEET_TOLERANCE_FACTOR
 
 _KIND_DTYPE = np.dtype("<U1")
 

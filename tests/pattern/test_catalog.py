@@ -22,7 +22,7 @@ from kinegami.pattern._build import assemble, crease_block
 from kinegami.pattern._fold import polygon_point, translation
 from kinegami.pattern._prism import make_prism
 from kinegami.pattern.counts import ModuleCounts, expected_counts
-from kinegami.pattern.elbow import _build_elbow, _build_elbow_reference, _layout, elbow_geometry
+from kinegami.pattern.elbow import _build_elbow_reference, elbow_geometry
 from kinegami.pattern.folded import folded_form, unsnapped_form
 
 KINDS = ("tube", "twist", "elbow", "revolute", "rebo", "prismatic", "start_tip", "end_tip",
@@ -200,8 +200,9 @@ def test_elbow_layout_matches_the_reference_build(n, theta, phi):
     prism = make_prism(n, 1.0)
     geo = elbow_geometry(prism, theta, phi)
     record = ModuleRecord("elbow", {"bendingAngle": theta, "rotationalAxisAngle": phi})
-    fast = _build_elbow(prism, geo, _layout(prism, geo), record)
+    fast = ElbowFittingPattern(n, 1.0, theta, phi)
     slow = _build_elbow_reference(prism, geo, record)
+    assert fast.modules == (record,)
     for name in ("vertices_coords", "edges_vertices", "edges_assignment", "proximalBase",
                  "distalBase", "distalMarker"):  # fmt: skip
         np.testing.assert_array_equal(getattr(fast, name), getattr(slow, name))
