@@ -336,8 +336,11 @@ def _target(path: Any, verb: str = "export") -> Path:
 
 def _subject(obj: Any, fmt: ExportFormat, options: dict[str, Any]) -> Any:
     """The object the exporter takes (a chain's crease pattern for pattern formats)."""
-    from kinegami.chain import KinematicChain
     from kinegami.pattern.tubular import TubularPattern
+
+    if fmt.accepts != "chain" and isinstance(obj, TubularPattern):
+        return obj  # the common case, without importing the chain and tree packages
+    from kinegami.chain import KinematicChain
     from kinegami.tree.model import KinematicTree
 
     if fmt.accepts == "chain":

@@ -17,6 +17,21 @@ def crease_block(first, second, label: str) -> tuple[np.ndarray, str]:
     return block, label
 
 
+def distinct_creases(
+    edges: np.ndarray, labels: np.ndarray, num_vertices: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The creases without those joining a vertex to itself and without repeats (the first of
+    equal creases kept), with their labels."""
+    keep = edges[:, 0] != edges[:, 1]
+    lo = np.minimum(edges[:, 0], edges[:, 1])
+    hi = np.maximum(edges[:, 0], edges[:, 1])
+    key = lo.astype(np.int64) * num_vertices + hi
+    first = np.zeros(key.shape[0], dtype=bool)
+    first[np.unique(key, return_index=True)[1]] = True
+    keep &= first
+    return edges[keep], labels[keep]
+
+
 def assemble(
     prism: Prism,
     vertices: np.ndarray,
@@ -44,14 +59,7 @@ def assemble(
         ]
     ).astype("<U1")
     if drop_degenerate:
-        keep = edges[:, 0] != edges[:, 1]
-        lo = np.minimum(edges[:, 0], edges[:, 1])
-        hi = np.maximum(edges[:, 0], edges[:, 1])
-        key = lo.astype(np.int64) * vertices.shape[0] + hi
-        first = np.zeros(key.shape[0], dtype=bool)
-        first[np.unique(key, return_index=True)[1]] = True
-        keep &= first
-        edges, labels = edges[keep], labels[keep]
+        edges, labels = distinct_creases(edges, labels, vertices.shape[0])
     return TubularPattern._build(
         prism.numSides,
         prism.r,

@@ -12,7 +12,7 @@ import numpy as np
 from kinegami._record import Record
 from kinegami.errors import InvalidParameterError
 from kinegami.pattern import catalog
-from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._build import assemble, crease_block, distinct_creases
 from kinegami.pattern._fold import (
     MERGE_TOLERANCE,
     assign,
@@ -22,7 +22,7 @@ from kinegami.pattern._fold import (
     require_all,
     rot_axis,
 )
-from kinegami.pattern._prism import Prism, make_prism, periodic_dx, wrap_x
+from kinegami.pattern._prism import Prism, _readonly, make_prism, periodic_dx, wrap_x
 from kinegami.pattern.checks import real
 from kinegami.pattern.counts import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
@@ -286,13 +286,16 @@ class _Layout:
         x_index[Of[full]], y_index[Of[full]] = n + k[full], 2
         x_index[L[has_l]], y_index[L[has_l]] = k[has_l], 3 + k[has_l]
         x_index[U[has_l]], y_index[U[has_l]] = k[has_l], 3 + n + k[has_l]
-        blocks = [crease_block(a, c, label) for a, c, label in _crease_table(P, D, L, M, Of, U)]
-        template = assemble(prism, np.zeros((total, 2)), blocks, P, D, 0.0, ModuleRecord("elbow"))
-        self.P, self.D, self.total = template.proximalBase, template.distalBase, total
-        self.edges, self.labels = template.edges_vertices, template.edges_assignment
-        x_index.flags.writeable = False
-        y_index.flags.writeable = False
-        self.x_index, self.y_index = x_index, y_index
+        table = _crease_table(P, D, L, M, Of, U)
+        edges = np.empty((n * len(table), 2), dtype=np.intp)
+        edges[:, 0] = np.concatenate([first for first, _, _ in table])
+        edges[:, 1] = np.concatenate([second for _, second, _ in table])
+        labels = np.repeat(np.array([label for _, _, label in table], dtype="<U1"), n)
+        edges, labels = distinct_creases(edges, labels, total)
+        self.P, self.D, self.total = _readonly(P.copy()), _readonly(D), total
+        self.edges, self.labels = _readonly(edges), _readonly(labels)
+        self.x_index, self.y_index = _readonly(x_index), _readonly(y_index)
+
 
 
 def _layout(prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> _Layout | None:

@@ -156,7 +156,7 @@ class ValidationReport(Record):
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:
-    array.flags.writeable = False
+    array.setflags(write=False)  # half the cost of array.flags.writeable = False
     return array
 
 
@@ -626,7 +626,10 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
     on those two vertices, whichever module it came from: the first one wins.
     """
     n, W, eps = first.numSides, first.width, first.eps
-    items = [(i, p) for i, p in enumerate(patterns) if i > 0 and not p.isEmpty]
+    items = [
+        (i, p) for i, p in enumerate(patterns)
+        if i > 0 and (p.edges_vertices.shape[0] or not p.isEmpty)
+    ]  # fmt: skip
     if not items:
         return first
     m = len(items)
@@ -643,7 +646,7 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
         ox, oy = mx - px, my - py
         offsets[k, 0], offsets[k, 1] = ox, oy
         mx, my = wrap_scalar(dx + ox, W, eps), dy + oy
-        sizes[k] = p.numVertices
+        sizes[k] = p.vertices_coords.shape[0]
         height += p.height
         removed += p.removedDuplicates
         modules.extend(p.modules)
@@ -728,6 +731,9 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
         placements = list(placements)
         ends = (N0 + starts + sizes).tolist()
         for p, a, b in zip(pats, (N0 + starts).tolist(), ends, strict=True):
+            if p._module_vertices is None and len(p.modules) == 1:  # _placed's common case
+                placements.append(_readonly(index[a:b]))
+                continue
             own = _placed(p, index[a:b])
             if own is None:
                 placements = None
