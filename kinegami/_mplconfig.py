@@ -15,10 +15,8 @@ from __future__ import annotations
 
 import atexit
 import os
-import shutil
 import stat
 import sys
-import tempfile
 from pathlib import Path
 
 __all__ = ["running_the_command", "matplotlib_folders", "use_private_folder_if_needed"]
@@ -75,6 +73,9 @@ def _writable_folder(path: Path) -> bool:
 def _private_folder() -> Path | None:
     """``<tmp>/kinegami-matplotlib-<uid>`` if it is (or can be made) this user's own folder, mode
     0700; else a fresh temporary folder removed at exit; None if neither can be made."""
+    import shutil  # here, not at the top: importing kinegami should not pay for them
+    import tempfile
+
     getuid = getattr(os, "getuid", None)
     if getuid is not None:
         path = Path(tempfile.gettempdir()) / f"kinegami-matplotlib-{getuid()}"

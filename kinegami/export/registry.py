@@ -42,7 +42,6 @@ import errno
 import importlib
 import io
 import os
-import secrets
 import shutil
 import signal
 from collections.abc import Callable, Iterator, Mapping
@@ -471,7 +470,7 @@ def save_pattern(pattern: Any, dxfName: str | os.PathLike | None, **options: Any
 
 def _temp_folder(parent: Path, name: str, tag: str) -> Path:
     for _ in range(100):
-        candidate = parent / f".{name}.{secrets.token_hex(4)}.{tag}"
+        candidate = parent / f".{name}.{os.urandom(4).hex()}.{tag}"
         try:
             candidate.mkdir()
             return candidate
