@@ -63,7 +63,58 @@ def twist_geometry(prism: Prism, twistAngle: float, moduleHeight: float) -> Twis
     return TwistGeometry(K, residual, shift, excess, height, height < prism.eps)
 
 
-@catalog.cached_build
+def _many_twists(calls: list[tuple]) -> list[TubularPattern]:
+    """TwistFittingPattern of every (numSides, r, twistAngle, moduleHeight) call, the distal
+    columns of the calls on one prism wrapped together (bit for bit as alone: elementwise)."""
+    checked = [
+        (make_prism(numSides, r), real("twistAngle", alpha), nonnegative("moduleHeight", h))
+        for numSides, r, alpha, h in calls
+    ]
+    geos = [twist_geometry(prism, alpha, h) for prism, alpha, h in checked]
+    groups: dict[Prism, list[int]] = {}
+    for i, ((prism, _, _), geo) in enumerate(zip(checked, geos, strict=True)):
+        if not geo.degenerate:
+            groups.setdefault(prism, []).append(i)
+    shifted: list = [None] * len(calls)
+    for prism, rows in groups.items():
+        shifts = np.array([geos[i].shift for i in rows])
+        for i, row in zip(rows, wrap_x(prism.columns + shifts[:, None], prism.W, prism.eps),
+                          strict=True):  # fmt: skip
+            shifted[i] = row
+    return [
+        _twist(prism, alpha, h, geo, x)
+        for (prism, alpha, h), geo, x in zip(checked, geos, shifted, strict=True)
+    ]
+
+
+def _twist(
+    prism: Prism, alpha: float, h: float, geo: TwistGeometry, shifted: np.ndarray | None
+) -> TubularPattern:
+    """The twist of checked ``alpha`` and ``h``; ``shifted``: its distal columns, wrapped."""
+    record = ModuleRecord._of("twist", {"twistAngle": alpha, "moduleHeight": h})
+    n, b = prism.numSides, prism.b
+    if geo.degenerate:
+        k = np.arange(n)
+        columns = round(n * ((alpha % (2.0 * math.pi)) / (2.0 * math.pi))) % n
+        vertices = np.stack([prism.columns, np.zeros(n)], axis=1)
+        return assemble(
+            prism, vertices, [(np.zeros((0, 2), int), "M")], k, k, 0.0, record,
+            distal_marker_x=float(wrap_x(np.array([columns * b]), prism.W, prism.eps)[0]),
+        )  # fmt: skip
+    H = geo.height
+    band = prism.cached("twist", lambda: _band(prism))
+    vertices = band.vertices_coords.copy()
+    vertices[n:, 0] = shifted
+    vertices[n:, 1] = H
+    marker_x = wrap_scalar(geo.K * b + geo.shift, prism.W, prism.eps)
+    return TubularPattern._build(
+        n, prism.r, vertices, band.edges_vertices, band.edges_assignment, band.proximalBase,
+        band.distalBase, np.zeros(2), np.array([marker_x, H]), float(H), (record,), 0, None,
+        False,
+    )  # fmt: skip
+
+
+@catalog.cached_build(many=_many_twists)
 def TwistFittingPattern(
     numSides: int, r: float, twistAngle: float, moduleHeight: float
 ) -> TubularPattern:
@@ -90,31 +141,10 @@ def TwistFittingPattern(
         distal marker shifted by the nearest whole number of columns.
     """
     prism = make_prism(numSides, r)
-    alpha = real("twistAngle", twistAngle)
-    h = nonnegative("moduleHeight", moduleHeight)
+    alpha, h = real("twistAngle", twistAngle), nonnegative("moduleHeight", moduleHeight)
     geo = twist_geometry(prism, alpha, h)
-    record = ModuleRecord._of("twist", {"twistAngle": alpha, "moduleHeight": h})
-    n, b = prism.numSides, prism.b
-    k = np.arange(n)
-    x = prism.columns
-    if geo.degenerate:
-        columns = round(n * ((alpha % (2.0 * math.pi)) / (2.0 * math.pi))) % n
-        vertices = np.stack([x, np.zeros(n)], axis=1)
-        return assemble(
-            prism, vertices, [(np.zeros((0, 2), int), "M")], k, k, 0.0, record,
-            distal_marker_x=float(wrap_x(np.array([columns * b]), prism.W, prism.eps)[0]),
-        )  # fmt: skip
-    H = geo.height
-    band = prism.cached("twist", lambda: _band(prism))
-    vertices = band.vertices_coords.copy()
-    vertices[n:, 0] = wrap_x(x + geo.shift, prism.W, prism.eps)
-    vertices[n:, 1] = H
-    marker_x = wrap_scalar(geo.K * b + geo.shift, prism.W, prism.eps)
-    return TubularPattern._build(
-        n, prism.r, vertices, band.edges_vertices, band.edges_assignment, band.proximalBase,
-        band.distalBase, np.zeros(2), np.array([marker_x, H]), float(H), (record,), 0, None,
-        False,
-    )  # fmt: skip
+    shifted = None if geo.degenerate else wrap_x(prism.columns + geo.shift, prism.W, prism.eps)
+    return _twist(prism, alpha, h, geo, shifted)
 
 
 def _band(prism: Prism) -> TubularPattern:
