@@ -146,12 +146,16 @@ def cached_build(
     def build_many(calls: list[tuple]) -> list[TubularPattern]:
         """``[wrapper(*args) for args in calls]``, building the missing ones in one batch."""
         keys = []
+        found: dict = {}  # this call's patterns (the cache may drop some while it fills)
         missing: dict = {}
         for args in calls:
             key = (args, tuple(map(type, args)))
             try:
-                if key not in cache:
-                    missing.setdefault(key, args)
+                if key not in found:
+                    if key in cache:
+                        found[key] = cache[key]
+                    else:
+                        missing.setdefault(key, args)
             except TypeError:
                 return [wrapper(*a) for a in calls]
             keys.append(key)
@@ -160,9 +164,10 @@ def cached_build(
             built = many(todo) if many is not None and len(todo) > 1 else [build(*a) for a in todo]
             for key, value in zip(missing, built, strict=True):
                 remember(key, value)
+                found[key] = value
             hits_misses[1] += len(missing)
         hits_misses[0] += len(keys) - len(missing)
-        return [cache[key] for key in keys]
+        return [found[key] for key in keys]
 
     def cache_clear() -> None:
         cache.clear()

@@ -140,3 +140,18 @@ def test_the_cache_keeps_at_most_cache_size_patterns(monkeypatch):
     assert TubeFittingPattern.cache_info().currsize == 3
     assert TubeFittingPattern(4, 1.0, 1.0) is not first  # the oldest was dropped
     TubeFittingPattern.cache_clear()
+
+
+def test_a_batch_larger_than_the_cache_returns_every_pattern(monkeypatch):
+    """The cache drops its oldest patterns while a batch fills it (the gallery's SVG tests hit
+    this once a long test run had filled the caches): the batch still returns all of them."""
+    monkeypatch.setattr(catalog, "CACHE_SIZE", 2)
+    calls = [(6, 1.0, 0.3, 0.0)] + [(6, 1.0, 0.4 + 0.1 * i, 1.0) for i in range(5)]
+    alone = one_at_a_time("elbow", calls)
+    cached = ElbowFittingPattern(6, 1.0, 0.3, 0.0)  # a hit, then dropped by the batch's misses
+    together = ElbowFittingPattern.many(calls)
+    assert together[0] is cached
+    for a, b in zip(together, alone, strict=True):
+        assert_same_pattern(a, b)
+    assert ElbowFittingPattern.cache_info().currsize == 2
+    ElbowFittingPattern.cache_clear()
