@@ -70,6 +70,7 @@ __all__ = [
     "part_label",
     "junction_extent",
     "link_polyline",
+    "link_capsule_ends",
     "Overlap",
     "CONTACT_TOLERANCE",
     "JUNCTION_REACH",
@@ -700,6 +701,14 @@ def link_polyline(link) -> np.ndarray:
     end = np.asarray(link.end_frame[:3, 3], dtype=float)
     return np.concatenate([start[None], link.elbows1.vertices(), link.elbows2.vertices(),
                            end[None]])  # fmt: skip
+
+
+def link_capsule_ends(link) -> np.ndarray:
+    """Both ends of every capsule of the link (its polyline's edges and the mitre capsules at
+    its elbow vertices), shape (2k, 3), world: the link lies within r of their convex hulls.
+    Empty (0, 3) for a link of length 0."""
+    (starts, ends, _, _), _, _ = _link_arrays(link, 0, link.r, 0.2)
+    return np.concatenate([starts, ends]).reshape(-1, 3)
 
 
 def _polyline_samples(points: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:

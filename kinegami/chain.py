@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from kinegami.bodies import worst_overlap
+from kinegami.bodies import link_capsule_ends, worst_overlap
 from kinegami.errors import (
     ClearanceWarning,
     InvalidParameterError,
@@ -513,20 +513,25 @@ class _JointAssembly:
     def _radial_variants(self, distal: np.ndarray, k: int, p: int):
         """RADIAL_VARIANTS, then the same escaping sideways first: away from the tube that
         arrived at the parent (for a parent reached by a U-turn), then out of the plane of
-        that U-turn on either side."""
+        that U-turn on either side; then RADIAL_VARIANTS again, holding straight on until past
+        every capsule of that tube before turning towards the joint (its U-turn fitting can
+        reach far behind the parent, where the joint may be)."""
         yield from RADIAL_VARIANTS
         A, d1 = distal[:3, 3], distal[:3, k]
-        path = self._links[p].path
+        arrived = self._links[p]
+        path = arrived.path
         if path.length <= 0.0:
             return
         away = A - 0.5 * (np.asarray(path.q1) + np.asarray(path.q2))
         away = away - float(away @ d1) * d1
-        if float(np.linalg.norm(away)) < 1e-9 * self.r:
-            return
-        side = np.cross(d1, away)
-        for escape in (away, side, -side):
-            for variant in RADIAL_VARIANTS:
-                yield {**variant, "escape": escape}
+        if float(np.linalg.norm(away)) >= 1e-9 * self.r:
+            side = np.cross(d1, away)
+            for escape in (away, side, -side):
+                for variant in RADIAL_VARIANTS:
+                    yield {**variant, "escape": escape}
+        past = link_capsule_ends(arrived)
+        for variant in RADIAL_VARIANTS:
+            yield {**variant, "hold_past": past}
 
     def _cost(self, extended) -> tuple[float, float]:
         """(growth of the ball radius, length of the new links) of an extension."""

@@ -172,6 +172,7 @@ def radial_safe_placement(
     bend_straight: float = 0.5,
     two_arcs_above: float = 2.0 * math.pi / 3.0,
     escape: np.ndarray | None = None,
+    hold_past: np.ndarray | None = None,
 ) -> list[Joint]:
     """Safe placement whose parts stay within a fixed distance of the ball (docs/placement.md).
 
@@ -199,7 +200,14 @@ def radial_safe_placement(
     more than 2r away from the parent's axis. ``escape`` (a unit vector perpendicular to the
     parent's path direction) first turns the tube by pi/2 towards it and runs 2r straight (a
     waypoint), the way out when the tube arrived at the parent by a U-turn and anything leaving
-    the parent would otherwise run back along it.
+    the parent would otherwise run back along it. ``hold_past`` (points, shape (k, 3)) puts
+    one more waypoint W_h straight ahead of W_a, 2r past every one of those points along m,
+    and starts the S-curve only there (R' grows until W_b is still 2r ahead of W_h): from W_h
+    on, the heading never turns back against m, so every later part lies at least 2r beyond
+    each capsule whose ends are those points. The chain passes the capsule ends of the tube
+    that arrived at the parent: after a U-turn made of one elbow fitting (a large
+    maxAnglePerElbow), the fitting's legs and mitre reach far behind the parent, along the
+    way the tube comes back (W_a -> W_h is a straight tube: a CSC path with no turns).
     """
     r = joint.r
     c, R = ball.c, ball.r
@@ -222,6 +230,7 @@ def radial_safe_placement(
     T = joint.pose_matrix
     p, z = T[:3, 3], T[:3, 2]
     radius = max(R + 4.0 * r + rho, float(np.linalg.norm(A - c)) + L / 2.0 + 9.0 * r)
+    past = None if hold_past is None else np.asarray(hold_past, dtype=float).reshape(-1, 3)
 
     for _ in range(8):
         lam_c = float((c - p) @ z)
@@ -252,12 +261,17 @@ def radial_safe_placement(
                 + bend_straight * r * u_mid
                 + _arc_displacement(r, u_mid, axis, half)
             )
-        if float((wb - wa) @ m) >= 2.0 * r:
+        held = []  # W_h: straight ahead of W_a until 2r past every point of hold_past along m
+        if past is not None:
+            hold = float(np.max((past - wa) @ m)) + 2.0 * r
+            if hold > 0.0:
+                held = [wa + hold * m]
+        ahead = float((wb - (held[-1] if held else wa)) @ m)
+        if ahead >= 2.0 * r:
             R_turned = rotation_matrix(axis, psi) @ R_parent
             return lead_waypoints + [
-                _waypoint(joint, R_turned, wa, parent_path_index),
-                _waypoint(joint, R_turned, wb, parent_path_index),
-                placed,
-            ]
-        radius += 4.0 * r
+                _waypoint(joint, R_turned, point, parent_path_index) for point in [wa, *held, wb]
+            ] + [placed]  # fmt: skip
+        # a long hold may need more than 4r: the joint (so W_b) moves out about as far as R'
+        radius += max(4.0 * r, 2.0 * r - ahead) if held else 4.0 * r
     raise NoPathError("radial safe placement found no waypoint layout (degenerate input)")

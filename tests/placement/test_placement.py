@@ -14,6 +14,7 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
+from kinegami.bodies import link_polyline
 from kinegami.geometry.balls import Ball
 from kinegami.placement import radial_safe_placement
 
@@ -89,3 +90,56 @@ def test_safe_appends_on_long_random_chain_never_fail():
             assert chain.append(joint) is not None
     assert chain.boundingBall.r <= 10 * r * 48
     assert chain.totalPathLength() <= 60 * r * 48
+
+
+@settings(deadline=None, max_examples=100)
+@given(
+    r=st.sampled_from([0.05, 1.0, 20.0]),
+    kind=st.integers(0, 2),
+    rotvec=vectors.map(lambda v: 3.0 * v),
+    offset=vectors.map(lambda v: 6.0 * v),
+    parent_rotvec=vectors.map(lambda v: 3.0 * v),
+    parent_offset=vectors,
+    ball_radius=st.floats(1.5, 40.0),
+    past=st.lists(vectors, min_size=1, max_size=6),
+)
+def test_radial_placement_holding_past_points(
+    r, kind, rotvec, offset, parent_rotvec, parent_offset, ball_radius, past
+):
+    # hold_past: one more waypoint W_h straight ahead of W_a; from it on, every point of the
+    # new tube lies at least 2r past every given point along the outward normal m
+    R = ball_radius * r
+    parent_T = _pose(parent_rotvec, parent_offset * (R - 1.5 * r) / np.sqrt(3.0))
+    parent = RevoluteJoint(4, r, np.pi, parent_T)
+    T = parent_T @ _pose(rotvec, offset * r)
+    joint = [
+        RevoluteJoint(4, r, 2.0, T),
+        PrismaticJoint(4, r, 3 * r, 3, np.pi / 3, T),
+        Waypoint(4, r, T, pathIndex=2),
+    ][kind]
+    points = np.array(past) * 1.5 * R  # anywhere in and somewhat beyond the ball
+    chain = KinematicChain(parent)
+    ball = Ball(np.zeros(3), R)
+    chain._ball = ball
+    plain = radial_safe_placement(parent.distal_frame(), parent.pathIndex(), joint, ball)
+    new = radial_safe_placement(
+        parent.distal_frame(), parent.pathIndex(), joint, ball, hold_past=points
+    )
+    joints, links, _, _ = chain._extended(new, len(chain.Joints) - 1)  # NoPathError: no link
+    for link in links[1:]:
+        assert link.path.theta1 < np.pi and link.path.theta2 < np.pi
+    placed = new[-1]
+    assert np.linalg.norm(np.cross(placed.pose_matrix[:3, 3] - T[:3, 3], T[:3, 2])) < 1e-9 * r
+    wa = new[0].pose_matrix[:3, 3]
+    m = new[0].path_direction()  # W_a faces m
+    if len(new) == len(plain):  # W_a was already 2r past every point: nothing added
+        assert float(np.max((points - wa) @ m)) + 2.0 * r <= 0.0
+        return
+    assert len(new) == len(plain) + 1
+    wh = new[1].pose_matrix[:3, 3]
+    assert np.linalg.norm(np.cross(wh - wa, m)) < 1e-9 * R  # straight ahead of W_a
+    limit = float(np.max(points @ m)) + 2.0 * r - 1e-9 * R
+    assert float(wh @ m) >= limit
+    for link in links[3:]:  # W_h -> W_b and W_b -> the joint never come back against m
+        assert float(np.min(link_polyline(link) @ m)) >= limit
+    assert float(placed.proximal_frame()[:3, 3] @ m) >= limit
