@@ -598,6 +598,22 @@ def _check_executor(executor):
         )
 
 
+def _input_problem(chain, motion_task, junctions: bool) -> tuple[str, str] | None:
+    """Why the input cannot compete with the starts' results: (what the result needs, what
+    the input does), or None when it is a valid result itself."""
+    if _overlap(chain) != 0.0:
+        return "", "passes through itself"
+    if motion_task is not None and _motion_collision(chain, motion_task) is not None:
+        return (" and collides no more often in motion",
+                "collides in more sampled configurations than allowed")  # fmt: skip
+    if junctions:
+        problems = junction_problems(chain)
+        if problems:
+            return (" and whose junctions can be made",
+                    f"has a junction that cannot be made: {problems[0][1]};")  # fmt: skip
+    return None
+
+
 def _progress_bar(progress, total: int):
     show = sys.stderr.isatty() if progress is None else bool(progress)
     if not show:
@@ -707,14 +723,14 @@ def compact(
         results = _run_all(executor, own, tasks, _progress_bar(progress, starts))
     found = [res for res in results if res[3] is not None and res[1] == 0.0
              and not (junctions and junction_problems(res[3]))]  # fmt: skip
-    if (_overlap(chain) == 0.0
-            and (motion_task is None or _motion_collision(chain, motion_task) is None)
-            and not (junctions and junction_problems(chain))):  # fmt: skip
+    problem = _input_problem(chain, motion_task, junctions)
+    if problem is None:
         found.append((_objective(chain, objective), 0.0, starts, copy.copy(chain)))
     if not found:
         raise CompactionError(
-            "compact found no design that is clear of itself (the input passes through itself "
-            f"and {starts} start(s) could not fix it); try more starts or another seed"
+            f"compact found no design that is clear of itself{problem[0]} (the input "
+            f"{problem[1]} and {starts} start(s) could not fix it); try more starts or another "
+            "seed"
         )
     value, _, _, best = min(found, key=lambda res: (res[0], res[2]))
     return best

@@ -23,7 +23,8 @@ from kinegami import (
     RevoluteJoint,
     Waypoint,
 )
-from kinegami.optimize import compact, tube_length
+from kinegami.optimize import CompactionError, compact, tube_length
+from kinegami.tree.sheets import junction_problems
 
 from .helpers import quiet_hand
 
@@ -95,11 +96,38 @@ def test_compaction_of_random_safe_trees_is_clear_and_never_longer(children):
             pose = SE3.Rz(angle) * SE3.Trans(3, 0, 4) * SE3.Rx(tilt) * RY
             a = tree.addJoint(0, RevoluteJoint(4, 1, math.pi, pose))
             tree.addJoint(a, EndTip(4, 1, SE3.Trans(3, 0, 0) * RY, 1.5))
-    shorter = compact(tree, executor=_serial(), starts=1)
+    sockets = junction_problems(tree)
+    try:
+        shorter = compact(tree, executor=_serial(), starts=1)
+    except CompactionError as error:  # only a design compaction must repair may be refused
+        assert not tree.clearance().ok or sockets, error
+        if tree.clearance().ok:
+            assert f"has a junction that cannot be made: {sockets[0][1]}" in str(error)
+        return
     assert shorter.clearance().ok
-    if tree.clearance().ok:
+    assert not junction_problems(shorter)
+    if tree.clearance().ok and not sockets:  # the input competes: never longer
         assert tube_length(shorter) <= tube_length(tree) + 1e-9
     assert_same_kinematics(tree, shorter)
+
+
+def test_a_clear_tree_whose_sockets_do_not_fit_is_refused_by_name_or_repaired():
+    """Two children 2 rad apart leave no room for the sockets (a hypothesis example): clear,
+    but not a valid result, so one start that cannot repair it is an error that says so."""
+    tree = KinematicTree(Waypoint(4, 1, SE3()))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        for angle in (2.0, 0.0, 1.625):
+            pose = SE3.Rz(angle) * SE3.Trans(3, 0, 4) * RY
+            a = tree.addJoint(0, RevoluteJoint(4, 1, math.pi, pose))
+            tree.addJoint(a, EndTip(4, 1, SE3.Trans(3, 0, 0) * RY, 1.5))
+    assert tree.clearance().ok and junction_problems(tree)
+    with pytest.raises(CompactionError, match=r"the input has a junction that cannot be made: "
+                       r"joint 1 \(a child of joint 0\)"):  # fmt: skip
+        compact(tree, executor=_serial(), starts=1)
+    repaired = compact(tree, executor=_serial(), starts=2)
+    assert repaired.clearance().ok and not junction_problems(repaired)
+    assert_same_kinematics(tree, repaired)
 
 
 def test_motion_is_refused_for_trees():
