@@ -66,13 +66,17 @@ class Debounced:
         return True
 
     def close(self, flush: bool = False) -> None:
-        """Stop the thread (after running a pending call when ``flush``)."""
+        """Stop the thread (after running a pending call when ``flush``); a call in progress
+        finishes before this returns (unless ``func`` itself closes), so nothing runs after."""
         if flush:
             self.flush()
         with self._cond:
             self._closed = True
             self._due = None
             self._cond.notify()
+        if threading.current_thread() is not self._thread:
+            with self._running:  # wait for a call in progress
+                pass
 
     def _loop(self) -> None:
         while True:
@@ -90,6 +94,8 @@ class Debounced:
                 self._due = None
             try:
                 with self._running:
+                    if self._closed:  # closed while this call was about to start
+                        return
                     self._func()
             except Exception as error:  # noqa: BLE001 - kept for the owner; the thread goes on
                 self.error = error

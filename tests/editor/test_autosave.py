@@ -167,3 +167,25 @@ def test_debounced_flush_runs_now_and_only_when_due():
     assert debounced.pending and debounced.flush()
     assert calls == [1] and not debounced.pending
     debounced.close()
+
+
+def test_debounced_close_waits_for_a_call_in_progress():
+    """Nothing runs after close: a view closed while its sheets are being fitted in the
+    background has finished fitting when close returns (and a later view counts only its own)."""
+    started, release, finished = threading.Event(), threading.Event(), []
+
+    def slow():
+        started.set()
+        release.wait(10.0)
+        finished.append(time.monotonic())
+
+    debounced = Debounced(slow, 0.0)
+    debounced.trigger()
+    assert started.wait(10.0)
+    threading.Timer(0.2, release.set).start()
+    begun = time.monotonic()
+    debounced.close()
+    assert finished and finished[0] >= begun  # the call ended before close returned
+    debounced.trigger()  # closed: nothing runs any more
+    time.sleep(0.1)
+    assert len(finished) == 1
