@@ -623,7 +623,7 @@ class _AxisMove(Command, abc.ABC):
         new = fork_chain(document.chain)
         method = getattr(new, self._method)
         run(
-            f"{self.label} {_label(document, j)}",
+            f"{self.label.split()[0]} {_label(document, j)}",  # "slide joint 3 (...)"
             lambda: method(j, amount, applyToPreviousWaypoint=previous, propagate=propagate),
         )
         sources = tuple(range(len(new.Joints)))

@@ -79,6 +79,15 @@ def test_the_model_default_propagate_is_used_by_the_helpers(model):
     assert not np.array_equal(model.chain.Joints[-1].pose_matrix, end)
 
 
+def test_a_refused_slide_or_roll_names_the_joint_once(model):
+    reason = refused(model, SlideJoint("revolute", -5.0, propagate=False),
+                     "slide joint 4 (RevoluteJoint 'revolute'): ", "no CSC path")  # fmt: skip
+    assert "joint joint" not in reason
+    reason = refused(model, RollJoint("revolute", 0.5, propagate=False),
+                     "roll joint 4 (RevoluteJoint 'revolute'): ", "no CSC path")  # fmt: skip
+    assert "joint joint" not in reason
+
+
 def test_roll_turns_the_joint_about_its_axis(model):
     j = model.document.names.index("revolute")
     T = model.chain.Joints[j].pose_matrix.copy()
