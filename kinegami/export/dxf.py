@@ -235,17 +235,18 @@ def _line_entities(
         for kind, (name, color) in LAYERS.items()
     }
     # one list of pieces, filled a field at a time (str.join of it is the fastest way)
-    pieces: list[str] = [""] * (10 * count)
-    pieces[0::10] = ["  0\nLINE\n  5\n"] * count
-    pieces[1::10] = map("%X".__mod__, range(first_handle, first_handle + count))
-    pieces[2::10] = map(heads.__getitem__, kinds.tolist())
-    pieces[3::10] = numbers[0::4]
-    pieces[4::10] = ["\n 20\n"] * count
-    pieces[5::10] = numbers[1::4]
-    pieces[6::10] = ["\n 30\n0.0\n 11\n"] * count
-    pieces[7::10] = numbers[2::4]
-    pieces[8::10] = ["\n 21\n"] * count
-    pieces[9::10] = [f"{y1}\n 31\n0.0\n" for y1 in numbers[3::4]]
+    pieces: list[str] = [""] * (11 * count)
+    pieces[0::11] = ["  0\nLINE\n  5\n"] * count
+    pieces[1::11] = map("%X".__mod__, range(first_handle, first_handle + count))
+    pieces[2::11] = map(heads.__getitem__, kinds.tolist())
+    pieces[3::11] = numbers[0::4]
+    pieces[4::11] = ["\n 20\n"] * count
+    pieces[5::11] = numbers[1::4]
+    pieces[6::11] = ["\n 30\n0.0\n 11\n"] * count
+    pieces[7::11] = numbers[2::4]
+    pieces[8::11] = ["\n 21\n"] * count
+    pieces[9::11] = numbers[3::4]
+    pieces[10::11] = ["\n 31\n0.0\n"] * count
     return "".join(pieces)
 
 

@@ -32,6 +32,7 @@ Everything is in pattern units (the unit of the tube radius r); exporters scale 
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -335,25 +336,39 @@ def unique_segments(segments: np.ndarray, kinds: np.ndarray, tol: float) -> np.n
     keep = np.ones(k, dtype=bool)
     if k < 2:
         return keep
-    _, codes = np.unique(np.asarray(kinds), return_inverse=True)
+    kinds = np.asarray(kinds)
+    if kinds.dtype == np.dtype("<U1"):  # one character each: its code point orders as the text
+        codes = kinds.reshape(-1).view(np.uint32).astype(np.int64)
+    else:
+        codes = np.unique(kinds, return_inverse=True)[1].reshape(-1).astype(np.int64)
     ix = _cluster_ids(segments[:, :, 0].ravel(), tol).reshape(k, 2)
     iy = _cluster_ids(segments[:, :, 1].ravel(), tol).reshape(k, 2)
     # canonical orientation: the end with the smaller (x group, y group) first
     swap = (ix[:, 0] > ix[:, 1]) | ((ix[:, 0] == ix[:, 1]) & (iy[:, 0] > iy[:, 1]))
     ix = np.where(swap[:, None], ix[:, ::-1], ix)
     iy = np.where(swap[:, None], iy[:, ::-1], iy)
-    keys = (iy[:, 1], ix[:, 1], iy[:, 0], ix[:, 0], codes.reshape(-1))
-    order = np.lexsort(keys)  # stable: the first of a group has the smallest index
-    rows = np.stack(keys, axis=1)[order]
+    keys = (iy[:, 1], ix[:, 1], iy[:, 0], ix[:, 0], codes)  # the last is the first sort key
     repeated = np.zeros(k, dtype=bool)
-    repeated[1:] = (rows[1:] == rows[:-1]).all(axis=1)
+    radices = [int(key.max()) + 1 for key in keys]
+    if math.prod(radices) < 2**63:  # the keys as digits of one int64: one stable sort
+        packed = np.zeros(k, dtype=np.int64)
+        for key, radix in zip(keys[::-1], radices[::-1], strict=True):
+            packed *= radix
+            packed += key
+        order = np.argsort(packed, kind="stable")  # the first of a group has the smallest index
+        ordered = packed[order]
+        repeated[1:] = ordered[1:] == ordered[:-1]
+    else:
+        order = np.lexsort(keys)  # stable: the first of a group has the smallest index
+        rows = np.stack(keys, axis=1)[order]
+        repeated[1:] = (rows[1:] == rows[:-1]).all(axis=1)
     keep[order[repeated]] = False
     return keep
 
 
 def _cluster_ids(values: np.ndarray, tol: float) -> np.ndarray:
     """Group ids of ``values``: sorted neighbours less than ``tol`` apart share a group."""
-    order = np.argsort(values, kind="stable")
+    order = np.argsort(values)  # equal values get one group in any order: no need for stable
     ordered = values[order]
     ids = np.empty(values.shape[0], dtype=np.int64)
     ids[order] = np.concatenate([[0], np.cumsum(np.diff(ordered) > tol)])

@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
@@ -199,6 +201,56 @@ def test_unique_segments_either_orientation_same_kind_only():
     )
     kinds = np.array(["M", "M", "V", "M"])
     assert unique_segments(segs, kinds, 1e-9).tolist() == [True, False, True, True]
+
+
+def _first_of_each_group(segs: np.ndarray, kinds, tol: float) -> list[bool]:
+    """unique_segments written out: coordinates grouped by single linkage (sorted values less
+    than tol apart share a group), then each line compared with the earlier ones."""
+
+    def groups(values):
+        order = sorted(range(len(values)), key=values.__getitem__)
+        ids, group = [0] * len(values), 0
+        for a, b in zip(order[:-1], order[1:], strict=True):
+            group += values[b] - values[a] > tol
+            ids[b] = group
+        return ids
+
+    gx = groups(segs[:, :, 0].ravel().tolist())
+    gy = groups(segs[:, :, 1].ravel().tolist())
+    seen, keep = set(), []
+    for i, kind in enumerate(kinds):
+        ends = sorted([(gx[2 * i], gy[2 * i]), (gx[2 * i + 1], gy[2 * i + 1])])
+        key = (str(kind), tuple(ends))
+        keep.append(key not in seen)
+        seen.add(key)
+    return keep
+
+
+@given(
+    st.lists(st.tuples(st.integers(0, 5), st.integers(0, 5), st.integers(0, 5),
+                       st.integers(0, 5), st.sampled_from("MVBCF")), max_size=60),
+    st.lists(st.floats(-1.0, 1.0), min_size=240, max_size=240),
+    st.sampled_from(["<U1", "<U2", "object"]),
+)  # fmt: skip
+def test_unique_segments_keeps_the_first_of_every_group(rows, noise, dtype):
+    """Random lines on a coarse grid, each coordinate moved by up to 0.3 tol (so near values
+    group, also in chains), any kind dtype: the first of each group of equal lines stays."""
+    tol = 1e-3
+    segs = np.array([r[:4] for r in rows], dtype=float).reshape(-1, 2, 2) * 0.01
+    segs += 0.3 * tol * np.array(noise[: segs.size]).reshape(segs.shape)
+    kinds = np.array([r[4] for r in rows], dtype=dtype)
+    assert unique_segments(segs, kinds, tol).tolist() == _first_of_each_group(segs, kinds, tol)
+
+
+def test_unique_segments_with_many_groups_falls_back_to_a_sort_by_columns():
+    """Too many distinct groups for one 64-bit key: the same answer."""
+    rng = np.random.default_rng(3)
+    segs = np.round(rng.uniform(0, 1, (40000, 2, 2)), 5)
+    segs[20000:] = segs[:20000][:, ::-1]  # every line again, reversed
+    kinds = np.array(["M"] * 40000)
+    keep = unique_segments(segs, kinds, 1e-9)
+    assert keep.tolist() == _first_of_each_group(segs, kinds, 1e-9)
+    assert not keep[20000:].any()
 
 
 def test_sheet_is_read_only(revolute6):
