@@ -226,10 +226,14 @@ def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
     crease: list[int] = []
     start = v[e[:, 0]]
     dx = periodic_dx(v[e[:, 1], 0] - start[:, 0], W)
-    for i in range(e.shape[0]):
-        u, w = int(e[i, 0]), int(e[i, 1])
-        x0, y_0 = float(start[i, 0]), float(start[i, 1])
-        x1, y_1 = x0 + float(dx[i]), float(v[w, 1])
+    # the loop reads Python floats and ints (the same values, without numpy's per-item cost)
+    vx, vy = v[:, 0].tolist(), v[:, 1].tolist()
+    copies, copy_x = copy_index.tolist(), cx.tolist()
+    shift_values = shifts.tolist()
+    x0s, dxs, labels_list = start[:, 0].tolist(), dx.tolist(), labels.tolist()
+    for i, (u, w) in enumerate(e.tolist()):
+        x0, y_0 = x0s[i], vy[u]
+        x1, y_1 = x0 + dxs[i], vy[w]
         for s in (0.0, W, -W):
             a, c = x0 + s, x1 + s
             lo, hi = min(a, c), max(a, c)
@@ -241,10 +245,11 @@ def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
             xs = []
             for x_end, vert in ((a, u), (c, w)):
                 if xmin - tol <= x_end <= xmax + tol:
-                    shift = x_end - v[vert, 0]
-                    k = int(np.argmin(np.abs(shifts - shift)))
-                    ends.append(int(copy_index[k, vert]))
-                    xs.append(float(cx[k, vert]))
+                    shift = x_end - vx[vert]
+                    gaps = [abs(value - shift) for value in shift_values]
+                    k = gaps.index(min(gaps))  # the first nearest, as numpy's argmin
+                    ends.append(copies[k][vert])
+                    xs.append(copy_x[k][vert])
                 else:
                     edge_x = xmin if x_end < xmin else xmax
                     t = (edge_x - a) / (c - a)
@@ -257,7 +262,7 @@ def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
             if ends[0] == ends[1]:
                 continue
             edges.append((ends[0], ends[1]))
-            assignment.append(str(labels[i]))
+            assignment.append(labels_list[i])
             crease.append(i)
     # sheet corners that are no vertex (the distal base is shifted after a twist): a point of
     # the straight edge between the two nearest vertices on that end of the pattern
@@ -528,7 +533,8 @@ def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float | None):
     prev_rank = (rank - 1) % degree[v]
     nxt = order[first[v] + prev_rank]
     face_of = np.full(2 * m, -1)
-    visited = np.zeros(2 * m, dtype=bool)
+    visited = bytearray(2 * m)
+    following = nxt.tolist()  # the cycles are traced on Python ints (no numpy per-item cost)
     faces = []
     outer = []
     for h0 in range(2 * m):
@@ -537,9 +543,9 @@ def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float | None):
         cycle = []
         h = h0
         while not visited[h]:
-            visited[h] = True
+            visited[h] = 1
             cycle.append(h)
-            h = nxt[h]
+            h = following[h]
         cycle = np.array(cycle)
         verts = tail[cycle]
         if _signed_area(P[verts]) > 0:
@@ -555,7 +561,7 @@ def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float | None):
         sheet_area = -_signed_area(P[outer[0]])
     if sheet_area is not None and not math.isclose(total, sheet_area, rel_tol=1e-9):
         problems.append(f"faces cover {total!r} instead of the sheet area {sheet_area!r}")
-    repeated = sum(1 for f in faces if np.unique(f).size != f.size)
+    repeated = sum(1 for f in faces if len(set(f.tolist())) != f.size)
     if repeated:
         problems.append(f"{repeated} faces are not simple polygons")
     if problems:
