@@ -32,6 +32,7 @@ Lengths are written in millimetres: one pattern unit is one ``units`` (default `
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from dataclasses import dataclass
@@ -762,7 +763,51 @@ def fold_data(pattern_or_chain, **options: Any) -> str:
     Takes the options of :func:`fold_dict`; ``kinegami.export(obj, "name.fold")`` (or
     ``pattern.save("name.fold")``) writes it to a file atomically.
     """
-    return json.dumps(fold_dict(pattern_or_chain, **options), indent=1, allow_nan=False) + "\n"
+    return _json_text(fold_dict(pattern_or_chain, **options)) + "\n"
+
+
+def _json_text(value: Any, depth: int = 0) -> str:
+    """``json.dumps(value, indent=1, allow_nan=False)``, the same text, several times as fast
+    for a FOLD file's long lists: a list of scalars, or of non-empty lists of numbers, is
+    written by json's C encoder in one call (its separators carry the indentation).
+
+    Raises
+    ------
+    ValueError
+        For a NaN or infinite float (as ``allow_nan=False``).
+    TypeError
+        For a value that json cannot write.
+    """
+    if type(value) is list and value:
+        indent = "\n" + " " * depth
+        inner = indent + " "
+        kinds = set(map(type, value))
+        if kinds <= _SCALARS:  # one level: the item separator holds the indentation
+            body = json.dumps(value, separators=("," + inner, ": "), allow_nan=False)[1:-1]
+            return "[" + inner + body + indent + "]"
+        if kinds == {list} and all(value) and _NUMBERS.issuperset(
+            map(type, itertools.chain.from_iterable(value))
+        ):  # two levels of numbers: no "," or "]," but the separators' own
+            deeper = inner + " "
+            body = json.dumps(value, separators=(",", ":"), allow_nan=False)[2:-2]
+            body = body.replace("],[", "\0").replace(",", "," + deeper)
+            body = body.replace("\0", inner + "]," + inner + "[" + deeper)
+            return "[" + inner + "[" + deeper + body + inner + "]" + indent + "]"
+        items = [_json_text(item, depth + 1) for item in value]
+        return "[" + inner + ("," + inner).join(items) + indent + "]"
+    if type(value) is dict and value:
+        indent = "\n" + " " * depth
+        inner = indent + " "
+        if not all(type(key) is str for key in value):
+            raise TypeError(f"FOLD keys are str, got {sorted(map(repr, value))}")
+        items = [f"{json.dumps(key)}: {_json_text(item, depth + 1)}"
+                 for key, item in value.items()]  # fmt: skip
+        return "{" + inner + ("," + inner).join(items) + indent + "}"
+    return json.dumps(value, allow_nan=False)  # a scalar, [] or {}
+
+
+_NUMBERS = frozenset({float, int, bool, type(None)})
+_SCALARS = _NUMBERS | {str}
 
 
 def write_fold(pattern_or_chain, stream: TextIO, **options: Any) -> None:

@@ -41,6 +41,7 @@ from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export._options import UNITS_IN_MM
 from kinegami.export.fold import (
     FoldExportError,
+    _json_text,
     fold_angles,
     fold_dict,
     save_fold,
@@ -1317,3 +1318,42 @@ def test_registry_exports_chains_and_patterns(tmp_path, example_1a):
     assert_allclose(X, sheet_graph(chain).vertices_3d, atol=1e-9)
     path = registry.export(chain.creasePattern(), tmp_path / "pattern.fold", units="cm")
     assert check_fold(json.loads(Path(path).read_text())) == []
+
+
+# --- the JSON text ------------------------------------------------------------------------------
+_JSON_SCALARS = (
+    st.floats(allow_nan=False, allow_infinity=False) | st.integers(-(2**70), 2**70)
+    | st.booleans() | st.none() | st.text(max_size=6)
+)  # fmt: skip
+_JSON_VALUES = st.recursive(
+    _JSON_SCALARS,
+    lambda inner: st.lists(inner, max_size=5) | st.dictionaries(st.text(max_size=4), inner,
+                                                                 max_size=4),
+    max_leaves=40,
+)  # fmt: skip
+_NUMBER_ROWS = st.lists(
+    st.lists(st.floats(allow_nan=False, allow_infinity=False) | st.integers(-9, 9)
+             | st.booleans() | st.none(), min_size=1, max_size=4),
+    max_size=6,
+)  # fmt: skip
+
+
+@given(st.one_of(_JSON_VALUES, _NUMBER_ROWS, st.dictionaries(st.text(max_size=3), _NUMBER_ROWS)))
+def test_fold_text_is_json_dumps_with_indent_1(value):
+    """The FOLD writer's own JSON text (fast for long lists) is json.dumps(indent=1)'s, for
+    any JSON value: nested lists and dicts, lists of number rows, strings with commas and
+    brackets, empty lists."""
+    assert _json_text(value) == json.dumps(value, indent=1, allow_nan=False)
+
+
+@pytest.mark.parametrize("bad", [[1.0, float("nan")], [[0.0, float("inf")]], {"a": [-math.inf]}])
+def test_fold_text_refuses_non_finite_numbers(bad):
+    with pytest.raises(ValueError, match="not JSON compliant"):
+        _json_text(bad)
+
+
+def test_fold_text_refuses_what_json_cannot_write():
+    with pytest.raises(TypeError):
+        _json_text([np.float32(1.0)])
+    with pytest.raises(TypeError, match="keys are str"):
+        _json_text({1: [1.0]})
