@@ -537,6 +537,7 @@ def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float | None):
     visited = bytearray(2 * m)
     following = nxt.tolist()  # the cycles are traced on Python ints (no numpy per-item cost)
     faces = []
+    areas = []  # of the faces
     outer = []
     for h0 in range(2 * m):
         if visited[h0]:
@@ -549,12 +550,14 @@ def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float | None):
             h = following[h]
         cycle = np.array(cycle)
         verts = tail[cycle]
-        if _signed_area(P[verts]) > 0:
+        area = _signed_area(P[verts])
+        if area > 0:
             face_of[cycle] = len(faces)
             faces.append(verts)
+            areas.append(area)
         else:
             outer.append(verts)
-    total = sum(_signed_area(P[f]) for f in faces)
+    total = sum(areas)
     problems = []
     if len(outer) != 1:
         problems.append(f"{len(outer)} boundary loops (expected 1: creases not connected)")
