@@ -291,6 +291,9 @@ def main(argv: list[str] | None = None) -> None:
         target = Path(folder) / "chain.svg"
         t = _median_seconds(lambda: pattern.save(dxfName=str(target)), 5)
         rows.append(("SVG save, same pattern", f"{t * 1e3:.1f} ms", "-"))
+        target = Path(folder) / "chain.fold"
+        t = _median_seconds(lambda: pattern.save(str(target)), 5)
+        rows.append(("FOLD save, same pattern", f"{t * 1e3:.1f} ms", "-"))
 
     # design files, DH tables, the command line and the exporters of the registry
     from kinegami import export
