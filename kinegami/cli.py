@@ -24,10 +24,10 @@ import stat
 import sys
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 from kinegami import __version__, _startup
+from kinegami._record import Record
 from kinegami._startup import INTERRUPTED
 from kinegami.errors import KinegamiError
 from kinegami.validation import shown, shown_path
@@ -41,8 +41,7 @@ class CommandError(Exception):
 
 
 # --- outputs of `build` ------------------------------------------------------------------------
-@dataclass(frozen=True)
-class OutputFormat:
+class OutputFormat(Record):
     """One ``--formats`` entry: the files it writes and how."""
 
     name: str
@@ -51,14 +50,14 @@ class OutputFormat:
     write: Callable[..., None]  # write(job, paths) with one path per suffix
 
 
-@dataclass
 class BuildJob:
     """What the writers need: the chain, its pattern and the design's metadata."""
 
-    chain: object
-    info: object
-    _pattern: object = None
-    _clearance: object = None
+    __slots__ = ("chain", "info", "_pattern", "_clearance")
+
+    def __init__(self, chain, info, _pattern=None, _clearance=None):
+        self.chain, self.info = chain, info
+        self._pattern, self._clearance = _pattern, _clearance
 
     @property
     def pattern(self):

@@ -4,12 +4,12 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from kinegami._format import shown
+from kinegami._record import Record
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.validation import check_bool, check_options, check_positive
 
@@ -56,8 +56,7 @@ def check_label(label: Any) -> str | None:
     return label
 
 
-@dataclass(frozen=True)
-class SheetOptions:
+class SheetOptions(Record):
     """Validated exporter options.
 
     Attributes

@@ -42,14 +42,13 @@ import errno
 import importlib
 import io
 import os
-import shutil
 import signal
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any
 
 from kinegami._atomic import create_temp, discard, export_error, prepare_folder, write_atomic
+from kinegami._record import Record
 from kinegami.errors import (
     ExportError,
     ExporterUnavailableError,
@@ -102,8 +101,7 @@ def _unavailable(what: str, module: str, extra: str | None, exc: ImportError):
     )
 
 
-@dataclass(frozen=True)
-class ExportFormat:
+class ExportFormat(Record):
     """A registered file format.
 
     Attributes
@@ -595,14 +593,14 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
                         temps.remove((head, tmp))
                 except BaseException:
                     for target, backup in reversed(moved):
-                        shutil.rmtree(target, ignore_errors=True)
+                        _rmtree(target)
                         if backup is not None:
                             os.replace(backup, target)
                     raise
         finally:
             for _, tmp in temps:
                 if tmp.is_dir():
-                    shutil.rmtree(tmp, ignore_errors=True)
+                    _rmtree(tmp)
                 else:
                     discard(str(tmp))
     except OSError as exc:
@@ -611,7 +609,7 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
         raise export_error(exc, path, "write failed") from exc
     for _, backup in moved:
         if backup is not None:
-            shutil.rmtree(backup, ignore_errors=True)
+            _rmtree(backup)
 
 
 # --- built-in formats ----------------------------------------------------------------------
@@ -673,3 +671,11 @@ def _register_builtin() -> None:
 
 
 _register_builtin()
+
+
+def _rmtree(path) -> None:
+    """``shutil.rmtree(path, ignore_errors=True)`` (shutil imported only here: every command
+    imports this module, few remove a folder)."""
+    import shutil
+
+    shutil.rmtree(path, ignore_errors=True)
