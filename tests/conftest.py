@@ -19,6 +19,21 @@ from spatialmath import SE3
 from kinegami import EndTip, KinematicChain, PrismaticJoint, RevoluteJoint, StartTip
 from kinegami.geometry.frames import rotation_matrix
 
+
+# --- test order --------------------------------------------------------------------------------
+def pytest_collection_modifyitems(session, config, items):
+    """Run the files that drive a browser first (the same order on every xdist worker).
+
+    Whole files go to the two workers (``--dist loadfile``) in collection order
+    (``--no-loadscope-reorder``; by default xdist sends the files with the most tests first).
+    Origami Simulator's file alone takes 6-7 minutes. With its 10 tests it used to be sent near
+    the end, and it was still running on one worker long after the other had finished
+    everything else. Now it and the editor's browser tests start at once, one on each worker.
+    """
+    slow = {item.path for item in items if item.get_closest_marker("browser") is not None}
+    items.sort(key=lambda item: item.path not in slow)  # stable: each file's order is kept
+
+
 # --- hypothesis profiles ------------------------------------------------------------------------
 # "quick" (the default) for working on the code, "ci" (thorough: .ci/run sets
 # KINEGAMI_HYPOTHESIS_PROFILE=ci). Tests that need a particular budget set max_examples
