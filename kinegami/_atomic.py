@@ -68,6 +68,17 @@ def discard(tmp: str | os.PathLike) -> None:
         pass
 
 
+def discard_tree(folder: str | os.PathLike) -> None:
+    """Remove a temporary folder and everything in it, ignoring errors (it may not exist).
+
+    ``shutil`` is imported here, not at the top: every command imports this module (through
+    the export registry), few remove a folder, and shutil loads bz2 and lzma.
+    """
+    import shutil
+
+    shutil.rmtree(folder, ignore_errors=True)
+
+
 def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:
     """Write ``data`` to ``path`` atomically, creating missing parent folders; returns the path.
 

@@ -52,7 +52,6 @@ import errno
 import json
 import os
 import re
-import shutil
 import signal
 import tempfile
 import threading
@@ -61,6 +60,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from kinegami._atomic import discard_tree
 from kinegami.errors import ExportError, PublishError
 
 try:
@@ -248,7 +248,7 @@ def _retire(staging: Path) -> None:
     """Mark a rolled back or committed staging folder as garbage, then remove it."""
     if os.path.lexists(staging / JOURNAL):
         _move(staging / JOURNAL, staging / "journal.done")
-    shutil.rmtree(staging, ignore_errors=True)
+    discard_tree(staging)
 
 
 def _names(names: list[str], limit: int = 4) -> str:
@@ -457,7 +457,7 @@ class Staging:
         :func:`open_staging` created, when empty."""
         with deferred_signals():
             if not self._keep:
-                shutil.rmtree(self.path, ignore_errors=True)
+                discard_tree(self.path)
             if self._fd is not None:
                 os.close(self._fd)
                 self._fd = None
@@ -497,7 +497,7 @@ def _create_staging(out: Path, note: str | None) -> Staging:
     except BaseException:
         if fd is not None:
             os.close(fd)
-        shutil.rmtree(path, ignore_errors=True)
+        discard_tree(path)
         raise
     return Staging(out, path, fd, note)
 

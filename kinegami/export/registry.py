@@ -47,7 +47,14 @@ from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from kinegami._atomic import create_temp, discard, export_error, prepare_folder, write_atomic
+from kinegami._atomic import (
+    create_temp,
+    discard,
+    discard_tree,
+    export_error,
+    prepare_folder,
+    write_atomic,
+)
 from kinegami._record import Record
 from kinegami.errors import (
     ExportError,
@@ -593,14 +600,14 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
                         temps.remove((head, tmp))
                 except BaseException:
                     for target, backup in reversed(moved):
-                        _rmtree(target)
+                        discard_tree(target)
                         if backup is not None:
                             os.replace(backup, target)
                     raise
         finally:
             for _, tmp in temps:
                 if tmp.is_dir():
-                    _rmtree(tmp)
+                    discard_tree(tmp)
                 else:
                     discard(str(tmp))
     except OSError as exc:
@@ -609,7 +616,7 @@ def write_atomic_files(path: Path, files: Mapping[str, bytes]) -> None:
         raise export_error(exc, path, "write failed") from exc
     for _, backup in moved:
         if backup is not None:
-            _rmtree(backup)
+            discard_tree(backup)
 
 
 # --- built-in formats ----------------------------------------------------------------------
@@ -671,11 +678,3 @@ def _register_builtin() -> None:
 
 
 _register_builtin()
-
-
-def _rmtree(path) -> None:
-    """``shutil.rmtree(path, ignore_errors=True)`` (shutil imported only here: every command
-    imports this module, few remove a folder)."""
-    import shutil
-
-    shutil.rmtree(path, ignore_errors=True)
