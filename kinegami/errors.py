@@ -135,7 +135,8 @@ class DesignError(KinegamiError, ValueError):
     reason : str
         What is wrong and what is allowed.
 
-    ``str(error)`` is one line: ``<file>: <field>: <reason> (got <value>)``.
+    ``str(error)`` is one line: ``<file>: <field>: <reason> (got <value>)``; the field is left
+    out when the problem is the document as a whole (``$``).
     """
 
     def __init__(
@@ -161,7 +162,7 @@ class DesignError(KinegamiError, ValueError):
     def __str__(self) -> str:
         from kinegami._format import format_value  # a leaf module, imported when needed
 
-        text = f"{self.field}: {self.reason}"
+        text = self.reason if self.field == "$" else f"{self.field}: {self.reason}"
         if self.has_value:
             text += f" (got {format_value(self.value)})"
         if self.file is not None:

@@ -29,6 +29,11 @@ TEXT = json.dumps(BASE)  # one line: fragments below are replaced in it
 LONG = "7" * 5000  # an integer literal too long for int() (more than 4300 digits)
 
 
+def _located(error) -> str:
+    """The ``<field>: `` part of a DesignError's message (left out for the whole document)."""
+    return "" if error.field == "$" else f"{error.field}: "
+
+
 def _error(text_or_document, file="d.json") -> DesignError:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -40,7 +45,7 @@ def _error(text_or_document, file="d.json") -> DesignError:
     error = info.value
     text = str(error)
     assert "\n" not in text and len(text) < 500, text
-    assert text.startswith(f"{file}: {error.field}: ")
+    assert text.startswith(f"{file}: {_located(error)}")
     return error
 
 

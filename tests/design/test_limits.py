@@ -448,7 +448,7 @@ def test_a_device_is_refused_without_reading():
     with pytest.raises(DesignError) as info:
         validate_design("/dev/zero")
     assert str(info.value) == (
-        "/dev/zero: $: cannot read the design file: it is a character device, not a regular file"
+        "/dev/zero: cannot read the design file: it is a character device, not a regular file"
     )
 
 
