@@ -1208,6 +1208,17 @@ def make_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _check_source_date_epoch() -> None:
+    """Refuse a malformed ``SOURCE_DATE_EPOCH`` before any command runs (docs/fabrication.md,
+    "Reproducible builds"); an empty one is unset, as documented, for the whole process (numpy's
+    f2py, which scipy imports, cannot read an empty one)."""
+    from kinegami.export._reproducible import VARIABLE, source_date_epoch
+
+    if VARIABLE in os.environ and not os.environ[VARIABLE].strip():
+        del os.environ[VARIABLE]
+    source_date_epoch()
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``kinegami`` console script; returns the exit code."""
     _encoding_safe_output()
@@ -1227,6 +1238,7 @@ def main(argv: list[str] | None = None) -> int:
         if previous[signum] != signal.SIG_IGN:  # nohup: stay ignored
             signal.signal(signum, _terminate)
     try:
+        _check_source_date_epoch()
         with warnings.catch_warnings():
             # numerical warnings of plotting libraries are not the user's business; the
             # design checks reject the inputs that would make kinegami's own numbers overflow

@@ -20,8 +20,10 @@ ignore DXF line types).
 
 The document skeleton (header, tables, layers, objects) is a template made once with ezdxf and
 stored in :mod:`kinegami.export._dxf_template`: :func:`dxf_data` fills in the sheet's extents,
-the handle seed, new GUIDs and the time, and writes the LINE entities as text straight into
-the ENTITIES section, with the handles the template leaves free. So a DXF file is written
+the handle seed, new GUIDs and the time (with ``SOURCE_DATE_EPOCH`` set: that time, and GUIDs
+made from the drawing, so equal sheets give equal files; :mod:`kinegami.export._reproducible`),
+and writes the LINE entities as text straight into the ENTITIES section, with the handles the
+template leaves free. So a DXF file is written
 without importing ezdxf (the first save in a process: ~10 ms instead of ~350 ms), and the file
 is the one ezdxf writes for the same drawing. :func:`dxf_document` builds the same drawing
 with ezdxf entities, for users who want to edit it; :func:`make_template` makes the template
@@ -46,6 +48,7 @@ from kinegami.export._options import (
     resolve_sheet_options,
     sheet_lines,
 )
+from kinegami.export._reproducible import content_uuid, source_date_epoch
 from kinegami.pattern.sheet import SHEET_KINDS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -174,17 +177,28 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
                      f"100\nAcDbEntity\n  8\n0\n100\nAcDbText\n 10\n{x}\n 20\n{y}\n 30\n0.0\n"
                      f" 40\n{LABEL_HEIGHT!r}\n  1\n{label}\n100\nAcDbText\n")  # fmt: skip
         count += 1
-    now = datetime.datetime.now(datetime.UTC)
-    julian = 2440587.5 + time.time() / 86400.0  # the Julian date, as ezdxf writes $TDUPDATE
     xmin, ymin, xmax, ymax = (repr(float(v)) for v in bounds)
+    epoch = source_date_epoch()
+    if epoch is None:  # as ezdxf writes a file: the time now and new GUIDs
+        seconds = time.time()
+        fingerprint, version = _guid(), _guid()
+    else:  # SOURCE_DATE_EPOCH: that time, and GUIDs made from the drawing
+        seconds = float(epoch)
+        drawing = b"".join((segments.tobytes(), kinds.tobytes(), repr((bounds, label)).encode()))
+        fingerprint, version = (f"{{{content_uuid(drawing, tag).upper()}}}"
+                                for tag in ("FINGERPRINTGUID", "VERSIONGUID"))  # fmt: skip
+    now = datetime.datetime.fromtimestamp(seconds, datetime.UTC)
+    # as ezdxf and AutoCAD write $TDCREATE: the Julian day number (2440588 on 1970-01-01) plus
+    # the fraction of the day since midnight (not the astronomical Julian date, half a day less)
+    julian = 2440588.0 + seconds / 86400.0
     fields = {
         "XMIN": xmin,
         "YMIN": ymin,
         "XMAX": xmax,
         "YMAX": ymax,
         "HANDSEED": f"{template.FIRST_HANDLE + count:X}",
-        "FINGERPRINTGUID": _guid(),
-        "VERSIONGUID": _guid(),
+        "FINGERPRINTGUID": fingerprint,
+        "VERSIONGUID": version,
         "TDCREATE": repr(julian),
         "TDUPDATE": repr(julian),
         "CREATED": f"{template.EZDXF_VERSION} @ {now.isoformat()}",

@@ -21,6 +21,7 @@ from pathlib import Path
 from kinegami._atomic import write_atomic
 from kinegami.errors import InvalidParameterError
 from kinegami.export._options import UNITS_IN_MM
+from kinegami.export._reproducible import reproducible_3mf
 
 __all__ = ["TREE_FORMATS", "DEFAULT_TREE_FORMATS", "write_tree_files", "sheet_labels"]
 
@@ -105,7 +106,10 @@ def write_tree_files(
                         registry.import_library("lxml", "3MF connectors", "print")
                         registry.import_library("networkx", "3MF connectors", "print")
                     path = folder / f"{stem}_junction_{junction.index}.{suffix}"
-                    written.append(write_atomic(path, mesh.export(file_type=suffix)))
+                    data = mesh.export(file_type=suffix)
+                    if suffix == "3mf":
+                        data = reproducible_3mf(data)
+                    written.append(write_atomic(path, data))
         else:  # the whole tree as folded (take-off branches from their faces): stl, obj, urdf
             path = folder / f"{stem}.{fmt}"
             registry.export(folded, path, units=units, twistPortion=twistPortion)
