@@ -74,15 +74,18 @@ def reproducible_3mf(data: bytes) -> bytes:
     out = io.BytesIO()
     with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as target:
         for entry in source.infolist():
-            content = source.read(entry)
-            blank = _UUID.sub(b"0" * 36, content)  # the part without its random identifiers
-            count = iter(range(1 << 30))
-
-            def replaced(match, blank=blank, count=count, name=entry.filename) -> bytes:
-                return content_uuid(blank, f"{name} #{next(count)}").encode()
-
             info = zipfile.ZipInfo(entry.filename, date_time=date)
             info.compress_type = entry.compress_type
             info.external_attr = entry.external_attr
-            target.writestr(info, _UUID.sub(replaced, content))
+            target.writestr(info, _with_content_uuids(source.read(entry), entry.filename))
     return out.getvalue()
+
+
+def _with_content_uuids(content: bytes, name: str) -> bytes:
+    """``content`` (the part ``name`` of a file) with its k-th UUID made from the part without
+    its UUIDs, its name and k."""
+    import itertools
+
+    blank = _UUID.sub(b"0" * 36, content)
+    k = itertools.count()
+    return _UUID.sub(lambda _: content_uuid(blank, f"{name} #{next(k)}").encode(), content)

@@ -25,6 +25,11 @@ DATA = Path(__file__).parent / "data"
 PI = math.pi
 
 
+def located(error) -> str:
+    """The ``<field>: `` part of a DesignError's message (left out for the whole document)."""
+    return "" if error.field == "$" else f"{error.field}: "
+
+
 def pose_error(a: KinematicChain, b: KinematicChain) -> float:
     """Largest joint pose difference, relative to max(1, |coordinate|) (0 for equal chains)."""
     worst = 0.0

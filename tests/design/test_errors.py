@@ -20,15 +20,10 @@ from kinegami.design import (
 )
 from kinegami.errors import KinegamiError
 
-from . import DATA
+from . import DATA, located
 
 BASE = json.loads((DATA / "example1a.json").read_text(encoding="utf-8"))
 JOINT_TYPES = "StartTip, EndTip, RevoluteJoint, ExtendedRevoluteJoint, PrismaticJoint, Waypoint"
-
-
-def _located(error) -> str:
-    """The ``<field>: `` part of a DesignError's message (left out for the whole document)."""
-    return "" if error.field == "$" else f"{error.field}: "
 
 
 def _mutated(change) -> dict:
@@ -55,7 +50,7 @@ def _error_of(folder: Path, document, check=load_design) -> DesignError:
     error = info.value
     text = str(error)
     assert "\n" not in text and "Traceback" not in text and 'File "' not in text
-    assert text.startswith(f"{path}: {_located(error)}{error.reason}")
+    assert text.startswith(f"{path}: {located(error)}{error.reason}")
     assert error.file == str(path)
     return error
 

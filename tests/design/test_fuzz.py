@@ -25,6 +25,8 @@ from kinegami.design import DesignError, chain_from_dict, limits, loads_design
 from kinegami.design.schema import EDIT_OPS, JOINT_TYPES
 from kinegami.errors import ClearanceWarning
 
+from . import located
+
 GALLERY = sorted((Path(__file__).parents[2] / "examples" / "designs").glob("*.json"))
 DESIGNS = {path.name: json.loads(path.read_text(encoding="utf-8")) for path in GALLERY}
 EXAMPLES = int(os.environ.get("KINEGAMI_FUZZ_EXAMPLES", "40"))
@@ -58,11 +60,6 @@ values = st.recursive(
     | st.dictionaries(st.sampled_from(WORDS) | st.text(max_size=8), children, max_size=4),
     max_leaves=12,
 )
-
-
-def _located(error) -> str:
-    """The ``<field>: `` part of a DesignError's message (left out for the whole document)."""
-    return "" if error.field == "$" else f"{error.field}: "
 
 
 def _places(document):
@@ -166,7 +163,7 @@ def _loads_or_design_error(load, design, how) -> None:
             load(design, "fuzz.json")
         except DesignError as error:
             text = str(error)
-            assert text.startswith(f"fuzz.json: {_located(error)}"), (how, text)
+            assert text.startswith(f"fuzz.json: {located(error)}"), (how, text)
             assert "\n" not in text and len(text) < 1200, (how, text)
             assert error.file == "fuzz.json"
 

@@ -21,17 +21,12 @@ from kinegami.design import (
 from kinegami.design.errors import format_value
 from kinegami.design.reader import parse_design_text
 
-from . import DATA
+from . import DATA, located
 
 BASE_TEXT = (DATA / "example1a.json").read_text(encoding="utf-8")
 BASE = json.loads(BASE_TEXT)
 TEXT = json.dumps(BASE)  # one line: fragments below are replaced in it
 LONG = "7" * 5000  # an integer literal too long for int() (more than 4300 digits)
-
-
-def _located(error) -> str:
-    """The ``<field>: `` part of a DesignError's message (left out for the whole document)."""
-    return "" if error.field == "$" else f"{error.field}: "
 
 
 def _error(text_or_document, file="d.json") -> DesignError:
@@ -45,7 +40,7 @@ def _error(text_or_document, file="d.json") -> DesignError:
     error = info.value
     text = str(error)
     assert "\n" not in text and len(text) < 500, text
-    assert text.startswith(f"{file}: {_located(error)}")
+    assert text.startswith(f"{file}: {located(error)}")
     return error
 
 

@@ -35,17 +35,12 @@ from kinegami.design.trees import TreeSpecification, construction_available
 from kinegami.errors import ClearanceWarning
 from kinegami.tree import KinematicTree
 
-from . import _MIDDLE, DATA, PI, _joint, _pose, joint_parameters, pose_error
+from . import _MIDDLE, DATA, PI, _joint, _pose, joint_parameters, located, pose_error
 from . import reference_values as ref
 
 HAND = Path(__file__).resolve().parents[2] / "examples" / "designs" / "hand.json"
 ALGORITHMIC_HAND = DATA / "algorithmic_hand.json"
 FIXED = dict(relative=True, safe=False, fixedPosition=True, fixedOrientation=True)
-
-
-def _located(error) -> str:
-    """The ``<field>: `` part of a DesignError's message (left out for the whole document)."""
-    return "" if error.field == "$" else f"{error.field}: "
 
 
 def _document(path: Path) -> dict:
@@ -245,7 +240,7 @@ def _error(document, file="tree.json") -> DesignError:
     with pytest.raises(DesignError) as caught:
         chain_from_dict(document, file)
     error = caught.value
-    assert str(error).startswith(f"{file}: {_located(error)}") and "\n" not in str(error)
+    assert str(error).startswith(f"{file}: {located(error)}") and "\n" not in str(error)
     return error
 
 
