@@ -286,14 +286,20 @@ PARTS = (
     (
         '\n  9\n'
         '$TDUCREATE\n 40\n'
-        '2458532.153996898\n  9\n'
+    ),
+    'TDUCREATE',
+    (
+        '\n  9\n'
         '$TDUPDATE\n 40\n'
     ),
     'TDUPDATE',
     (
         '\n  9\n'
         '$TDUUPDATE\n 40\n'
-        '2458532.1544311\n  9\n'
+    ),
+    'TDUUPDATE',
+    (
+        '\n  9\n'
         '$TDINDWG\n 40\n'
         '0.0\n  9\n'
         '$TDUSRTIMER\n 40\n'

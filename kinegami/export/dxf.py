@@ -189,7 +189,10 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
                                 for tag in ("FINGERPRINTGUID", "VERSIONGUID"))  # fmt: skip
     now = datetime.datetime.fromtimestamp(seconds, datetime.UTC)
     # as ezdxf and AutoCAD write $TDCREATE: the Julian day number (2440588 on 1970-01-01) plus
-    # the fraction of the day since midnight (not the astronomical Julian date, half a day less)
+    # the fraction of the day since midnight (not the astronomical Julian date, half a day less).
+    # seconds count from 1970-01-01 UTC (time.time() or SOURCE_DATE_EPOCH), never local time,
+    # so this is the UTC time that $TDUCREATE and $TDUUPDATE hold, and $TDCREATE and $TDUPDATE
+    # get the same value (a file does not depend on the time zone of the machine writing it)
     julian = 2440588.0 + seconds / 86400.0
     fields = {
         "XMIN": xmin,
@@ -200,7 +203,9 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
         "FINGERPRINTGUID": fingerprint,
         "VERSIONGUID": version,
         "TDCREATE": repr(julian),
+        "TDUCREATE": repr(julian),
         "TDUPDATE": repr(julian),
+        "TDUUPDATE": repr(julian),
         "CREATED": f"{template.EZDXF_VERSION} @ {now.isoformat()}",
         "WRITTEN": f"{template.EZDXF_VERSION} @ {now.isoformat()}",
         "ENTITIES": entities,
@@ -313,7 +318,8 @@ def make_template() -> str:
     for value, field in zip(_SENTINEL_BOUNDS, ("XMIN", "YMIN", "XMAX", "YMAX"), strict=True):
         text = text.replace(f"\n{value!r}\n", f"\n@@{field}@@\n")
     variables = (("$HANDSEED", "  5"), ("$FINGERPRINTGUID", "  2"), ("$VERSIONGUID", "  2"),
-                 ("$TDCREATE", " 40"), ("$TDUPDATE", " 40"))  # fmt: skip
+                 ("$TDCREATE", " 40"), ("$TDUCREATE", " 40"), ("$TDUPDATE", " 40"),
+                 ("$TDUUPDATE", " 40"))  # fmt: skip
     for name, code in variables:
         text = _replace_value(text, name, code, name[1:])
     for key, field in (("CREATED_BY_EZDXF", "CREATED"), ("WRITTEN_BY_EZDXF", "WRITTEN")):

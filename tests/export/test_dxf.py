@@ -208,7 +208,7 @@ def _normalised(text: str) -> list[str]:
 
     text = re.sub(r"\{[0-9A-F]{8}-[0-9A-F-]{27}\}", "{GUID}", text)
     text = re.sub(r"\n\d+\.\d+\.\d+ @ [^\n]+\n", "\nVERSION @ TIME\n", text)
-    text = re.sub(r"(\$TD(?:CREATE|UPDATE)\n 40\n)[^\n]+", r"\1JULIAN", text)
+    text = re.sub(r"(\$TDU?(?:CREATE|UPDATE)\n 40\n)[^\n]+", r"\1JULIAN", text)
     start = text.index("  2\nCLASSES\n")
     end = text.index("  0\nENDSEC\n", start)
     classes = sorted(text[start:end].split("  0\nCLASS\n"))

@@ -86,6 +86,34 @@ def test_without_source_date_epoch_every_dxf_gets_new_guids_and_the_time_now(mon
     assert abs(first["$TDCREATE"] - now) < 60.0 / 86400.0
 
 
+@pytest.mark.parametrize("epoch", [None, EPOCH])
+def test_utc_times_are_the_times_written(monkeypatch, tmp_path, epoch):
+    """$TDUCREATE and $TDUUPDATE (UTC) are the time of writing, as $TDCREATE and $TDUPDATE: the
+    times written are UTC (time.time() or SOURCE_DATE_EPOCH), not the template's 2019 values."""
+    import time
+
+    from kinegami.export import save_pattern
+
+    if epoch is None:
+        monkeypatch.delenv("SOURCE_DATE_EPOCH", raising=False)
+    else:
+        monkeypatch.setenv("SOURCE_DATE_EPOCH", str(epoch))
+    path = save_pattern(TubeFittingPattern(4, 10.0, 30.0), tmp_path / "tube.dxf")
+    header = ezdxf.readfile(path).header
+    # ezdxf.readfile sets $TDCREATE to the time of reading: that one as written in the file
+    lines = path.read_text(encoding="utf-8").splitlines()
+    written = {name: float(lines[lines.index(name) + 2]) for name in ("$TDCREATE", "$TDUPDATE")}
+    assert header["$TDUCREATE"] == written["$TDCREATE"]
+    assert header["$TDUUPDATE"] == written["$TDUPDATE"] == header["$TDUPDATE"]
+    if epoch is None:
+        now = 2440588.0 + time.time() / 86400.0
+        assert abs(header["$TDUCREATE"] - now) < 60.0 / 86400.0
+    else:
+        utc = datetime.datetime.fromtimestamp(epoch, datetime.UTC).replace(tzinfo=None)
+        assert header["$TDUCREATE"] == pytest.approx(juliandate(utc), abs=1e-9)
+        assert header["$TDUUPDATE"] == pytest.approx(juliandate(utc), abs=1e-9)
+
+
 @pytest.mark.parametrize("value", ["abc", "-1", "1.5", "1e9", "\u0661\u0662", "9" * 13, "0x10"])
 def test_a_bad_source_date_epoch_is_named(monkeypatch, value):
     monkeypatch.setenv("SOURCE_DATE_EPOCH", value)
