@@ -60,3 +60,21 @@ def test_readme_names_only_design_files_that_exist_or_are_made():
                 else:
                     assert design in made or (ROOT / design).is_file(), line
     assert made  # the README shows how to start a design of one's own
+
+
+def test_pytest_q_still_prints_how_many_tests_passed():
+    """The README's test command takes the options of pyproject.toml; a ``-q`` there would make
+    ``pytest -q`` a ``-qq``, which prints no "N passed" line."""
+    import os
+    import subprocess
+    import sys
+    import tomllib
+
+    options = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))["tool"]["pytest"]
+    assert not {"-q", "--quiet"} & set(shlex.split(options["ini_options"]["addopts"]))
+    env = {k: v for k, v in os.environ.items() if k != "PYTEST_ADDOPTS"}
+    command = [sys.executable, "-m", "pytest", "-q", "-n", "0", "-p", "no:cacheprovider",
+               "tests/test_readme.py::test_quick_start_has_the_two_commands"]  # fmt: skip
+    done = subprocess.run(command, capture_output=True, text=True, env=env, cwd=ROOT)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert re.search(r"^1 passed\b", done.stdout, flags=re.M), done.stdout
