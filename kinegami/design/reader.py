@@ -424,7 +424,10 @@ def _read_regular_file(name: str) -> bytes:
 
 
 def read_design_file(path) -> tuple[object, str]:
-    """The JSON value of the design file at ``path`` and the file name (for messages)."""
+    """The JSON value of the design file at ``path`` and the file name (for messages).
+
+    A file that is empty or holds only whitespace is a DesignError saying so (field ``$``).
+    """
     if not isinstance(path, str | os.PathLike):
         raise DesignError(f"the design file name must be a str or a path, got {path!r}")
     name = os.fspath(path)
@@ -437,6 +440,13 @@ def read_design_file(path) -> tuple[object, str]:
         raise DesignError(
             f"the design file is not UTF-8 text (byte {exc.start}: {exc.reason})", file=name
         ) from None
+    if _WHITESPACE.fullmatch(text):  # not "invalid JSON at line 1, column 1: Expecting value"
+        what = "empty" if not text else "empty (only whitespace)"
+        raise DesignError(
+            f"the design file is {what}: a design is a JSON object {{...}} with "
+            '"format": "kinegami-design" (\'kinegami new FILE\' writes a starter design)',
+            file=name,
+        )
     return parse_design_text(text, name), name
 
 

@@ -135,6 +135,7 @@ def test_output_is_a_file(design, tmp_path):
 
 BROKEN = {
     "invalid JSON": ('{"format": "kinegami-design", "version": 1,,}', ["line 1"]),
+    "empty file": ("", ["the design file is empty", "JSON object"]),
     "missing field": ({k: v for k, v in DESIGN.items() if k != "numSides"}, ["numSides"]),
     "wrong type": (dict(DESIGN, r="one"), ["r:", '"one"', "number"]),
     "out of range": (dict(DESIGN, numSides=2), ["numSides", "2"]),
@@ -188,6 +189,15 @@ def test_validate_rejects(case, tmp_path):
     data, words = BROKEN[case]
     result = run("validate", write(tmp_path / "bad.json", data))
     assert_clean_failure(result, "bad.json", *words)
+
+
+@pytest.mark.parametrize("text", ["", "\n", " \t\r\n  \n"])
+def test_validate_an_empty_file_says_it_is_empty(text, tmp_path):
+    result = run("validate", write(tmp_path / "bad.json", text))
+    empty = "empty (only whitespace)" if text else "empty"
+    reason = f'the design file is {empty}: a design is a JSON object {{...}} with "format": '
+    assert_clean_failure(result, f"bad.json: {reason}", '"kinegami-design"', "kinegami new")
+    assert "invalid JSON" not in result.stderr
 
 
 def test_validate_does_not_build_unless_asked(tmp_path):

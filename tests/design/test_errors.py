@@ -383,6 +383,24 @@ def test_invalid_json_names_line_and_column(tmp_path):
     assert "invalid JSON at line 3, column 16" in error.reason
 
 
+@pytest.mark.parametrize("content", [b"", b" \n\t\r\n", b"\xef\xbb\xbf"])
+@pytest.mark.parametrize("check", [load_design, validate_design, read_design])
+def test_an_empty_file_says_it_is_empty(tmp_path, content, check):
+    """Not "invalid JSON at line 1, column 1: Expecting value": empty, only whitespace, or only
+    a BOM (which a design file may start with)."""
+    path = tmp_path / "design.json"
+    path.write_bytes(content)
+    with pytest.raises(DesignError) as info:
+        check(path)
+    error = info.value
+    assert type(error) is DesignError and error.field == "$" and error.file == str(path)
+    assert str(error) == f"{path}: {error.reason}" and "\n" not in str(error)
+    empty = "empty (only whitespace)" if content.decode("utf-8-sig") else "empty"
+    assert error.reason.startswith(f"the design file is {empty}: a design is a JSON object {{")
+    assert '"format": "kinegami-design"' in error.reason and "kinegami new" in error.reason
+    assert "invalid JSON" not in error.reason
+
+
 @pytest.mark.parametrize(
     ("text", "field", "fragment"),
     [
@@ -391,7 +409,7 @@ def test_invalid_json_names_line_and_column(tmp_path):
         ('{"format": "kinegami-design", "version": 1, "r": -Infinity}', "r", "finite"),
         ('{"format": "kinegami-design", "version": 1, "r": 1, "r": 2}', "r", "duplicate key 'r'"),
         ("[1, 2]", "$", "JSON object"),
-        ("", "$", "invalid JSON at line 1, column 1"),
+        ("", "$", "the design file is empty"),
     ],
 )
 def test_invalid_values(tmp_path, text, field, fragment):
