@@ -525,7 +525,7 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
     tree (kinegami.export.tree_build), published as one transaction."""
     from kinegami.design.reader import carry_origin
     from kinegami.errors import InvalidParameterError
-    from kinegami.export.tree_build import write_tree_files
+    from kinegami.export.tree_build import FORMAT_LIBRARIES, write_tree_files
     from kinegami.tree.sheets import fabricate, fit_junctions
     from kinegami.tree.takeoffs import JUNCTION_KINDS
 
@@ -535,12 +535,12 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
                            f"{', '.join(JUNCTION_KINDS)}")  # fmt: skip
     formats = _parse_tree_formats(args.formats)
     if args.formats is None:  # the defaults: leave out what a missing optional library stops
-        needs = {"urdf": (("trimesh",), "mesh")}
-        if kind != "takeoff":  # folded take-offs print no connector
-            needs["junctions"] = (("manifold3d", "trimesh"), "print")
+        needs = dict(FORMAT_LIBRARIES)
+        if kind == "takeoff":  # folded take-offs print no connector
+            del needs["junctions"]
         for fmt, (modules, extra) in needs.items():
-            missing = [m for m in modules if not _importable(m)]
-            if fmt in formats and missing:
+            missing = [m for m in modules if fmt in formats and not _importable(m)]
+            if missing:
                 formats.remove(fmt)
                 _note(args.command, f"{fmt} not written: it needs {missing[0]} "
                                     f"(pip install 'kinegami[{extra}]')")  # fmt: skip

@@ -23,7 +23,13 @@ from kinegami.errors import InvalidParameterError
 from kinegami.export._options import UNITS_IN_MM
 from kinegami.export._reproducible import reproducible_3mf
 
-__all__ = ["TREE_FORMATS", "DEFAULT_TREE_FORMATS", "write_tree_files", "sheet_labels"]
+__all__ = [
+    "TREE_FORMATS",
+    "DEFAULT_TREE_FORMATS",
+    "FORMAT_LIBRARIES",
+    "write_tree_files",
+    "sheet_labels",
+]
 
 #: ``--formats`` names for trees and what each writes.
 TREE_FORMATS = {
@@ -37,6 +43,14 @@ TREE_FORMATS = {
     "urdf": "URDF of the whole tree (<stem>.urdf, metres, meshes in <stem>_meshes/)",
 }
 DEFAULT_TREE_FORMATS = ("dxf", "svg", "fold", "pdf", "junctions", "urdf")
+#: The optional libraries a tree format needs and the ``pip install 'kinegami[extra]'`` that
+#: installs them (``kinegami build`` leaves a default format out when one is missing).
+FORMAT_LIBRARIES = {
+    "junctions": (("manifold3d", "trimesh", "lxml", "networkx"), "print"),  # 3MF: lxml, networkx
+    "stl": (("trimesh",), "mesh"),
+    "obj": (("trimesh",), "mesh"),
+    "urdf": (("trimesh",), "mesh"),
+}
 
 
 def sheet_labels(fabrication, names: Sequence[str | None] | None = None,
@@ -79,6 +93,12 @@ def write_tree_files(
         )
     folder = Path(folder)
     labels = sheet_labels(fabrication, names, units)
+    for fmt in formats:  # before writing anything: every library the formats need
+        if fmt == "junctions" and not fabrication.junctions:  # folded take-offs: none printed
+            continue
+        modules, extra = FORMAT_LIBRARIES.get(fmt, ((), None))
+        for module in modules:
+            registry.import_library(module, TREE_FORMATS[fmt].partition(" (")[0], extra)
     folded = fabrication.folded_tree()
     written: list[Path] = []
     for fmt in formats:
@@ -102,9 +122,6 @@ def write_tree_files(
                 mesh = fabrication.connector(junction.index).copy()
                 mesh.apply_scale(factor)
                 for suffix in ("stl", "3mf"):
-                    if suffix == "3mf":
-                        registry.import_library("lxml", "3MF connectors", "print")
-                        registry.import_library("networkx", "3MF connectors", "print")
                     path = folder / f"{stem}_junction_{junction.index}.{suffix}"
                     data = mesh.export(file_type=suffix)
                     if suffix == "3mf":

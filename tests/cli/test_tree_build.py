@@ -90,7 +90,12 @@ def test_only_the_formats_asked_for_are_written(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     "missing, left_out, extra",
-    [("manifold3d", JUNCTION_FILES, "print"), ("trimesh", JUNCTION_FILES | WHOLE_TREE, "mesh")],
+    [
+        ("manifold3d", JUNCTION_FILES, "print"),
+        ("trimesh", JUNCTION_FILES | WHOLE_TREE, "mesh"),
+        ("lxml", JUNCTION_FILES, "print"),  # trimesh writes 3MF with lxml and networkx
+        ("networkx", JUNCTION_FILES, "print"),
+    ],
 )
 def test_a_missing_optional_library_leaves_out_its_files_with_a_note(
     tmp_path, capsys, monkeypatch, missing, left_out, extra
@@ -102,7 +107,7 @@ def test_a_missing_optional_library_leaves_out_its_files_with_a_note(
     assert SHEET_FILES | {"hand.pdf"} <= written
     err = capsys.readouterr().err
     assert f"needs {missing}" in err
-    assert "pip install 'kinegami[" in err
+    assert f"pip install 'kinegami[{extra}]'" in err
 
 
 def test_asking_for_junctions_without_manifold3d_fails_in_one_line_writing_nothing(
