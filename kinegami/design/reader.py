@@ -812,15 +812,20 @@ def origin_of(chain: KinematicChain) -> DesignOrigin | None:
 def carry_origin(source: KinematicChain, target: KinematicChain) -> DesignOrigin | None:
     """Give ``target`` the origin (joint names, design entries) of ``source`` and return it.
 
-    For a chain made from a loaded one with the same joints in the same order apart from
-    waypoints (:func:`kinegami.optimize.compact`: waypoints may move, appear or disappear):
-    each non-waypoint joint of ``target`` takes the origin of the matching joint of ``source``;
-    waypoints have none. None (and nothing remembered) when ``source`` has no origin or the
-    non-waypoint joints do not match by type.
+    For a chain or tree made from a loaded one with the same joints in the same order (a
+    tree whose children :func:`kinegami.tree.sheets.fit_junctions` slid), every joint takes
+    the origin of its counterpart, waypoints included. When only the joints apart from
+    waypoints match (:func:`kinegami.optimize.compact`: waypoints may move, appear or
+    disappear), each non-waypoint joint takes the origin of the matching joint of ``source``
+    and waypoints have none. None (and nothing remembered) when ``source`` has no origin or
+    the non-waypoint joints do not match by type.
     """
     origin = origin_of(source)
     if origin is None:
         return None
+    if tuple(origin.types) == _type_names(target):  # the same joints: names for every one
+        _ORIGINS[target] = origin
+        return origin
     kept = [i for i, joint in enumerate(source.Joints) if type(joint) is not Waypoint]
     others = [i for i, joint in enumerate(target.Joints) if type(joint) is not Waypoint]
     if [origin.types[i] for i in kept] != [type(target.Joints[i]).__name__ for i in others]:

@@ -206,6 +206,27 @@ def _samples(lines):
     return (lines[:, :1] + f * (lines[:, 1:] - lines[:, :1])).reshape(-1, 2)
 
 
+def test_the_connector_build_names_the_joints_as_the_design_does(hand_build, takeoff_build):
+    """Fitting the connectors slides children but keeps every joint, so the sheet labels keep
+    every name the design gives, waypoints' included (the root is a named waypoint)."""
+    import re
+
+    import ezdxf
+
+    _, out, text = hand_build
+    assert "sheet 0: joints 0 'root' to 11 'middleEnd'" in text
+    assert "starts in junction 0 (at joint 0 'root')" in text
+    named = re.compile(r"joints? \d+ '\w+'")
+    takeoff_text = takeoff_build[2]
+    for k in range(3):  # the same names in both builds' sheet lines
+        line = next(x for x in text.splitlines() if x.startswith(f"    sheet {k}: "))
+        other = next(x for x in takeoff_text.splitlines() if x.startswith(f"    sheet {k}: "))
+        assert named.findall(line) == named.findall(other), (line, other)
+    labels = [e.dxf.text for e in ezdxf.readfile(out / "hand_sheet_0.dxf").modelspace()
+              if e.dxftype() in ("TEXT", "MTEXT") and hasattr(e.dxf, "text")]  # fmt: skip
+    assert any("'root'" in label for label in labels), labels
+
+
 def test_the_takeoff_dxf_cuts_the_holes_and_the_tabs_and_labels_them(takeoff_build,
                                                                     takeoff_fabrication):
     pytest.importorskip("ezdxf")
