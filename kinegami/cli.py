@@ -18,7 +18,9 @@ from __future__ import annotations
 
 import argparse
 import errno
+import functools
 import os
+import re
 import signal
 import stat
 import sys
@@ -1243,6 +1245,7 @@ def main(argv: list[str] | None = None) -> int:
             # numerical warnings of plotting libraries are not the user's business; the
             # design checks reject the inputs that would make kinegami's own numbers overflow
             warnings.simplefilter("ignore", RuntimeWarning)
+            warnings.showwarning = functools.partial(_show_warning, args.command)
             return args.run(args)
     except (CommandError, KinegamiError) as error:
         _fail(args.command, str(error))
@@ -1297,6 +1300,22 @@ def _encoding_safe_output() -> None:
             reconfigure(errors="backslashreplace")
         except (ValueError, OSError):  # detached or closed
             pass
+
+
+#: matplotlib's warning for a character its font cannot draw (it draws a box instead)
+_MISSING_GLYPH = re.compile(r"Glyph (\d+) \(.*\) missing from font\(s\) (.+?)\.?$")
+
+
+def _show_warning(command: str, message, category, filename, lineno, file=None, line=None):
+    """A warning that reaches the command line (a library's, or one kinegami does not report
+    itself): one line, ``kinegami COMMAND: warning: ...``, not Python's two-line form."""
+    text = str(message)
+    glyph = _MISSING_GLYPH.match(text)
+    if glyph:
+        char = chr(int(glyph.group(1)))
+        text = (f"the font {glyph.group(2)} has no {char!r} (U+{ord(char):04X}): the PDF and the "
+                "pictures draw it as an empty box")  # fmt: skip
+    _warn(command, text)
 
 
 def _warn(command: str, message: str) -> None:

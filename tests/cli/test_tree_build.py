@@ -304,3 +304,18 @@ def test_takeoffs_need_no_connector_library_and_a_bad_kind_is_checked_first(
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--junctions: unknown kind 'bogus'" in err[0], err
     assert not (tmp_path / "b").exists()
+
+
+def test_a_character_the_font_lacks_is_one_warning_line(tmp_path, capsys):
+    """matplotlib warns (in Python's two-line form) when a name has a character its font cannot
+    draw; the command line says it in one line, naming the character."""
+    design = json.loads(HAND.read_text())
+    renamed = [j for j in design["joints"] if j.get("name") == "palm"]
+    assert renamed, "the hand names its palm"
+    renamed[0]["name"] = "palm\N{RAISED HAND}"
+    path = tmp_path / "hand.json"
+    path.write_text(json.dumps(design), encoding="utf-8")
+    assert main_in_process("build", path, "-o", tmp_path / "out", "--formats", "pdf") == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["kinegami build: warning: the font DejaVu Sans has no '\N{RAISED HAND}' "
+                   "(U+270B): the PDF and the pictures draw it as an empty box"], err  # fmt: skip
