@@ -38,7 +38,9 @@ itself cut short again leaves a prefix of the plan.
 * A crash of the whole machine is not covered: nothing is flushed to disk (no ``fsync``), so
   the file system may not keep the order of the moves.
 
-Entries of ``OUT`` that the new build does not write are never touched.
+Entries of ``OUT`` that the new build does not write are never touched, and a folder of
+``OUT`` is replaced only by a folder of the same name (a URDF's meshes): where the build would
+put a file in its place, publishing is refused before anything moves.
 
 Test hook: if the environment variable ``KINEGAMI_TEST_PAUSE_BEFORE_STEP`` is set to a step
 number k, publishing writes ``kinegami: test hook: paused before publishing step k`` to
@@ -251,6 +253,11 @@ def _retire(staging: Path) -> None:
     discard_tree(staging)
 
 
+def _is_folder(path: Path) -> bool:
+    """Whether ``path`` is a folder itself (not a symbolic link to one)."""
+    return path.is_dir() and not path.is_symlink()
+
+
 def _names(names: list[str], limit: int = 4) -> str:
     shown = ", ".join(names[:limit])
     return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
@@ -386,6 +393,13 @@ class Staging:
         out, staging = self.out, self.path
         names = sorted(os.listdir(self.new))
         with _folder_lock(out), deferred_signals() as received:
+            for name in names:  # a file of the build never replaces a folder of the user's
+                if _is_folder(out / name) and not _is_folder(self.new / name):
+                    raise PublishError(
+                        f"{str(out / name)!r} is a folder, and the build would replace it with "
+                        f"a file of the same name; move or rename the folder (nothing was "
+                        f"written, {str(out)!r} is as before)"
+                    )
             entries = [(name, os.path.lexists(out / name)) for name in names]
             steps = _plan_steps(entries)
             try:

@@ -504,3 +504,17 @@ def test_missing_exporter_library_is_one_line(design, tmp_path, monkeypatch, cap
     assert "pdf export" in err and "pip install 'kinegami[pdf]'" in err
     assert "internal error" not in err and "Traceback" not in err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_build_never_replaces_a_folder_of_the_user_with_a_file(design, tmp_path):
+    """docs/cli.md: files the build does not write are never touched; a folder with the name
+    of an output file is the user's, so the build stops in one line and writes nothing."""
+    out = tmp_path / "o"
+    (out / "arm.dxf" / "sub").mkdir(parents=True)
+    (out / "arm.dxf" / "sub" / "data.txt").write_text("mine")
+    (out / "arm.svg").write_text("earlier")
+    result = run("build", design, "-o", out, "--formats", "dxf,svg")
+    assert_clean_failure(result, "arm.dxf", "is a folder", "move or rename")
+    assert (out / "arm.dxf" / "sub" / "data.txt").read_text() == "mine"
+    assert (out / "arm.svg").read_text() == "earlier"
+    assert sorted(p.name for p in out.iterdir()) == ["arm.dxf", "arm.svg"]

@@ -470,3 +470,31 @@ def test_write_atomic_files_rolls_back_on_a_signal(tmp_path, monkeypatch):
         registry.write_atomic_files(main, {"r.urdf": b"new", "r_meshes/b.stl": b"new b"})
     monkeypatch.undo()
     assert snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize("link", [False, True])
+def test_a_file_never_replaces_a_folder_of_the_user(tmp_path, link):
+    """The build would put the file n.txt where the user has a folder n.txt: refused before
+    anything moves, the folder and everything else as before. A symbolic link named n.txt
+    is an entry like a file: replaced, and the folder it points to is not touched."""
+    out = tmp_path / "out"
+    write_files(out, OLD)
+    if link:
+        write_files(tmp_path / "elsewhere", {"data.txt": b"mine"})
+        (out / "n.txt").symlink_to(tmp_path / "elsewhere", target_is_directory=True)
+        build(out)
+        assert (out / "n.txt").read_bytes() == NEW["n.txt"]
+        assert (tmp_path / "elsewhere" / "data.txt").read_bytes() == b"mine"
+        return
+    write_files(out, {"n.txt/sub/data.txt": b"mine"})
+    before = snapshot(out)
+    with pytest.raises(PublishError, match=r"n\.txt' is a folder.*move or rename"):
+        build(out)
+    assert snapshot(out) == before
+    assert leftovers(out) == []
+
+
+def test_a_folder_replaces_a_folder(out):
+    """As the URDF's meshes folder replaces the last build's: m/ is replaced whole."""
+    build(out)
+    assert not (out / "m" / "sub").exists() and (out / "m" / "z.bin").read_bytes() == b"new z"
