@@ -39,8 +39,9 @@ itself cut short again leaves a prefix of the plan.
   the file system may not keep the order of the moves.
 
 Entries of ``OUT`` that the new build does not write are never touched, and a folder of
-``OUT`` is replaced only by a folder of the same name (a URDF's meshes): where the build would
-put a file in its place, publishing is refused before anything moves.
+``OUT`` with anything in it is replaced only by a folder of the same name (a URDF's meshes):
+where the build would put a file in its place, publishing is refused before anything moves (an
+empty folder in the way is replaced: nothing is lost).
 
 Test hook: if the environment variable ``KINEGAMI_TEST_PAUSE_BEFORE_STEP`` is set to a step
 number k, publishing writes ``kinegami: test hook: paused before publishing step k`` to
@@ -258,6 +259,14 @@ def _is_folder(path: Path) -> bool:
     return path.is_dir() and not path.is_symlink()
 
 
+def _holds_files(path: Path) -> bool:
+    """Whether ``path`` is a folder itself (not a symbolic link) with anything in it."""
+    if not _is_folder(path):
+        return False
+    with os.scandir(path) as entries:
+        return next(entries, None) is not None
+
+
 def _names(names: list[str], limit: int = 4) -> str:
     shown = ", ".join(names[:limit])
     return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
@@ -394,11 +403,11 @@ class Staging:
         names = sorted(os.listdir(self.new))
         with _folder_lock(out), deferred_signals() as received:
             for name in names:  # a file of the build never replaces a folder of the user's
-                if _is_folder(out / name) and not _is_folder(self.new / name):
+                if _holds_files(out / name) and not _is_folder(self.new / name):
                     raise PublishError(
-                        f"{str(out / name)!r} is a folder, and the build would replace it with "
-                        f"a file of the same name; move or rename the folder (nothing was "
-                        f"written, {str(out)!r} is as before)"
+                        f"{str(out / name)!r} is a folder with files in it, and the build would "
+                        f"replace it with a file of the same name; move or rename the folder "
+                        f"(nothing was written, {str(out)!r} is as before)"
                     )
             entries = [(name, os.path.lexists(out / name)) for name in names]
             steps = _plan_steps(entries)

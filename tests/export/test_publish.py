@@ -488,10 +488,16 @@ def test_a_file_never_replaces_a_folder_of_the_user(tmp_path, link):
         return
     write_files(out, {"n.txt/sub/data.txt": b"mine"})
     before = snapshot(out)
-    with pytest.raises(PublishError, match=r"n\.txt' is a folder.*move or rename"):
+    with pytest.raises(PublishError, match=r"n\.txt' is a folder with files in it.*move or"):
         build(out)
     assert snapshot(out) == before
     assert leftovers(out) == []
+
+
+def test_a_file_replaces_an_empty_folder(out):
+    (out / "n.txt").mkdir()
+    build(out)
+    assert snapshot(out) == new_state()
 
 
 def test_a_folder_replaces_a_folder(out):
