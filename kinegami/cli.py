@@ -1050,8 +1050,17 @@ def cmd_compact(args: argparse.Namespace) -> int:
 
 
 # --- parser ------------------------------------------------------------------------------------
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, whose errors are one line as every other error of the command line
+    (argparse prints the usage block, then the error): the error, then the usage, joined."""
+
+    def error(self, message: str):
+        usage = " ".join(self.format_usage().split())
+        self.exit(2, f"{self.prog}: error: {_printable(message)}; {usage}\n")
+
+
 def make_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="kinegami",
         description="Design tubular origami kinematic chains and their crease patterns.",
         epilog="Design files: see docs/design-format.md. "

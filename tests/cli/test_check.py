@@ -279,6 +279,7 @@ def test_unparseable_command_lines_are_usage_errors(args):
     assert result.returncode == 2
     assert "usage: kinegami" in result.stderr
     assert "Traceback" not in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1, result.stderr  # docs/cli.md: one line
 
 
 @pytest.mark.parametrize(

@@ -59,6 +59,19 @@ def test_unknown_command_is_a_usage_error():
     assert result.returncode == 2
     assert "invalid choice" in result.stderr
     assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()  # one line: the error, then the usage
+    assert len(lines) == 1 and lines[0].startswith("kinegami: error: argument COMMAND"), lines
+    assert "usage: kinegami [-h] [--version] COMMAND ..." in lines[0]
+
+
+@pytest.mark.parametrize("args", [["build"], ["build", "x.json"], ["build", "x", "-o", "y",
+                                  "--formats"], ["compact", "x.json", "--seed"]])  # fmt: skip
+def test_a_command_line_that_cannot_be_parsed_is_one_line(args):
+    result = run(*args)
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"kinegami {args[0]}: error: "), lines
+    assert f"usage: kinegami {args[0]} " in lines[0]
 
 
 # --- build ---------------------------------------------------------------------------------
