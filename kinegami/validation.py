@@ -168,10 +168,14 @@ def check_in_range(
     return value
 
 
-def check_int(name: str, value, minimum: int | None = None) -> int:
-    """An integer (bools rejected), optionally >= ``minimum``."""
+def check_int(name: str, value, minimum: int | None = None, *, floats: bool = True) -> int:
+    """An integer (bools rejected), optionally >= ``minimum``.
+
+    A float with an integral value (``2.0``) is taken as that integer unless ``floats=False``
+    (for indices, where a float is more likely a mistake: ``parents`` of a tree).
+    """
     if isinstance(value, bool) or not isinstance(value, numbers.Integral | np.integer):
-        if isinstance(value, float) and value.is_integer():
+        if floats and isinstance(value, float) and value.is_integer():
             value = int(value)
         else:
             raise InvalidTypeError(f"{name} must be an integer, got {shown(value)}")

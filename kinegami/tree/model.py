@@ -15,7 +15,7 @@ the same calls on both give the same joints, links and ball, bit for bit (tested
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from kinegami.bodies import link_polyline, tree_worst_overlap
 from kinegami.chain import RADIAL_VARIANTS, KinematicChain, _JointAssembly
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
 from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube
-from kinegami.validation import check_real
+from kinegami.validation import check_int, check_real, shown
 
 __all__ = ["KinematicTree"]
 
@@ -88,21 +88,16 @@ class KinematicTree(_JointAssembly):
         ------
         NoPathError
             When no link reaches joint k; the error's ``joint`` attribute is k.
-        InvalidParameterError, InvalidTypeError
-            For parents that do not describe a tree, or joints of another tube.
+        InvalidTypeError
+            When ``joints`` is not a sequence of Joint objects, ``parents`` not a sequence
+            (or one-dimensional array) of integers (numpy integers are; bools, floats, strings
+            and None are not), or a joint is of another tube.
+        InvalidParameterError
+            For parents that do not describe a tree (not one per joint, ``parents[0]`` not -1,
+            a parent that is not an earlier joint), or joints of another tube.
         """
-        joints = list(joints)
-        parents = [int(p) for p in parents] if isinstance(parents, Sequence) else parents
-        if not isinstance(parents, list) or len(parents) != len(joints) or not joints:
-            raise InvalidParameterError(
-                f"parents must have one entry per joint ({len(joints)}), got {parents!r}"
-            )
-        for k, p in enumerate(parents):
-            if (k == 0 and p != -1) or (k > 0 and not 0 <= p < k):
-                raise InvalidParameterError(
-                    f"parents[{k}] must be {'-1 (the root)' if k == 0 else f'in [0, {k - 1}]'}, "
-                    f"got {p}"
-                )
+        joints = _joint_list(joints)
+        parents = _parent_list(parents, len(joints))
         tree = cls(joints[0], maxAnglePerElbow)
         placed, links, ball = [tree._joints[0]], [tree._links[0]], tree._ball
         for k in range(1, len(joints)):
@@ -396,3 +391,42 @@ class KinematicTree(_JointAssembly):
         from kinegami.viz.chain_plot import show_chain
 
         return show_chain(self, **options)
+
+
+def _joint_list(joints) -> list[Joint]:
+    """``joints`` of :meth:`KinematicTree.from_joints` as a non-empty list of Joint objects."""
+    if isinstance(joints, str | bytes | Joint) or not isinstance(joints, Iterable):
+        raise InvalidTypeError(f"joints must be a sequence of Joint objects, got {shown(joints)}")
+    joints = list(joints)
+    if not joints:
+        raise InvalidParameterError("joints must hold at least one joint (the root), got []")
+    for k, joint in enumerate(joints):
+        if not isinstance(joint, Joint):
+            raise InvalidTypeError(f"joints[{k}] must be a Joint, got {shown(joint)}")
+    return joints
+
+
+def _parent_list(parents, n: int) -> list[int]:
+    """``parents`` of :meth:`KinematicTree.from_joints` for ``n`` joints as a list of ints:
+    ``parents[0] = -1`` and every other parent an earlier joint."""
+    if isinstance(parents, str | bytes) or not (
+        isinstance(parents, Sequence) or (isinstance(parents, np.ndarray) and parents.ndim == 1)
+    ):
+        raise InvalidTypeError(
+            "parents must be a sequence of integers (one per joint, -1 for the root), "
+            f"got {shown(parents)}"
+        )
+    if len(parents) != n:
+        raise InvalidParameterError(
+            f"parents must have one entry per joint ({n}), got {len(parents)}: {shown(parents)}"
+        )
+    checked = []
+    for k, p in enumerate(parents):
+        p = check_int(f"parents[{k}]", p, floats=False)
+        if (k == 0 and p != -1) or (k > 0 and not 0 <= p < k):
+            raise InvalidParameterError(
+                f"parents[{k}] must be {'-1 (the root)' if k == 0 else f'in [0, {k - 1}]'}, "
+                f"got {shown(p)}"
+            )
+        checked.append(p)
+    return checked

@@ -412,6 +412,88 @@ def test_bad_input_names_the_parameter():
         tree.addJoint(0, RevoluteJoint(4, 1, math.pi, SE3()), fixedPosition=True)
 
 
+# --- from_joints: bad input ---------------------------------------------------------------
+W0, W5 = Waypoint(4, 1, SE3()), Waypoint(4, 1, SE3.Trans(0, 0, 5))
+
+
+@pytest.mark.parametrize(
+    ("parents", "message"),
+    [
+        ([-1, None], r"parents\[1\] must be an integer, got None"),
+        ([-1, 0.5], r"parents\[1\] must be an integer, got 0\.5"),
+        ([-1, 0.0], r"parents\[1\] must be an integer, got 0\.0"),
+        ([-1.0, 0], r"parents\[0\] must be an integer, got -1\.0"),
+        ([-1, "0"], r"parents\[1\] must be an integer, got '0'"),
+        ([-1, True], r"parents\[1\] must be an integer, got True"),
+        ((-1, np.bool_(False)), r"parents\[1\] must be an integer, got .*False"),
+        (np.array([-1.0, 0.0]), r"parents\[0\] must be an integer, got np\.float64\(-1\.0\)"),
+        ("x", r"parents must be a sequence of integers .*, got 'x'"),
+        ("-10", r"parents must be a sequence of integers .*, got '-10'"),
+        (None, r"parents must be a sequence of integers .*, got None"),
+        ({-1, 0}, r"parents must be a sequence of integers"),
+        (iter([-1, 0]), r"parents must be a sequence of integers"),
+        (np.array([[-1, 0]]), r"parents must be a sequence of integers"),
+        (np.int64(-1), r"parents must be a sequence of integers"),
+    ],
+)
+def test_from_joints_parents_must_be_integers(parents, message):
+    with pytest.raises(InvalidTypeError, match=message):
+        KinematicTree.from_joints([W0, W5], parents)
+
+
+def test_from_joints_parents_one_per_joint_describing_a_tree():
+    with pytest.raises(InvalidParameterError, match=r"one entry per joint \(1\), got 2"):
+        KinematicTree.from_joints([W0], [-1, 0])
+    with pytest.raises(InvalidParameterError, match=r"one entry per joint \(2\), got 1"):
+        KinematicTree.from_joints([W0, W5], np.array([-1]))
+    with pytest.raises(InvalidParameterError, match=r"parents\[0\] must be -1 \(the root\), got 0"):
+        KinematicTree.from_joints([W0, W5], np.array([0, 0]))
+    with pytest.raises(InvalidParameterError, match=r"parents\[1\] must be in \[0, 0\], got 1"):
+        KinematicTree.from_joints([W0, W5], [-1, np.int32(1)])
+    with pytest.raises(InvalidParameterError, match=r"parents\[1\] must be in \[0, 0\], got <an"):
+        KinematicTree.from_joints([W0, W5], [-1, 10**5000])  # named, not printed
+
+
+@pytest.mark.parametrize(
+    ("joints", "message"),
+    [
+        (None, r"joints must be a sequence of Joint objects, got None"),
+        ("ab", r"joints must be a sequence of Joint objects, got 'ab'"),
+        (W0, r"joints must be a sequence of Joint objects, got Waypoint\("),
+        ([W0, "x"], r"joints\[1\] must be a Joint, got 'x'"),
+        (["x", W5], r"joints\[0\] must be a Joint, got 'x'"),
+        ([W0, None], r"joints\[1\] must be a Joint, got None"),
+    ],
+)
+def test_from_joints_joints_must_be_joints(joints, message):
+    with pytest.raises(InvalidTypeError, match=message):
+        KinematicTree.from_joints(joints, [-1, 0])
+
+
+def test_from_joints_needs_a_root():
+    with pytest.raises(InvalidParameterError, match="at least one joint"):
+        KinematicTree.from_joints([], [])
+
+
+def test_from_joints_takes_numpy_integers(snapshot):
+    hand = quiet_hand()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        expected = snapshot(KinematicTree.from_joints(hand.Joints, hand.Parents))
+        for parents in (
+            np.array(hand.Parents),
+            np.array(hand.Parents, dtype=np.int8),
+            [np.int64(p) for p in hand.Parents],
+            list(hand.Parents),
+        ):
+            tree = KinematicTree.from_joints(list(hand.Joints), parents)
+            assert tree.Parents == hand.Parents
+            assert all(type(p) is int for p in tree.Parents)
+            assert snapshot(tree) == expected
+    small = KinematicTree.from_joints((j for j in (W0, W5)), range(-1, 1))  # any iterable of joints
+    assert small.Parents == (-1, 0)
+
+
 def test_clearance_at_other_states_does_not_change_the_tree(hand, snapshot):
     before = snapshot(hand)
     report = hand.clearance([0.0] * len(hand.Joints))
