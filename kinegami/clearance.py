@@ -39,7 +39,7 @@ from kinegami.bodies import (
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.segments import segment_distances
-from kinegami.validation import check_real
+from kinegami.validation import check_int, check_real, shown
 
 __all__ = [
     "CONTACT_TOLERANCE",
@@ -603,7 +603,7 @@ def sweep(
         Number of configurations drawn uniformly from the joints' state ranges (> 0; ignored
         when ``configurations`` is given).
     seed : int
-        Seed of the random configurations (numpy ``default_rng``).
+        Seed of the random configurations (numpy ``default_rng``; >= 0).
     configurations : sequence of sequences of float, optional
         The configurations to test instead (absolute states, one per joint).
     names : joint names for the report, optional.
@@ -623,19 +623,16 @@ def sweep(
     else:
         engine = engine_for(chain, names)
     if isinstance(resolution, bool) or not isinstance(resolution, int | np.integer):
-        raise InvalidTypeError(f"resolution must be an integer >= 1, got {resolution!r}")
+        raise InvalidTypeError(f"resolution must be an integer >= 1, got {shown(resolution)}")
     if resolution < 1:
-        raise InvalidParameterError(f"resolution must be an integer >= 1, got {resolution!r}")
+        raise InvalidParameterError(f"resolution must be an integer >= 1, got {shown(resolution)}")
     if configurations is None:
         if isinstance(samples, bool) or not isinstance(samples, int | np.integer):
-            raise InvalidTypeError(f"samples must be an integer > 0, got {samples!r}")
+            raise InvalidTypeError(f"samples must be an integer > 0, got {shown(samples)}")
         if samples <= 0:
-            raise InvalidParameterError(f"samples must be an integer > 0, got {samples!r}")
-        if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
-            raise InvalidTypeError(f"seed must be an integer >= 0, got {seed!r}")
-        if seed < 0:
-            raise InvalidParameterError(f"seed must be an integer >= 0, got {seed!r}")
-        rng = np.random.default_rng(int(seed))
+            raise InvalidParameterError(f"samples must be an integer > 0, got {shown(samples)}")
+        seed = check_int("seed", seed, minimum=0, floats=False)
+        rng = np.random.default_rng(seed)
         lo, hi = engine.ranges[:, 0], engine.ranges[:, 1]
         Q = lo + (hi - lo) * rng.random((int(samples), lo.size))
     else:

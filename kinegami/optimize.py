@@ -651,7 +651,7 @@ def compact(
         search runs from the leaves up (docs/trees.md); waypoints where the tree branches stay
         (they hold the junction).
     seed : int
-        Seed of the search; the result depends only on it (and on ``time_limit``, when the
+        Seed of the search (>= 0); the result depends only on it (and on ``time_limit``, when the
         limit cuts the search short), not on the executor (up to the last bit of rounding,
         which numpy may do differently in another process).
     motion : bool
@@ -693,7 +693,7 @@ def compact(
         raise InvalidTypeError(
             f"chain must be a KinematicChain or a KinematicTree, got {type(chain).__name__}"
         )
-    seed = check_int("seed", seed)
+    seed = check_int("seed", seed, minimum=0)  # numpy seeds are >= 0
     motion = check_bool("motion", motion)
     if motion and isinstance(chain, KinematicTree):
         raise InvalidParameterError(

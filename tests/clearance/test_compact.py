@@ -166,6 +166,12 @@ def test_compaction_error_when_no_start_is_clear(monkeypatch):
         ({"objective": "volume"}, InvalidParameterError, "objective must be 'length' or 'ball'"),
         ({"starts": 0}, InvalidParameterError, "starts"),
         ({"seed": "x"}, InvalidTypeError, "seed"),
+        ({"seed": 1.5}, InvalidTypeError, "seed must be an integer, got 1.5"),
+        ({"seed": None}, InvalidTypeError, "seed must be an integer, got None"),
+        ({"seed": True}, InvalidTypeError, "seed must be an integer, got True"),
+        ({"seed": -1}, InvalidParameterError, "seed must be an integer >= 0, got -1"),
+        ({"seed": np.int64(-7)}, InvalidParameterError, "seed must be an integer >= 0, got -7"),
+        ({"seed": -(10**5000)}, InvalidParameterError, "seed must be an integer >= 0, got <a"),
     ],
 )
 def test_bad_arguments(kwargs, error, words):

@@ -409,4 +409,5 @@ def test_compact_keeps_names_and_shortens(model):
 
 def test_compact_with_bad_options_is_refused(model):
     assert "objective" in model.compact(objective="short").reason
+    assert "seed must be an integer >= 0, got -1" in model.compact(seed=-1).reason
     assert not model.compact(colour="red").ok

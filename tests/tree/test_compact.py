@@ -130,6 +130,12 @@ def test_a_clear_tree_whose_sockets_do_not_fit_is_refused_by_name_or_repaired():
     assert_same_kinematics(tree, repaired)
 
 
+@pytest.mark.parametrize("seed", [-1, np.int64(-1), -(10**5000)], ids=["int", "numpy", "huge"])
+def test_a_negative_seed_is_refused(seed):
+    with pytest.raises(InvalidParameterError, match="seed must be an integer >= 0, got -1|got <a"):
+        compact(quiet_hand(), seed=seed)
+
+
 def test_motion_is_refused_for_trees():
     with pytest.raises(InvalidParameterError, match="chains only"):
         compact(quiet_hand(), motion=True)
