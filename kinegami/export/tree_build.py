@@ -106,6 +106,8 @@ def write_tree_files(
             for sheet, label in zip(fabrication.sheets, labels, strict=True):
                 path = folder / f"{stem}_sheet_{sheet.index}.{fmt}"
                 extra = {} if fmt == "fold" else {"label": label}
+                if fmt == "fold" and getattr(sheet.pattern, "frame", None) is None:
+                    extra["frame"] = sheet.frame  # folded in the tree's world frame
                 registry.export(sheet.pattern, path, units=units, **extra)
                 written.append(path)
         elif fmt == "pdf":

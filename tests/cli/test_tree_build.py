@@ -265,6 +265,37 @@ def test_the_takeoff_fold_files_meet_in_the_world(takeoff_build, takeoff_fabrica
         assert gap.max() <= 1e-6  # mm; measured 1e-13
 
 
+def test_the_connector_build_fold_files_start_where_their_sheets_start(hand_build):
+    """As the take-off sheets: every sheet's FOLD file is folded in the tree's world frame, its
+    proximal polygon centred on the sheet's frame (mm), its axis along the frame's x."""
+    import warnings
+
+    from kinegami.design import load_design_with_info
+    from kinegami.errors import ClearanceWarning
+    from kinegami.tree.sheets import fabricate, fit_junctions
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        tree, info = load_design_with_info(HAND)
+    fabrication = fabricate(fit_junctions(tree)[0], twistPortion=info.twistPortion)
+    _, out, _ = hand_build
+    for sheet in fabrication.sheets:
+        data = json.loads((out / f"hand_sheet_{sheet.index}.fold").read_text())
+        flat = np.array(data["vertices_coords"])
+        folded = np.array(data["file_frames"][0]["vertices_coords"])
+        pattern = sheet.pattern
+        base = pattern.vertices_coords[pattern.proximalBase] * MM
+        at = [int(np.argmin(np.hypot(*(flat - p).T))) for p in base]
+        assert np.hypot(*(flat[at] - base).T).max() <= 1e-9  # the base vertices themselves
+        ring = folded[at]
+        frame = np.asarray(sheet.frame)
+        np.testing.assert_allclose(ring.mean(axis=0), frame[:3, 3] * MM, atol=1e-6)
+        # the ring lies in the plane normal to the path direction, at radius r
+        np.testing.assert_allclose((ring - frame[:3, 3] * MM) @ frame[:3, 0], 0.0, atol=1e-6)
+        np.testing.assert_allclose(np.linalg.norm(ring - frame[:3, 3] * MM, axis=1), MM,
+                                   rtol=1e-9)  # fmt: skip
+
+
 def test_an_unknown_junction_kind_is_a_one_line_error(tmp_path, capsys):
     assert main_in_process("build", HAND, "-o", tmp_path, "--junctions", "glue") == 1
     err = capsys.readouterr().err.strip().splitlines()
