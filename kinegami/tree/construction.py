@@ -53,7 +53,15 @@ from kinegami.joints import (
     pose_array,
 )
 from kinegami.tree.model import KinematicTree
-from kinegami.validation import check_bool, check_real, shown
+from kinegami.validation import (
+    R_MAX,
+    R_MIN,
+    check_bool,
+    check_num_sides,
+    check_radius,
+    check_real,
+    shown,
+)
 
 __all__ = [
     "JointSpecification",
@@ -386,7 +394,9 @@ def _from_document(data, file=None) -> JointSpecification:
         if key not in data:
             raise DesignError(f"missing (a joint specification needs {key!r})", field=key,
                               file=file)  # fmt: skip
-    r, n = data["r"], data["numSides"]
+    radius = f"a number in [{R_MIN:g}, {R_MAX:g}] (the tube radius)"
+    r = _top_level(data, "r", check_radius, radius, file)
+    n = _top_level(data, "numSides", check_num_sides, "an even integer >= 4", file)
     entries = data["joints"]
     if not isinstance(entries, Sequence) or isinstance(entries, str) or not entries:
         raise DesignError("must be a non-empty list of joints", field="joints", file=file)
@@ -428,17 +438,23 @@ def _from_document(data, file=None) -> JointSpecification:
                 T = T @ _motion(step, f"{where}.relative_pose[{k}]", file)
             if parent >= 0:
                 T = joints[parent].pose_matrix @ T
+            pose_field = f"{where}.relative_pose"
         elif "pose" in entry:
             T = entry["pose"]
+            pose_field = f"{where}.pose"
         else:
             raise DesignError("needs a relative_pose or a pose", field=where, file=file)
+        try:
+            T = pose_array(T, "pose", r)
+        except (InvalidParameterError, InvalidTypeError) as error:
+            reason = str(error).removeprefix("pose ")  # "must be ...", "translation must ..."
+            raise DesignError(reason, field=pose_field, file=file) from None
         params = entry.get("params", {})
         if not isinstance(params, Mapping):
             raise DesignError("must be an object", field=f"{where}.params", value=params,
                               file=file)  # fmt: skip
         try:
-            joint = _JOINT_TYPES[kind](numSides=n, r=r, Pose=pose_array(T, f"{where}.pose"),
-                                       **params)  # fmt: skip
+            joint = _JOINT_TYPES[kind](numSides=n, r=r, Pose=T, **params)
         except TypeError as error:
             raise DesignError(f"wrong parameters for {kind}: {error}", field=f"{where}.params",
                               value=dict(params), file=file) from None  # fmt: skip
@@ -447,22 +463,74 @@ def _from_document(data, file=None) -> JointSpecification:
         joints.append(joint)
         parents.append(parent)
         names.append(name)
-    placement = data.get("placement") or {}
-    direction = placement.get("growth_direction") if isinstance(placement, Mapping) else None
+    direction = _growth_direction(data, file)
     try:
         return JointSpecification(joints, parents, names, direction)
     except ValueError as error:
         raise DesignError(str(error), file=file) from None
 
 
+def _top_level(data: Mapping, key: str, check, valid: str, file):
+    """``data[key]`` checked by ``check`` (a kinegami.validation check), else a DesignError at
+    ``key`` saying that it must be ``valid``."""
+    value = data[key]
+    try:
+        return check(value)
+    except (InvalidParameterError, InvalidTypeError):
+        raise DesignError(f"must be {valid}", field=key, value=value, file=file) from None
+
+
+def _growth_direction(data: Mapping, file) -> list | None:
+    """``placement.growth_direction`` of a joint specification document (None if absent), as
+    given (:class:`JointSpecification` makes it a unit vector); DesignError naming the field."""
+    placement = data.get("placement")
+    if placement is None:
+        return None
+    if not isinstance(placement, Mapping):
+        raise DesignError("must be an object", field="placement", value=placement, file=file)
+    direction = placement.get("growth_direction")
+    if direction is None:
+        return None
+    field = "placement.growth_direction"
+    numbers = (
+        isinstance(direction, Sequence)
+        and not isinstance(direction, str)
+        and len(direction) == 3
+        and all(isinstance(c, int | float) and not isinstance(c, bool) for c in direction)
+    )
+    if not numbers:
+        raise DesignError(
+            "must be a list [x, y, z] of three numbers (the growth direction)",
+            field=field,
+            value=direction,
+            file=file,
+        )
+    try:
+        _unit_direction(direction, field)
+    except InvalidParameterError:
+        if all(c == 0 for c in direction):
+            reason = "must be a nonzero vector (the growth direction)"
+        else:
+            reason = "must be a vector of finite numbers (the growth direction)"
+        raise DesignError(reason, field=field, value=direction, file=file) from None
+    return list(direction)
+
+
 # --- the growth direction ----------------------------------------------------------------------
 def _unit_direction(value, name: str = "growth_direction") -> np.ndarray:
     try:
         v = np.array(value, dtype=float)
+    except OverflowError:  # a Python int beyond the float range
+        raise InvalidParameterError(
+            f"{name} must be a finite 3-vector, got {shown(value)}"
+        ) from None
     except (TypeError, ValueError):
         raise InvalidTypeError(f"{name} must be a 3-vector, got {shown(value)}") from None
     if v.shape != (3,) or not np.all(np.isfinite(v)):
         raise InvalidParameterError(f"{name} must be a finite 3-vector, got {shown(value)}")
+    items = value.tolist() if isinstance(value, np.ndarray) else value
+    if any(isinstance(c, bool | np.bool_ | str | bytes) for c in items):  # numbers only
+        raise InvalidTypeError(f"{name} must be a 3-vector of numbers, got {shown(value)}")
     norm = math.sqrt(float(v @ v))
     if norm < 1e-12:
         raise InvalidParameterError(f"{name} must be a nonzero 3-vector, got {shown(value)}")

@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation
 
 import kinegami.tree
 from kinegami import EndTip, ExtendedRevoluteJoint, PrismaticJoint, RevoluteJoint, Waypoint
-from kinegami.errors import DesignError, InvalidParameterError, JointIndexError
+from kinegami.errors import DesignError, InvalidParameterError, InvalidTypeError, JointIndexError
 from kinegami.geometry.balls import Ball
 from kinegami.geometry.csc import solve_csc
 from kinegami.tree.construction import (
@@ -377,6 +377,104 @@ def test_a_growth_direction_orthogonal_to_an_axis_is_refused():
         from_specification(spec, growth_direction=(1, 0, 0))
     with pytest.raises(InvalidParameterError, match="growth_direction"):
         from_specification(spec, growth_direction=(0, 0, 0))
+
+
+def _small_document(**changes) -> dict:
+    """A two-joint joint specification document, with top-level fields replaced."""
+    document = {
+        "format": "kinegami.joint_tree/1",
+        "r": 1,
+        "numSides": 4,
+        "placement": {"growth_direction": [0, 0, 1]},
+        "joints": [
+            {"name": "root", "type": "Waypoint", "parent": -1, "relative_pose": []},
+            {"name": "tip", "type": "EndTip", "parent": 0, "params": {"length": 1},
+             "relative_pose": [["Trans", [0, 0, 4]]]},
+        ],
+    }  # fmt: skip
+    document.update(changes)
+    return document
+
+
+def _with_tip_pose(**pose) -> dict:
+    document = _small_document()
+    del document["joints"][1]["relative_pose"]
+    document["joints"][1].update(pose)
+    return document
+
+
+def _growth(direction) -> dict:
+    return _small_document(placement={"growth_direction": direction})
+
+
+@pytest.mark.parametrize(
+    ("document", "field", "reason"),
+    [
+        (_growth("up"), "placement.growth_direction", "must be a list [x, y, z] of three numbers"),
+        (_growth([1, "a", 0]), "placement.growth_direction", "of three numbers"),
+        (_growth([True, False, False]), "placement.growth_direction", "of three numbers"),
+        (_growth([1, 0]), "placement.growth_direction", "of three numbers"),
+        (_growth([[1, 0, 0]]), "placement.growth_direction", "of three numbers"),
+        (_growth({"x": 1}), "placement.growth_direction", "of three numbers"),
+        (_growth([0, 0, 0]), "placement.growth_direction", "must be a nonzero vector"),
+        (_growth([0.0, -0.0, 0]), "placement.growth_direction", "must be a nonzero vector"),
+        (_growth([1, 0, math.inf]), "placement.growth_direction", "of finite numbers"),
+        (_growth([10**400, 0, 1]), "placement.growth_direction", "of finite numbers"),
+        (_small_document(placement=[0, 0, 1]), "placement", "must be an object"),
+        (_small_document(placement="up"), "placement", "must be an object"),
+        (_small_document(r="1"), "r", "must be a number in [1e-06, 1e+06] (the tube radius)"),
+        (_small_document(r=None), "r", "must be a number in"),
+        (_small_document(r=True), "r", "must be a number in"),
+        (_small_document(r=-1), "r", "must be a number in"),
+        (_small_document(r=1e7), "r", "must be a number in"),
+        (_small_document(numSides="4"), "numSides", "must be an even integer >= 4"),
+        (_small_document(numSides=5), "numSides", "must be an even integer >= 4"),
+        (_small_document(numSides=4.5), "numSides", "must be an even integer >= 4"),
+        (_small_document(numSides=True), "numSides", "must be an even integer >= 4"),
+        (_with_tip_pose(pose="x"), "joints[1].pose", "must be an SE3 or a 4x4 array"),
+        (_with_tip_pose(pose=[[1, 0, 0, 0]]), "joints[1].pose", "must be a 4x4 rigid transform"),
+        (_with_tip_pose(relative_pose=[["Trans", [1e7, 0, 0]]]), "joints[1].relative_pose",
+         "translation must be within"),
+    ],  # fmt: skip
+)
+def test_a_bad_specification_file_names_the_file_and_the_field(tmp_path, document, field, reason):
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps(document), encoding="utf-8")
+    with pytest.raises(DesignError) as caught:
+        load_joint_specification(path)
+    error = caught.value
+    assert (error.file, error.field) == (str(path), field)
+    assert str(error).startswith(f"{path}: {field}: ")
+    assert reason in str(error)
+    assert "\n" not in str(error)
+
+
+def test_a_good_specification_file_keeps_its_values(tmp_path):
+    path = tmp_path / "spec.json"
+    document = _small_document(numSides=4.0, r=0.5, placement={"growth_direction": [0, 0, 2]})
+    path.write_text(json.dumps(document))
+    spec = load_joint_specification(path)
+    assert (spec.numSides, spec.r, type(spec.numSides)) == (4, 0.5, int)
+    assert spec.growth_direction.tolist() == [0.0, 0.0, 1.0]
+    assert spec.Joints[1].pose_matrix[:3, 3].tolist() == [0.0, 0.0, 4.0]
+    for placement in (None, {}, {"growth_direction": None}):
+        path.write_text(json.dumps(_small_document(placement=placement)))
+        assert load_joint_specification(path).growth_direction is None
+
+
+@pytest.mark.parametrize(
+    ("direction", "error"),
+    [
+        ((True, False, True), InvalidTypeError),
+        (("0", "0", "1"), InvalidTypeError),
+        (np.array([True, False, True]), InvalidTypeError),
+        ((10**400, 0, 1), InvalidParameterError),
+    ],
+)
+def test_a_growth_direction_is_three_numbers(direction, error):
+    spec = JointSpecificationTree(Waypoint(4, 1, np.eye(4)))
+    with pytest.raises(error, match="growth_direction must be a"):
+        from_specification(spec, growth_direction=direction)
 
 
 def test_report_cylinder_contains():
