@@ -49,7 +49,7 @@ from kinegami.tree.takeoffs import (
     hole_name,
     place_takeoffs,
 )
-from kinegami.validation import check_twist_portion
+from kinegami.validation import check_twist_portion, shown
 
 __all__ = [
     "TreeSheet",
@@ -253,9 +253,29 @@ def _downstream(tree: KinematicTree) -> list[float]:
     return longest
 
 
+def _check_tree(tree) -> KinematicTree:
+    """``tree``, or InvalidTypeError unless it is a KinematicTree (a chain says how to get one)."""
+    if not isinstance(tree, KinematicTree):
+        from kinegami.chain import KinematicChain
+
+        hint = (" (KinematicTree.from_chain(chain) is the tree of a chain)"
+                if isinstance(tree, KinematicChain) else "")  # fmt: skip
+        raise InvalidTypeError(f"tree must be a KinematicTree{hint}, got {type(tree).__name__}")
+    return tree
+
+
+def _check_connector_options(options) -> ConnectorOptions:
+    """``options``, the default ConnectorOptions for None, or InvalidTypeError."""
+    options = ConnectorOptions() if options is None else options
+    if not isinstance(options, ConnectorOptions):
+        raise InvalidTypeError(f"options must be ConnectorOptions, got {shown(options)}")
+    return options
+
+
 def default_trunks(tree: KinematicTree) -> dict[int, int]:
     """The trunk of every joint with several children: the child with the longest path to a
     leaf (ties: the smaller index)."""
+    _check_tree(tree)
     longest = _downstream(tree)
     return {k: max(kids, key=lambda c: (longest[c], -c))
             for k, kids in enumerate(tree.Children) if len(kids) > 1}  # fmt: skip
@@ -302,8 +322,9 @@ def choose_trunks(
     a sibling's socket would not fit with it and does fit as the trunk (the trunk needs no
     socket: its tube runs through the connector), in which case that sibling is the trunk.
     """
+    _check_tree(tree)
+    options = _check_connector_options(options)
     chosen = _check_trunks(tree, trunks)
-    options = ConnectorOptions() if options is None else options
     depth = options.resolved(tree.r).socket_depth
     problems: list[tuple[int, str]] = []
     for joint in sorted(chosen):
@@ -367,12 +388,9 @@ def fabricate(
         when a joint asked to be made with take-offs cannot be (the message names the joint and
         why); for a bad ``junction`` value.
     """
-    if not isinstance(tree, KinematicTree):
-        raise InvalidTypeError(f"tree must be a KinematicTree, got {type(tree).__name__}")
+    _check_tree(tree)
     twistPortion = check_twist_portion(twistPortion)
-    options = ConnectorOptions() if options is None else options
-    if not isinstance(options, ConnectorOptions):
-        raise InvalidTypeError(f"options must be ConnectorOptions, got {options!r}")
+    options = _check_connector_options(options)
     takeoff = TakeoffOptions() if takeoff is None else takeoff
     if not isinstance(takeoff, TakeoffOptions):
         raise InvalidTypeError(f"takeoff must be TakeoffOptions, got {takeoff!r}")
@@ -611,6 +629,9 @@ def fit_junctions(
 
     Raises
     ------
+    InvalidTypeError
+        When ``tree`` is not a KinematicTree (a chain: ``KinematicTree.from_chain``), or
+        ``options`` not ConnectorOptions.
     InvalidParameterError
         When no slide makes some socket fit (the message names the joint).
     """
@@ -619,6 +640,8 @@ def fit_junctions(
 
     from kinegami.errors import ClearanceWarning, PlacementWarning
 
+    _check_tree(tree)
+    options = _check_connector_options(options)
     fitted = copy.copy(tree)
     moves: list[tuple[int, float]] = []
 

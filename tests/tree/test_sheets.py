@@ -17,6 +17,8 @@ from kinegami import (
     ClearanceWarning,
     EndTip,
     InvalidParameterError,
+    InvalidTypeError,
+    KinematicChain,
     KinematicTree,
     LinkCSC,
     RevoluteJoint,
@@ -27,6 +29,7 @@ from kinegami.tree.sheets import (
     choose_trunks,
     default_trunks,
     fabricate,
+    fit_junctions,
     junction_problems,
 )
 
@@ -208,3 +211,34 @@ def test_default_labels_give_lengths_as_multiples_of_r():
         found = re.search(r"([0-9.]+) r along its link", sheet.label(tree))
         assert found, sheet.label(tree)
         assert abs(float(found.group(1)) - sheet.start_arc / tree.r) < 0.01
+
+
+# --- bad input -----------------------------------------------------------------------------
+TREE_FUNCTIONS = [fit_junctions, junction_problems, choose_trunks, default_trunks, fabricate]
+
+
+@pytest.mark.parametrize("function", TREE_FUNCTIONS, ids=lambda f: f.__name__)
+@pytest.mark.parametrize(
+    ("value", "got"), [("x", "str"), (None, "NoneType"), (1, "int")], ids=["str", "None", "int"]
+)
+def test_a_tree_is_needed(function, value, got):
+    with pytest.raises(InvalidTypeError, match=f"^tree must be a KinematicTree, got {got}$"):
+        function(value)
+
+
+@pytest.mark.parametrize("function", TREE_FUNCTIONS, ids=lambda f: f.__name__)
+def test_a_chain_is_not_a_tree_and_the_message_says_how_to_get_one(function):
+    chain = KinematicChain.from_dh([(0, math.pi / 2, 0, 0), (0, 0, 4, 0)], 4, 1)
+    hint = r"\(KinematicTree\.from_chain\(chain\) is the tree of a chain\)"
+    with pytest.raises(InvalidTypeError, match=f"tree must be a KinematicTree {hint}, got Kinem"):
+        function(chain)
+    tree, moves = fit_junctions(KinematicTree.from_chain(chain))  # what the message says works
+    assert moves == [] and tree.Parents == chain.Parents
+
+
+@pytest.mark.parametrize("function", [fit_junctions, junction_problems, choose_trunks, fabricate],
+                         ids=lambda f: f.__name__)  # fmt: skip
+def test_connector_options_are_checked(function):
+    tree = KinematicTree(Waypoint(4, 1, SE3()))
+    with pytest.raises(InvalidTypeError, match="^options must be ConnectorOptions, got 'x'$"):
+        function(tree, options="x")
