@@ -57,6 +57,7 @@ from kinegami.validation import (
     R_MAX,
     R_MIN,
     check_bool,
+    check_int,
     check_num_sides,
     check_radius,
     check_real,
@@ -132,7 +133,15 @@ class JointSpecification:
 
     def __post_init__(self):
         joints = tuple(self.Joints)
-        parents = tuple(int(p) for p in self.Parents)
+        parents = self.Parents
+        if isinstance(parents, str | bytes) or not (
+            isinstance(parents, Sequence) or (isinstance(parents, np.ndarray) and parents.ndim == 1)
+        ):
+            raise InvalidTypeError(
+                "Parents must be a sequence of integers (one per joint, -1 for the root), "
+                f"got {shown(parents)}"
+            )
+        parents = tuple(check_int(f"Parents[{k}]", p, floats=False) for k, p in enumerate(parents))
         names = tuple(str(n) for n in self.names)
         if not joints:
             raise InvalidParameterError("a joint specification needs a root joint, got none")

@@ -482,3 +482,43 @@ def test_report_cylinder_contains():
     cylinder = tree.construction.cylinder
     assert cylinder.contains(Ball(np.zeros(3), 1.0))
     assert not cylinder.contains(Ball(np.array([0.0, 0.0, 5.0]), 1.0))
+
+
+def _two_waypoints():
+    from kinegami.joints import Waypoint
+
+    above = np.eye(4)
+    above[2, 3] = 5.0
+    return [Waypoint(4, 1, np.eye(4)), Waypoint(4, 1, above)]
+
+
+@pytest.mark.parametrize(
+    "parents, words",
+    [
+        ([-1, 0.5], ["Parents[1]", "integer", "0.5"]),
+        ([-1, "0"], ["Parents[1]", "'0'"]),
+        ([-1, None], ["Parents[1]", "None"]),
+        ([-1, True], ["Parents[1]", "True"]),
+        ("x", ["Parents", "sequence of integers", "'x'"]),
+        (None, ["Parents", "sequence of integers", "None"]),
+    ],
+)
+def test_joint_specification_parents_must_be_integers(parents, words):
+    from kinegami.errors import InvalidTypeError
+    from kinegami.tree.construction import JointSpecification
+
+    joints = _two_waypoints()
+    with pytest.raises(InvalidTypeError) as info:
+        JointSpecification(joints, parents, ["a", "b"])
+    assert isinstance(info.value, TypeError)
+    for word in words:
+        assert word in str(info.value), (word, str(info.value))
+
+
+@pytest.mark.parametrize("parents", [[-1, 0], (-1, 0), np.array([-1, 0]), [-1, np.int64(0)]])
+def test_joint_specification_takes_integer_parents_of_any_kind(parents):
+    from kinegami.tree.construction import JointSpecification
+
+    joints = _two_waypoints()
+    spec = JointSpecification(joints, parents, ["a", "b"])
+    assert spec.Parents == (-1, 0) and all(type(p) is int for p in spec.Parents)
