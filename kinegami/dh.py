@@ -65,31 +65,48 @@ def dh_transform(theta: float, alpha: float, a: float, d: float, convention: str
     return rot_x(alpha) @ translation([a, 0.0, 0.0]) @ rot_z(theta) @ translation([0.0, 0.0, d])
 
 
+#: The columns of a DH table row, named in messages (``table row 0 theta``).
+_COLUMNS = ("theta", "alpha", "a", "d")
+
+
 def _check_table(table) -> np.ndarray:
+    """The table as an n x 4 float array; every entry is a finite real number (bools and
+    strings are not numbers: ``True`` or ``"1"`` raise InvalidTypeError naming the entry)."""
     if isinstance(table, str | bytes) or not hasattr(table, "__len__"):
         raise InvalidTypeError(
             f"table must be a sequence of rows (theta, alpha, a, d), got {type(table).__name__}"
         )
+    if (
+        isinstance(table, np.ndarray)
+        and table.dtype.kind in "iuf"
+        and table.ndim == 2
+        and table.shape[0] > 0
+        and table.shape[1] == 4
+    ):
+        rows = np.array(table, dtype=float)
+        if np.all(np.isfinite(rows)):
+            return rows  # else the row by row checks below name the entry
     rows = []
     for i, row in enumerate(table):
         try:
-            values = [float(v) for v in row]
-        except OverflowError:  # a Python int beyond the float range
-            raise InvalidParameterError(
-                f"table row {i} must be finite numbers (within +-1.8e308), got {shown(row)}"
-            ) from None
-        except (TypeError, ValueError):
+            if isinstance(row, str | bytes):  # its characters would be read as numbers
+                raise TypeError
+            entries = list(row)
+        except TypeError:
             raise InvalidTypeError(
                 f"table row {i} must be 4 numbers (theta, alpha, a, d), got {shown(row)}"
             ) from None
-        if len(values) != 4:
+        if len(entries) != 4:
             raise InvalidParameterError(
-                f"table row {i} must have 4 entries (theta, alpha, a, d), got {len(values)}: "
+                f"table row {i} must have 4 entries (theta, alpha, a, d), got {len(entries)}: "
                 f"{shown(row)}"
             )
-        if not all(math.isfinite(v) for v in values):
-            raise InvalidParameterError(f"table row {i} must be finite numbers, got {shown(row)}")
-        rows.append(values)
+        rows.append(
+            [
+                check_real(f"table row {i} {column} (table[{i}][{j}])", value)
+                for j, (column, value) in enumerate(zip(_COLUMNS, entries, strict=True))
+            ]
+        )
     if not rows:
         raise InvalidParameterError("table must have at least one row (theta, alpha, a, d)")
     return np.array(rows, dtype=float)

@@ -306,6 +306,62 @@ def test_bad_input(kwargs, error, words):
     assert words in str(info.value)
 
 
+# bools and strings are not numbers (as for dh_transform and design files): each names its
+# entry (row and column) and the value; numbers of every numeric type give the same chain
+@pytest.mark.parametrize(
+    ("table", "entry", "value"),
+    [
+        ([(True, 0, 0, 0)], "table row 0 theta (table[0][0])", "True"),
+        ([(0, 0, 5, 0), (0, False, 1, 0)], "table row 1 alpha (table[1][1])", "False"),
+        ([(np.bool_(True), 0, 5, 0)], "table row 0 theta (table[0][0])", "True"),
+        ([("0", "0", "1", "0")], "table row 0 theta (table[0][0])", "'0'"),
+        ([(0, 0, b"1", 0)], "table row 0 a (table[0][2])", "b'1'"),
+        ([(0, 0, 1, None)], "table row 0 d (table[0][3])", "None"),
+        ([(0, 0, 1 + 0j, 0)], "table row 0 a (table[0][2])", "(1+0j)"),
+        (np.array([[True, False, True, False]]), "table row 0 theta (table[0][0])", "True"),
+        (np.array([["0", "0", "1", "0"]]), "table row 0 theta (table[0][0])", "'0'"),
+        (np.array([[0, 0, 1, 0]], dtype=complex), "table row 0 theta (table[0][0])", "0j"),
+        (["0010"], "table row 0", "'0010'"),  # its characters are not 4 numbers either
+    ],
+    ids=(
+        "bool bool-row-1 numpy-bool strings bytes None complex bool-array string-array "
+        "complex-array string-row"
+    ).split(),
+)
+def test_table_entries_must_be_real_numbers(table, entry, value):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no ComplexWarning from numpy either
+        with pytest.raises(InvalidTypeError) as info:
+            KinematicChain.from_dh(table, 4, 1)
+        message = str(info.value)
+        assert entry in message and value in message, message
+        assert "must be" in message, message
+        with pytest.raises(InvalidTypeError):
+            dh_frames(table)
+
+
+def test_table_of_any_numeric_type_gives_the_same_chain(snapshot):
+    from fractions import Fraction
+
+    rows = [(0, 1, 2, 0), (1, 0, 3, -2), (0, -1, 0, 4)]
+    expected = snapshot(KinematicChain.from_dh([tuple(map(float, r)) for r in rows], 4, 1))
+    tables = [
+        rows,
+        [list(r) for r in rows],
+        tuple(rows),
+        np.array(rows),
+        np.array(rows, dtype=np.int8),
+        np.array(rows, dtype=np.float32),
+        np.array(rows, dtype=object),
+        list(np.array(rows, dtype=float)),
+        [tuple(np.int64(v) for v in r) for r in rows],
+        [tuple(np.float16(v) for v in r) for r in rows],
+        [tuple(Fraction(v) for v in r) for r in rows],
+    ]
+    for table in tables:
+        assert snapshot(KinematicChain.from_dh(table, 4, 1)) == expected, table
+
+
 # --- compact placement's other side (used by the PUMA's first joint) ----------------------
 def test_compact_tries_the_other_side_of_the_ball():
     """The tie case sends the joint to +z, where no link reaches it; the other side works."""
