@@ -15,7 +15,7 @@ import math
 import os
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence, Set
 
 import numpy as np
 
@@ -773,10 +773,24 @@ class KinematicChain(_JointAssembly):
         return self._accept("setJointState", joints, links)
 
     def setJointStates(self, states: Sequence[float]) -> bool:
-        """Set every joint's state at once (one value per joint); all-or-nothing."""
-        if len(states) != len(self._joints):
+        """Set every joint's state at once (one value per joint, in index order);
+        all-or-nothing.
+
+        ``states`` is a sequence (list, tuple, 1-D numpy array) of real numbers; anything else
+        (a number, None, a generator, a dict or a set, whose order is not the joints') raises
+        InvalidTypeError, as ``KinematicTree.setJointStates`` does.
+        """
+        try:
+            if isinstance(states, str | bytes | Mapping | Set):
+                raise TypeError
+            count = len(states)  # a 0-d numpy array has __len__ but raises TypeError
+        except TypeError:
+            raise InvalidTypeError(
+                f"states must be a sequence of numbers, got {shown(states)}"
+            ) from None
+        if count != len(self._joints):
             raise InvalidParameterError(
-                f"states must have one value per joint ({len(self._joints)}), got {len(states)}"
+                f"states must have one value per joint ({len(self._joints)}), got {count}"
             )
         values = [check_real(f"states[{i}]", s) for i, s in enumerate(states)]
         for i, (joint, s) in enumerate(zip(self._joints, values, strict=True)):

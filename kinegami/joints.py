@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import functools
 import math
+import numbers
 import sys
 from typing import TYPE_CHECKING
 
@@ -44,6 +45,7 @@ from kinegami.validation import (
     check_num_sides,
     check_radius,
     check_translation_part,
+    shown,
 )
 
 __all__ = [
@@ -78,11 +80,87 @@ def _is_se3(value) -> bool:
     return spatialmath is not None and isinstance(value, spatialmath.SE3)
 
 
+#: Kinds of numpy dtypes whose arrays are real numbers (signed, unsigned ints and floats).
+_REAL_KINDS = frozenset("iuf")
+#: Types of entries an object array (or a nested sequence) may hold, as check_real allows them.
+_REAL_TYPES = (numbers.Real, np.integer, np.floating)
+_NOT_REAL_TYPES = (bool, np.bool_)
+
+
+#: Entry types found real so far (issubclass with the abstract numbers.Real is slow).
+_KNOWN_REAL_TYPES = {int, float, np.float64, np.int64}
+
+
+def _is_real_type(t: type) -> bool:
+    if t in _KNOWN_REAL_TYPES:
+        return True
+    if issubclass(t, _REAL_TYPES) and not issubclass(t, _NOT_REAL_TYPES):
+        _KNOWN_REAL_TYPES.add(t)
+        return True
+    return False
+
+
+def _value_text(value) -> str:
+    """``value`` in a message, with its type (``str '1'``, ``bool True``; ``None``)."""
+    return "None" if value is None else f"{type(value).__name__} {shown(value)}"
+
+
+def _not_a_pose(name: str, got: str) -> InvalidTypeError:
+    return InvalidTypeError(
+        f"{name} must be an SE3 or a 4x4 array of real numbers (ints or floats), got {got}"
+    )
+
+
+def _real_entries(A: np.ndarray, name: str, what: str) -> None:
+    """Raise InvalidTypeError unless every entry of the object array ``A`` (``what``, in the
+    message) is a real number (bools, strings, complex numbers and None are not), naming the
+    first entry that is not."""
+    types = set(map(type, A.flat))
+    if types <= _KNOWN_REAL_TYPES or all(_is_real_type(t) for t in types):
+        return
+    if A.ndim == 0:
+        raise _not_a_pose(name, _value_text(A[()]))
+    for index in np.ndindex(A.shape):
+        value = A[index]
+        if not _is_real_type(type(value)):
+            entry = f"{name}{''.join(f'[{i}]' for i in index)}"
+            if isinstance(value, list | tuple | np.ndarray):  # np.array found no common shape
+                got = f"{what} whose rows differ in length ({entry} is {shown(value)})"
+            else:
+                got = f"{what} whose entry {entry} is {_value_text(value)}"
+            raise _not_a_pose(name, got)
+
+
+def _real_matrix(Pose, name: str) -> np.ndarray:
+    """``Pose`` (not an SE3) as a float array, or InvalidTypeError unless it is an array or a
+    nested sequence of real numbers (numpy's int and float dtypes; bool, complex, string
+    dtypes and None are refused). The shape is checked by the caller."""
+    if isinstance(Pose, np.ndarray):
+        kind = Pose.dtype.kind
+        if kind not in _REAL_KINDS:
+            if kind != "O":
+                raise _not_a_pose(name, f"an array of dtype {Pose.dtype} (shape {Pose.shape})")
+            _real_entries(Pose, name, f"an object array (shape {Pose.shape})")
+        return np.array(Pose, dtype=float)
+    if Pose is None or isinstance(Pose, str | bytes):
+        raise _not_a_pose(name, _value_text(Pose))
+    # a nested sequence: its entries as they are (np.array(..., dtype=float) would read the
+    # strings '1', and bools as 0/1), checked, then converted as np.array(Pose, dtype=float)
+    try:
+        A = np.array(Pose, dtype=object)
+    except (TypeError, ValueError):
+        raise _not_a_pose(name, type(Pose).__name__) from None
+    _real_entries(A, name, type(Pose).__name__)
+    return A.astype(float)
+
+
 def pose_array(Pose, name: str = "Pose", r: float | None = None) -> np.ndarray:
     """A validated 4x4 float array from an SE3 or a 4x4 array-like (proper rigid, finite).
 
-    With the tube radius ``r``, the translation must also lie within +-1e6 r in each
-    coordinate (:data:`kinegami.validation.LENGTH_FACTOR`).
+    An array-like is an array or nested sequence of real numbers: ints and floats (Python's,
+    numpy's); None, strings, bools and complex numbers raise InvalidTypeError. With the tube
+    radius ``r``, the translation must also lie within +-1e6 r in each coordinate
+    (:data:`kinegami.validation.LENGTH_FACTOR`).
     """
     if _is_se3(Pose):
         if len(Pose) != 1:
@@ -90,14 +168,10 @@ def pose_array(Pose, name: str = "Pose", r: float | None = None) -> np.ndarray:
         T = np.array(Pose.A, dtype=float)
     else:
         try:
-            T = np.array(Pose, dtype=float)
+            T = _real_matrix(Pose, name)
         except OverflowError:  # a Python int beyond the float range
             raise InvalidParameterError(
                 f"{name} must be finite, got an entry beyond the float range (+-1.8e308)"
-            ) from None
-        except (TypeError, ValueError):
-            raise InvalidTypeError(
-                f"{name} must be an SE3 or a 4x4 array, got {type(Pose).__name__}"
             ) from None
     if T.shape != (4, 4):
         raise InvalidParameterError(f"{name} must be a 4x4 rigid transform, got shape {T.shape}")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 
 import numpy as np
 import pytest
@@ -359,7 +360,82 @@ BAD_POSES = {
     "4x3": (lambda: np.eye(4)[:, :3], InvalidParameterError, "(4, 3)"),
     "vector": (lambda: np.zeros(16), InvalidParameterError, "(16,)"),
     "text": (lambda: "identity", InvalidTypeError, "str"),
+    # not real numbers (np.array(..., dtype=float) read them as numbers, bools as 0 and 1)
+    "None": (lambda: None, InvalidTypeError, "got None"),
+    "strings": (lambda: string_rows(), InvalidTypeError, "str '1'"),
+    "string array": (lambda: np.array(string_rows()), InvalidTypeError, "<U1"),
+    "bool array": (lambda: np.eye(4, dtype=bool), InvalidTypeError, "dtype bool"),
+    "bools in a list": (lambda: with_entry(True), InvalidTypeError, "[3][3] is bool True"),
+    "numpy bool in a list": (lambda: with_entry(np.bool_(True)), InvalidTypeError, "[3][3]"),
+    "complex array": (lambda: np.eye(4) + 0j, InvalidTypeError, "complex128"),
+    "complex in a list": (lambda: with_entry(1 + 0j), InvalidTypeError, "(1+0j)"),
+    "None in an object array": (
+        lambda: np.array(with_entry(None), dtype=object),
+        InvalidTypeError,
+        "[3][3] is None",
+    ),
+    "ragged rows": (lambda: np.eye(4).tolist()[:3] + [[0, 0, 1]], InvalidTypeError, "length"),
 }
+
+
+def string_rows():
+    """The identity moved to x = 5, in strings (was a valid pose)."""
+    return [["1", "0", "0", "5"], ["0", "1", "0", "0"], ["0", "0", "1", "0"], ["0", "0", "0", "1"]]
+
+
+def with_entry(value):
+    """The identity as nested lists with ``value`` as its last entry."""
+    rows = np.eye(4).tolist()
+    rows[3][3] = value
+    return rows
+
+
+@pytest.mark.parametrize(
+    "case", [case for case, (_, error, _) in BAD_POSES.items() if error is InvalidTypeError]
+)
+def test_pose_of_the_wrong_type_warns_nothing(case):
+    """No numpy warning (ComplexWarning) on the way to the InvalidTypeError."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InvalidTypeError):
+            RevoluteJoint(4, 1, math.pi, BAD_POSES[case][0]())
+
+
+def _valid_pose_forms():
+    """(name, pose) of the forms a valid pose may take, all the same integer transform."""
+    from fractions import Fraction
+
+    T = np.array([[0, -1, 0, 5], [1, 0, 0, -2], [0, 0, 1, 3], [0, 0, 0, 1]])
+    return [
+        ("SE3", SE3(T.astype(float))),
+        ("float array", T.astype(float)),
+        ("int array", T),
+        ("int8 array", T.astype(np.int8)),
+        ("float32 array", T.astype(np.float32)),
+        ("object array", np.array(T.tolist(), dtype=object)),
+        ("list of lists", T.tolist()),
+        ("tuple of tuples", tuple(map(tuple, T.tolist()))),
+        ("list of arrays", list(T.astype(float))),
+        ("numpy scalars", [[np.float64(v) for v in row] for row in T]),
+        ("fractions", [[Fraction(int(v)) for v in row] for row in T]),
+    ]
+
+
+def test_valid_pose_forms_give_the_same_joint_and_edit(example_1a_factory, snapshot):
+    forms = _valid_pose_forms()
+    expected = np.array(forms[1][1], dtype=float)
+    same = example_1a_factory()
+    same_result = same.transformJoint(4, SE3(expected))
+    for name, pose in forms:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            joint = RevoluteJoint(4, 1, math.pi, pose)
+            chain = example_1a_factory()
+            result = chain.transformJoint(4, pose)
+        assert joint.pose_matrix.tobytes() == expected.tobytes(), name
+        assert joint.pose_matrix.dtype == np.float64 and joint.pose_matrix.shape == (4, 4)
+        assert result == same_result, name
+        assert snapshot(chain) == snapshot(same), name
 
 
 @pytest.mark.parametrize("kind", CONSTRUCTORS)

@@ -796,6 +796,50 @@ def test_set_joint_states_is_all_or_nothing(example_1a, snapshot):
     assert snapshot(example_1a) == before
 
 
+@pytest.mark.parametrize(
+    "states",
+    [
+        3,
+        None,
+        "0000000",
+        b"0000000",
+        {0: 0.0, 1: 0.0, 2: 0.8, 3: 0.0, 4: 0.0, 5: 0.0, 6: 0.0},
+        {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6},
+        np.float64(0.0),
+        np.array(0.0),
+    ],
+    ids=["int", "None", "str", "bytes", "dict", "set", "numpy scalar", "0-d array"],
+)
+def test_set_joint_states_refuses_what_is_not_a_sequence(example_1a, snapshot, states):
+    """A dict's keys, a string's characters and a set in no order are not read as states."""
+    from kinegami import InvalidTypeError
+
+    before = snapshot(example_1a)
+    with pytest.raises(InvalidTypeError, match=r"^states must be a sequence of numbers, got "):
+        example_1a.setJointStates(states)
+    assert snapshot(example_1a) == before
+
+
+def test_set_joint_states_refuses_a_generator(example_1a, snapshot):
+    from kinegami import InvalidTypeError
+
+    before = snapshot(example_1a)
+    with pytest.raises(InvalidTypeError, match="states must be a sequence of numbers"):
+        example_1a.setJointStates(0.0 for _ in example_1a.Joints)
+    assert snapshot(example_1a) == before
+
+
+def test_set_joint_states_takes_a_tuple_and_an_array(example_1a_factory):
+    states = [0.0, 0.0, 0.8, 0.0, -1.1, 0.0, 0.0]
+    results = []
+    for form in (list, tuple, np.array):
+        chain = example_1a_factory()
+        with no_warnings():
+            assert chain.setJointStates(form(states)) is True
+        results.append([j.pose_matrix.tobytes() for j in chain.Joints])
+    assert results[0] == results[1] == results[2]
+
+
 def test_states_back_to_zero_restore_the_design(example_1a, chain_checker):
     design = [j.pose_matrix for j in example_1a.Joints]
     design_links = [(lk.start_frame, lk.end_frame) for lk in example_1a.Links]
