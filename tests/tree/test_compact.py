@@ -54,12 +54,16 @@ def assert_same_kinematics(before: KinematicTree, after: KinematicTree) -> None:
 def test_the_papers_hand_gets_shorter_and_clear():
     hand = quiet_hand()
     assert not hand.clearance().ok  # the palm nearly touches the tube to pointer1
-    shorter = compact(hand, executor=_serial(), starts=2)
+    # three starts: which start finds the short design depends on the last bits of rounding,
+    # which differ between machines (numpy picks SIMD code by CPU): on an AVX2 machine start 0
+    # ends at 34.09, longer than the input's 32.28, and start 2 at 27.05; on the machine this
+    # test was written on, start 0 was already shorter
+    shorter = compact(hand, executor=_serial(), starts=3)
     assert shorter.clearance().ok
     assert shorter.Parents == hand.Parents  # no waypoint to drop, none added
     assert shorter.totalPathLength() < hand.totalPathLength() - 1.0
     assert_same_kinematics(hand, shorter)
-    again = compact(hand, executor=_serial(), starts=2)
+    again = compact(hand, executor=_serial(), starts=3)
     assert tube_length(again) == tube_length(shorter)  # deterministic for a seed
 
 
