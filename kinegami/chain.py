@@ -515,7 +515,8 @@ class _JointAssembly:
         arrived at the parent (for a parent reached by a U-turn), then out of the plane of
         that U-turn on either side; then RADIAL_VARIANTS again, holding straight on until past
         every capsule of that tube before turning towards the joint (its U-turn fitting can
-        reach far behind the parent, where the joint may be)."""
+        reach far behind the parent, where the joint may be); last, escaping sideways and then
+        holding (the joint's axis runs beside the parent and the arriving tube crosses it)."""
         yield from RADIAL_VARIANTS
         A, d1 = distal[:3, 3], distal[:3, k]
         arrived = self._links[p]
@@ -532,6 +533,10 @@ class _JointAssembly:
         past = link_capsule_ends(arrived)
         for variant in RADIAL_VARIANTS:
             yield {**variant, "hold_past": past}
+        if float(np.linalg.norm(away)) >= 1e-9 * self.r:
+            for escape in (away, side, -side):
+                for variant in RADIAL_VARIANTS[:2]:  # a lead would only lengthen the hold
+                    yield {**variant, "escape": escape, "hold_past": past}
 
     def _cost(self, extended) -> tuple[float, float]:
         """(growth of the ball radius, length of the new links) of an extension."""

@@ -402,3 +402,30 @@ def test_safe_placement_of_the_hypothesis_counterexample_stays_clear():
     chain = build_safe(SAFE_PLACEMENT_OVERLAP)  # asserts chain.clearance().ok after each append
     # the last append holds straight on past link 4's fitting: W_a, W_h, W_b and the joint
     assert len(chain.Joints) == 9 and chain.clearance().min_clearance > 0.0
+
+
+#: Found by hypothesis: the last waypoint's axis runs beside the prismatic parent, which points
+#: into the ball, and the tube that arrived at the parent crosses that axis; every radial
+#: variant that only escapes or only holds crossed that tube (overlap up to 3.6).
+SAFE_PLACEMENT_BESIDE_THE_ARRIVING_TUBE = {
+    "r": 2.528515896590552, "n": 4, "max_angle": 1.2,
+    "root": ("R", ((0.0, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0))),
+    "steps": [
+        ("P", ((0.7864448866545142, -0.7509531609853322, -0.2013147998049878,
+                -0.5881194239359003), (-2.9930403621775756, 0.0, 0.0)), False, False),
+        ("W0", ((0.0, 0.0, 0.625, -0.4375),
+                (1.050419498470176, -8.476107698366055e-262, -2.289467002332747)), True, True),
+        ("P", ((0.21822482809548682, -0.4462683060296645, -0.8934381278992971,
+                -0.45820103094754516), (-1.1746470187978484, 0.0, -3.6543345030252095)),
+         False, False),
+        ("R", ((0.0, 0.4375, 0.0, 0.5), (0.0, 2.0, 2.0)), True, False),
+        ("P", ((0.875, 0.125, 0.0, 0.4375), (4.0, 3.0, 0.0)), False, False),
+        ("W0", ((0.0, 0.0, 0.0, -1.0), (0.0, 2.0, 0.0)), True, False),
+    ],
+}  # fmt: skip
+
+
+def test_safe_placement_escapes_and_holds_beside_the_arriving_tube():
+    chain = build_safe(SAFE_PLACEMENT_BESIDE_THE_ARRIVING_TUBE)  # asserts clearance per append
+    # the last append escapes sideways, turns onto m, holds past the arriving tube, then W_b
+    assert len(chain.Joints) == 19 and chain.clearance().min_clearance > 0.0
