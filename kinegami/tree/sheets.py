@@ -49,7 +49,7 @@ from kinegami.tree.takeoffs import (
     hole_name,
     place_takeoffs,
 )
-from kinegami.validation import check_twist_portion, shown
+from kinegami.validation import check_int, check_twist_portion, shown
 
 __all__ = [
     "TreeSheet",
@@ -282,24 +282,28 @@ def default_trunks(tree: KinematicTree) -> dict[int, int]:
 
 
 def _check_trunks(tree: KinematicTree, trunks) -> dict[int, int]:
+    """``trunks`` (None, or a mapping from branching joints to one of their children) checked
+    and merged over the default trunks; indices are integers (numpy's too), never bools."""
     chosen = default_trunks(tree)
     if trunks is None:
         return chosen
     if not isinstance(trunks, Mapping):
-        raise InvalidTypeError(f"trunks must map joints to children, got {trunks!r}")
+        raise InvalidTypeError(f"trunks must map joints to children, got {shown(trunks)}")
     children = tree.Children
-    for joint, child in trunks.items():
+    for key, value in trunks.items():
+        joint = check_int("trunks: a joint", key, floats=False)
         if joint not in chosen:
             raise InvalidParameterError(
-                f"trunks: joint {joint!r} does not branch (joints with several children: "
+                f"trunks: joint {shown(joint)} does not branch (joints with several children: "
                 f"{sorted(chosen)})"
             )
+        child = check_int(f"trunks[{joint}]", value, floats=False)
         if child not in children[joint]:
             raise InvalidParameterError(
-                f"trunks: {child!r} is not a child of joint {joint} (its children: "
+                f"trunks: {shown(child)} is not a child of joint {joint} (its children: "
                 f"{list(children[joint])})"
             )
-        chosen[joint] = int(child)
+        chosen[joint] = child
     return chosen
 
 
@@ -369,7 +373,8 @@ def fabricate(
 
     Parameters
     ----------
-    tree : KinematicTree (a chain gives one sheet and no junction).
+    tree : KinematicTree (one without branches gives one sheet and no junction; a
+        KinematicChain is refused: its tree is ``KinematicTree.from_chain(chain)``).
     trunks : ``{joint: child}`` for the joints whose trunk is not the default one.
     options : connector options (wall, clearance, socket depth; docs/junctions.md).
     twistPortion : fraction of each straight part taken by its twist fitting (default 0.2).

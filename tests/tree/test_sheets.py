@@ -88,6 +88,34 @@ def test_an_overridden_trunk():
         fabricate(slid_hand(), trunks={1: 2})
 
 
+@pytest.mark.parametrize(
+    ("trunks", "error", "message"),
+    [
+        ({0: True}, InvalidTypeError, r"trunks\[0\] must be an integer, got True"),
+        ({True: 1}, InvalidTypeError, "trunks: a joint must be an integer, got True"),
+        ({0: 1.0}, InvalidTypeError, r"trunks\[0\] must be an integer, got 1.0"),
+        ({"0": 1}, InvalidTypeError, "trunks: a joint must be an integer, got '0'"),
+        ({0: 10**5000}, InvalidParameterError, "integer of about 5001 digits"),
+        ({10**5000: 1}, InvalidParameterError, "integer of about 5001 digits"),
+        ([(0, 1)], InvalidTypeError, r"trunks must map joints to children, got \[\(0, 1\)\]"),
+    ],
+    ids=["bool child", "bool joint", "float child", "str joint", "huge child", "huge joint",
+         "list"],
+)
+def test_trunks_of_the_wrong_kind(trunks, error, message):
+    """Bools were read as 0/1, a huge index crashed repr(); each names what is wrong."""
+    hand = slid_hand()
+    with pytest.raises(error, match=message):
+        junction_problems(hand, trunks=trunks)
+
+
+def test_trunks_take_numpy_integers():
+    hand = slid_hand()
+    assert junction_problems(hand, trunks={np.int64(0): np.int64(5)}) == junction_problems(
+        hand, trunks={0: 5}
+    )
+
+
 def test_a_child_whose_socket_does_not_fit_becomes_the_trunk():
     hand = slid_hand()
     assert hand.translateJointAlongAxisOfMotion(1, 3.0)  # back where the paper has it
