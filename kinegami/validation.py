@@ -42,6 +42,12 @@ R_MAX = 1e6
 #: file) satisfies ``|value| <= LENGTH_FACTOR * r``. With r <= R_MAX, squares and products of
 #: such values stay far from the float range, and r stays well above their rounding error.
 LENGTH_FACTOR = 1e6
+#: Most polygon sides of a tube given to the API: far more than any foldable tube, and far below
+#: what would exhaust memory (at 256 sides, already, elbows and joints are too fine to resolve
+#: and say so). Design and joint-specification files allow at most FILE_NUM_SIDES_MAX.
+NUM_SIDES_MAX = 1024
+#: Most polygon sides in a design or joint-specification file (kinegami.design.limits).
+FILE_NUM_SIDES_MAX = 64
 def check_bool(name: str, value, none: bool = False) -> bool | None:
     """``value`` as a bool, or InvalidTypeError unless it is True or False (numpy's too).
 
@@ -185,8 +191,8 @@ def check_int(name: str, value, minimum: int | None = None, *, floats: bool = Tr
     return value
 
 
-def check_num_sides(value) -> int:
-    """The number of polygon sides: an even integer >= 4."""
+def check_num_sides(value, maximum: int = NUM_SIDES_MAX) -> int:
+    """The number of polygon sides: an even integer >= 4, at most ``maximum``."""
     try:
         n = check_int("numSides", value)
     except InvalidTypeError:
@@ -195,6 +201,10 @@ def check_num_sides(value) -> int:
         ) from None
     if n < 4 or n % 2:
         raise InvalidParameterError(f"numSides must be an even integer >= 4, got {shown(n)}")
+    if n > maximum:
+        raise InvalidParameterError(
+            f"numSides must be an even integer in [4, {maximum}], got {shown(n)}"
+        )
     return n
 
 

@@ -271,6 +271,20 @@ def test_num_sides_odd_or_too_small(kind, n):
 
 
 @pytest.mark.parametrize("kind", CONSTRUCTORS)
+@pytest.mark.parametrize("n", [1026, 10**30])
+def test_num_sides_too_many(kind, n):
+    """10**30 sides were accepted; the first pattern then failed deep in numpy."""
+    with pytest.raises(InvalidParameterError) as excinfo:
+        CONSTRUCTORS[kind](n=n)
+    check_error(excinfo, ValueError, "numSides", n)
+    assert "[4, 1024]" in str(excinfo.value)
+
+
+def test_num_sides_at_the_cap_build():
+    assert RevoluteJoint(1024, 1.0, math.pi, SE3()).numSides == 1024
+
+
+@pytest.mark.parametrize("kind", CONSTRUCTORS)
 @pytest.mark.parametrize("n", [4.5, "4", None, True])
 def test_num_sides_not_an_integer(kind, n):
     with pytest.raises(InvalidTypeError) as excinfo:

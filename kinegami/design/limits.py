@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 
 from kinegami.design.errors import DesignError, json_path
-from kinegami.validation import LENGTH_FACTOR, R_MAX, R_MIN
+from kinegami.validation import FILE_NUM_SIDES_MAX, LENGTH_FACTOR, R_MAX, R_MIN
 
 __all__ = [
     "NUM_SIDES_MAX",
@@ -48,8 +48,8 @@ __all__ = [
     "too_deep",
 ]
 
-#: Largest number of polygon sides of the tube.
-NUM_SIDES_MAX = 64
+#: Largest number of polygon sides of the tube (joint-specification files share it).
+NUM_SIDES_MAX = FILE_NUM_SIDES_MAX
 #: Largest number of sink layers of a revolute joint.
 NUM_SINK_LAYERS_MAX = 32
 #: Largest number of REBO layers of a prismatic joint.

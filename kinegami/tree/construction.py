@@ -54,6 +54,7 @@ from kinegami.joints import (
 )
 from kinegami.tree.model import KinematicTree
 from kinegami.validation import (
+    FILE_NUM_SIDES_MAX,
     R_MAX,
     R_MIN,
     check_bool,
@@ -405,7 +406,8 @@ def _from_document(data, file=None) -> JointSpecification:
                               file=file)  # fmt: skip
     radius = f"a number in [{R_MIN:g}, {R_MAX:g}] (the tube radius)"
     r = _top_level(data, "r", check_radius, radius, file)
-    n = _top_level(data, "numSides", check_num_sides, "an even integer >= 4", file)
+    n = _top_level(data, "numSides", _file_num_sides,
+                   f"an even integer >= 4 (at most {FILE_NUM_SIDES_MAX})", file)  # fmt: skip
     entries = data["joints"]
     if not isinstance(entries, Sequence) or isinstance(entries, str) or not entries:
         raise DesignError("must be a non-empty list of joints", field="joints", file=file)
@@ -477,6 +479,11 @@ def _from_document(data, file=None) -> JointSpecification:
         return JointSpecification(joints, parents, names, direction)
     except ValueError as error:
         raise DesignError(str(error), file=file) from None
+
+
+def _file_num_sides(value) -> int:
+    """numSides of a file: at most FILE_NUM_SIDES_MAX, as in design files."""
+    return check_num_sides(value, maximum=FILE_NUM_SIDES_MAX)
 
 
 def _top_level(data: Mapping, key: str, check, valid: str, file):

@@ -53,6 +53,16 @@ def test_bad_num_sides(fn, n):
 
 
 @pytest.mark.parametrize("fn", list(GOOD))
+@pytest.mark.parametrize("n", [1026, 10**30])
+def test_too_many_sides(fn, n):
+    """Was numpy's 'Maximum allowed size exceeded' (10**30) or minutes of work."""
+    with pytest.raises(
+        InvalidParameterError, match=r"numSides must be an even integer in \[4, 1024\], got "
+    ):
+        _call(fn, 0, n)
+
+
+@pytest.mark.parametrize("fn", list(GOOD))
 def test_num_sides_of_wrong_type(fn):
     with pytest.raises(InvalidTypeError, match="numSides"):
         _call(fn, 0, "6")

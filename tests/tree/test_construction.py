@@ -431,6 +431,9 @@ def _growth(direction) -> dict:
         (_small_document(numSides=5), "numSides", "must be an even integer >= 4"),
         (_small_document(numSides=4.5), "numSides", "must be an even integer >= 4"),
         (_small_document(numSides=True), "numSides", "must be an even integer >= 4"),
+        # as in design files (10**30 passed, then numpy failed deep in the first pattern)
+        (_small_document(numSides=66), "numSides", "must be an even integer >= 4 (at most 64)"),
+        (_small_document(numSides=10**30), "numSides", "(at most 64)"),
         (_with_tip_pose(pose="x"), "joints[1].pose", "must be an SE3 or a 4x4 array"),
         (_with_tip_pose(pose=[[1, 0, 0, 0]]), "joints[1].pose", "must be a 4x4 rigid transform"),
         (_with_tip_pose(relative_pose=[["Trans", [1e7, 0, 0]]]), "joints[1].relative_pose",
