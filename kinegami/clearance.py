@@ -603,7 +603,8 @@ def sweep(
         Number of configurations drawn uniformly from the joints' state ranges (> 0; ignored
         when ``configurations`` is given).
     seed : int
-        Seed of the random configurations (numpy ``default_rng``; >= 0).
+        Seed of the random configurations (numpy ``default_rng``; >= 0; ignored when
+        ``configurations`` is given).
     configurations : sequence of sequences of float, optional
         The configurations to test instead (absolute states, one per joint).
     names : joint names for the report, optional.

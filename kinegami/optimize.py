@@ -693,7 +693,7 @@ def compact(
         raise InvalidTypeError(
             f"chain must be a KinematicChain or a KinematicTree, got {type(chain).__name__}"
         )
-    seed = check_int("seed", seed, minimum=0)  # numpy seeds are >= 0
+    seed = check_int("seed", seed, minimum=0, floats=False)  # numpy seeds: ints >= 0, as sweep
     motion = check_bool("motion", motion)
     if motion and isinstance(chain, KinematicTree):
         raise InvalidParameterError(

@@ -167,6 +167,7 @@ def test_compaction_error_when_no_start_is_clear(monkeypatch):
         ({"starts": 0}, InvalidParameterError, "starts"),
         ({"seed": "x"}, InvalidTypeError, "seed"),
         ({"seed": 1.5}, InvalidTypeError, "seed must be an integer, got 1.5"),
+        ({"seed": 1.0}, InvalidTypeError, "seed must be an integer, got 1.0"),  # as sweep
         ({"seed": None}, InvalidTypeError, "seed must be an integer, got None"),
         ({"seed": True}, InvalidTypeError, "seed must be an integer, got True"),
         ({"seed": -1}, InvalidParameterError, "seed must be an integer >= 0, got -1"),
