@@ -2,7 +2,8 @@
 existed, and version-2 fields in a version-1 file are reported.
 
 The fingerprints (tests/design/data/version1_fingerprints.json) were computed before version 2
-existed, by :func:`fingerprint` on every version-1 design of the gallery and of tests/design/data.
+existed, by :func:`fingerprint` on every version-1 design of the gallery and of tests/design/data,
+on two kinds of machine (their last bits differ; see :func:`known`).
 """
 
 from __future__ import annotations
@@ -33,6 +34,15 @@ from . import DATA
 
 GALLERY = Path(__file__).resolve().parents[2] / "examples" / "designs"
 FINGERPRINTS = json.loads((DATA / "version1_fingerprints.json").read_text(encoding="utf-8"))
+
+
+def known(kind: str, name: str) -> set[str]:
+    """The fingerprints of design ``name`` (``kind`` "loaded" or "saved") computed before
+    version 2 existed, one per kind of machine: the last bits of a chain depend on the CPU
+    (numpy and OpenBLAS pick their SIMD code by it), so each machine kind has its own."""
+    return {FINGERPRINTS[kind][name]} | {
+        machine[kind][name] for machine in FINGERPRINTS.get("other_machines", ())
+    }
 
 
 def _hex(values) -> str:
@@ -80,13 +90,13 @@ def _quiet_load(path: Path):
 def test_version_1_designs_load_bit_for_bit_as_before(name):
     chain = _quiet_load(_path(name))
     assert type(chain) is KinematicChain
-    assert fingerprint(chain) == FINGERPRINTS["loaded"][name]
+    assert fingerprint(chain) in known("loaded", name)
 
 
 @pytest.mark.parametrize("name", sorted(FINGERPRINTS["saved"]))
 def test_version_1_designs_save_the_same_text_as_before(name):
     text = dumps_design(design_to_dict(load_design(GALLERY / name), name="x"))
-    assert hashlib.sha256(text.encode()).hexdigest() == FINGERPRINTS["saved"][name]
+    assert hashlib.sha256(text.encode()).hexdigest() in known("saved", name)
     assert json.loads(text)["version"] == 1 and "structure" not in text
 
 
@@ -101,7 +111,7 @@ def test_a_version_1_design_written_as_version_2_is_the_same_chain(name):
     document["version"] = 2
     chain = chain_from_dict(document)
     assert type(chain) is KinematicChain
-    assert fingerprint(chain) == FINGERPRINTS["loaded"][name]
+    assert fingerprint(chain) in known("loaded", name)
 
 
 def _joints_design(name: str) -> dict:
