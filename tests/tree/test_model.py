@@ -313,6 +313,27 @@ def test_safe_siblings_are_clear(children):
     assert len(tree.Children[0]) == len(children)
 
 
+def test_a_child_of_a_waypoint_inside_a_junction_is_refused_or_warned():
+    """Found by a stress run: the root's second child runs within r of the waypoint that safe
+    placement put r beyond the root; a child of that waypoint cannot be clear (docs/trees.md).
+    requireClearance refuses it and leaves the tree as it was; otherwise it is warned."""
+    for require in (True, False):
+        tree = KinematicTree(Waypoint(4, 1, SE3()), requireClearance=require)
+        for _ in range(2):
+            tree.addJoint(0, RevoluteJoint(4, 1, math.pi, np.eye(4)), relative=False)
+        assert tree.clearance().ok and isinstance(tree.Joints[1], Waypoint)
+        assert tree.Parents == (-1, 0, 1, 0, 3, 4, 5)
+        before = (tree.Parents, [j.pose_matrix.tobytes() for j in tree.Joints])
+        if require:
+            with pytest.warns(PlacementWarning, match="would pass through itself"):
+                assert tree.addJoint(1, RevoluteJoint(4, 1, math.pi, np.eye(4)), False) is None
+            assert (tree.Parents, [j.pose_matrix.tobytes() for j in tree.Joints]) == before
+        else:
+            with pytest.warns(ClearanceWarning, match="passes through itself"):
+                assert tree.addJoint(1, RevoluteJoint(4, 1, math.pi, np.eye(4)), False) == 10
+            assert not tree.clearance().ok
+
+
 def test_four_identical_safe_siblings_are_placed_and_clear():
     tree = KinematicTree(Waypoint(4, 1, SE3()), requireClearance=True)
     pose = SE3.Trans(3, 0, 4) * SE3.Ry(math.pi / 2)
