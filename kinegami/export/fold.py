@@ -222,49 +222,78 @@ def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
 
     e = pattern.edges_vertices
     labels = pattern.edges_assignment
-    edges: list[tuple[int, int]] = []
-    assignment: list[str] = []
-    crease: list[int] = []
     start = v[e[:, 0]]
     dx = periodic_dx(v[e[:, 1], 0] - start[:, 0], W)
-    # the loop reads Python floats and ints (the same values, without numpy's per-item cost)
+    # every crease at the shifts 0, +W, -W (in that order, crease by crease): its ends a, c
+    x0 = start[:, 0]
+    a = x0[:, None] + shifts[None, :]
+    c = (x0 + dx)[:, None] + shifts[None, :]
+    lo, hi = np.minimum(a, c), np.maximum(a, c)
+    on_sheet = ~((hi < xmin + tol) | (lo > xmax - tol))  # else outside, or touching an edge
+    # a piece lying on a vertical edge of the sheet is the outline
+    on_sheet &= ~((np.abs(c - a) <= tol) & ((np.abs(a - xmin) <= tol) | (np.abs(a - xmax) <= tol)))
+    a_in = (xmin - tol <= a) & (a <= xmax + tol)
+    c_in = (xmin - tol <= c) & (c <= xmax + tol)
+    u_all, w_all = e[:, 0], e[:, 1]
+    # pieces with both ends on the sheet: each end is the copy of its vertex at the shift
+    # nearest to where the piece puts it (the first nearest, as argmin), all at once
+    whole = on_sheet & a_in & c_in
+    i_whole, s_whole = np.nonzero(whole)
+    u_w, w_w = u_all[i_whole], w_all[i_whole]
+    k_a = np.argmin(np.abs(shifts[None, :] - (a[i_whole, s_whole] - v[u_w, 0])[:, None]), axis=1)
+    k_c = np.argmin(np.abs(shifts[None, :] - (c[i_whole, s_whole] - v[w_w, 0])[:, None]), axis=1)
+    ends_a, ends_c = copy_index[k_a, u_w], copy_index[k_c, w_w]
+    if ends_a.size and min(int(ends_a.min()), int(ends_c.min())) < 0:  # pragma: no cover
+        raise FoldExportError("a crease ends at a vertex missing from the sheet")
+    xs_a, xs_c = cx[k_a, u_w], cx[k_c, w_w]
+    keep = ~((np.maximum(xs_a, xs_c) <= xmin + tol) | (np.minimum(xs_a, xs_c) >= xmax - tol))
+    keep &= ends_a != ends_c
+    order = [i_whole[keep] * 3 + s_whole[keep]]
+    found_a, found_c = [ends_a[keep]], [ends_c[keep]]
+    # pieces with an end beyond the sheet: clipped there, one by one in crease order (clip
+    # points are numbered in the order they are first met)
     vx, vy = v[:, 0].tolist(), v[:, 1].tolist()
     copies, copy_x = copy_index.tolist(), cx.tolist()
     shift_values = shifts.tolist()
-    x0s, dxs, labels_list = start[:, 0].tolist(), dx.tolist(), labels.tolist()
-    for i, (u, w) in enumerate(e.tolist()):
-        x0, y_0 = x0s[i], vy[u]
-        x1, y_1 = x0 + dxs[i], vy[w]
-        for s in (0.0, W, -W):
-            a, c = x0 + s, x1 + s
-            lo, hi = min(a, c), max(a, c)
-            if hi < xmin + tol or lo > xmax - tol:
-                continue  # outside, or touching the sheet only on a vertical edge
-            if abs(c - a) <= tol and (abs(a - xmin) <= tol or abs(a - xmax) <= tol):
-                continue  # lies on a vertical edge of the sheet: that is the outline
-            ends = []
-            xs = []
-            for x_end, vert in ((a, u), (c, w)):
-                if xmin - tol <= x_end <= xmax + tol:
-                    shift = x_end - vx[vert]
-                    gaps = [abs(value - shift) for value in shift_values]
-                    k = gaps.index(min(gaps))  # the first nearest, as numpy's argmin
-                    ends.append(copies[k][vert])
-                    xs.append(copy_x[k][vert])
-                else:
-                    edge_x = xmin if x_end < xmin else xmax
-                    t = (edge_x - a) / (c - a)
-                    ends.append(clip_vertex(edge_x, y_0 + t * (y_1 - y_0), u, w, t))
-                    xs.append(edge_x)
-            if min(ends) < 0:  # pragma: no cover - copies and clipping use the same tolerance
-                raise FoldExportError(f"crease {i} ends at a vertex missing from the sheet")
-            if max(xs) <= xmin + tol or min(xs) >= xmax - tol:
-                continue  # the piece inside lies on a vertical edge: that is the outline
-            if ends[0] == ends[1]:
-                continue
-            edges.append((ends[0], ends[1]))
-            assignment.append(labels_list[i])
-            crease.append(i)
+    clipped_order, clipped_a, clipped_c = [], [], []
+    i_clip, s_clip = np.nonzero(on_sheet & ~(a_in & c_in))
+    for i, k_s in zip(i_clip.tolist(), s_clip.tolist(), strict=True):
+        u, w = int(u_all[i]), int(w_all[i])
+        a_i, c_i = float(a[i, k_s]), float(c[i, k_s])
+        y_0, y_1 = vy[u], vy[w]
+        ends = []
+        xs = []
+        for x_end, vert in ((a_i, u), (c_i, w)):
+            if xmin - tol <= x_end <= xmax + tol:
+                shift = x_end - vx[vert]
+                gaps = [abs(value - shift) for value in shift_values]
+                k = gaps.index(min(gaps))  # the first nearest, as numpy's argmin
+                ends.append(copies[k][vert])
+                xs.append(copy_x[k][vert])
+            else:
+                edge_x = xmin if x_end < xmin else xmax
+                t = (edge_x - a_i) / (c_i - a_i)
+                ends.append(clip_vertex(edge_x, y_0 + t * (y_1 - y_0), u, w, t))
+                xs.append(edge_x)
+        if min(ends) < 0:  # pragma: no cover - copies and clipping use the same tolerance
+            raise FoldExportError(f"crease {i} ends at a vertex missing from the sheet")
+        if max(xs) <= xmin + tol or min(xs) >= xmax - tol:
+            continue  # the piece inside lies on a vertical edge: that is the outline
+        if ends[0] == ends[1]:
+            continue
+        clipped_order.append(i * 3 + k_s)
+        clipped_a.append(ends[0])
+        clipped_c.append(ends[1])
+    order.append(np.array(clipped_order, dtype=np.intp))
+    found_a.append(np.array(clipped_a, dtype=np.intp))
+    found_c.append(np.array(clipped_c, dtype=np.intp))
+    order_all = np.concatenate(order)
+    by_piece = np.argsort(order_all, kind="stable")  # crease by crease, shift by shift
+    piece_crease = (order_all[by_piece] // 3).tolist()
+    edges = list(zip(np.concatenate(found_a)[by_piece].tolist(),
+                     np.concatenate(found_c)[by_piece].tolist(), strict=True))  # fmt: skip
+    assignment = labels[piece_crease].tolist() if piece_crease else []
+    crease = piece_crease
     # sheet corners that are no vertex (the distal base is shifted after a twist): a point of
     # the straight edge between the two nearest vertices on that end of the pattern
     for cy in (y0, y0 + H):
