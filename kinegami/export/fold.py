@@ -565,9 +565,7 @@ def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float | None):
     face_of = np.full(2 * m, -1)
     visited = bytearray(2 * m)
     following = nxt.tolist()  # the cycles are traced on Python ints (no numpy per-item cost)
-    faces = []
-    areas = []  # of the faces
-    outer = []
+    cycles = []
     for h0 in range(2 * m):
         if visited[h0]:
             continue
@@ -577,11 +575,26 @@ def _faces(P: np.ndarray, E: np.ndarray, sheet_area: float | None):
             visited[h] = 1
             cycle.append(h)
             h = following[h]
-        cycle = np.array(cycle)
-        verts = tail[cycle]
-        area = _signed_area(P[verts])
+        cycles.append(cycle)
+    # every cycle's shoelace area at once, each relative to its first corner (_signed_area)
+    lengths = np.array([len(cycle) for cycle in cycles], dtype=np.intp)
+    half_edges = np.concatenate([np.array(cycle, dtype=np.intp) for cycle in cycles])
+    starts = np.zeros(lengths.size, dtype=np.intp)
+    np.cumsum(lengths[:-1], out=starts[1:])
+    verts_all = tail[half_edges]
+    rel = P[verts_all] - np.repeat(P[verts_all[starts]], lengths, axis=0)
+    x, y = rel[:, 0], rel[:, 1]
+    terms = np.zeros(half_edges.size)
+    terms[:-1] = x[:-1] * y[1:] - y[:-1] * x[1:]
+    terms[starts[1:] - 1] = 0.0  # no term across two cycles (each closing term vanishes)
+    cycle_areas = 0.5 * np.add.reduceat(terms, starts)
+    faces = []
+    areas = []  # of the faces
+    outer = []
+    for k, area in enumerate(cycle_areas.tolist()):
+        verts = verts_all[starts[k] : starts[k] + lengths[k]]
         if area > 0:
-            face_of[cycle] = len(faces)
+            face_of[half_edges[starts[k] : starts[k] + lengths[k]]] = len(faces)
             faces.append(verts)
             areas.append(area)
         else:
