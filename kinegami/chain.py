@@ -525,18 +525,47 @@ class _JointAssembly:
             return
         away = A - 0.5 * (np.asarray(path.q1) + np.asarray(path.q2))
         away = away - float(away @ d1) * d1
+        escapes = ()
         if float(np.linalg.norm(away)) >= 1e-9 * self.r:
             side = np.cross(d1, away)
-            for escape in (away, side, -side):
-                for variant in RADIAL_VARIANTS:
-                    yield {**variant, "escape": escape}
+            escapes = (away, side, -side)
+        for escape in escapes:
+            for variant in RADIAL_VARIANTS:
+                yield {**variant, "escape": escape}
         past = link_capsule_ends(arrived)
         for variant in RADIAL_VARIANTS:
             yield {**variant, "hold_past": past}
-        if float(np.linalg.norm(away)) >= 1e-9 * self.r:
-            for escape in (away, side, -side):
-                for variant in RADIAL_VARIANTS[:2]:  # a lead would only lengthen the hold
-                    yield {**variant, "escape": escape, "hold_past": past}
+        for escape in escapes:
+            for variant in RADIAL_VARIANTS[:2]:  # a lead would only lengthen the hold
+                yield {**variant, "escape": escape, "hold_past": past}
+
+    def _state_values(self, states) -> list[float] | None:
+        """``states`` of setJointStates checked: a sequence (list, tuple, 1-D numpy array) of
+        one real number per joint, each in its joint's range. Anything else (a number, None, a
+        string, a generator, a dict or a set, whose order is not the joints') raises
+        InvalidTypeError; a state out of range is rejected (PlacementWarning) and gives None."""
+        try:
+            if isinstance(states, str | bytes | Mapping | Set):
+                raise TypeError
+            count = len(states)  # a 0-d numpy array has __len__ but raises TypeError
+        except TypeError:
+            raise InvalidTypeError(
+                f"states must be a sequence of numbers, got {shown(states)}"
+            ) from None
+        if count != len(self._joints):
+            raise InvalidParameterError(
+                f"states must have one value per joint ({len(self._joints)}), got {count}"
+            )
+        values = [check_real(f"states[{i}]", s) for i, s in enumerate(states)]
+        for i, (joint, s) in enumerate(zip(self._joints, values, strict=True)):
+            lo, hi = joint.stateRange()
+            if not lo <= s <= hi:
+                self._reject(
+                    f"setJointStates failed: state {s!r} of joint {i} is outside "
+                    f"[{lo:.6g}, {hi:.6g}]"
+                )
+                return None
+        return values
 
     def _cost(self, extended) -> tuple[float, float]:
         """(growth of the ball radius, length of the new links) of an extension."""
@@ -779,33 +808,10 @@ class KinematicChain(_JointAssembly):
 
     def setJointStates(self, states: Sequence[float]) -> bool:
         """Set every joint's state at once (one value per joint, in index order);
-        all-or-nothing.
-
-        ``states`` is a sequence (list, tuple, 1-D numpy array) of real numbers; anything else
-        (a number, None, a generator, a dict or a set, whose order is not the joints') raises
-        InvalidTypeError, as ``KinematicTree.setJointStates`` does.
-        """
-        try:
-            if isinstance(states, str | bytes | Mapping | Set):
-                raise TypeError
-            count = len(states)  # a 0-d numpy array has __len__ but raises TypeError
-        except TypeError:
-            raise InvalidTypeError(
-                f"states must be a sequence of numbers, got {shown(states)}"
-            ) from None
-        if count != len(self._joints):
-            raise InvalidParameterError(
-                f"states must have one value per joint ({len(self._joints)}), got {count}"
-            )
-        values = [check_real(f"states[{i}]", s) for i, s in enumerate(states)]
-        for i, (joint, s) in enumerate(zip(self._joints, values, strict=True)):
-            lo, hi = joint.stateRange()
-            if not lo <= s <= hi:
-                self._reject(
-                    f"setJointStates failed: state {s!r} of joint {i} is outside "
-                    f"[{lo:.6g}, {hi:.6g}]"
-                )
-                return False
+        all-or-nothing (``states``: see :meth:`_state_values`)."""
+        values = self._state_values(states)
+        if values is None:
+            return False
         joints = list(self._joints)
         links = list(self._links)
         accumulated = None  # world motion of everything after the joints changed so far

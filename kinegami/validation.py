@@ -48,6 +48,8 @@ LENGTH_FACTOR = 1e6
 NUM_SIDES_MAX = 1024
 #: Most polygon sides in a design or joint-specification file (kinegami.design.limits).
 FILE_NUM_SIDES_MAX = 64
+
+
 def check_bool(name: str, value, none: bool = False) -> bool | None:
     """``value`` as a bool, or InvalidTypeError unless it is True or False (numpy's too).
 

@@ -339,22 +339,10 @@ class KinematicTree(_JointAssembly):
 
     def setJointStates(self, states: Sequence[float]) -> bool:
         """Set every joint's state at once (one value per joint, in index order); all or
-        nothing."""
-        if isinstance(states, str | bytes) or not hasattr(states, "__len__"):
-            raise InvalidTypeError(f"states must be a sequence of numbers, got {states!r}")
-        if len(states) != len(self._joints):
-            raise InvalidParameterError(
-                f"states must have one value per joint ({len(self._joints)}), got {len(states)}"
-            )
-        values = [check_real(f"states[{i}]", s) for i, s in enumerate(states)]
-        for i, (joint, s) in enumerate(zip(self._joints, values, strict=True)):
-            lo, hi = joint.stateRange()
-            if not lo <= s <= hi:
-                self._reject(
-                    f"setJointStates failed: state {s!r} of joint {i} is outside "
-                    f"[{lo:.6g}, {hi:.6g}]"
-                )
-                return False
+        nothing (``states`` as for a chain)."""
+        values = self._state_values(states)
+        if values is None:
+            return False
         joints, links = self._configured(values)
         return self._accept("setJointStates", joints, links)
 

@@ -434,6 +434,21 @@ def test_delete_the_root():
 
 
 # --- transactions and bad input --------------------------------------------------------------
+@pytest.mark.parametrize(
+    "states",
+    [3, None, "0" * 12, {k: 0.0 for k in range(12)}, set(range(12)), np.array(0.0)],
+    ids=["int", "None", "str", "dict", "set", "0-d array"],
+)
+def test_set_joint_states_refuses_what_is_not_a_sequence(states, snapshot):
+    """As for a chain (one check): a dict's keys, a set in no order and a 0-d array (its len()
+    raised numpy's TypeError) are not states."""
+    tree = quiet_hand()
+    before = snapshot(tree)
+    with pytest.raises(InvalidTypeError, match=r"^states must be a sequence of numbers, got "):
+        tree.setJointStates(states)
+    assert snapshot(tree) == before
+
+
 def test_refused_operations_leave_the_tree_bit_identical(snapshot):
     tree = quiet_hand()
     before = snapshot(tree)
