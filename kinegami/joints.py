@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import functools
 import math
-import numbers
 import sys
 from typing import TYPE_CHECKING
 
@@ -38,6 +37,7 @@ from kinegami.geometry.frames import (
     unit,
 )
 from kinegami.validation import (
+    REAL_NUMBER_TYPES,
     ReadOnlyAttributes,
     check_in_range,
     check_int,
@@ -82,19 +82,15 @@ def _is_se3(value) -> bool:
 
 #: Kinds of numpy dtypes whose arrays are real numbers (signed, unsigned ints and floats).
 _REAL_KINDS = frozenset("iuf")
-#: Types of entries an object array (or a nested sequence) may hold, as check_real allows them.
-_REAL_TYPES = (numbers.Real, np.integer, np.floating)
-_NOT_REAL_TYPES = (bool, np.bool_)
-
-
 #: Entry types found real so far (issubclass with the abstract numbers.Real is slow).
 _KNOWN_REAL_TYPES = {int, float, np.float64, np.int64}
 
 
 def _is_real_type(t: type) -> bool:
+    """Whether entries of type ``t`` are real numbers, as check_real decides (no bools)."""
     if t in _KNOWN_REAL_TYPES:
         return True
-    if issubclass(t, _REAL_TYPES) and not issubclass(t, _NOT_REAL_TYPES):
+    if issubclass(t, REAL_NUMBER_TYPES) and not issubclass(t, bool):
         _KNOWN_REAL_TYPES.add(t)
         return True
     return False

@@ -89,9 +89,13 @@ def resolve_options(
     return values
 
 
+#: Types whose values are real numbers (bool, an int subclass, is refused separately).
+REAL_NUMBER_TYPES = (numbers.Real, np.floating, np.integer)
+
+
 def check_real(name: str, value) -> float:
     """Return ``value`` as a float, or raise if it is not a finite real number."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real | np.floating | np.integer):
+    if isinstance(value, bool) or not isinstance(value, REAL_NUMBER_TYPES):
         raise InvalidTypeError(f"{name} must be a real number, got {shown(value)}")
     try:
         value = float(value)
