@@ -235,26 +235,26 @@ def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
     a_in = (xmin - tol <= a) & (a <= xmax + tol)
     c_in = (xmin - tol <= c) & (c <= xmax + tol)
     u_all, w_all = e[:, 0], e[:, 1]
-    # pieces with both ends on the sheet: each end is the copy of its vertex at the shift
-    # nearest to where the piece puts it (the first nearest, as argmin), all at once
+    # each end on the sheet is the copy of its vertex at the shift nearest to where the piece
+    # puts it (the first nearest, as argmin); for every piece at once
+    k_a = np.argmin(np.abs(shifts - (a - v[u_all, 0][:, None])[..., None]), axis=2)
+    k_c = np.argmin(np.abs(shifts - (c - v[w_all, 0][:, None])[..., None]), axis=2)
+    end_a, end_c = copy_index[k_a, u_all[:, None]], copy_index[k_c, w_all[:, None]]
+    x_a, x_c = cx[k_a, u_all[:, None]], cx[k_c, w_all[:, None]]
+    # pieces with both ends on the sheet, all at once
     whole = on_sheet & a_in & c_in
     i_whole, s_whole = np.nonzero(whole)
-    u_w, w_w = u_all[i_whole], w_all[i_whole]
-    k_a = np.argmin(np.abs(shifts[None, :] - (a[i_whole, s_whole] - v[u_w, 0])[:, None]), axis=1)
-    k_c = np.argmin(np.abs(shifts[None, :] - (c[i_whole, s_whole] - v[w_w, 0])[:, None]), axis=1)
-    ends_a, ends_c = copy_index[k_a, u_w], copy_index[k_c, w_w]
+    ends_a, ends_c = end_a[whole], end_c[whole]
     if ends_a.size and min(int(ends_a.min()), int(ends_c.min())) < 0:  # pragma: no cover
         raise FoldExportError("a crease ends at a vertex missing from the sheet")
-    xs_a, xs_c = cx[k_a, u_w], cx[k_c, w_w]
+    xs_a, xs_c = x_a[whole], x_c[whole]
     keep = ~((np.maximum(xs_a, xs_c) <= xmin + tol) | (np.minimum(xs_a, xs_c) >= xmax - tol))
     keep &= ends_a != ends_c
     order = [i_whole[keep] * 3 + s_whole[keep]]
     found_a, found_c = [ends_a[keep]], [ends_c[keep]]
     # pieces with an end beyond the sheet: clipped there, one by one in crease order (clip
     # points are numbered in the order they are first met)
-    vx, vy = v[:, 0].tolist(), v[:, 1].tolist()
-    copies, copy_x = copy_index.tolist(), cx.tolist()
-    shift_values = shifts.tolist()
+    vy = v[:, 1].tolist()
     clipped_order, clipped_a, clipped_c = [], [], []
     i_clip, s_clip = np.nonzero(on_sheet & ~(a_in & c_in))
     for i, k_s in zip(i_clip.tolist(), s_clip.tolist(), strict=True):
@@ -263,13 +263,10 @@ def _build_graph(pattern, X3: np.ndarray | None) -> SheetGraph:
         y_0, y_1 = vy[u], vy[w]
         ends = []
         xs = []
-        for x_end, vert in ((a_i, u), (c_i, w)):
+        for x_end, end, x_copy in ((a_i, end_a, x_a), (c_i, end_c, x_c)):
             if xmin - tol <= x_end <= xmax + tol:
-                shift = x_end - vx[vert]
-                gaps = [abs(value - shift) for value in shift_values]
-                k = gaps.index(min(gaps))  # the first nearest, as numpy's argmin
-                ends.append(copies[k][vert])
-                xs.append(copy_x[k][vert])
+                ends.append(int(end[i, k_s]))
+                xs.append(float(x_copy[i, k_s]))
             else:
                 edge_x = xmin if x_end < xmin else xmax
                 t = (edge_x - a_i) / (c_i - a_i)
