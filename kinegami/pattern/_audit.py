@@ -6,7 +6,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from kinegami.pattern._prism import make_prism, periodic_dx
-from kinegami.pattern.counts import expected_counts
+from kinegami.pattern.catalog import expected_counts
 from kinegami.pattern.tubular import TubularPattern
 
 _SHOWN = 8  # how many offending indices a message lists

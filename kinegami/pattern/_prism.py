@@ -74,6 +74,17 @@ class Prism:
             value = self._cache[key] = make()
             return value
 
+    def cached_many(self, keys: list, make_many) -> list:
+        """:meth:`cached` of every key, the values not yet cached computed by one call
+        ``make_many(missing)``: ``missing`` lists those keys once each, in order of first
+        appearance, and the call returns their values in that order."""
+        cache = self._cache
+        missing = [key for key in dict.fromkeys(keys) if key not in cache]
+        if missing:
+            for key, value in zip(missing, make_many(missing), strict=True):
+                cache[key] = value
+        return [cache[key] for key in keys]
+
     def __setattr__(self, name: str, value) -> None:
         raise AttributeError(f"Prism is immutable (cannot set {name!r})")
 

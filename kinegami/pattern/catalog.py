@@ -22,14 +22,15 @@ from kinegami.errors import UnknownModuleKindError
 
 if TYPE_CHECKING:
     from kinegami.pattern._prism import Prism
-    from kinegami.pattern.counts import ModuleCounts
-    from kinegami.pattern.tubular import TubularPattern
+    from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 
 __all__ = [
+    "ModuleCounts",
     "ModuleKind",
     "UnknownModuleKindError",
     "build_pieces",
     "cached_build",
+    "expected_counts",
     "find_kind",
     "kinds",
     "module_kind",
@@ -48,6 +49,17 @@ Fold = Callable[["Prism", "TubularPattern", Mapping[str, Any]], tuple[Any, Any]]
 def identity_unsnapped(prism: Prism, catalog: TubularPattern, params: Mapping[str, Any]):
     """The unsnapped geometry of a module the eps rules never move: the module itself."""
     return catalog, np.arange(catalog.numVertices)
+
+
+class ModuleCounts(Record):
+    """Expected numbers of vertices, creases and (when known) mountain creases of a module:
+    what a catalog entry's ``counts`` returns (its closed-form counts, written independently of
+    the module's builder, so that :meth:`TubularPattern.validate` can compare a pattern with
+    them)."""
+
+    numVertices: int
+    numEdges: int
+    numMountains: int | None = None
 
 
 class ModuleKind(Record):
@@ -230,6 +242,19 @@ def module_kind(name: str) -> ModuleKind:
         raise UnknownModuleKindError(
             f"unknown module kind {name!r}; the catalog has {', '.join(sorted(_REGISTRY))}"
         ) from None
+
+
+def expected_counts(record: ModuleRecord, prism: Prism) -> ModuleCounts | None:
+    """The counts of one catalog module, or None for a kind the catalog does not have.
+
+    Fix B6 (no coincident vertices, no zero-length creases) changes the reference's formulas
+    in two places: a tube or twist of pattern height below eps is the empty pattern (n, 0), and
+    every elbow column with h_k < eps reuses P_k and D_k (2 vertices and 2 creases fewer).
+    Fix B2 removes 4 creases from the revolute joint with N >= 2 sink layers
+    (docs/theory/patterns.md §6).
+    """
+    entry = find_kind(record.kind)
+    return None if entry is None else entry.counts(prism, record.params)
 
 
 def find_kind(name: str) -> ModuleKind | None:

@@ -12,7 +12,7 @@ import numpy as np
 from kinegami._record import Record
 from kinegami.errors import InvalidParameterError
 from kinegami.pattern import catalog
-from kinegami.pattern._build import assemble, crease_block, distinct_creases
+from kinegami.pattern._build import assemble, crease_block, real
 from kinegami.pattern._fold import (
     MERGE_TOLERANCE,
     assign,
@@ -23,8 +23,7 @@ from kinegami.pattern._fold import (
     rot_axis,
 )
 from kinegami.pattern._prism import Prism, _readonly, make_prism, periodic_dx, wrap_x
-from kinegami.pattern.checks import real
-from kinegami.pattern.counts import ModuleCounts
+from kinegami.pattern.catalog import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 
 __all__ = ["ELBOW_ANGLE_TOL", "ElbowFittingPattern", "ElbowGeometry", "elbow_geometry"]
@@ -212,7 +211,7 @@ def _elbow_patterns(prism: Prism, angles: list[tuple]) -> list[TubularPattern]:
     d_w = np.array([r * math.tan(theta / 2.0) for theta, _ in normalised])
     phi = np.array([phi for _, phi in normalised])
     h, H_m, tuck, collapsed, low = _column_arrays(prism, phi, d_w)
-    layouts = [_layout(prism, c, z) for c, z in zip(collapsed, low, strict=True)]
+    layouts = _layouts(prism, collapsed, low)
     for (theta, _), layout, c in zip(angles, layouts, collapsed, strict=True):
         if layout is None:
             raise InvalidParameterError(
@@ -232,23 +231,35 @@ def _elbow_patterns(prism: Prism, angles: list[tuple]) -> list[TubularPattern]:
     y_source[:, 2] = H_m
     y_source[:, 3 : 3 + n] = h
     y_source[:, 3 + n :] = H[:, None] - h
-    patterns = []
-    for (theta, phi), layout, xs, ys, height in zip(
-        angles, layouts, x_source, y_source, H.tolist(), strict=True
-    ):
-        record = ModuleRecord._of(
-            "elbow", {"bendingAngle": float(theta), "rotationalAxisAngle": float(phi)}
+    # the vertices of the elbows sharing a layout gathered at once (each elbow's array is a
+    # row of the block, read-only); the markers are rows of one array too
+    vertices: list = [None] * E
+    groups: dict[int, list[int]] = {}
+    for i, layout in enumerate(layouts):
+        groups.setdefault(id(layout), []).append(i)
+    for rows in groups.values():
+        layout = layouts[rows[0]]
+        block = np.empty((len(rows), layout.total, 2))
+        block[:, :, 0] = x_source[rows][:, layout.x_index]
+        block[:, :, 1] = y_source[rows][:, layout.y_index]
+        block.setflags(write=False)
+        for i, row in zip(rows, block, strict=True):
+            vertices[i] = row
+    proximal_marker = np.zeros(2)
+    distal_markers = np.zeros((E, 2))
+    distal_markers[:, 1] = H
+    distal_markers.setflags(write=False)
+    return [
+        TubularPattern._build(
+            n, r, xy, layout.edges, layout.labels, layout.P, layout.D, proximal_marker, marker,
+            height, (ModuleRecord._of("elbow", {"bendingAngle": float(theta),
+                                                "rotationalAxisAngle": float(phi)}),),
+            0, None, False,
         )
-        vertices = np.empty((layout.total, 2))
-        vertices[:, 0] = xs[layout.x_index]
-        vertices[:, 1] = ys[layout.y_index]
-        patterns.append(
-            TubularPattern._build(
-                n, r, vertices, layout.edges, layout.labels, layout.P, layout.D, np.zeros(2),
-                np.array([0.0, height]), height, (record,), 0, None, False,
-            )  # fmt: skip
+        for (theta, phi), layout, xy, marker, height in zip(
+            angles, layouts, vertices, distal_markers, H.tolist(), strict=True
         )
-    return patterns
+    ]  # fmt: skip
 
 
 class _Layout:
@@ -263,52 +274,89 @@ class _Layout:
 
     __slots__ = ("P", "D", "total", "edges", "labels", "x_index", "y_index")
 
-    def __init__(self, prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> None:
-        n = prism.numSides
-        k = np.arange(n)
-        P, D = k, n + k
-        full = ~collapsed
-        # vertices: P, D, then per column Q (collapsed) or L, M, O (array Of), U (no L, U when
-        # low)
-        has_l = full & ~low
-        counts = np.where(collapsed, 1, 2 + 2 * has_l.astype(int))
-        start = 2 * n + np.concatenate([[0], np.cumsum(counts)[:-1]])
-        L = np.where(has_l, start, np.where(low, P, start))
-        M = np.where(has_l, start + 1, np.where(low, start, start))
-        Of = np.where(has_l, start + 2, np.where(low, start + 1, start))
-        U = np.where(has_l, start + 3, np.where(low, D, start))
-        total = 2 * n + int(counts.sum())
-        x_index = np.empty(total, dtype=np.intp)
-        y_index = np.empty(total, dtype=np.intp)
-        x_index[P], y_index[P] = k, 0
-        x_index[D], y_index[D] = k, 1
-        x_index[M], y_index[M] = k, 2
-        x_index[Of[full]], y_index[Of[full]] = n + k[full], 2
-        x_index[L[has_l]], y_index[L[has_l]] = k[has_l], 3 + k[has_l]
-        x_index[U[has_l]], y_index[U[has_l]] = k[has_l], 3 + n + k[has_l]
-        table = _crease_table(P, D, L, M, Of, U)
-        edges = np.empty((n * len(table), 2), dtype=np.intp)
-        edges[:, 0] = np.concatenate([first for first, _, _ in table])
-        edges[:, 1] = np.concatenate([second for _, second, _ in table])
-        labels = np.repeat(np.array([label for _, _, label in table], dtype="<U1"), n)
-        edges, labels = distinct_creases(edges, labels, total)
-        self.P, self.D, self.total = _readonly(P.copy()), _readonly(D), total
-        self.edges, self.labels = _readonly(edges), _readonly(labels)
-        self.x_index, self.y_index = _readonly(x_index), _readonly(y_index)
+
+def _layouts(prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> list[_Layout | None]:
+    """The shared layout of each row of ``collapsed`` and ``low`` (shape (E, n)), or None for
+    a row that cannot be resolved (more than two collapsed columns, or two that are not
+    adjacent). Layouts not yet in the prism's cache are computed together."""
+    keys = [
+        ("elbow layout", c.tobytes(), z.tobytes()) for c, z in zip(collapsed, low, strict=True)
+    ]
+    row_of = {key: i for i, key in reversed(list(enumerate(keys)))}
+
+    def make_many(missing: list) -> list:
+        rows = [row_of[key] for key in missing]
+        c, z = collapsed[rows], low[rows]
+        count = np.count_nonzero(c, axis=1)
+        adjacent = (count == 1) | ((count == 2) & np.any(c & np.roll(c, 1, axis=1), axis=1))
+        layouts: list = [None] * len(rows)
+        good = np.flatnonzero(adjacent)
+        if good.shape[0]:
+            for j, layout in zip(good.tolist(), _new_layouts(prism, c[good], z[good]),
+                                 strict=True):  # fmt: skip
+                layouts[j] = layout
+        return layouts
+
+    return prism.cached_many(keys, make_many)
 
 
-
-def _layout(prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> _Layout | None:
-    """The shared layout of an elbow's columns, or None when they cannot be resolved (more
-    than two collapsed columns, or two that are not adjacent)."""
-    key = ("elbow layout", collapsed.tobytes(), low.tobytes())
-
-    def make():
-        c = int(np.count_nonzero(collapsed))
-        adjacent = c == 1 or (c == 2 and np.any(collapsed & np.roll(collapsed, 1)))
-        return _Layout(prism, collapsed.copy(), low.copy()) if adjacent else None
-
-    return prism.cached(key, make)
+def _new_layouts(prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> list[_Layout]:
+    """The layouts of the rows of ``collapsed`` and ``low`` (shape (U, n), every row
+    resolvable), computed in whole-array passes over the rows."""
+    n = prism.numSides
+    U = collapsed.shape[0]
+    k = np.arange(n)
+    P, D = k, n + k
+    full = ~collapsed
+    # vertices: P, D, then per column Q (collapsed) or L, M, O (array Of), U (no L, U when
+    # low)
+    has_l = full & ~low
+    counts = np.where(collapsed, 1, 2 + 2 * has_l.astype(int))
+    ends = np.cumsum(counts, axis=1)
+    start = 2 * n + ends - counts
+    L = np.where(has_l, start, np.where(low, P, start))
+    M = np.where(has_l, start + 1, start)
+    Of = np.where(has_l, start + 2, np.where(low, start + 1, start))
+    Up = np.where(has_l, start + 3, np.where(low, D, start))
+    totals = (2 * n + ends[:, -1]).tolist()
+    # x_index and y_index of every row, padded to the longest
+    width = max(totals)
+    x_index = np.empty((U, width), dtype=np.intp)
+    y_index = np.empty((U, width), dtype=np.intp)
+    x_index[:, P], y_index[:, P] = k, 0
+    x_index[:, D], y_index[:, D] = k, 1
+    row = np.broadcast_to(np.arange(U)[:, None], (U, n))
+    kk = np.broadcast_to(k, (U, n))
+    x_index[row, M], y_index[row, M] = kk, 2
+    x_index[row[full], Of[full]], y_index[row[full], Of[full]] = n + kk[full], 2
+    x_index[row[has_l], L[has_l]], y_index[row[has_l], L[has_l]] = kk[has_l], 3 + kk[has_l]
+    x_index[row[has_l], Up[has_l]] = kk[has_l]
+    y_index[row[has_l], Up[has_l]] = 3 + n + kk[has_l]
+    # the creases of every row, and the first of each distinct one (as distinct_creases)
+    table = _crease_table(
+        np.broadcast_to(P, (U, n)), np.broadcast_to(D, (U, n)), L, M, Of, Up
+    )
+    edges = np.empty((U, n * len(table), 2), dtype=np.intp)
+    edges[:, :, 0] = np.concatenate([first for first, _, _ in table], axis=1)
+    edges[:, :, 1] = np.concatenate([second for _, second, _ in table], axis=1)
+    labels = np.repeat(np.array([label for _, _, label in table], dtype="<U1"), n)
+    lo = np.minimum(edges[:, :, 0], edges[:, :, 1]).astype(np.int64)
+    hi = np.maximum(edges[:, :, 0], edges[:, :, 1])
+    key = (np.arange(U)[:, None] * width + lo) * width + hi
+    first = np.zeros(key.size, dtype=bool)
+    first[np.unique(key, return_index=True)[1]] = True
+    keep = first.reshape(U, -1) & (edges[:, :, 0] != edges[:, :, 1])
+    P, D = _readonly(P), _readonly(D.copy())
+    layouts = []
+    for u, total in enumerate(totals):
+        layout = _Layout()
+        layout.P, layout.D, layout.total = P, D, total
+        layout.edges = _readonly(edges[u][keep[u]])
+        layout.labels = _readonly(labels[keep[u]])
+        layout.x_index = _readonly(x_index[u, :total].copy())
+        layout.y_index = _readonly(y_index[u, :total].copy())
+        layouts.append(layout)
+    return layouts
 
 
 def _build_elbow_reference(prism: Prism, geo: ElbowGeometry, record: ModuleRecord):
@@ -350,18 +398,19 @@ def _crease_table(P, D, L, M, Of, U) -> list:
     The arrays give, per column k, the indices of P_k, D_k and of the tuck vertices L_k, M_k,
     O_k, U_k (the catalog reuses indices where fix B6 merges points; the unsnapped elbow does
     not). The order matters: where two collapsed columns are adjacent the lower boundary, upper
-    boundary and midline coincide, and the first (lower boundary, M) is kept.
+    boundary and midline coincide, and the first (lower boundary, M) is kept. The arrays may
+    have leading dimensions (several layouts at once): columns are the last axis.
     """
-    n = P.shape[0]
+    n = P.shape[-1]
     k = np.arange(n)
     prev, nxt = (k - 1) % n, (k + 1) % n
     return [
-        (L[prev], L, "M"),  # lower tuck boundary
+        (L[..., prev], L, "M"),  # lower tuck boundary
         (P, L, "M"),  # proximal tube edge
-        (U[prev], U, "M"),  # upper tuck boundary
+        (U[..., prev], U, "M"),  # upper tuck boundary
         (U, D, "M"),  # distal tube edge
         (M, Of, "V"),  # midline
-        (Of, M[nxt], "V"),  # midline
+        (Of, M[..., nxt], "V"),  # midline
         (L, M, "V"),  # lower half of the column line
         (M, U, "M"),  # upper half of the column line
         (L, Of, "M"),  # lower tuck diagonal

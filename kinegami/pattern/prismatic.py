@@ -9,7 +9,7 @@ import numpy as np
 from kinegami._record import Record
 from kinegami.errors import InvalidParameterError
 from kinegami.pattern import catalog
-from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._build import assemble, check_bool, crease_block
 from kinegami.pattern._fold import (
     assign,
     corners,
@@ -20,8 +20,7 @@ from kinegami.pattern._fold import (
     translation,
 )
 from kinegami.pattern._prism import Prism, make_prism, wrap_x
-from kinegami.pattern.checks import check_bool
-from kinegami.pattern.counts import ModuleCounts
+from kinegami.pattern.catalog import ModuleCounts
 from kinegami.pattern.tube import _tube
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 from kinegami.validation import check_in_range, check_int, check_num_sides, check_positive

@@ -15,7 +15,7 @@ from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
 from kinegami.pattern._fold import FoldedFormError, assign, corners, translation
 from kinegami.pattern._prism import Prism, make_prism, periodic_dx
-from kinegami.pattern.counts import ModuleCounts
+from kinegami.pattern.catalog import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 from kinegami.validation import check_in_range, check_int, check_positive
 

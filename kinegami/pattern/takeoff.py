@@ -33,7 +33,7 @@ from kinegami.pattern import catalog
 from kinegami.pattern._build import assemble, crease_block
 from kinegami.pattern._fold import polygon_point
 from kinegami.pattern._prism import Prism, make_prism, wrap_x
-from kinegami.pattern.counts import ModuleCounts
+from kinegami.pattern.catalog import ModuleCounts
 from kinegami.pattern.sheet import clip_segments
 from kinegami.pattern.tube import fold_straight
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern

@@ -8,11 +8,10 @@ from __future__ import annotations
 import numpy as np
 
 from kinegami.pattern import catalog
-from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._build import assemble, crease_block, nonnegative
 from kinegami.pattern._fold import polygon_point, translation
 from kinegami.pattern._prism import make_prism
-from kinegami.pattern.checks import nonnegative
-from kinegami.pattern.counts import ModuleCounts
+from kinegami.pattern.catalog import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 
 __all__ = ["TubeFittingPattern", "WaypointPattern"]

@@ -330,24 +330,37 @@ class TubularPattern:
         internal_duplicates: bool | None,
         module_vertices: tuple[np.ndarray, ...] | None,
     ) -> None:
+        # every module of a chain passes here: the arrays are frozen in place (setflags, not a
+        # helper call) and the slots set through object.__setattr__ (bound once)
         s = object.__setattr__
-        s(self, "numSides", int(n))
-        s(self, "r", float(r))
+        vertices.setflags(write=False)
+        edges.setflags(write=False)
+        assignment.setflags(write=False)
+        proximal_marker.setflags(write=False)
+        distal_marker.setflags(write=False)
+        if proximal is not None:
+            proximal.setflags(write=False)
+        if distal is not None:
+            distal.setflags(write=False)
+        if distal_keys is not None:
+            distal_keys.setflags(write=False)
         width = _WIDTHS.get((n, r))
         if width is None:
             width = _WIDTHS[(n, r)] = float(n * 2.0 * r * np.sin(np.pi / n))
+        s(self, "numSides", int(n))
+        s(self, "r", float(r))
         s(self, "width", width)
         s(self, "height", float(height))
-        s(self, "vertices_coords", _readonly(vertices))
-        s(self, "edges_vertices", _readonly(edges))
-        s(self, "edges_assignment", _readonly(assignment))
-        s(self, "proximalBase", None if proximal is None else _readonly(proximal))
-        s(self, "distalBase", None if distal is None else _readonly(distal))
-        s(self, "proximalMarker", _readonly(proximal_marker))
-        s(self, "distalMarker", _readonly(distal_marker))
+        s(self, "vertices_coords", vertices)
+        s(self, "edges_vertices", edges)
+        s(self, "edges_assignment", assignment)
+        s(self, "proximalBase", proximal)
+        s(self, "distalBase", distal)
+        s(self, "proximalMarker", proximal_marker)
+        s(self, "distalMarker", distal_marker)
         s(self, "modules", modules)
         s(self, "removedDuplicates", int(removed))
-        s(self, "_distal_keys", None if distal_keys is None else _readonly(distal_keys))
+        s(self, "_distal_keys", distal_keys)
         s(self, "_has_internal_duplicates", internal_duplicates)
         s(self, "_module_vertices", module_vertices)
 
@@ -516,8 +529,14 @@ class TubularPattern:
             if not isinstance(p, TubularPattern):
                 raise InvalidTypeError(f"patterns[{i}] must be a TubularPattern, got {p!r}")
         first = patterns[0]
-        for i in range(1, len(patterns)):
-            _check_composable(first, patterns[i], i, previous=patterns[i - 1])
+        n, r = first.numSides, first.r
+        if not (
+            all(p.numSides == n and p.r == r and p.proximalBase is not None for p in patterns[1:])
+            and all(p.distalBase is not None for p in patterns[:-1])
+        ):  # the common case in one pass; otherwise find the first pair at fault (and its r
+            # may still be close enough)
+            for i in range(1, len(patterns)):
+                _check_composable(first, patterns[i], i, previous=patterns[i - 1])
         if len(patterns) == 1:
             return first
         return _compose_all(first, patterns)
@@ -633,24 +652,26 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
     if not items:
         return first
     m = len(items)
+    pats = [p for _, p in items]
     # 1. the markers: module k is translated by offsets[k], the composite ends at (mx, my)
-    offsets = np.empty((m, 2))
+    #    (a scalar recurrence on Python floats, the markers read in one numpy call)
+    markers = np.concatenate([a for p in pats for a in (p.proximalMarker, p.distalMarker)])
+    markers = markers.tolist()
+    offsets = [0.0] * (2 * m)
     mx, my = (float(v) for v in first.distalMarker)
     height = first.height
     removed = first.removedDuplicates
     modules = list(first.modules)
-    sizes = np.empty(m, dtype=np.intp)
-    for k, (_, p) in enumerate(items):
-        px, py = p.proximalMarker.tolist()
-        dx, dy = p.distalMarker.tolist()
+    for k, p in enumerate(pats):
+        px, py, dx, dy = markers[4 * k : 4 * k + 4]
         ox, oy = mx - px, my - py
-        offsets[k, 0], offsets[k, 1] = ox, oy
+        offsets[2 * k], offsets[2 * k + 1] = ox, oy
         mx, my = wrap_scalar(dx + ox, W, eps), dy + oy
-        sizes[k] = p.vertices_coords.shape[0]
         height += p.height
         removed += p.removedDuplicates
         modules.extend(p.modules)
-    pats = [p for _, p in items]
+    offsets = np.array(offsets).reshape(m, 2)
+    sizes = np.array([p.vertices_coords.shape[0] for p in pats], dtype=np.intp)
     # 2. every module's vertices, translated and wrapped; slots are module vertices, numbered
     #    after the first pattern's vertices (slot s < N0 is vertex s of the first pattern)
     N0 = first.numVertices
@@ -730,9 +751,10 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
     if placements is not None:
         placements = list(placements)
         ends = (N0 + starts + sizes).tolist()
+        _readonly(index)  # its slices are read-only views
         for p, a, b in zip(pats, (N0 + starts).tolist(), ends, strict=True):
             if p._module_vertices is None and len(p.modules) == 1:  # _placed's common case
-                placements.append(_readonly(index[a:b]))
+                placements.append(index[a:b])
                 continue
             own = _placed(p, index[a:b])
             if own is None:

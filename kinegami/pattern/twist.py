@@ -11,11 +11,10 @@ import numpy as np
 
 from kinegami._record import Record
 from kinegami.pattern import catalog
-from kinegami.pattern._build import assemble, crease_block
+from kinegami.pattern._build import assemble, crease_block, nonnegative, real
 from kinegami.pattern._fold import corners, mod_w, moved_copy, polygon_point, rot_axis
 from kinegami.pattern._prism import Prism, make_prism, wrap_scalar, wrap_x
-from kinegami.pattern.checks import nonnegative, real
-from kinegami.pattern.counts import ModuleCounts
+from kinegami.pattern.catalog import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 
 __all__ = ["TwistFittingPattern", "TwistGeometry", "twist_geometry"]

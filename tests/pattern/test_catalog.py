@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from kinegami.errors import InvalidTypeError, ReadOnlyError
 from kinegami.pattern import (
@@ -21,7 +23,7 @@ from kinegami.pattern import (
 from kinegami.pattern._build import assemble, crease_block
 from kinegami.pattern._fold import polygon_point, translation
 from kinegami.pattern._prism import make_prism
-from kinegami.pattern.counts import ModuleCounts, expected_counts
+from kinegami.pattern.catalog import ModuleCounts, expected_counts
 from kinegami.pattern.elbow import _build_elbow_reference, elbow_geometry
 from kinegami.pattern.folded import folded_form, unsnapped_form
 
@@ -207,6 +209,45 @@ def test_elbow_layout_matches_the_reference_build(n, theta, phi):
                  "distalBase", "distalMarker"):  # fmt: skip
         np.testing.assert_array_equal(getattr(fast, name), getattr(slow, name))
     assert fast.height == slow.height
+
+
+def _elbow_phi(n: int, mode: str, column: int, free: float) -> float:
+    """A free axis angle, or one where columns ``column`` and ``column + 1`` both collapse
+    ("pair": midway between them) or where ``column`` is low ("low": a quarter turn from it)."""
+    beta = (column + 0.5) * 2.0 * np.pi / n
+    return {"free": free, "pair": beta + np.pi / n, "low": beta + np.pi / 2}[mode]
+
+
+@settings(deadline=None, max_examples=40)
+@given(
+    n=st.sampled_from([4, 6, 8, 12]),
+    elbows=st.lists(
+        st.tuples(
+            st.floats(0.05, 3.0) | st.sampled_from([np.pi / 2, 3.1]),
+            st.sampled_from(["free", "pair", "low"]),
+            st.integers(0, 11),
+            st.floats(-7.0, 7.0),
+        ),
+        min_size=1,
+        max_size=10,
+    ),
+)
+def test_elbows_built_together_match_the_reference_build(n, elbows):
+    """A batch with several layouts (plain, collapsed pairs, low columns) computes them
+    together; each elbow equals the column-by-column build of its own angles."""
+    angles = [(theta, _elbow_phi(n, mode, j % n, free)) for theta, mode, j, free in elbows]
+    prism = make_prism(n, 1.0)
+    ElbowFittingPattern.cache_clear()
+    prism._cache.clear()  # the layouts too: the batch computes them
+    together = ElbowFittingPattern.many([(n, 1.0, theta, phi) for theta, phi in angles])
+    for (theta, phi), fast in zip(angles, together, strict=True):
+        geo = elbow_geometry(prism, theta, phi)
+        slow = _build_elbow_reference(prism, geo, fast.modules[0])
+        for name in ("vertices_coords", "edges_vertices", "edges_assignment", "proximalBase",
+                     "distalBase", "proximalMarker", "distalMarker"):  # fmt: skip
+            np.testing.assert_array_equal(getattr(fast, name), getattr(slow, name), err_msg=name)
+            assert not getattr(fast, name).flags.writeable
+        assert fast.height == slow.height
 
 
 def test_constructors_share_patterns_for_equal_arguments_only():
