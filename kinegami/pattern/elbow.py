@@ -245,7 +245,7 @@ def _elbow_patterns(prism: Prism, angles: list[tuple]) -> list[TubularPattern]:
         block.setflags(write=False)
         for i, row in zip(rows, block, strict=True):
             vertices[i] = row
-    proximal_marker = np.zeros(2)
+    proximal_marker = _readonly(np.zeros(2))
     distal_markers = np.zeros((E, 2))
     distal_markers[:, 1] = H
     distal_markers.setflags(write=False)
@@ -254,7 +254,7 @@ def _elbow_patterns(prism: Prism, angles: list[tuple]) -> list[TubularPattern]:
             n, r, xy, layout.edges, layout.labels, layout.P, layout.D, proximal_marker, marker,
             height, (ModuleRecord._of("elbow", {"bendingAngle": float(theta),
                                                 "rotationalAxisAngle": float(phi)}),),
-            0, None, False,
+            0, None, False, None, True,
         )
         for (theta, phi), layout, xy, marker, height in zip(
             angles, layouts, vertices, distal_markers, H.tolist(), strict=True

@@ -214,10 +214,10 @@ def PrismaticJointPattern(
     piston = _tube(prism, L, "M", ModuleRecord("tube", {"height": L}))
     whole = TubularPattern.concatenate([sleeve, lining, rebo, piston])
     record = ModuleRecord("prismatic", {"neutralLength": d, "numLayers": N, "coneAngle": beta})
-    return TubularPattern._build(
-        n, prism.r, whole.vertices_coords.copy(), whole.edges_vertices.copy(),
-        whole.edges_assignment.copy(), whole.proximalBase.copy(), whole.distalBase.copy(),
-        np.zeros(2), np.array([0.0, 4.0 * L]), 4.0 * L, (record,), 0, None, False,
+    return TubularPattern._build(  # whole's arrays are its own (read-only, shared with none)
+        n, prism.r, whole.vertices_coords, whole.edges_vertices, whole.edges_assignment,
+        whole.proximalBase, whole.distalBase, np.zeros(2), np.array([0.0, 4.0 * L]), 4.0 * L,
+        (record,), 0, None, False,
     )  # fmt: skip
 
 

@@ -51,7 +51,41 @@ def _empty_template(prism) -> TubularPattern:
     return assemble(prism, vertices, [(np.zeros((0, 2), int), "M")], base, base, 0.0, record)
 
 
-@catalog.cached_build
+def _many_tubes(calls: list[tuple]) -> list[TubularPattern]:
+    """TubeFittingPattern of every (numSides, r, height) call; the tubes of one prism share
+    one block of vertices (each tube's array a read-only row) and one of distal markers."""
+    checked = [(make_prism(numSides, r), nonnegative("height", h)) for numSides, r, h in calls]
+    built: list = [None] * len(calls)
+    groups: dict = {}
+    for i, (prism, h) in enumerate(checked):
+        if h < prism.eps:
+            built[i] = _empty(prism, ModuleRecord._of("tube", {"height": h}))
+        else:
+            groups.setdefault(prism, []).append(i)
+    for prism, rows in groups.items():
+        n = prism.numSides
+        template = prism.cached(("tube", "M"), lambda prism=prism: _tube_template(prism, "M"))
+        heights = np.array([checked[i][1] for i in rows])
+        block = np.empty((len(rows), 2 * n, 2))
+        block[:] = template.vertices_coords
+        block[:, n:, 1] = heights[:, None]
+        block.setflags(write=False)
+        markers = np.zeros((len(rows), 2))
+        markers[:, 1] = heights
+        markers.setflags(write=False)
+        origin = np.zeros(2)
+        origin.setflags(write=False)
+        for i, vertices, marker in zip(rows, block, markers, strict=True):
+            h = checked[i][1]
+            built[i] = TubularPattern._build(
+                n, prism.r, vertices, template.edges_vertices, template.edges_assignment,
+                template.proximalBase, template.distalBase, origin, marker, float(h),
+                (ModuleRecord._of("tube", {"height": h}),), 0, None, False, None, True,
+            )  # fmt: skip
+    return built
+
+
+@catalog.cached_build(many=_many_tubes)
 def TubeFittingPattern(numSides: int, r: float, height: float) -> TubularPattern:
     """A straight tube of axial length ``height`` (section 3.1).
 

@@ -167,6 +167,15 @@ def _edge_keys(edges: np.ndarray) -> np.ndarray:
     return lo * _KEY_SHIFT + hi
 
 
+def _repeats(keys: np.ndarray) -> np.ndarray:
+    """Boolean mask of the keys equal to an earlier key (all but the first of each group)."""
+    order = np.argsort(keys, kind="stable")  # equal keys stay in their order: the first leads
+    ordered = keys[order]
+    repeated = np.zeros(keys.shape[0], dtype=bool)
+    repeated[order[1:][ordered[1:] == ordered[:-1]]] = True
+    return repeated
+
+
 def _first_occurrence_mask(keys: np.ndarray) -> np.ndarray:
     """Boolean mask keeping the first crease of every group of equal keys."""
     mask = np.zeros(keys.shape[0], dtype=bool)
@@ -329,21 +338,24 @@ class TubularPattern:
         distal_keys: np.ndarray | None,
         internal_duplicates: bool | None,
         module_vertices: tuple[np.ndarray, ...] | None,
+        frozen: bool = False,
     ) -> None:
         # every module of a chain passes here: the arrays are frozen in place (setflags, not a
-        # helper call) and the slots set through object.__setattr__ (bound once)
+        # helper call; not at all when the caller says they are: ``frozen``) and the slots set
+        # through object.__setattr__ (bound once)
         s = object.__setattr__
-        vertices.setflags(write=False)
-        edges.setflags(write=False)
-        assignment.setflags(write=False)
-        proximal_marker.setflags(write=False)
-        distal_marker.setflags(write=False)
-        if proximal is not None:
-            proximal.setflags(write=False)
-        if distal is not None:
-            distal.setflags(write=False)
-        if distal_keys is not None:
-            distal_keys.setflags(write=False)
+        if not frozen:
+            vertices.setflags(write=False)
+            edges.setflags(write=False)
+            assignment.setflags(write=False)
+            proximal_marker.setflags(write=False)
+            distal_marker.setflags(write=False)
+            if proximal is not None:
+                proximal.setflags(write=False)
+            if distal is not None:
+                distal.setflags(write=False)
+            if distal_keys is not None:
+                distal_keys.setflags(write=False)
         width = _WIDTHS.get((n, r))
         if width is None:
             width = _WIDTHS[(n, r)] = float(n * 2.0 * r * np.sin(np.pi / n))
@@ -367,15 +379,17 @@ class TubularPattern:
     @classmethod
     def _build(cls, n, r, vertices, edges, assignment, proximal, distal, pm, dm, height, modules,
                removed=0, distal_keys=None, internal_duplicates=None,
-               module_vertices=None):  # fmt: skip
+               module_vertices=None, frozen=False):  # fmt: skip
         """Internal constructor from arrays that are already valid (no checks, no copies).
 
         ``module_vertices``: see :attr:`module_vertices`; None for a single module (its own
-        vertices, in order) or when unknown.
+        vertices, in order) or when unknown. ``frozen``: every array given is read-only already
+        (the batch builders', whose arrays are rows of read-only blocks).
         """
         self = object.__new__(cls)
         self._init(n, r, vertices, edges, assignment, proximal, distal, pm, dm, height, modules,
-                   removed, distal_keys, internal_duplicates, module_vertices)  # fmt: skip
+                   removed, distal_keys, internal_duplicates, module_vertices,
+                   frozen)  # fmt: skip
         return self
 
     def __setattr__(self, name: str, value) -> None:
@@ -703,7 +717,7 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
     previous = np.empty((m, n), dtype=np.intp)
     previous[0] = first.distalBase
     previous[1:] = (N0 + distal).reshape(m - 1, n)
-    previous = np.take_along_axis(previous, (np.arange(n)[None, :] + shift[:, None]) % n, axis=1)
+    previous = previous[np.arange(m)[:, None], (np.arange(n)[None, :] + shift[:, None]) % n]
     S = int(sizes.sum())
     ref = np.arange(N0 + S)
     ref[N0 + proximal] = previous.ravel()
@@ -739,10 +753,7 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
     sub = np.flatnonzero(shared[edges[:, 0]] & shared[edges[:, 1]])
     if sub.shape[0]:
         keys = _edge_keys(np.concatenate([old_sub, edges[sub]]))
-        _, first_index, inverse = np.unique(keys, return_index=True, return_inverse=True)
-        position = np.arange(keys.shape[0])
-        repeated = (first_index[inverse] != position)[old_sub.shape[0] :]
-        keep[sub[repeated]] = False
+        keep[sub[_repeats(keys)[old_sub.shape[0] :]]] = False
     dropped = int(keep.shape[0] - np.count_nonzero(keep))
     if dropped:
         edges, assignment = edges[keep], assignment[keep]

@@ -74,16 +74,38 @@ def _many_twists(calls: list[tuple]) -> list[TubularPattern]:
     for i, ((prism, _, _), geo) in enumerate(zip(checked, geos, strict=True)):
         if not geo.degenerate:
             groups.setdefault(prism, []).append(i)
-    shifted: list = [None] * len(calls)
+    built: list = [None] * len(calls)
+    for i, ((prism, alpha, h), geo) in enumerate(zip(checked, geos, strict=True)):
+        if geo.degenerate:
+            built[i] = _twist(prism, alpha, h, geo, None)
+    # the twists of one prism share one block of vertices (each twist's array a read-only
+    # row) and one of distal markers
     for prism, rows in groups.items():
+        n, b = prism.numSides, prism.b
+        band = prism.cached("twist", lambda prism=prism: _band(prism))
         shifts = np.array([geos[i].shift for i in rows])
-        for i, row in zip(rows, wrap_x(prism.columns + shifts[:, None], prism.W, prism.eps),
-                          strict=True):  # fmt: skip
-            shifted[i] = row
-    return [
-        _twist(prism, alpha, h, geo, x)
-        for (prism, alpha, h), geo, x in zip(checked, geos, shifted, strict=True)
-    ]
+        heights = np.array([geos[i].height for i in rows])
+        block = np.empty((len(rows), 2 * n, 2))
+        block[:] = band.vertices_coords
+        block[:, n:, 0] = wrap_x(prism.columns + shifts[:, None], prism.W, prism.eps)
+        block[:, n:, 1] = heights[:, None]
+        block.setflags(write=False)
+        markers = np.empty((len(rows), 2))
+        markers[:, 0] = [wrap_scalar(geos[i].K * b + geos[i].shift, prism.W, prism.eps)
+                         for i in rows]  # fmt: skip
+        markers[:, 1] = heights
+        markers.setflags(write=False)
+        origin = np.zeros(2)
+        origin.setflags(write=False)
+        for i, vertices, marker in zip(rows, block, markers, strict=True):
+            _, alpha, h = checked[i]
+            built[i] = TubularPattern._build(
+                n, prism.r, vertices, band.edges_vertices, band.edges_assignment,
+                band.proximalBase, band.distalBase, origin, marker, float(geos[i].height),
+                (ModuleRecord._of("twist", {"twistAngle": alpha, "moduleHeight": h}),), 0, None,
+                False, None, True,
+            )  # fmt: skip
+    return built
 
 
 def _twist(
