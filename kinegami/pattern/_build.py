@@ -86,12 +86,17 @@ def assemble(
     The proximal marker is (0, 0) and the distal marker (``distal_marker_x``, ``height``).
     """
     edges = np.concatenate([b for b, _ in blocks]).astype(np.intp)
-    labels = np.concatenate(
-        [
-            np.full(b.shape[0], lab, dtype="<U1") if isinstance(lab, str) else np.asarray(lab)
-            for b, lab in blocks
-        ]
-    ).astype("<U1")
+    if all(type(lab) is str for _, lab in blocks):  # one label per block: one numpy call
+        labels = np.repeat(
+            np.array([lab for _, lab in blocks], dtype="<U1"), [b.shape[0] for b, _ in blocks]
+        )
+    else:
+        labels = np.concatenate(
+            [
+                np.full(b.shape[0], lab, dtype="<U1") if isinstance(lab, str) else np.asarray(lab)
+                for b, lab in blocks
+            ]
+        ).astype("<U1")
     if drop_degenerate:
         edges, labels = distinct_creases(edges, labels, vertices.shape[0])
     return TubularPattern._build(
