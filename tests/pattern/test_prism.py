@@ -56,3 +56,21 @@ def test_periodic_dx_is_shortest_representative():
     W = 6.0
     assert_allclose(periodic_dx(np.array([0.5, 5.5, -5.5, 3.0, -3.0, 9.0]), W),
                     [0.5, -0.5, 0.5, 3.0, 3.0, 3.0])  # fmt: skip
+
+
+def test_cached_many_computes_the_missing_values_in_one_call():
+    prism = make_prism(10, 0.25)  # a prism no other test of this file caches values on
+    prism._cache.clear()
+    prism.cached("b", lambda: "cached b")
+    calls = []
+
+    def make_many(missing):
+        calls.append(list(missing))
+        return [f"made {key}" for key in missing]
+
+    values = prism.cached_many(["a", "b", "c", "a", "c"], make_many)
+    assert values == ["made a", "cached b", "made c", "made a", "made c"]
+    assert calls == [["a", "c"]]  # once, each missing key once, in order of first appearance
+    assert prism.cached_many(["c", "a"], make_many) == ["made c", "made a"]
+    assert len(calls) == 1  # nothing missing: no call
+    prism._cache.clear()
