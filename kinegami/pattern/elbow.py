@@ -24,7 +24,7 @@ from kinegami.pattern._fold import (
 )
 from kinegami.pattern._prism import Prism, _readonly, make_prism, periodic_dx, wrap_x
 from kinegami.pattern.catalog import ModuleCounts
-from kinegami.pattern.tubular import ModuleRecord, TubularPattern
+from kinegami.pattern.tubular import ModuleRecord, TubularPattern, _first_occurrence_mask
 
 __all__ = ["ELBOW_ANGLE_TOL", "ElbowFittingPattern", "ElbowGeometry", "elbow_geometry"]
 
@@ -279,16 +279,18 @@ def _layouts(prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> list[_Layo
     """The shared layout of each row of ``collapsed`` and ``low`` (shape (E, n)), or None for
     a row that cannot be resolved (more than two collapsed columns, or two that are not
     adjacent). Layouts not yet in the prism's cache are computed together."""
-    keys = [
-        ("elbow layout", c.tobytes(), z.tobytes()) for c, z in zip(collapsed, low, strict=True)
-    ]
+    n = prism.numSides
+    # a row's key: its columns as bytes, 1 for collapsed, 2 for low (one tobytes for all)
+    codes = (collapsed.view(np.uint8) | (low.view(np.uint8) << 1)).tobytes()
+    keys = [("elbow layout", codes[i : i + n]) for i in range(0, len(codes), n)]
     row_of = {key: i for i, key in reversed(list(enumerate(keys)))}
 
     def make_many(missing: list) -> list:
         rows = [row_of[key] for key in missing]
         c, z = collapsed[rows], low[rows]
         count = np.count_nonzero(c, axis=1)
-        adjacent = (count == 1) | ((count == 2) & np.any(c & np.roll(c, 1, axis=1), axis=1))
+        previous = c[:, np.arange(-1, n - 1)]  # column k - 1 of every row
+        adjacent = (count == 1) | ((count == 2) & np.any(c & previous, axis=1))
         layouts: list = [None] * len(rows)
         good = np.flatnonzero(adjacent)
         if good.shape[0]:
@@ -325,17 +327,15 @@ def _new_layouts(prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> list[_
     y_index = np.empty((U, width), dtype=np.intp)
     x_index[:, P], y_index[:, P] = k, 0
     x_index[:, D], y_index[:, D] = k, 1
-    row = np.broadcast_to(np.arange(U)[:, None], (U, n))
-    kk = np.broadcast_to(k, (U, n))
-    x_index[row, M], y_index[row, M] = kk, 2
-    x_index[row[full], Of[full]], y_index[row[full], Of[full]] = n + kk[full], 2
-    x_index[row[has_l], L[has_l]], y_index[row[has_l], L[has_l]] = kk[has_l], 3 + kk[has_l]
-    x_index[row[has_l], Up[has_l]] = kk[has_l]
-    y_index[row[has_l], Up[has_l]] = 3 + n + kk[has_l]
+    kk = k + np.zeros((U, 1), dtype=np.intp)  # column k of every row
+    at = np.arange(U)[:, None] * width  # where each row starts in the flattened index arrays
+    x_flat, y_flat = x_index.reshape(-1), y_index.reshape(-1)
+    x_flat[at + M], y_flat[at + M] = kk, 2
+    x_flat[(at + Of)[full]], y_flat[(at + Of)[full]] = n + kk[full], 2
+    x_flat[(at + L)[has_l]], y_flat[(at + L)[has_l]] = kk[has_l], 3 + kk[has_l]
+    x_flat[(at + Up)[has_l]], y_flat[(at + Up)[has_l]] = kk[has_l], 3 + n + kk[has_l]
     # the creases of every row, and the first of each distinct one (as distinct_creases)
-    table = _crease_table(
-        np.broadcast_to(P, (U, n)), np.broadcast_to(D, (U, n)), L, M, Of, Up
-    )
+    table = _crease_table(kk, n + kk, L, M, Of, Up)
     edges = np.empty((U, n * len(table), 2), dtype=np.intp)
     edges[:, :, 0] = np.concatenate([first for first, _, _ in table], axis=1)
     edges[:, :, 1] = np.concatenate([second for _, second, _ in table], axis=1)
@@ -343,9 +343,8 @@ def _new_layouts(prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> list[_
     lo = np.minimum(edges[:, :, 0], edges[:, :, 1]).astype(np.int64)
     hi = np.maximum(edges[:, :, 0], edges[:, :, 1])
     key = (np.arange(U)[:, None] * width + lo) * width + hi
-    first = np.zeros(key.size, dtype=bool)
-    first[np.unique(key, return_index=True)[1]] = True
-    keep = first.reshape(U, -1) & (edges[:, :, 0] != edges[:, :, 1])
+    first = _first_occurrence_mask(key.reshape(-1)).reshape(U, -1)
+    keep = first & (edges[:, :, 0] != edges[:, :, 1])
     P, D = _readonly(P), _readonly(D.copy())
     layouts = []
     for u, total in enumerate(totals):

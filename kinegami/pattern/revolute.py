@@ -204,17 +204,17 @@ class _Layout:
 
 
 def _revolute_vertices(prism: Prism, geo: RevoluteGeometry, lay: _Layout) -> np.ndarray:
-    n = prism.numSides
     x = prism.columns
     H = geo.H
     v = np.empty((lay.total, 2))
-    v[lay.P] = np.stack([x, np.zeros(n)], axis=1)
+    v[lay.P, 0], v[lay.P, 1] = x, 0.0
+    cr = lay.crimped
     if lay.D is not None:
-        v[lay.D] = np.stack([x, np.full(n, 2.0 * H)], axis=1)
-        v[lay.U[lay.crimped]] = np.stack([x[lay.crimped], 2.0 * H - geo.t[lay.crimped]], axis=1)
-    v[lay.M] = np.stack([x, np.full(n, H)], axis=1)
-    v[lay.C] = np.stack([prism.panel_centres, np.full(n, H)], axis=1)
-    v[lay.K[lay.crimped]] = np.stack([x[lay.crimped], geo.t[lay.crimped]], axis=1)
+        v[lay.D, 0], v[lay.D, 1] = x, 2.0 * H
+        v[lay.U[cr], 0], v[lay.U[cr], 1] = x[cr], 2.0 * H - geo.t[cr]
+    v[lay.M, 0], v[lay.M, 1] = x, H
+    v[lay.C, 0], v[lay.C, 1] = prism.panel_centres, H
+    v[lay.K[cr], 0], v[lay.K[cr], 1] = x[cr], geo.t[cr]
     return v
 
 

@@ -178,10 +178,7 @@ def _repeats(keys: np.ndarray) -> np.ndarray:
 
 def _first_occurrence_mask(keys: np.ndarray) -> np.ndarray:
     """Boolean mask keeping the first crease of every group of equal keys."""
-    mask = np.zeros(keys.shape[0], dtype=bool)
-    if keys.shape[0]:
-        mask[np.unique(keys, return_index=True)[1]] = True
-    return mask
+    return ~_repeats(keys)
 
 
 class TubularPattern:
