@@ -52,8 +52,9 @@ def _empty_template(prism) -> TubularPattern:
 
 
 def _many_tubes(calls: list[tuple]) -> list[TubularPattern]:
-    """TubeFittingPattern of every (numSides, r, height) call; the tubes of one prism share
-    one block of vertices (each tube's array a read-only row) and one of distal markers."""
+    """TubeFittingPattern of every (numSides, r, height) call (a single tube is a batch of
+    one); the tubes of one prism share one block of vertices (each tube's array a read-only
+    row) and one of distal markers."""
     checked = [(make_prism(numSides, r), nonnegative("height", h)) for numSides, r, h in calls]
     built: list = [None] * len(calls)
     groups: dict = {}
@@ -104,9 +105,7 @@ def TubeFittingPattern(numSides: int, r: float, height: float) -> TubularPattern
         eps = 1e-4 b (including 0) gives the empty pattern, which adds nothing when appended
         (fix B6: no coincident vertices or zero-length creases).
     """
-    prism = make_prism(numSides, r)
-    h = nonnegative("height", height)
-    return _tube(prism, h, "M", ModuleRecord._of("tube", {"height": h}))
+    return _many_tubes([(numSides, r, height)])[0]
 
 
 def _tube(prism, h: float, label: str, record: ModuleRecord) -> TubularPattern:

@@ -63,23 +63,22 @@ def twist_geometry(prism: Prism, twistAngle: float, moduleHeight: float) -> Twis
 
 
 def _many_twists(calls: list[tuple]) -> list[TubularPattern]:
-    """TwistFittingPattern of every (numSides, r, twistAngle, moduleHeight) call, the distal
-    columns of the calls on one prism wrapped together (bit for bit as alone: elementwise)."""
+    """TwistFittingPattern of every (numSides, r, twistAngle, moduleHeight) call (a single
+    twist is a batch of one). The twists of one prism share one block of vertices (each
+    twist's array a read-only row) and one of distal markers, their distal columns wrapped
+    together (bit for bit as alone: elementwise)."""
     checked = [
         (make_prism(numSides, r), real("twistAngle", alpha), nonnegative("moduleHeight", h))
         for numSides, r, alpha, h in calls
     ]
     geos = [twist_geometry(prism, alpha, h) for prism, alpha, h in checked]
-    groups: dict[Prism, list[int]] = {}
-    for i, ((prism, _, _), geo) in enumerate(zip(checked, geos, strict=True)):
-        if not geo.degenerate:
-            groups.setdefault(prism, []).append(i)
     built: list = [None] * len(calls)
+    groups: dict[Prism, list[int]] = {}
     for i, ((prism, alpha, h), geo) in enumerate(zip(checked, geos, strict=True)):
         if geo.degenerate:
-            built[i] = _twist(prism, alpha, h, geo, None)
-    # the twists of one prism share one block of vertices (each twist's array a read-only
-    # row) and one of distal markers
+            built[i] = _relabelling(prism, alpha, h)
+        else:
+            groups.setdefault(prism, []).append(i)
     for prism, rows in groups.items():
         n, b = prism.numSides, prism.b
         band = prism.cached("twist", lambda prism=prism: _band(prism))
@@ -108,30 +107,17 @@ def _many_twists(calls: list[tuple]) -> list[TubularPattern]:
     return built
 
 
-def _twist(
-    prism: Prism, alpha: float, h: float, geo: TwistGeometry, shifted: np.ndarray | None
-) -> TubularPattern:
-    """The twist of checked ``alpha`` and ``h``; ``shifted``: its distal columns, wrapped."""
+def _relabelling(prism: Prism, alpha: float, h: float) -> TubularPattern:
+    """A degenerate twist (pattern height below eps): no creases, the distal marker moved by
+    the nearest whole number of columns."""
     record = ModuleRecord._of("twist", {"twistAngle": alpha, "moduleHeight": h})
     n, b = prism.numSides, prism.b
-    if geo.degenerate:
-        k = np.arange(n)
-        columns = round(n * ((alpha % (2.0 * math.pi)) / (2.0 * math.pi))) % n
-        vertices = np.stack([prism.columns, np.zeros(n)], axis=1)
-        return assemble(
-            prism, vertices, [(np.zeros((0, 2), int), "M")], k, k, 0.0, record,
-            distal_marker_x=float(wrap_x(np.array([columns * b]), prism.W, prism.eps)[0]),
-        )  # fmt: skip
-    H = geo.height
-    band = prism.cached("twist", lambda: _band(prism))
-    vertices = band.vertices_coords.copy()
-    vertices[n:, 0] = shifted
-    vertices[n:, 1] = H
-    marker_x = wrap_scalar(geo.K * b + geo.shift, prism.W, prism.eps)
-    return TubularPattern._build(
-        n, prism.r, vertices, band.edges_vertices, band.edges_assignment, band.proximalBase,
-        band.distalBase, np.zeros(2), np.array([marker_x, H]), float(H), (record,), 0, None,
-        False,
+    k = np.arange(n)
+    columns = round(n * ((alpha % (2.0 * math.pi)) / (2.0 * math.pi))) % n
+    vertices = np.stack([prism.columns, np.zeros(n)], axis=1)
+    return assemble(
+        prism, vertices, [(np.zeros((0, 2), int), "M")], k, k, 0.0, record,
+        distal_marker_x=float(wrap_x(np.array([columns * b]), prism.W, prism.eps)[0]),
     )  # fmt: skip
 
 
@@ -161,11 +147,7 @@ def TwistFittingPattern(
         eps = 1e-4 b the twist is only a relabelling: the result has no creases, height 0 and a
         distal marker shifted by the nearest whole number of columns.
     """
-    prism = make_prism(numSides, r)
-    alpha, h = real("twistAngle", twistAngle), nonnegative("moduleHeight", moduleHeight)
-    geo = twist_geometry(prism, alpha, h)
-    shifted = None if geo.degenerate else wrap_x(prism.columns + geo.shift, prism.W, prism.eps)
-    return _twist(prism, alpha, h, geo, shifted)
+    return _many_twists([(numSides, r, twistAngle, moduleHeight)])[0]
 
 
 def _band(prism: Prism) -> TubularPattern:
