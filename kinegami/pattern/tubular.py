@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
+from itertools import chain
 from typing import Any
 
 import numpy as np
 
 from kinegami._record import Record
 from kinegami.errors import InvalidParameterError, InvalidTypeError, ReadOnlyError
-from kinegami.pattern._prism import EPS_FACTOR, make_prism, periodic_dx, wrap_scalar, wrap_x
+from kinegami.pattern._prism import EPS_FACTOR, make_prism, periodic_dx, wrap_x
 from kinegami.validation import check_nonnegative
 
 _KEY_SHIFT = np.int64(1) << np.int64(32)
@@ -668,19 +669,20 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
     #    (a scalar recurrence on Python floats, the markers read in one numpy call)
     markers = np.concatenate([a for p in pats for a in (p.proximalMarker, p.distalMarker)])
     markers = markers.tolist()
-    offsets = [0.0] * (2 * m)
+    offsets = []
     mx, my = (float(v) for v in first.distalMarker)
-    height = first.height
-    removed = first.removedDuplicates
-    modules = list(first.modules)
-    for k, p in enumerate(pats):
-        px, py, dx, dy = markers[4 * k : 4 * k + 4]
+    high = W - eps  # wrap_scalar, inlined: x mod W, snapped to 0 within eps of 0 or W
+    four = iter(markers)
+    for px, py, dx, dy in zip(four, four, four, four, strict=True):
         ox, oy = mx - px, my - py
-        offsets[2 * k], offsets[2 * k + 1] = ox, oy
-        mx, my = wrap_scalar(dx + ox, W, eps), dy + oy
+        offsets += (ox, oy)
+        x = (dx + ox) % W
+        mx, my = 0.0 if x < eps or x > high else x, dy + oy
+    height = first.height
+    for p in pats:  # in order: a float sum
         height += p.height
-        removed += p.removedDuplicates
-        modules.extend(p.modules)
+    removed = first.removedDuplicates + sum(p.removedDuplicates for p in pats)
+    modules = first.modules + tuple(chain.from_iterable(p.modules for p in pats))
     offsets = np.array(offsets).reshape(m, 2)
     sizes = np.array([p.vertices_coords.shape[0] for p in pats], dtype=np.intp)
     # 2. every module's vertices, translated and wrapped; slots are module vertices, numbered
@@ -737,7 +739,10 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
     edges = index[slot_edges]
     assignment = np.concatenate([p.edges_assignment for p in pats])
     keep = np.ones(edges.shape[0], dtype=bool)
-    flagged = [k for k, p in enumerate(pats) if p._get_internal_duplicates()]
+    flagged = [
+        k for k, p in enumerate(pats)
+        if p._has_internal_duplicates is not False and p._get_internal_duplicates()
+    ]  # fmt: skip
     if flagged:
         edge_starts = np.concatenate([[0], np.cumsum(counts)])
         for k in flagged:
@@ -758,24 +763,24 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
     placements = first.module_vertices
     if placements is not None:
         placements = list(placements)
-        ends = (N0 + starts + sizes).tolist()
+        bounds = zip((N0 + starts).tolist(), (N0 + starts + sizes).tolist(), strict=True)
         _readonly(index)  # its slices are read-only views
-        for p, a, b in zip(pats, (N0 + starts).tolist(), ends, strict=True):
-            if p._module_vertices is None and len(p.modules) == 1:  # _placed's common case
-                placements.append(index[a:b])
-                continue
-            own = _placed(p, index[a:b])
-            if own is None:
-                placements = None
-                break
-            placements.extend(own)
+        if all(p._module_vertices is None and len(p.modules) == 1 for p in pats):
+            placements += [index[a:b] for a, b in bounds]  # _placed's common case, at once
+        else:
+            for p, (a, b) in zip(pats, bounds, strict=True):
+                own = _placed(p, index[a:b])
+                if own is None:
+                    placements = None
+                    break
+                placements.extend(own)
         placements = None if placements is None else tuple(placements)
     distal_idx = None if last_distal is None else index[N0 + starts[-1] + last_distal]
     return TubularPattern._build(
         n, first.r, np.concatenate([first.vertices_coords, coords[is_new]]),
         np.concatenate([first.edges_vertices, edges]),
         np.concatenate([first.edges_assignment, assignment]), first.proximalBase, distal_idx,
-        first.proximalMarker, np.array([mx, my]), height, tuple(modules), removed, None,
+        first.proximalMarker, np.array([mx, my]), height, modules, removed, None,
         first._has_internal_duplicates, placements,
     )  # fmt: skip
 
