@@ -266,10 +266,10 @@ class _Layout:
     """The elbow's vertex numbering and creases for one set of collapsed and low columns.
 
     They depend on n and on which columns are collapsed or low only, so they are computed once
-    per prism and column set (:meth:`Prism.cached`) and shared, read-only, by every elbow with
-    that set; an elbow then only computes its vertex coordinates: x = x_source[x_index] and
-    y = y_source[y_index], with x_source = (x_k, O_k's wrapped x) and y_source = (0, H, H_m,
-    h_k, H - h_k).
+    per prism and column set (:func:`_layouts`, through :meth:`Prism.cached_many`) and shared,
+    read-only, by every elbow with that set; an elbow then only computes its vertex
+    coordinates: x = x_source[x_index] and y = y_source[y_index], with x_source = (x_k, O_k's
+    wrapped x) and y_source = (0, H, H_m, h_k, H - h_k).
     """
 
     __slots__ = ("P", "D", "total", "edges", "labels", "x_index", "y_index")
