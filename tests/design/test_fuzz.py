@@ -41,6 +41,8 @@ WORDS = [
 ]  # fmt: skip
 LONG_LITERAL = "-" + "9" * 5000  # too many digits for int()
 DEEP_LITERAL = "[" * 100_000 + "]" * 100_000
+#: The deepest nesting a mutated document gets (json.dumps writes it; the loader's cap is 32).
+DEEPEST = 980
 
 scalars = st.one_of(
     st.none(),
@@ -128,6 +130,10 @@ def mutated_designs(draw, splice: bool = True):
             parent[path[-1]] = draw(values)
         elif kind == "wrap":
             depth = draw(st.sampled_from([1, 2, limits.MAX_DEPTH - 2, limits.MAX_DEPTH, 980]))
+            # at most DEEPEST levels in all: two wraps of a thousand (or one and another of
+            # 32) nest past what json.dumps itself can write (a RecursionError in the test's
+            # own dumps, before the loader sees anything)
+            depth = min(depth, DEEPEST - max(len(place) for place, _ in _places(document)))
             for _ in range(depth):
                 node = [node]
             if path:
