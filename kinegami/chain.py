@@ -539,6 +539,20 @@ class _JointAssembly:
             for variant in RADIAL_VARIANTS[:2]:  # a lead would only lengthen the hold
                 yield {**variant, "escape": escape, "hold_past": past}
 
+    def _state_value(self, j: int, newState) -> float | None:
+        """``newState`` of setJointState checked for joint ``j``: a real number (else
+        InvalidTypeError) in the joint's range (else rejected with a PlacementWarning: None)."""
+        s = check_real("newState", newState)
+        joint = self._joints[j]
+        lo, hi = joint.stateRange()
+        if not lo <= s <= hi:
+            self._reject(
+                f"setJointState failed: state {s!r} of joint {j} ({type(joint).__name__}) "
+                f"is outside its range [{lo:.6g}, {hi:.6g}]"
+            )
+            return None
+        return s
+
     def _state_values(self, states) -> list[float] | None:
         """``states`` of setJointStates checked: a sequence (list, tuple, 1-D numpy array) of
         one real number per joint, each in its joint's range. Anything else (a number, None, a
@@ -788,15 +802,10 @@ class KinematicChain(_JointAssembly):
         joint's ``stateRange()``. Link shapes never change: downstream links move rigidly.
         """
         j = self._index(jointIndex)
-        s = check_real("newState", newState)
-        joint = self._joints[j]
-        lo, hi = joint.stateRange()
-        if not lo <= s <= hi:
-            self._reject(
-                f"setJointState failed: state {s!r} of joint {j} ({type(joint).__name__}) "
-                f"is outside its range [{lo:.6g}, {hi:.6g}]"
-            )
+        s = self._state_value(j, newState)
+        if s is None:
             return False
+        joint = self._joints[j]
         G = joint.state_transform(s - joint.state)
         joints = list(self._joints)
         links = list(self._links)

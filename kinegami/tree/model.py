@@ -23,7 +23,7 @@ from kinegami.bodies import link_polyline, tree_worst_overlap
 from kinegami.chain import RADIAL_VARIANTS, KinematicChain, _JointAssembly
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
 from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube
-from kinegami.validation import check_int, check_real, shown
+from kinegami.validation import check_int, shown
 
 __all__ = ["KinematicTree"]
 
@@ -319,15 +319,10 @@ class KinematicTree(_JointAssembly):
         move; the joint itself, its siblings and every other branch stay. Returns False with a
         PlacementWarning (tree unchanged) if ``newState`` is outside ``stateRange()``."""
         j = self._index(jointIndex)
-        s = check_real("newState", newState)
-        joint = self._joints[j]
-        lo, hi = joint.stateRange()
-        if not lo <= s <= hi:
-            self._reject(
-                f"setJointState failed: state {s!r} of joint {j} ({type(joint).__name__}) "
-                f"is outside its range [{lo:.6g}, {hi:.6g}]"
-            )
+        s = self._state_value(j, newState)
+        if s is None:
             return False
+        joint = self._joints[j]
         G = joint.state_transform(s - joint.state)
         joints = list(self._joints)
         links = list(self._links)
