@@ -543,15 +543,20 @@ class _JointAssembly:
         """``newState`` of setJointState checked for joint ``j``: a real number (else
         InvalidTypeError) in the joint's range (else rejected with a PlacementWarning: None)."""
         s = check_real("newState", newState)
+        return None if self._rejected_state("setJointState", j, s) else s
+
+    def _rejected_state(self, operation: str, j: int, s: float) -> bool:
+        """Whether ``s`` lies outside joint ``j``'s range; if so, the operation is rejected
+        (PlacementWarning naming the joint, the state and the range)."""
         joint = self._joints[j]
         lo, hi = joint.stateRange()
-        if not lo <= s <= hi:
-            self._reject(
-                f"setJointState failed: state {s!r} of joint {j} ({type(joint).__name__}) "
-                f"is outside its range [{lo:.6g}, {hi:.6g}]"
-            )
-            return None
-        return s
+        if lo <= s <= hi:
+            return False
+        self._reject(
+            f"{operation} failed: state {s!r} of joint {j} ({type(joint).__name__}) "
+            f"is outside its range [{lo:.6g}, {hi:.6g}]"
+        )
+        return True
 
     def _state_values(self, states) -> list[float] | None:
         """``states`` of setJointStates checked: a sequence (list, tuple, 1-D numpy array) of
@@ -571,14 +576,8 @@ class _JointAssembly:
                 f"states must have one value per joint ({len(self._joints)}), got {count}"
             )
         values = [check_real(f"states[{i}]", s) for i, s in enumerate(states)]
-        for i, (joint, s) in enumerate(zip(self._joints, values, strict=True)):
-            lo, hi = joint.stateRange()
-            if not lo <= s <= hi:
-                self._reject(
-                    f"setJointStates failed: state {s!r} of joint {i} is outside "
-                    f"[{lo:.6g}, {hi:.6g}]"
-                )
-                return None
+        if any(self._rejected_state("setJointStates", i, s) for i, s in enumerate(values)):
+            return None
         return values
 
     def _cost(self, extended) -> tuple[float, float]:
