@@ -591,6 +591,7 @@ def sweep(
     *,
     names=None,
     resolution: int = 64,
+    progress=None,
 ) -> SweepReport:
     """Clearance over the range of motion of a chain or a tree.
 
@@ -610,6 +611,10 @@ def sweep(
     names : joint names for the report, optional.
     resolution : int
         Grid steps per joint and direction when searching the free intervals (>= 1).
+    progress : bool or callable, optional
+        ``progress(done, total)`` as configurations are tested (total: their count);
+        returning False stops the sweep with :class:`~kinegami.errors.Cancelled`. True or
+        None: a progress bar on stderr (None: when stderr is a terminal). docs/progress.md.
 
     Returns
     -------
@@ -649,7 +654,7 @@ def sweep(
         Q = np.array(
             [engine.check_states(c, f"configurations[{k}]") for k, c in enumerate(configurations)]
         )
-    clearance, pairs = engine.worst(Q)
+    clearance, pairs = _worst_with_progress(engine, Q, progress)
     colliding = int(np.count_nonzero(np.isfinite(clearance)))
     tally: dict[tuple[str, str], list] = {}
     for pair in pairs:
@@ -668,6 +673,21 @@ def sweep(
         free_intervals=engine.free_intervals(current, int(resolution)),
         states=tuple(float(x) for x in current),
     )
+
+
+def _worst_with_progress(engine, Q: np.ndarray, progress) -> tuple[np.ndarray, list]:
+    """``engine.worst(Q)`` in chunks, reporting each chunk to ``progress`` (may cancel)."""
+    from kinegami.progress import Progress
+
+    chunk = 2048 if isinstance(engine, ClearanceEngine) else 4
+    clearance, pairs = [], []
+    with Progress(progress, Q.shape[0], desc="sweep", unit="configuration") as bar:
+        for start in range(0, Q.shape[0], chunk):
+            c, p = engine.worst(Q[start : start + chunk])
+            clearance.append(c)
+            pairs.extend(p)
+            bar.update(c.shape[0])
+    return np.concatenate(clearance), pairs
 
 
 def tree_clearance(tree, states=None, names=None) -> ClearanceReport:

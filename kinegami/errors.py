@@ -20,7 +20,8 @@ inherit the matching builtin, so ``except ValueError`` keeps working (as ezdxf d
     +-- FoldExportError(ValueError)          a pattern FOLD export cannot write
     +-- ExporterUnavailableError(ImportError)
     +-- ExportError(OSError)                 a file could not be written
-        +-- PublishError                     a build could not be published
+    |   +-- PublishError                     a build could not be published
+    +-- Cancelled                            long work stopped by its progress callback
 
     UserWarning
     +-- PlacementWarning                     a placement, edit or state change was rejected
@@ -52,6 +53,7 @@ __all__ = [
     "PublishError",
     "ExporterUnavailableError",
     "FoldExportError",
+    "Cancelled",
     "PlacementWarning",
     "ClearanceWarning",
 ]
@@ -110,6 +112,13 @@ class UnknownModuleKindError(InvalidParameterError, KeyError):
 
     def __str__(self) -> str:  # KeyError would quote the message
         return str(self.args[0]) if self.args else ""
+
+
+# --- long work -----------------------------------------------------------------------------
+class Cancelled(KinegamiError):  # noqa: N818 - the name users catch (as asyncio)
+    """Long work (compaction, a motion sweep, a build) was stopped because its ``progress``
+    callback returned False (docs/progress.md). Nothing the work would have changed was
+    changed."""
 
 
 # --- design files --------------------------------------------------------------------------

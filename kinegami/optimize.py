@@ -15,7 +15,6 @@ import concurrent.futures
 import copy
 import math
 import os
-import sys
 import time
 import warnings
 from dataclasses import dataclass
@@ -34,6 +33,7 @@ from kinegami.errors import (
 from kinegami.geometry.csc import csc_lengths
 from kinegami.geometry.frames import rotation_about_line
 from kinegami.joints import Waypoint
+from kinegami.progress import Progress, ProgressCallback, check_progress
 from kinegami.tree import KinematicTree
 from kinegami.tree.sheets import junction_problems
 from kinegami.validation import check_bool, check_int, check_positive
@@ -614,17 +614,6 @@ def _input_problem(chain, motion_task, junctions: bool) -> tuple[str, str] | Non
     return None
 
 
-def _progress_bar(progress, total: int):
-    show = sys.stderr.isatty() if progress is None else bool(progress)
-    if not show:
-        return None
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover - tqdm is a dependency
-        return None
-    return tqdm(total=total, desc="compact", unit="start", leave=False)
-
-
 def compact(
     chain: KinematicChain | KinematicTree,
     *,
@@ -632,7 +621,7 @@ def compact(
     motion: bool = False,
     executor: concurrent.futures.Executor | None = None,
     time_limit: float | None = None,
-    progress: bool | None = None,
+    progress: bool | ProgressCallback | None = None,
     objective: str = "length",
     starts: int = 4,
     samples: int = 200,
@@ -662,8 +651,11 @@ def compact(
         ``distributed.Client(...).get_executor()``.
     time_limit : float, optional
         Seconds each start may search (> 0); default: until no move improves.
-    progress : bool, optional
-        Show a progress bar (default: when stderr is a terminal).
+    progress : bool or callable, optional
+        ``progress(done, total)`` after each finished start (and a few times a second while
+        waiting); returning False stops the search, raises :class:`~kinegami.errors.Cancelled`
+        and stops the local worker processes. True or None: a progress bar on stderr (None:
+        when stderr is a terminal). See docs/progress.md.
     objective : {"length", "ball"}
         Minimise the total tube length (links plus joints) or the bounding-ball radius.
     starts : int
@@ -681,6 +673,8 @@ def compact(
     CompactionError
         When the input passes through itself (or, for a tree, a socket does not fit) and no
         start found a design without the problem.
+    Cancelled
+        When ``progress`` returned False.
 
     Examples
     --------
@@ -708,6 +702,7 @@ def compact(
         raise InvalidParameterError(f"objective must be 'length' or 'ball', got {objective!r}")
     starts = check_int("starts", starts, minimum=1)
     samples = check_int("samples", samples, minimum=1)
+    progress = check_progress(progress)
     motion_task = None
     if motion:
         movable_states = _motion_configurations(chain, samples, seed)
@@ -720,7 +715,8 @@ def compact(
         workers = min(starts, os.cpu_count() or 1)
         executor = concurrent.futures.ProcessPoolExecutor(max_workers=workers)
     with warnings.catch_warnings():  # the caller's filters, back after the search
-        results = _run_all(executor, own, tasks, _progress_bar(progress, starts))
+        with Progress(progress, starts, desc="compact", unit="start") as bar:
+            results = _run_all(executor, own, tasks, bar)
     found = [res for res in results if res[3] is not None and res[1] == 0.0
              and not (junctions and junction_problems(res[3]))]  # fmt: skip
     problem = _input_problem(chain, motion_task, junctions)
@@ -736,26 +732,43 @@ def compact(
     return best
 
 
-def _run_all(executor, own: bool, tasks: list, bar) -> list:
-    """Run every start on ``executor``; cancel the rest and re-raise on any error or Ctrl-C."""
+def _run_all(executor, own: bool, tasks: list, bar: Progress) -> list:
+    """Run every start on ``executor``, reporting to ``bar``; cancel the rest and re-raise on
+    any error, Ctrl-C or :class:`Cancelled` (stopping our own pool's workers at once)."""
     results = []
     futures = []
     try:
         futures = [executor.submit(_run_start, task) for task in tasks]
-        for future in concurrent.futures.as_completed(futures):
-            results.append(future.result())
-            if bar is not None:
-                bar.update(1)
+        pending = set(futures)
+        while pending:
+            finished, pending = concurrent.futures.wait(
+                pending, timeout=0.1, return_when=concurrent.futures.FIRST_COMPLETED
+            )
+            for future in finished:
+                results.append(future.result())
+            if finished:
+                bar.update(len(finished))
+            else:
+                bar.check()  # a heartbeat: the callback may cancel while starts run
     except BaseException:
         for future in futures:
             future.cancel()
+        if own:
+            _stop_workers(executor)
         raise
     finally:
-        if bar is not None:
-            bar.close()
         if own:
             executor.shutdown(wait=True, cancel_futures=True)
     return results
+
+
+def _stop_workers(executor: concurrent.futures.Executor) -> None:
+    """Stop the worker processes of our own process pool now (their starts are abandoned)."""
+    if hasattr(executor, "terminate_workers"):  # Python >= 3.14
+        executor.terminate_workers()
+        return
+    for process in list((getattr(executor, "_processes", None) or {}).values()):
+        process.terminate()
 
 
 def shorten_by_axis_translations(
