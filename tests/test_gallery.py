@@ -12,8 +12,8 @@ and the numbers the gallery states about them.
 * the trees (TREE_ENTRIES): each design equals its script's tree; the algorithmic hand is the
   joint specification of the reference (spec trees.md 3) placed by the construction; the
   quadruped's and the gripper's geometry; the paper's hand's grasps (spec trees.md 4, numbers
-  from its fixture); each tree's script writes its 3D view and every sheet (pattern picture and
-  DXF at true size); the gallery page and the README show every entry.
+  from tests/data/hand_reference.json); each tree's script writes its 3D view and every sheet
+  (pattern picture and DXF at true size); the gallery page and the README show every entry.
 """
 
 from __future__ import annotations
@@ -75,9 +75,9 @@ TREE_ENTRIES = {
     "gripper": (10, 2, 285.281991),
 }
 TREE_SCRIPTS = sorted(TREE_ENTRIES)
-#: The spec's reference data (trees.md 3 and 4): the joint specification of the algorithmic
-#: hand, and the paper's hand with its grasps.
-FIXTURES = ROOT.parent / "shared" / "fixtures"
+#: The reference data (tests/data/<name>_reference.json): the joint specification of the
+#: algorithmic hand, and the paper's hand with its grasps.
+REFERENCE_DATA = ROOT / "tests" / "data"
 #: trees.md 3.2: the algorithmic hand by the published construction (routes side by side) and
 #: without the extra roll, in r.
 ALGORITHMIC_HAND_PUBLISHED_TOTAL = 755.9963
@@ -388,7 +388,7 @@ def test_puma_joints_on_the_dh_axes_and_shorter(designs):
 
 # --- the trees ---------------------------------------------------------------------------------
 def fixture(name: str) -> dict:
-    with open(FIXTURES / f"{name}.json", encoding="utf-8") as f:
+    with open(REFERENCE_DATA / f"{name}_reference.json", encoding="utf-8") as f:
         return json.load(f)
 
 

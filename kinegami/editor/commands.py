@@ -22,6 +22,7 @@ from kinegami.chain import KinematicChain
 from kinegami.design import limits
 from kinegami.design.reader import UNITS
 from kinegami.editor.document import Document, fork_chain, joint_parameters
+from kinegami.editor.units import angle_text
 from kinegami.errors import (
     ClearanceWarning,
     EditorCommandError,
@@ -51,6 +52,7 @@ __all__ = [
     "RollJoint",
     "TransformJoint",
     "TransformAll",
+    "SetJointPose",
     "SetJointParameters",
     "RenameJoint",
     "SetJointState",
@@ -327,7 +329,8 @@ def _new_joint(kind: str, parameters: Mapping, pose: np.ndarray, numSides: int, 
     if kind in ("RevoluteJoint", "ExtendedRevoluteJoint"):
         angle = _number("totalBendingAngle", p["totalBendingAngle"])
         if not 0.0 < angle < 2.0 * math.pi:
-            _fail(f"totalBendingAngle must be in (0, 2pi) radians, got {angle!r}")
+            _fail(f"totalBendingAngle must be in (0, 2pi) radians (0° to 360°), got {angle!r} "
+                  f"({angle_text(angle)})")  # fmt: skip
         layers = _integer("numSinkLayers", p["numSinkLayers"], 1, limits.NUM_SINK_LAYERS_MAX)
         if kind == "RevoluteJoint":
             return RevoluteJoint(numSides, r, angle, pose, layers)
@@ -338,7 +341,8 @@ def _new_joint(kind: str, parameters: Mapping, pose: np.ndarray, numSides: int, 
         layers = _integer("numLayers", p["numLayers"], 1, limits.NUM_LAYERS_MAX)
         cone = _number("coneAngle", p["coneAngle"])
         if not math.pi / 6 <= cone < math.pi / 2:
-            _fail(f"coneAngle must be in [pi/6, pi/2) radians, got {cone!r}")
+            _fail(f"coneAngle must be in [pi/6, pi/2) radians ([30°, 90°)), got {cone!r} "
+                  f"({angle_text(cone)})")  # fmt: skip
         return PrismaticJoint(numSides, r, length, layers, cone, pose)
     if kind == "Waypoint":
         return Waypoint(numSides, r, pose, _integer("pathIndex", p["pathIndex"], 0, 2))
@@ -701,6 +705,44 @@ class TransformJoint(Command):
 
 
 @dataclass(frozen=True)
+class SetJointPose(Command):
+    """Put a joint at the world pose ``pose`` (4x4 rigid; what a typed position and
+    orientation give).
+
+    The joint is moved by the transform that takes its Pose to ``pose`` (``transformJoint``):
+    with ``propagate`` its subtree moves along, else only its links are solved again. For a
+    revolute or prismatic joint the pose is its axis of motion, so typing one changes the
+    robot's kinematics on purpose (a drag or :class:`SlideJoint` keeps them).
+    """
+
+    joint: int | str
+    pose: Any
+    propagate: bool = True
+
+    label: ClassVar[str] = "set pose"
+
+    def describe(self) -> str:
+        return f"set pose of joint {self.joint!r}"
+
+    def apply(self, document: Document) -> Outcome:
+        chain = document.chain
+        j = resolve_joint(document, self.joint)
+        P = _pose("pose", self.pose, chain.r)
+        propagate = _flag("propagate", self.propagate)
+        old = np.asarray(chain.Joints[j].pose_matrix, dtype=float)
+        T = P @ np.linalg.inv(old)
+        T[3] = (0.0, 0.0, 0.0, 1.0)
+        run = _Run()
+        new = fork_chain(chain)
+        run(
+            f"set pose of {_label(document, j)}",
+            lambda: new.transformJoint(j, T, propagate=propagate),
+        )
+        sources = tuple(range(len(new.Joints)))
+        return Outcome(document.replaced(chain=new), j, run.clear_warning(new), sources)
+
+
+@dataclass(frozen=True)
 class TransformAll(Command):
     """Move the whole chain rigidly by the world transform ``transform``."""
 
@@ -780,10 +822,13 @@ def _check_state(document: Document, j: int, value, name: str) -> float:
     joint = document.chain.Joints[j]
     lo, hi = joint.stateRange()
     if not lo <= s <= hi:
-        unit = "a length" if isinstance(joint, PrismaticJoint) else "radians"
-        _fail(
-            f"{name} of {_label(document, j)} must be in [{lo:.6g}, {hi:.6g}] ({unit}), got {s!r}"
-        )
+        if isinstance(joint, PrismaticJoint):
+            unit = f"(a length, {document.units})"
+            got = repr(s)
+        else:
+            unit = f"radians ([{angle_text(lo)}, {angle_text(hi)}])"
+            got = f"{s!r} ({angle_text(s)})"
+        _fail(f"{name} of {_label(document, j)} must be in [{lo:.6g}, {hi:.6g}] {unit}, got {got}")
     return s
 
 

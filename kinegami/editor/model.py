@@ -637,6 +637,11 @@ class EditorModel:
             )
         )
 
+    def set_pose(self, joint, pose, *, propagate: bool | None = None) -> CommandResult:
+        """Put a joint at a world pose (4x4; see :class:`~kinegami.editor.commands.
+        SetJointPose`)."""
+        return self.apply(cmd.SetJointPose(self._target(joint), pose, self._propagate(propagate)))
+
     def transform_all(self, transform) -> CommandResult:
         """Move the whole chain rigidly."""
         return self.apply(cmd.TransformAll(transform))

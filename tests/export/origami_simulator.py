@@ -9,9 +9,9 @@ run is repeatable. The results are read from the page: the average vertex error 
 (``#globalError``, in %), the node positions (``globals.model.getPositionsArray()``, the model
 scaled to a unit bounding sphere), the nodes' flat positions and the creases' target angles.
 
-Where the simulator comes from: ``KINEGAMI_ORIGAMI_SIMULATOR`` or ``../shared/tools/
-OrigamiSimulator`` beside the repository; the browser: tests/headless_chromium.py (Debian's
-chromium, shared with the editor's browser tests).
+Where the simulator comes from: the folder ``KINEGAMI_ORIGAMI_SIMULATOR`` names (a copy of
+https://github.com/amandaghassaei/OrigamiSimulator; .ci/run sets it); the browser:
+tests/headless_chromium.py (Debian's chromium, also used by the editor's browser tests).
 """
 
 from __future__ import annotations
@@ -28,13 +28,11 @@ from pathlib import Path
 import numpy as np
 from headless_chromium import chromium_path, launch
 
-REPO = Path(__file__).resolve().parents[2]
 
-
-def simulator_folder() -> Path:
-    return Path(
-        os.environ.get("KINEGAMI_ORIGAMI_SIMULATOR", REPO.parent / "shared/tools/OrigamiSimulator")
-    )
+def simulator_folder() -> Path | None:
+    """The simulator's folder (``KINEGAMI_ORIGAMI_SIMULATOR``), or None when it is not set."""
+    folder = os.environ.get("KINEGAMI_ORIGAMI_SIMULATOR")
+    return Path(folder) if folder else None
 
 
 @dataclass
@@ -128,7 +126,10 @@ class OrigamiSimulator:
     """Context manager: an http server for the simulator and one headless Chromium."""
 
     def __init__(self, folder: Path | None = None, chromium: Path | None = None):
-        self.folder = Path(folder or simulator_folder())
+        folder = folder or simulator_folder()
+        if folder is None:
+            raise ValueError("no Origami Simulator: set KINEGAMI_ORIGAMI_SIMULATOR to its folder")
+        self.folder = Path(folder)
         self.chromium = Path(chromium or chromium_path())
 
     def __enter__(self) -> OrigamiSimulator:

@@ -55,8 +55,11 @@ GALLERY = sorted(p.stem for p in CHAIN_DESIGNS)  # one crease pattern each
 
 def _missing() -> str | None:
     """Why the browser tests cannot run here, or None."""
-    if not (simulator_folder() / "index.html").is_file():
-        return f"no Origami Simulator at {simulator_folder()} (set KINEGAMI_ORIGAMI_SIMULATOR)"
+    folder = simulator_folder()
+    if folder is None:
+        return "KINEGAMI_ORIGAMI_SIMULATOR is not set (the folder of a copy of Origami Simulator)"
+    if not (folder / "index.html").is_file():
+        return f"no Origami Simulator at {folder} (KINEGAMI_ORIGAMI_SIMULATOR)"
     return headless_chromium.missing()
 
 
@@ -174,6 +177,26 @@ def test_handedness_tells_a_fold_from_its_mirror_image():
     assert handedness_agreement(flat, X, flat)[1] == 0  # nothing is folded in the flat sheet
     index, mismatch = match_nodes(sheet, flat / 100.0 - 5.0, svg=False)
     assert mismatch < 1e-9 and (index == np.arange(len(sheet))).all()
+
+
+def test_without_the_simulator_its_tests_skip_and_fail_in_ci(monkeypatch, tmp_path):
+    """Only KINEGAMI_ORIGAMI_SIMULATOR (set by .ci/run) locates the simulator: unset or
+    pointing at no simulator, the browser tests skip with the reason, or fail under
+    KINEGAMI_REQUIRE_BROWSER."""
+    monkeypatch.delenv("KINEGAMI_ORIGAMI_SIMULATOR", raising=False)
+    assert simulator_folder() is None
+    assert "KINEGAMI_ORIGAMI_SIMULATOR is not set" in _missing()
+    with pytest.raises(ValueError, match="KINEGAMI_ORIGAMI_SIMULATOR"):
+        OrigamiSimulator()
+    monkeypatch.setenv("KINEGAMI_ORIGAMI_SIMULATOR", str(tmp_path))
+    assert simulator_folder() == tmp_path
+    assert _missing() == f"no Origami Simulator at {tmp_path} (KINEGAMI_ORIGAMI_SIMULATOR)"
+    monkeypatch.delenv("KINEGAMI_REQUIRE_BROWSER", raising=False)
+    with pytest.raises(pytest.skip.Exception, match="no Origami Simulator"):
+        headless_chromium.require(_missing())
+    monkeypatch.setenv("KINEGAMI_REQUIRE_BROWSER", "1")
+    with pytest.raises(pytest.fail.Exception, match="required but no Origami Simulator"):
+        headless_chromium.require(_missing())
 
 
 @pytest.mark.browser

@@ -1,4 +1,5 @@
-"""The paper's hand as a KinematicTree, built from the reference fixture (fixtures/hand.json)."""
+"""The paper's hand as a KinematicTree, built from its reference data
+(tests/data/hand_reference.json)."""
 
 from __future__ import annotations
 
@@ -9,11 +10,11 @@ from spatialmath import SE3
 
 from kinegami import EndTip, KinematicTree, RevoluteJoint, Waypoint
 
-FIXTURES = Path(__file__).resolve().parents[2].parent / "shared" / "fixtures"
-HAND = FIXTURES / "hand.json"
+HAND = Path(__file__).resolve().parents[1] / "data" / "hand_reference.json"
 
 
 def load_fixture(path: Path = HAND) -> dict:
+    """The hand's joint specification and reference numbers (``reference``)."""
     with open(path, encoding="utf-8") as f:
         return json.load(f)
 
@@ -28,7 +29,7 @@ def pose_of(steps) -> SE3:
 
 def hand_tree(**options) -> KinematicTree:
     """The paper's three-finger hand: every joint added with its exact pose (relative to its
-    parent's pose), in the fixture's order."""
+    parent's pose), in the file's order."""
     data = load_fixture()
     joints = data["joints"]
     tree = KinematicTree(Waypoint(4, 1, pose_of(joints[0]["relative_pose"])), **options)

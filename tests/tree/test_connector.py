@@ -26,7 +26,7 @@ from kinegami.tree.connector import (
 
 pytest.importorskip("manifold3d")
 
-# --- reference data: the paper's hand (fixtures/hand.json, trees.md §4) ---------------------
+# --- reference data: the paper's hand (tests/data/hand_reference.json) ---------------------
 R, N = 1.0, 4
 PI = math.pi
 #: The root's children (palm, pointer1, middle0): poses relative to the root Waypoint at I.

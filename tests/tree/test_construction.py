@@ -1,5 +1,5 @@
 """The tree construction (kinegami.tree.construction): the algorithmic hand's reference numbers
-(fixtures/algorithmic_hand.json), the construction's invariants on it and on random
+(tests/data/algorithmic_hand_reference.json), the construction's invariants on it and on random
 specifications, and the existence theorem behind it (docs/theory/trees.md)."""
 
 from __future__ import annotations
@@ -30,14 +30,11 @@ from kinegami.tree.construction import (
     load_joint_specification,
 )
 
-FIXTURES = Path(__file__).resolve().parents[2].parent / "shared" / "fixtures"
-HAND = FIXTURES / "algorithmic_hand.json"
+HAND = Path(__file__).resolve().parents[1] / "data" / "algorithmic_hand_reference.json"
 N_REF = (0.5, 1 / math.sqrt(2), 0.5)
 N_OTHER = (0.5, -1 / math.sqrt(2), 0.5)
 #: the published construction with the growth direction -N_REF (total link length, in r)
 TOTAL_NEGATED_REF = 976.4819
-
-pytestmark = pytest.mark.skipif(not HAND.exists(), reason="reference fixtures not available")
 
 
 @pytest.fixture(scope="module")
@@ -118,7 +115,8 @@ def test_the_fix_without_extra_roll(fixed, reference):
 
 def test_the_other_growth_directions(hand, reference):
     tol = reference["tolerance"]
-    ref = reference["growth_direction_0.5_-0.7071_0.5"]
+    ref = reference["other_growth_direction"]
+    assert_allclose(ref["growth_direction"], N_OTHER, rtol=0, atol=1e-15)
     other = from_specification(hand, growth_direction=N_OTHER, extra_roll=True, sibling_azimuth=0.0)
     assert abs(other.totalPathLength() - ref["total_link_length"]) < tol
     assert abs(other.construction.recomputed_ball.r - ref["bounding_ball_radius_recomputed"]) < tol
