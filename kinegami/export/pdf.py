@@ -19,6 +19,11 @@ Page layout (all lengths in mm)::
     |   title, units; print at 100 %                 |  title and units
     +------------------------------------------------+
 
+The footer is ``FOOTER`` high for a one-line title; a longer title wraps to the window's width
+and the footer grows by ``TITLE_STEP`` per line, and a legend too long to sit beside the scale
+bar goes under it on rows of its own, so the footer always lies inside the page less its
+margins.
+
 Pages are named by row letter (A = top) and column number (1 = left) and numbered row by row.
 Trim each page along its crop marks and butt the pages edge to edge; with ``overlap`` > 0 the
 windows of neighbouring pages overlap by that much and a dashed grey line marks where the
@@ -77,9 +82,17 @@ PDF_DEFAULTS = {
 }
 
 MIN_MARGIN = 6.0  # mm: the crop marks and the page label go in the margin
-FOOTER = 14.0  # mm of the window's bottom reserved for label, legend and scale bar
+#: mm between the bottom margin and the window for a one-line title and a one-row legend beside
+#: the scale bar; each further title line adds TITLE_STEP, each further legend row LEGEND_STEP.
+FOOTER = 14.0
+TITLE_STEP = 3.0  # mm from one line of the footer's title to the next
+LEGEND_STEP = 3.5  # mm from one row of the legend to the next
+LEGEND_SAMPLE = 8.0  # mm of each line style drawn in the legend
+LEGEND_GAP = 4.0  # mm between two legend entries
+BAR_GAP = 5.0  # mm between the legend and the scale bar on one row
 MARK_GAP = 1.5  # crop mark: gap to the window corner (mm)
 MARK_LENGTH = 4.0  # crop mark length (mm)
+LABEL_INDENT = MARK_GAP + MARK_LENGTH + 2.0  # mm from the window's left edge to the page label
 _FONT = 7.0  # points
 
 # kind -> (colour, line width mm, dash pattern mm or None, legend name)
@@ -140,6 +153,16 @@ class PdfLayout:
     units_text : str
         What one pattern unit is, for the footer (e.g. ``"1 unit = 1 mm"``).
     title : str
+    footer : float
+        Height of the footer between the bottom margin and the window, mm (``FOOTER`` for a
+        one-line title; more when the title wraps or the legend needs more rows).
+    title_lines : tuple of str
+        The footer's text (title, units, how to print) wrapped to the window's width, top line
+        first.
+    legend : tuple of (str, str, float, float)
+        (kind, name, x, y) of every legend entry: its line sample starts at (x, y), page mm.
+    bar_base : float
+        Height of the scale bar above the page's bottom edge, mm.
     """
 
     paper: str
@@ -158,6 +181,10 @@ class PdfLayout:
     perforated: bool
     units_text: str
     title: str
+    footer: float
+    title_lines: tuple[str, ...]
+    legend: tuple[tuple[str, str, float, float], ...]
+    bar_base: float
 
     @property
     def page_count(self) -> int:
@@ -234,6 +261,102 @@ def clip_to_rectangle(
     return keep, clipped
 
 
+def text_width(text: str, bold: bool = False) -> float:
+    """Width of ``text`` in the pages' font (7 pt, matplotlib's default family), mm."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextToPath
+
+    font = FontProperties(size=_FONT, weight="bold" if bold else "normal")
+    width, _, _ = TextToPath().get_text_width_height_descent(text, font, ismath=False)
+    return width / POINTS_PER_MM
+
+
+def wrap_text(text: str, width: float) -> tuple[str, ...]:
+    """``text`` cut into lines of at most ``width`` mm (:func:`text_width`): at spaces, and
+    inside a word only when the word alone is wider than a line."""
+    lines: list[str] = []
+    line = ""
+    for word in text.split(" "):
+        candidate = f"{line} {word}" if line else word
+        if text_width(candidate) <= width:
+            line = candidate
+            continue
+        if line:
+            lines.append(line)
+        line = ""
+        for char in word:  # a word longer than a line: cut it where the line is full
+            if line and text_width(line + char) > width:
+                lines.append(line)
+                line = ""
+            line += char
+    lines.append(line)
+    return tuple(lines)
+
+
+def page_label(tile: Tile, count: int, rows: int, cols: int) -> str:
+    """The label above the window of ``tile``'s page (``count`` pages in ``rows`` x ``cols``)."""
+    return (
+        f"{tile.label}   page {tile.page} of {count} (row {_row_label(tile.row)} of {rows}, "
+        f"column {tile.col + 1} of {cols})"
+    )
+
+
+def _legend_entries(perforated: bool) -> list[tuple[str, str, float]]:
+    """(kind, name, width in mm: line sample, gap and text) of the legend's entries."""
+    entries = []
+    for kind in ("M", "V", "C", "B"):
+        name = _STYLES[kind][3]
+        if perforated and kind in "MV":
+            name += " (perforated)"
+        entries.append((kind, name, LEGEND_SAMPLE + 1.5 + text_width(name)))
+    return entries
+
+
+@dataclass(frozen=True)
+class _Footer:
+    height: float
+    title_lines: tuple[str, ...]
+    legend: tuple[tuple[str, str, float, float], ...]
+    bar_base: float
+
+
+def _footer_layout(text: str, perforated: bool, margin: float, x: float, width: float,
+                   scale_bar: float) -> _Footer:  # fmt: skip
+    """Where the footer's parts go in a window ``width`` mm wide starting at ``x`` (page mm):
+    the text wrapped at the bottom, the legend above it, the scale bar at the right of the
+    legend's row when both fit on it, else above the legend (whose entries then fill rows of
+    the whole width)."""
+    lines = wrap_text(text, width)
+    above_text = margin + 6.5 + (len(lines) - 1) * TITLE_STEP  # centre of the legend's last row
+    entries = _legend_entries(perforated)
+    widest = max(w for _, _, w in entries)
+    if widest > width:
+        raise InvalidParameterError(
+            f"margin={margin:g} mm leaves a window {width:.1f} mm wide, too narrow for the "
+            f"legend (its widest entry is {widest:.1f} mm); use a smaller margin"
+        )
+    in_one_row = sum(w for _, _, w in entries) + LEGEND_GAP * (len(entries) - 1)
+    beside = in_one_row + BAR_GAP + scale_bar <= width
+    rows: list[list[tuple[str, str, float]]] = [[]]
+    used = 0.0
+    for entry in entries:
+        if rows[-1] and used + LEGEND_GAP + entry[2] > width and not beside:
+            rows.append([])
+            used = 0.0
+        used += (LEGEND_GAP if rows[-1] else 0.0) + entry[2]
+        rows[-1].append(entry)
+    legend = []
+    for row, members in enumerate(rows):
+        y = above_text + (len(rows) - 1 - row) * LEGEND_STEP
+        cursor = x
+        for kind, name, entry_width in members:
+            legend.append((kind, name, cursor, y))
+            cursor += entry_width + LEGEND_GAP
+    top_row = above_text + (len(rows) - 1) * LEGEND_STEP
+    bar_base = above_text if beside else top_row + LEGEND_STEP
+    return _Footer(bar_base + FOOTER - 6.5 - margin, lines, tuple(legend), bar_base)
+
+
 def _choice(name: str, value: Any, choices) -> Any:
     if not isinstance(value, str) or value not in choices:
         raise InvalidParameterError(
@@ -272,6 +395,10 @@ def pdf_layout(pattern: TubularPattern, **options: Any) -> PdfLayout:
     if not isinstance(title, str):
         raise InvalidTypeError(f"title must be a string, got {title!r}")
 
+    units = options.get("units", "mm")
+    scale = float(options.get("scale", 1.0))
+    units_text = f"1 unit = {scale:g} {units}" if scale != 1.0 else f"1 unit = 1 {units}"
+    text = f"{title}, {units_text}; print at 100 % (actual size); trim along the crop marks"
     segments, kinds, bounds = sheet_lines(pattern, opts)
     sheet_w, sheet_h = bounds[2] - bounds[0], bounds[3] - bounds[1]
     candidates = []
@@ -279,16 +406,11 @@ def pdf_layout(pattern: TubularPattern, **options: Any) -> PdfLayout:
         w, h = PAPER_SIZES[paper]
         if name == "landscape":
             w, h = h, w
-        win_w, win_h = w - 2.0 * margin, h - 2.0 * margin - FOOTER
-        if win_w < 20.0 or win_h < 20.0:
+        win_w = w - 2.0 * margin
+        if win_w < 20.0:
             raise InvalidParameterError(
                 f"margin={margin!r} mm leaves no room on {paper} {name} paper: the window "
-                f"({win_w:.1f} x {win_h:.1f} mm) must be at least 20 x 20 mm"
-            )
-        if overlap > 0.5 * min(win_w, win_h):
-            raise InvalidParameterError(
-                f"overlap must be at most half the window ({0.5 * min(win_w, win_h):.1f} mm on "
-                f"{paper} {name} paper), got {overlap!r}"
+                f"({win_w:.1f} mm wide) must be at least 20 mm wide"
             )
         if scale_bar > 0.5 * win_w - 10.0:
             raise InvalidParameterError(
@@ -296,10 +418,23 @@ def pdf_layout(pattern: TubularPattern, **options: Any) -> PdfLayout:
                 f"less 10 mm) on {paper} {name} paper with margin={margin:g} mm, got "
                 f"{scale_bar!r}"
             )
+        footer = _footer_layout(text, opts.perforate, margin, margin, win_w, scale_bar)
+        win_h = h - 2.0 * margin - footer.height
+        if win_h < 20.0:
+            raise InvalidParameterError(
+                f"margin={margin!r} mm and a footer of {footer.height:.1f} mm (title "
+                f"{len(title)} characters) leave no room on {paper} {name} paper: the window "
+                f"({win_w:.1f} x {win_h:.1f} mm) must be at least 20 x 20 mm"
+            )
+        if overlap > 0.5 * min(win_w, win_h):
+            raise InvalidParameterError(
+                f"overlap must be at most half the window ({0.5 * min(win_w, win_h):.1f} mm on "
+                f"{paper} {name} paper), got {overlap!r}"
+            )
         cols = _count(sheet_w, win_w, overlap)
         rows = _count(sheet_h, win_h, overlap)
-        candidates.append((rows * cols, name, (w, h), (win_w, win_h), rows, cols))
-    count, name, (w, h), (win_w, win_h), rows, cols = min(candidates, key=lambda c: c[0])
+        candidates.append((rows * cols, name, (w, h), (win_w, win_h), rows, cols, footer))
+    count, name, (w, h), (win_w, win_h), rows, cols, footer = min(candidates, key=lambda c: c[0])
     if count > max_pages:
         raise InvalidParameterError(
             f"the sheet ({sheet_w:.1f} x {sheet_h:.1f} mm) needs {count} {paper} pages, more "
@@ -323,14 +458,18 @@ def pdf_layout(pattern: TubularPattern, **options: Any) -> PdfLayout:
                     (x0, y1 - win_h, x0 + win_w, y1),
                 )
             )
-    units = options.get("units", "mm")
-    scale = float(options.get("scale", 1.0))
-    units_text = f"1 unit = {scale:g} {units}" if scale != 1.0 else f"1 unit = 1 {units}"
+    widest = max(text_width(page_label(t, len(tiles), rows, cols), bold=True) for t in tiles)
+    if widest > win_w - LABEL_INDENT:
+        raise InvalidParameterError(
+            f"margin={margin:g} mm leaves a window {win_w:.1f} mm wide on {paper} {name} paper, "
+            f"too narrow for the page labels ({widest:.1f} mm from {LABEL_INDENT:g} mm in); use "
+            f"a smaller margin"
+        )
     return PdfLayout(
         paper=paper,
         orientation=name,
         page_size=(w, h),
-        content=(margin, margin + FOOTER, win_w, win_h),
+        content=(margin, margin + footer.height, win_w, win_h),
         rows=rows,
         cols=cols,
         tiles=tuple(tiles),
@@ -343,6 +482,10 @@ def pdf_layout(pattern: TubularPattern, **options: Any) -> PdfLayout:
         perforated=opts.perforate,
         units_text=units_text,
         title=title,
+        footer=footer.height,
+        title_lines=footer.title_lines,
+        legend=footer.legend,
+        bar_base=footer.bar_base,
     )
 
 
@@ -354,10 +497,9 @@ def _dashes(pattern: tuple[float, ...] | None):
 
 def scale_bar_segment(layout: PdfLayout) -> np.ndarray:
     """(2, 2): the scale bar's line on every page, page mm (its length is ``scale_bar``)."""
-    x, y, w, _ = layout.content
+    x, _, w, _ = layout.content
     right = x + w
-    base = layout.margin + 6.5
-    return np.array([[right - layout.scale_bar, base], [right, base]])
+    return np.array([[right - layout.scale_bar, layout.bar_base], [right, layout.bar_base]])
 
 
 def draw_page(layout: PdfLayout, index: int, figure: Figure | None = None) -> Figure:
@@ -454,48 +596,28 @@ def _marks(ax, layout: PdfLayout, tile: Tile) -> None:
 
 
 def _footer(ax, layout: PdfLayout, tile: Tile, text: dict) -> None:
-    """Page label and title above the window; legend and scale bar below it."""
+    """Page label above the window; legend, scale bar and the wrapped title below it."""
     from matplotlib.collections import LineCollection
 
     x, y, w, h = layout.content
-    left = x + MARK_GAP + MARK_LENGTH + 2.0
-    top = y + h + MARK_GAP + 1.0
-    ax.text(
-        left,
-        top,
-        f"{tile.label}   page {tile.page} of {layout.page_count} (row {_row_label(tile.row)} "
-        f"of {layout.rows}, column {tile.col + 1} of {layout.cols})",
-        ha="left",
-        va="bottom",
-        fontweight="bold",
-        **text,
-    )
-    ax.text(
-        x,
-        layout.margin + 1.5,
-        f"{layout.title}, {layout.units_text}; print at 100 % (actual size); trim along the "
-        f"crop marks",
-        ha="left",
-        va="center",
-        **text,
-    )
-    base = layout.margin + 6.5
-    cursor = x
-    for kind in ("M", "V", "C", "B"):
-        color, width, dashes, name = _STYLES[kind]
+    ax.text(x + LABEL_INDENT, y + h + MARK_GAP + 1.0,
+            page_label(tile, layout.page_count, layout.rows, layout.cols), ha="left",
+            va="bottom", fontweight="bold", **text)  # fmt: skip
+    for k, line in enumerate(reversed(layout.title_lines)):  # the last line at the bottom
+        ax.text(x, layout.margin + 1.5 + k * TITLE_STEP, line, ha="left", va="center", **text)
+    for kind, name, left, base in layout.legend:
+        color, width, dashes, _ = _STYLES[kind]
         if layout.perforated and kind in "MV":
-            name += " (perforated)"
             dashes = None
         ax.add_collection(
             LineCollection(
-                [[(cursor, base), (cursor + 8.0, base)]],
+                [[(left, base), (left + LEGEND_SAMPLE, base)]],
                 colors=color,
                 linewidths=width * POINTS_PER_MM,
                 linestyles=[_dashes(dashes)],
             )
         )
-        ax.text(cursor + 9.5, base, name, ha="left", va="center", **text)
-        cursor += 9.5 + 1.6 * len(name) + 4.0
+        ax.text(left + LEGEND_SAMPLE + 1.5, base, name, ha="left", va="center", **text)
     bar = scale_bar_segment(layout)
     (x0, y0), (x1, _) = bar
     ticks = [[(x0, y0), (x1, y0)]]
@@ -533,7 +655,8 @@ def pdf_data(pattern: TubularPattern, **options: Any) -> bytes:
     max_pages : int, optional
         Refuse layouts needing more pages (default 200).
     title : str, optional
-        Text in the footer and the PDF's Title (default ``'kinegami crease pattern'``).
+        Text in the footer (wrapped to the window's width) and the PDF's Title (default
+        ``'kinegami crease pattern'``).
 
     Raises
     ------

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import io
 import math
+import warnings
+from pathlib import Path
 
 import numpy as np
 import pypdf
@@ -11,7 +13,14 @@ import pytest
 
 from kinegami import pattern as catalog
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.export.pdf import FOOTER, draw_page, pdf_layout, scale_bar_segment, write_pdf
+from kinegami.export.pdf import (
+    FOOTER,
+    TITLE_STEP,
+    draw_page,
+    pdf_layout,
+    scale_bar_segment,
+    write_pdf,
+)
 from kinegami.export.registry import export
 from kinegami.pattern.sheet import flatten
 
@@ -64,6 +73,43 @@ def stroked_segments(page) -> list[tuple[tuple[float, ...], np.ndarray]]:
                 pass
         numbers = []
     return out
+
+
+def text_spans(page) -> list[tuple[str, float, float, float]]:
+    """(text, left, right, baseline) of every horizontal text shown on a page, mm from the
+    page's lower-left corner. The width is the sum of the glyph widths in the font's own
+    /Widths table (the exporter's kerning, ignored here, moves the end by < 0.3 mm; a glyph
+    outside the table, such as the arrows of the neighbours' labels, counts as the widest)."""
+    spans = []
+
+    def visit(text, cm, tm, font, size):
+        if not text.strip() or cm[1] != 0.0 or cm[0] <= 0.0:  # rotated: neighbour labels
+            return
+        widths = [float(w) for w in font["/Widths"].get_object()]
+        first, scale = int(font["/FirstChar"]), float(font["/FontMatrix"][0])
+        glyphs = [widths[ord(c) - first] if 0 <= ord(c) - first < len(widths) else max(widths)
+                  for c in text]  # fmt: skip
+        width = sum(glyphs) * scale * size * cm[0]
+        x, y = cm[4] + tm[4] * cm[0], cm[5] + tm[5] * cm[3]
+        spans.append((text, x / PT, (x + width) / PT, y / PT))
+
+    page.extract_text(visitor_text=visit)
+    return spans
+
+
+def assert_footer_inside(page, margin: float, window_bottom: float) -> list:
+    """Every text below the window (the footer) lies within the page less its margins, and
+    every text within the page; returns the footer's spans."""
+    width, height = float(page.mediabox.width) / PT, float(page.mediabox.height) / PT
+    spans = text_spans(page)
+    footer = [s for s in spans if s[3] < window_bottom]
+    assert footer
+    for text, left, right, baseline in spans:
+        assert 0.0 <= left and right <= width and 0.0 < baseline < height, text
+    for text, left, right, baseline in footer:
+        assert left >= margin - 1e-6 and right <= width - margin + 0.3, (text, left, right)
+        assert baseline >= margin, text
+    return footer
 
 
 def lengths_mm(segments) -> np.ndarray:
@@ -251,6 +297,107 @@ def test_export_dispatch_for_chains_and_patterns(tmp_path, example_1a):
         assert len(page_a) == len(page_b)
         for (ca, sa), (cb, sb) in zip(page_a, page_b, strict=True):
             assert ca == cb and np.allclose(sa, sb)
+
+
+HAND = Path(__file__).resolve().parents[2] / "examples" / "designs" / "hand.json"
+
+
+def test_a_tree_pdfs_footers_lie_inside_its_pages(tmp_path):
+    """The tree build's PDF titles every sheet with its label (long: joints, junction, where
+    it starts): each footer wraps inside the page (it used to run 58 mm past the right edge)."""
+    from kinegami.design import load_design_with_info
+    from kinegami.design.reader import carry_origin
+    from kinegami.export.tree_build import sheet_labels, write_tree_files
+    from kinegami.tree.sheets import fabricate, fit_junctions
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        tree, info = load_design_with_info(HAND)
+        fitted, _ = fit_junctions(tree)
+        fabrication = fabricate(fitted)
+    names = carry_origin(tree, fitted).names  # as kinegami build names the joints
+    [path] = write_tree_files(fabrication, tmp_path, "hand", ["pdf"], units=info.units,
+                              names=names)  # fmt: skip
+    labels = sheet_labels(fabrication, names, info.units)
+    reader = read(path.read_bytes())
+    assert len(reader.pages) == len(labels) == 3  # one page per sheet
+    wrapped = 0
+    for page, label, sheet in zip(reader.pages, labels, fabrication.sheets, strict=True):
+        layout = pdf_layout(sheet.pattern, units=info.units, title=label)
+        footer = assert_footer_inside(page, 10.0, layout.content[1])
+        lines = len(layout.title_lines)
+        bottom = sorted(footer, key=lambda s: s[3])[:lines]  # the title: the lowest lines
+        text = "".join(s[0] for s in reversed(bottom))
+        assert text.replace(" ", "") == (
+            f"{label}, 1 unit = 1 cm; print at 100 % (actual size); trim along the crop marks"
+        ).replace(" ", "")
+        wrapped += lines > 1
+    assert wrapped == 3
+
+
+@pytest.mark.parametrize("orientation", ["portrait", "landscape"])
+def test_a_long_title_wraps_and_the_footer_grows(example_pattern, orientation):
+    word = "x" * 400  # longer than a line: cut inside the word
+    title = "a long title " * 30 + word
+    layout = pdf_layout(example_pattern, title=title, orientation=orientation, scale=3.0)
+    short = pdf_layout(example_pattern, orientation=orientation, scale=3.0)
+    lines = len(layout.title_lines)
+    assert lines >= 4 and len(short.title_lines) == 1
+    assert layout.footer == pytest.approx(FOOTER + (lines - 1) * TITLE_STEP)
+    assert short.footer == FOOTER
+    x, y, w, h = layout.content
+    assert y == pytest.approx(10.0 + layout.footer)
+    assert h == pytest.approx(short.content[3] - (lines - 1) * TITLE_STEP)
+    reader = read(pdf_bytes(example_pattern, title=title, orientation=orientation, scale=3.0))
+    for page in reader.pages:
+        footer = assert_footer_inside(page, 10.0, y)
+        bottom = sorted(footer, key=lambda s: s[3])[:lines]  # the title: the lowest lines
+        text = "".join(s[0] for s in reversed(bottom))
+        assert text.replace(" ", "").startswith(title.replace(" ", ""))
+        # the sheet's lines stay above the footer
+        creases = [s for c, s in stroked_segments(page) if c in (MOUNTAIN, VALLEY)]
+        sheet = [s for s in creases if s[:, 1].min() > (y - 1e-6) * PT]
+        assert len(sheet) == len(creases) - 2  # all but the legend's two samples
+
+
+def _boxes_overlap(a, b) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+@pytest.mark.parametrize(
+    ("margin", "scale_bar", "rows", "beside"),
+    [(10.0, 50.0, 1, True), (20.0, 50.0, 1, False), (48.0, 40.0, 2, False)],
+)
+def test_the_legend_never_runs_into_the_scale_bar(example_pattern, margin, scale_bar, rows,
+                                                  beside):  # fmt: skip
+    """Perforated, the legend is 118 mm long: in a narrower window it goes on rows of its own,
+    below the scale bar, instead of running into it (it did with margin=20 on A4)."""
+    options = {"perforate": True, "margin": margin, "orientation": "portrait", "scale": 2.0,
+               "scale_bar": scale_bar}  # fmt: skip
+    layout = pdf_layout(example_pattern, **options)
+    page = read(pdf_bytes(example_pattern, **options)).pages[0]
+    footer = assert_footer_inside(page, margin, layout.content[1])
+    boxes = [(left, base - 0.6, right, base + 2.0) for _, left, right, base in footer]
+    (x0, y0), (x1, _) = scale_bar_segment(layout)
+    bar = (x0, y0, x1, y0 + 2.0)  # the bar and its ticks
+    for i, box in enumerate(boxes):
+        assert not _boxes_overlap(box, bar), footer[i]
+        for other in boxes[i + 1 :]:
+            assert not _boxes_overlap(box, other), (footer[i], other)
+    samples = [s for c, s in stroked_segments(page) if c in (MOUNTAIN, VALLEY)
+               and s[:, 1].max() < layout.content[1] * PT]  # fmt: skip
+    for sample in samples:
+        assert sample[:, 0].max() / PT <= x0 or sample[:, 1].max() / PT < y0
+    assert len({round(entry[3], 6) for entry in layout.legend}) == rows
+    assert bool(y0 == pytest.approx(min(entry[3] for entry in layout.legend))) is beside
+
+
+@pytest.mark.parametrize(
+    ("margin", "words"), [(87.0, "too narrow for the legend"), (80.0, "too narrow for the page")]
+)
+def test_a_window_too_narrow_for_the_footer_is_refused(example_pattern, margin, words):
+    with pytest.raises(InvalidParameterError, match=f"margin={margin:g} mm .*{words}"):
+        pdf_layout(example_pattern, margin=margin, perforate=True, scale_bar=4.0)
 
 
 # --- bad input -----------------------------------------------------------------------------
