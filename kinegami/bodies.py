@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.segments import point_segment_parameters, segment_distances
 from kinegami.joints import (
     EndTip,
@@ -51,6 +52,7 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
+from kinegami.validation import shown
 
 __all__ = [
     "polygon_side",
@@ -73,6 +75,8 @@ __all__ = [
     "link_capsule_ends",
     "Overlap",
     "CONTACT_TOLERANCE",
+    "clear_limit",
+    "check_margin",
     "JUNCTION_REACH",
     "TURN_TOLERANCE",
     "JOINT_FIXED",
@@ -525,19 +529,25 @@ def _kink_prefix(joints) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Overlap:
-    """The deepest overlap of a chain: its clearance (< 0, chain units) and the two parts.
+    """The closest pair of parts of a chain that are closer than the margin: its clearance
+    (chain units; < 0 is an overlap, < ``margin`` when a margin is required) and the two parts.
 
     ``elements`` are the two parts' places along the tube (2 i: joint i, 2 i - 1: link i, the
-    link into joint i), in the order of ``first`` and ``second``.
+    link into joint i), in the order of ``first`` and ``second``. ``margin`` is the clearance
+    that was required (chain units; 0: parts that touch are clear).
     """
 
     clearance: float
     first: str
     second: str
     elements: tuple[int, int] = (-1, -1)
+    margin: float = 0.0
 
     def __str__(self) -> str:
-        return f"{self.first} and {self.second} overlap by {-self.clearance:.4g}"
+        if self.clearance < 0.0:
+            return f"{self.first} and {self.second} overlap by {-self.clearance:.4g}"
+        return (f"{self.first} and {self.second} are {self.clearance:.4g} apart, closer than "
+                f"the margin {self.margin:.4g}")  # fmt: skip
 
 
 def _near_pairs(rows, tau, first, centre, half, reach: float) -> tuple[np.ndarray, np.ndarray]:
@@ -581,14 +591,17 @@ def _near_pairs(rows, tau, first, centre, half, reach: float) -> tuple[np.ndarra
     return i[ok], j[ok]
 
 
-def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overlap | None:
-    """The deepest overlap of a chain at its current configuration (the pair rule of
-    :mod:`kinegami.clearance`), or None when no tested capsules overlap.
+def worst_overlap(
+    joints, links, r: float, names=None, since: int = 0, margin: float = 0.0
+) -> Overlap | None:
+    """The closest tested pair of parts of a chain at its current configuration (the pair rule
+    of :mod:`kinegami.clearance`) when it is closer than ``margin`` (chain units; 0: when the
+    parts overlap), or None when the chain is clear with that margin.
 
-    A fast test for placement, edits and searches: only pairs whose capsule balls overlap are
-    measured exactly. With ``since`` = k > 0 only pairs with a part of joint k or later (or of
-    the link into it) are measured: placement checks an extension without re-checking the
-    chain it extends.
+    A fast test for placement, edits and searches: only pairs whose capsule balls come within
+    ``margin`` are measured exactly. With ``since`` = k > 0 only pairs with a part of joint k
+    or later (or of the link into it) are measured: placement checks an extension without
+    re-checking the chain it extends.
     """
     a, b, body, tau, rows, first_rows = _chain_arrays(joints, links, r)
     S = len(rows)
@@ -608,25 +621,49 @@ def worst_overlap(joints, links, r: float, names=None, since: int = 0) -> Overla
         return None
     centre = 0.5 * (a + b)
     half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
-    i, j = _near_pairs(rows, tau, first, centre, half, 2.0 * r)
+    i, j = _near_pairs(rows, tau, first, centre, half, 2.0 * r + margin)
     if i.size == 0:
         return None
     dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
-    return _deepest(i, j, dist, s, t, rows, joints, names, r)
+    return _deepest(i, j, dist, s, t, rows, joints, names, r, margin)
 
 
-def _deepest(i, j, dist, s, t, rows, joints, names, r: float) -> Overlap | None:
+def check_margin(value, name: str = "margin") -> float:
+    """A margin (the clearance a design requires, chain units) as a float: a finite number
+    >= 0, or an InvalidParameterError / InvalidTypeError naming ``name`` and the value."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise InvalidTypeError(
+            f"{name} must be a finite number >= 0 (the clearance required, in the design's "
+            f"units), got {shown(value)}"
+        )
+    number = float(value)
+    if not (math.isfinite(number) and number >= 0.0):
+        raise InvalidParameterError(
+            f"{name} must be a finite number >= 0 (the clearance required, in the design's "
+            f"units), got {shown(value)}"
+        )
+    return number
+
+
+def clear_limit(r: float, margin: float = 0.0) -> float:
+    """The smallest clearance that is clear: ``margin - CONTACT_TOLERANCE * r`` (chain units;
+    with margin 0, parts that touch are clear). Every verdict uses it."""
+    return margin - CONTACT_TOLERANCE * r
+
+
+def _deepest(i, j, dist, s, t, rows, joints, names, r: float, margin: float = 0.0
+             ) -> Overlap | None:  # fmt: skip
     """The Overlap of the closest of the candidate pairs (row indices i, j at distance
-    ``dist``, curve parameters s, t), or None when even it is clear (a contact within
-    CONTACT_TOLERANCE r counts as clear)."""
+    ``dist``, curve parameters s, t), or None when even it is clear (at least ``margin``
+    apart, to within CONTACT_TOLERANCE r)."""
     k = int(np.argmin(dist))
     worst = float(dist[k]) - 2.0 * r
-    if worst >= -CONTACT_TOLERANCE * r:
+    if worst >= clear_limit(r, margin):
         return None
     first_row, second_row = rows[int(i[k])], rows[int(j[k])]
     return Overlap(worst, part_label(first_row, float(s[k]), joints, names),
                    part_label(second_row, float(t[k]), joints, names),
-                   (int(first_row[5]), int(second_row[5])))  # fmt: skip
+                   (int(first_row[5]), int(second_row[5])), margin)  # fmt: skip
 
 
 def deepest_overlap(joints, links, r: float) -> float:
@@ -727,11 +764,13 @@ def _polyline_samples(points: np.ndarray, step: float) -> tuple[np.ndarray, np.n
     return points[k] + t[:, None] * d[k], s
 
 
-def junction_extent(polyline: np.ndarray, own: tuple, siblings: tuple, r: float) -> float:
+def junction_extent(
+    polyline: np.ndarray, own: tuple, siblings: tuple, r: float, margin: float = 0.0
+) -> float:
     """How far (along ``polyline``, from its start) a tube leaving a branching joint runs
-    within 2r of a sibling tube leaving the same frame: the distance along it of the last
-    point of its capsules (``own``: segment starts and ends) within 2r of a sibling capsule
-    (``siblings``), sampled every 0.02 r. The junction body covers the tube up to there
+    within 2r + ``margin`` of a sibling tube leaving the same frame: the distance along it of
+    the last point of its capsules (``own``: segment starts and ends) that close to a sibling
+    capsule (``siblings``), sampled every 0.02 r. The junction body covers the tube up to there
     (docs/trees.md). 0 when nothing is that close."""
     a, b = siblings
     if a.shape[0] == 0 or own[0].shape[0] == 0:
@@ -746,7 +785,7 @@ def junction_extent(polyline: np.ndarray, own: tuple, siblings: tuple, r: float)
     t = _point_params(points[:, None, :], a[None], b[None])
     nearest = a[None] + t[..., None] * (b - a)[None]
     distance = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)
-    close = distance < 2.0 * r * (1.0 - CONTACT_TOLERANCE)
+    close = distance < (2.0 * r + margin) * (1.0 - CONTACT_TOLERANCE)
     if not close.any():
         return 0.0
     along = _polyline_distance(points[close], polyline)
@@ -770,9 +809,11 @@ def _polyline_distance(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
 
 
 def tree_pair_distances(
-    joints, links, parents, r: float, since: int = 0, reach: float | None = None
+    joints, links, parents, r: float, since: int = 0, reach: float | None = None,
+    margin: float = 0.0,
 ) -> tuple | None:
-    """The tested capsule pairs of a tree that come within ``reach`` (default 2r) and their
+    """The tested capsule pairs of a tree that come within ``reach`` (default 2r + ``margin``)
+    and their
     distances (docs/trees.md): ``(i, j, distance, s, t, rows, a, b)`` with ``i``, ``j`` row
     indices, ``s``, ``t`` the closest points' parameters, ``rows`` the capsule rows (labels)
     and ``a``, ``b`` their end points; None when nothing is tested.
@@ -780,11 +821,11 @@ def tree_pair_distances(
     Parts on one path from the root are tested as in a chain (when the centreline between
     them turns by at least pi, hinges included). Parts on different branches are always tested,
     except where two tubes leaving the same branching joint still run together within the
-    junction that joins them (:func:`junction_extent` of each); on a chain the tested pairs
-    are the chain's.
+    junction that joins them (:func:`junction_extent` of each, with ``margin``: the junction
+    covers them until they are the margin apart); on a chain the tested pairs are the chain's.
     """
     parents = [int(p) for p in parents]
-    reach = 2.0 * r if reach is None else reach
+    reach = 2.0 * r + margin if reach is None else reach
     n = len(joints)
     children: list[list[int]] = [[] for _ in range(n)]
     for k in range(1, n):
@@ -860,7 +901,8 @@ def tree_pair_distances(
             mine = np.isin(node, [m for m, top in branch_of.items() if top == k]) & is_link
             theirs = np.isin(node, [m for m, top in branch_of.items() if top in kids and top != k])
             theirs &= is_link
-            found = junction_extent(polylines[k], (a[mine], b[mine]), (a[theirs], b[theirs]), r)
+            found = junction_extent(polylines[k], (a[mine], b[mine]), (a[theirs], b[theirs]), r,
+                                    margin)  # fmt: skip
             extent[k] = min(found, JUNCTION_REACH * r)
 
     centre = 0.5 * (a + b)
@@ -942,8 +984,10 @@ def tree_pair_distances(
     return i, j, dist, s, t, rows, a, b
 
 
-def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int = 0):
-    """:func:`worst_overlap` for a tree (docs/trees.md): the deepest overlap, or None.
+def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int = 0,
+                       margin: float = 0.0):  # fmt: skip
+    """:func:`worst_overlap` for a tree (docs/trees.md): the closest pair when it is closer
+    than ``margin``, or None.
 
     Parts on one path from the root are tested as in a chain; parts on different branches are
     always tested, except where two tubes leaving the same branching joint still run together
@@ -951,12 +995,12 @@ def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int 
     """
     parents = [int(p) for p in parents]
     if parents == list(range(-1, len(joints) - 1)):
-        return worst_overlap(joints, links, r, names=names, since=since)
-    found = tree_pair_distances(joints, links, parents, r, since)
+        return worst_overlap(joints, links, r, names=names, since=since, margin=margin)
+    found = tree_pair_distances(joints, links, parents, r, since, margin=margin)
     if found is None:
         return None
     i, j, dist, s, t, rows, _, _ = found
-    return _deepest(i, j, dist, s, t, rows, joints, names, r)
+    return _deepest(i, j, dist, s, t, rows, joints, names, r, margin)
 
 
 def part_label(row, param: float, joints, names=None) -> str:

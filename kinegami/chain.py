@@ -19,7 +19,7 @@ from collections.abc import Mapping, Sequence, Set
 
 import numpy as np
 
-from kinegami.bodies import link_capsule_ends, worst_overlap
+from kinegami.bodies import check_margin, link_capsule_ends, worst_overlap
 from kinegami.errors import (
     ClearanceWarning,
     InvalidParameterError,
@@ -107,6 +107,7 @@ class _JointAssembly:
         startJoint: Joint,
         maxAnglePerElbow: float = np.pi / 2,
         requireClearance: bool = False,
+        margin: float = 0.0,
     ):
         if not isinstance(startJoint, Joint):
             raise InvalidTypeError(f"startJoint must be a Joint, got {type(startJoint).__name__}")
@@ -114,6 +115,7 @@ class _JointAssembly:
             raise InvalidParameterError("startJoint cannot be an EndTip (nothing may follow it)")
         self.maxAnglePerElbow = check_max_angle_per_elbow(maxAnglePerElbow)
         self.requireClearance = requireClearance
+        self.margin = margin
         self.numSides = startJoint.numSides
         self.r = startJoint.r
         root = startJoint._copy()
@@ -133,6 +135,18 @@ class _JointAssembly:
     @requireClearance.setter
     def requireClearance(self, value: bool) -> None:
         self._require_clearance = check_bool("requireClearance", value)
+
+    @property
+    def margin(self) -> float:
+        """The clearance the design requires between its parts (chain units, >= 0; default 0:
+        parts that touch are clear): what :meth:`clearance`, placement's clearance test, edits
+        under ``requireClearance`` and :func:`kinegami.optimize.compact` use (docs/clearance.md).
+        """
+        return self._margin
+
+    @margin.setter
+    def margin(self, value: float) -> None:
+        self._margin = check_margin(value)
 
     # --- published read-only views -----------------------------------------------------------
     @property
@@ -200,10 +214,10 @@ class _JointAssembly:
         return ball
 
     def _overlap(self, joints, links, parents, since: int = 0):
-        """The deepest overlap of the given lists (an Overlap) or None; with ``since`` = k only
-        pairs with a part of joint k or later (docs/clearance.md). ``parents`` as
-        :meth:`_extended` returns them (a chain ignores them)."""
-        return worst_overlap(joints, links, self.r, since=since)
+        """The closest pair of the given lists closer than the margin (an Overlap) or None;
+        with ``since`` = k only pairs with a part of joint k or later (docs/clearance.md).
+        ``parents`` as :meth:`_extended` returns them (a chain ignores them)."""
+        return worst_overlap(joints, links, self.r, since=since, margin=self._margin)
 
     def _accept(self, what: str, joints, links, ball: Ball | None = None, parents=None) -> bool:
         """Commit the new lists unless they pass through themselves and the chain requires
@@ -850,12 +864,13 @@ class KinematicChain(_JointAssembly):
             modules.append(joint.pattern)
         return TubularPattern.concatenate(modules)
 
-    def clearance(self, states=None):
-        """Self-intersection at the current states or at ``states`` (one per joint): a
-        ClearanceReport (``.ok``, ``.min_clearance``, ``.pairs``). See kinegami.clearance."""
+    def clearance(self, states=None, margin=None):
+        """Self-intersection at the current states or at ``states`` (one per joint), with
+        ``margin`` (default: :attr:`margin`): a ClearanceReport (``.ok``, ``.min_clearance``,
+        ``.pairs``, ``.verdict()``). See kinegami.clearance."""
         from kinegami.clearance import chain_clearance
 
-        return chain_clearance(self, states)
+        return chain_clearance(self, states, margin=margin)
 
     def show(self, **options):
         """Draw the chain in 3D with matplotlib; returns (figure, axes). See kinegami.viz."""

@@ -7,8 +7,10 @@ that turns by less than pi cannot come back to itself, and parts closer along th
 that touch by construction (the two legs of an elbow, the halves of a joint, a link and its
 joints). The clearance of a tested pair is the distance between their segments minus 2r;
 negative values are overlap depths. The chain is clear when every tested pair has a clearance
-of at least ``-CONTACT_TOLERANCE * r`` (parts that touch, such as the legs of a U-turn exactly
-2r apart, are clear).
+of at least ``margin - CONTACT_TOLERANCE * r`` (:func:`~kinegami.bodies.clear_limit`): the
+margin is the clearance the design requires (chain units, ``chain.margin``, default 0: parts
+that touch, such as the legs of a U-turn exactly 2r apart, are clear). Every verdict is worded
+by :meth:`ClearanceReport.verdict`, which states the margin.
 
 Examples
 --------
@@ -34,6 +36,8 @@ from kinegami.bodies import (
     TURN_TOLERANCE,
     CapsuleModel,
     capsule_model,
+    check_margin,
+    clear_limit,
     part_label,
     tree_pair_distances,
 )
@@ -44,6 +48,8 @@ from kinegami.validation import check_int, check_real, shown
 __all__ = [
     "CONTACT_TOLERANCE",
     "TURN_TOLERANCE",
+    "UNITS_IN_MM",
+    "Lengths",
     "CollidingPair",
     "ClearanceReport",
     "SweepReport",
@@ -57,6 +63,69 @@ __all__ = [
 
 #: Pairs x configurations evaluated at once (memory bound of the batched broad phase).
 _BATCH_PAIRS = 1_500_000
+
+#: Millimetres per design length unit (the units a verdict can print lengths in).
+UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
+
+
+class Lengths:
+    """Lengths in words as every verdict prints them: in millimetres and, when the design's
+    unit is not mm, in that unit beside them ("9.9 mm (0.99 cm)"), to about r / 100; without
+    ``units``, plain numbers in chain units to 4 significant digits.
+
+    Parameters
+    ----------
+    r : float
+        The tube's circumradius (chain units): sets the digits.
+    units : {"mm", "cm", "m", "in"} or None
+        The design's length unit.
+    """
+
+    def __init__(self, r: float, units: str | None = None):
+        if units is not None and units not in UNITS_IN_MM:
+            raise InvalidParameterError(
+                f"units must be one of {', '.join(UNITS_IN_MM)}, got {shown(units)}"
+            )
+        self.units = units
+        self.factor = UNITS_IN_MM.get(units, 1.0)
+        size = r * self.factor if math.isfinite(r) and r > 0 else 1.0
+        self.mm_digits = max(0, 2 - math.floor(math.log10(size)))
+        self.own_digits = max(0, 2 - math.floor(math.log10(size / self.factor)))
+
+    @staticmethod
+    def _fixed(value: float, digits: int) -> str:
+        value = round(value, digits)
+        return f"{value if value else 0.0:.{digits}f}"  # no "-0.00"
+
+    def mm(self, value: float) -> str:
+        """``value`` (chain units) in mm only: "9.9 mm" (without units: "9.9")."""
+        if self.units is None:
+            return f"{value:.4g}"
+        return f"{self._fixed(value * self.factor, self.mm_digits)} mm"
+
+    def __call__(self, value: float) -> str:
+        """``value`` (chain units) in mm and in the design's unit: "9.9 mm (0.99 cm)"."""
+        if self.units in (None, "mm"):
+            return self.mm(value)
+        return f"{self.mm(value)} ({self._fixed(value, self.own_digits)} {self.units})"
+
+    def exact(self, value: float) -> str:
+        """A value the user chose (a margin), without rounding: "0.2 mm (0.02 cm)"."""
+        if self.units is None:
+            return f"{value:g}"
+        text = f"{value * self.factor:g} mm"
+        return text if self.units == "mm" else f"{text} ({value:g} {self.units})"
+
+    def span(self, low: float, high: float) -> str:
+        """An interval: "-8.8 to 12.4 mm (-0.88 to 1.24 cm)"."""
+        if self.units is None:
+            return f"{low:.4g} to {high:.4g}"
+        f, d = self.factor, self.mm_digits
+        text = f"{self._fixed(low * f, d)} to {self._fixed(high * f, d)} mm"
+        if self.units != "mm":
+            d = self.own_digits
+            text += f" ({self._fixed(low, d)} to {self._fixed(high, d)} {self.units})"
+        return text
 
 
 @dataclass(frozen=True)
@@ -91,21 +160,30 @@ class CollidingPair:
 
 @dataclass(frozen=True)
 class ClearanceReport:
-    """The clearance of a chain at one configuration.
+    """The clearance of a chain at one configuration, judged with a margin.
 
     Attributes
     ----------
     ok : bool
-        True when no two parts overlap (clearance >= -CONTACT_TOLERANCE r everywhere).
+        True when every tested pair of parts is at least the margin apart (clearance >=
+        margin - CONTACT_TOLERANCE r everywhere; margin 0: no two parts overlap).
     min_clearance : float
         Smallest clearance over the tested pairs (chain units; negative is the overlap depth;
         inf when no pair of parts is far enough apart along the tube to be tested).
     pairs : tuple of CollidingPair
-        Every pair of parts that overlap, deepest first (one entry per pair of parts).
+        Every pair of parts closer than the margin (margin 0: that overlap), closest first (one
+        entry per pair of parts).
     closest : CollidingPair or None
         The tested pair with the smallest clearance (None when nothing is tested).
     states : tuple of float
         The configuration (one state per joint).
+    margin : float
+        The clearance required (chain units, >= 0).
+    r : float
+        The tube's circumradius (chain units; sets the digits of :meth:`verdict`).
+    note : str
+        For a tree whose closest parts are two tubes leaving a junction: where (words
+        :meth:`verdict` appends), else "".
     """
 
     ok: bool
@@ -113,15 +191,36 @@ class ClearanceReport:
     pairs: tuple
     closest: CollidingPair | None
     states: tuple
+    margin: float = 0.0
+    r: float = math.nan
+    note: str = ""
+
+    def verdict(self, units: str | None = None) -> str:
+        """The verdict in one line, as ``kinegami build``, ``kinegami check`` and the editor
+        print it: "clear with margin 0 mm: minimum clearance 9.9 mm (0.99 cm), between A and
+        B" or "self-intersects, parts closer than the margin 0 mm: minimum clearance -2.5 mm
+        (-0.25 cm), between A and B". Lengths in mm and the design's ``units`` (None: plain
+        numbers in chain units)."""
+        length = Lengths(self.r, units)
+        margin = length.exact(self.margin)
+        if self.closest is None:
+            return (f"clear with margin {margin}: no two parts are far enough apart along the "
+                    "tube to collide")  # fmt: skip
+        if self.ok:
+            return (f"clear with margin {margin}: minimum clearance "
+                    f"{length(self.min_clearance)}, between {self.closest.first} and "
+                    f"{self.closest.second}{self.note}")  # fmt: skip
+        first = self.pairs[0] if self.pairs else self.closest
+        overlapping = self.min_clearance < clear_limit(self.r if math.isfinite(self.r) else 0.0)
+        more = f"; {len(self.pairs)} pairs of parts" if len(self.pairs) > 1 else ""
+        return (f"{'self-intersects, ' if overlapping else ''}parts closer than the margin "
+                f"{margin}: minimum clearance {length(self.min_clearance)}, between "
+                f"{first.first} and {first.second}{more}")  # fmt: skip
 
     def __str__(self) -> str:
-        if self.closest is None:
-            return "clear (no parts far enough apart along the tube to collide)"
-        if self.ok:
-            return f"clear: minimum clearance {self.min_clearance:.4g}"
-        lines = [f"self-intersecting: {len(self.pairs)} pair(s), deepest overlap "
-                 f"{-self.min_clearance:.4g}"]  # fmt: skip
-        lines += [f"  {pair}" for pair in self.pairs]
+        lines = [self.verdict()]
+        if not self.ok:
+            lines += [f"  {pair}" for pair in self.pairs]
         return "\n".join(lines)
 
 
@@ -142,6 +241,11 @@ class SweepReport:
         Per joint, ``(low, high)``: the interval of its own state around its current state
         over which moving it alone keeps the chain clear (within its ``stateRange()``), or
         None when the chain is not clear at its current states.
+    states : tuple of float
+        The current states the free intervals start from.
+    margin : float
+        The clearance required (chain units): a configuration whose parts come closer counts
+        as colliding.
     """
 
     samples: int
@@ -149,6 +253,7 @@ class SweepReport:
     worst_pairs: tuple
     free_intervals: tuple
     states: tuple = field(default=())
+    margin: float = 0.0
 
     @property
     def colliding_fraction(self) -> float:
@@ -378,13 +483,14 @@ class ClearanceEngine:
                           a, b, self._static_clearance[k_static])  # fmt: skip
 
     # --- queries ---------------------------------------------------------------------------
-    def report(self, states) -> ClearanceReport:
-        """The :class:`ClearanceReport` at one configuration (absolute states, checked)."""
+    def report(self, states, margin: float = 0.0) -> ClearanceReport:
+        """The :class:`ClearanceReport` at one configuration (absolute states, checked), with
+        ``margin`` (chain units, >= 0) the clearance required."""
         q = self.check_states(states)
         values = tuple(float(x) for x in q)
         Q = q[None, :]
-        limit = -CONTACT_TOLERANCE * self.r
-        threshold = 4.0 * self.r
+        limit = clear_limit(self.r, margin)
+        threshold = 4.0 * self.r + margin
         while True:
             k, pair, clearance, s, t, a, b = self._candidates(Q, threshold)
             a0, b0 = a[0], b[0]
@@ -400,7 +506,7 @@ class ClearanceEngine:
         ]
         entries += [(float(c), ("s", n)) for n, c in enumerate(self._static_clearance)]
         if not entries:
-            return ClearanceReport(True, math.inf, (), None, values)
+            return ClearanceReport(True, math.inf, (), None, values, margin, self.r)
         entries.sort(key=lambda e: e[0])
 
         def make(entry):
@@ -418,9 +524,8 @@ class ClearanceEngine:
             pair = make(entry)
             pairs.setdefault((pair.first, pair.second), pair)
         min_clearance = entries[0][0]
-        return ClearanceReport(
-            min_clearance >= limit, min_clearance, tuple(pairs.values()), closest, values
-        )
+        return ClearanceReport(min_clearance >= limit, min_clearance, tuple(pairs.values()),
+                               closest, values, margin, self.r)  # fmt: skip
 
     def _extent(self) -> float:
         """Size of the chain (for the search radius of :meth:`report`)."""
@@ -430,18 +535,19 @@ class ClearanceEngine:
         pts = np.vstack([m.starts, m.ends])
         return float(np.ptp(pts, axis=0).max()) + self.r
 
-    def worst(self, Q: np.ndarray) -> tuple[np.ndarray, list]:
-        """Deepest overlap at each configuration of ``Q`` (K, J), unchecked.
+    def worst(self, Q: np.ndarray, margin: float = 0.0) -> tuple[np.ndarray, list]:
+        """Closest pair at each configuration of ``Q`` (K, J) that is closer than ``margin``
+        (chain units; 0: the deepest overlap), unchecked.
 
-        Returns ``(clearance, pairs)``: clearance (K,) is the most negative clearance of the
-        tested pairs, or +inf when no tested capsules overlap (clear); pairs[k] is the
-        CollidingPair of that overlap, or None.
+        Returns ``(clearance, pairs)``: clearance (K,) is the smallest clearance of the
+        tested pairs when it is below the margin, or +inf when the configuration is clear;
+        pairs[k] is the CollidingPair of that clearance, or None.
         """
         Q = np.asarray(Q, dtype=float)
         K = Q.shape[0]
         out = np.full(K, np.inf)
         found: list = [None] * K
-        limit = -CONTACT_TOLERANCE * self.r
+        limit = clear_limit(self.r, margin)
         static_worst = None
         if self._static_clearance.size:
             n = int(np.argmin(self._static_clearance))
@@ -450,7 +556,7 @@ class ClearanceEngine:
         chunk = 256
         for start in range(0, K, chunk):
             Qc = Q[start : start + chunk]
-            k, pair, clearance, s, t, a, b = self._candidates(Qc, 0.0)
+            k, pair, clearance, s, t, a, b = self._candidates(Qc, margin)
             if static_worst is not None:
                 value = float(self._static_clearance[static_worst])
                 for local in range(Qc.shape[0]):
@@ -478,13 +584,16 @@ class ClearanceEngine:
                     )  # fmt: skip
         return out, found
 
-    def colliding(self, Q: np.ndarray) -> np.ndarray:
-        """(K,) True where the configuration self-intersects."""
-        clearance, _ = self.worst(Q)
+    def colliding(self, Q: np.ndarray, margin: float = 0.0) -> np.ndarray:
+        """(K,) True where the configuration has parts closer than ``margin`` (0: where it
+        self-intersects)."""
+        clearance, _ = self.worst(Q, margin)
         return np.isfinite(clearance)
 
-    def free_intervals(self, states: np.ndarray, resolution: int = 64) -> tuple:
-        """Per joint, the clear interval of its own state around ``states`` (see SweepReport).
+    def free_intervals(self, states: np.ndarray, resolution: int = 64,
+                       margin: float = 0.0) -> tuple:  # fmt: skip
+        """Per joint, the clear interval (with ``margin``) of its own state around ``states``
+        (see SweepReport).
 
         The range is scanned on a grid of ``resolution`` steps per side and each end found by
         30 bisection steps between the last clear and the first colliding grid state, so an
@@ -492,7 +601,7 @@ class ClearanceEngine:
         states.
         """
         J = len(states)
-        if self.colliding(states[None, :])[0]:
+        if self.colliding(states[None, :], margin)[0]:
             return (None,) * J
         out: list = [(float(s), float(s)) for s in states]
         jobs = []  # (joint, side target)
@@ -509,7 +618,7 @@ class ClearanceEngine:
             Q = np.repeat(states[None, :], grid.size, axis=0)
             Q[:, j] = grid
             rows.append(Q)
-        hits = self.colliding(np.vstack(rows)).reshape(len(jobs), resolution)
+        hits = self.colliding(np.vstack(rows), margin).reshape(len(jobs), resolution)
         good = np.empty(len(jobs))
         bad = np.full(len(jobs), np.nan)
         for n, (j, target) in enumerate(jobs):
@@ -528,7 +637,7 @@ class ClearanceEngine:
             Q = np.repeat(states[None, :], open_.size, axis=0)
             for row, n in enumerate(open_):
                 Q[row, jobs[n][0]] = mid[row]
-            hit = self.colliding(Q)
+            hit = self.colliding(Q, margin)
             bad[open_[hit]] = mid[hit]
             good[open_[~hit]] = mid[~hit]
         for n, (j, _) in enumerate(jobs):
@@ -562,7 +671,14 @@ def _current(chain) -> np.ndarray:
     return np.array([joint.state for joint in chain.Joints], dtype=float)
 
 
-def chain_clearance(chain, states=None, names=None) -> ClearanceReport:
+def _margin_of(chain, margin) -> float:
+    """``margin`` checked, or the chain's (or tree's) own ``margin`` when None."""
+    if margin is None:
+        return float(getattr(chain, "margin", 0.0))
+    return check_margin(margin)
+
+
+def chain_clearance(chain, states=None, names=None, margin=None) -> ClearanceReport:
     """The clearance of ``chain`` at its current states, or at ``states`` (one per joint).
 
     Parameters
@@ -573,14 +689,17 @@ def chain_clearance(chain, states=None, names=None) -> ClearanceReport:
         the chain's current states. The chain is not changed.
     names : sequence of str or None, optional
         Joint names for the report.
+    margin : float, optional
+        The clearance required (chain units, >= 0); default: ``chain.margin``.
 
     Raises
     ------
     InvalidParameterError
-        For ``states`` of the wrong length or outside a joint's range.
+        For ``states`` of the wrong length or outside a joint's range, or a negative margin.
     """
+    margin = _margin_of(chain, margin)
     engine = engine_for(chain, names)
-    return engine.report(_current(chain) if states is None else states)
+    return engine.report(_current(chain) if states is None else states, margin)
 
 
 def sweep(
@@ -592,6 +711,7 @@ def sweep(
     names=None,
     resolution: int = 64,
     progress=None,
+    margin=None,
 ) -> SweepReport:
     """Clearance over the range of motion of a chain or a tree.
 
@@ -615,6 +735,9 @@ def sweep(
         ``progress(done, total)`` as configurations are tested (total: their count);
         returning False stops the sweep with :class:`~kinegami.errors.Cancelled`. True or
         None: a progress bar on stderr (None: when stderr is a terminal). docs/progress.md.
+    margin : float, optional
+        The clearance required (chain units, >= 0): a configuration whose parts come closer
+        counts as colliding; default: ``chain.margin``.
 
     Returns
     -------
@@ -624,10 +747,11 @@ def sweep(
     """
     from kinegami.chain import KinematicChain, _JointAssembly
 
+    margin = _margin_of(chain, margin)
     if isinstance(chain, _JointAssembly) and not isinstance(chain, KinematicChain):
-        engine = TreeMotion(chain, names)  # a KinematicTree (a layer above this one)
+        engine = TreeMotion(chain, names, margin)  # a KinematicTree (a layer above this one)
     else:
-        engine = engine_for(chain, names)
+        engine = _ChainMotion(engine_for(chain, names), margin)
     if isinstance(resolution, bool) or not isinstance(resolution, int | np.integer):
         raise InvalidTypeError(f"resolution must be an integer >= 1, got {shown(resolution)}")
     if resolution < 1:
@@ -672,6 +796,7 @@ def sweep(
         worst_pairs=tuple((pair, count) for pair, count in worst),
         free_intervals=engine.free_intervals(current, int(resolution)),
         states=tuple(float(x) for x in current),
+        margin=margin,
     )
 
 
@@ -679,7 +804,7 @@ def _worst_with_progress(engine, Q: np.ndarray, progress) -> tuple[np.ndarray, l
     """``engine.worst(Q)`` in chunks, reporting each chunk to ``progress`` (may cancel)."""
     from kinegami.progress import Progress
 
-    chunk = 2048 if isinstance(engine, ClearanceEngine) else 4
+    chunk = 2048 if isinstance(engine, _ChainMotion) else 4
     clearance, pairs = [], []
     with Progress(progress, Q.shape[0], desc="sweep", unit="configuration") as bar:
         for start in range(0, Q.shape[0], chunk):
@@ -690,20 +815,24 @@ def _worst_with_progress(engine, Q: np.ndarray, progress) -> tuple[np.ndarray, l
     return np.concatenate(clearance), pairs
 
 
-def tree_clearance(tree, states=None, names=None) -> ClearanceReport:
+def tree_clearance(tree, states=None, names=None, margin=None) -> ClearanceReport:
     """The clearance of a :class:`~kinegami.tree.KinematicTree` at its current states or at
-    ``states`` (one per joint, in index order); the tree is not changed.
+    ``states`` (one per joint, in index order), with ``margin`` (chain units, >= 0; default:
+    ``tree.margin``); the tree is not changed.
 
     The pair rule of trees (docs/trees.md): parts on one path from the root are tested as in a
     chain; parts on different branches always, except where two tubes leaving the same
-    branching joint run together inside the junction that joins them. A tree that is a chain
-    gets the chain's report.
+    branching joint run together inside the junction that joins them (until they are the
+    margin apart). A tree that is a chain gets the chain's report. When the closest parts of a
+    clear tree are two tubes leaving one junction, the report's ``note`` says so.
 
     Raises
     ------
     InvalidParameterError, InvalidTypeError
-        For ``states`` of the wrong length or type, or outside a joint's range.
+        For ``states`` of the wrong length or type, or outside a joint's range, or a negative
+        margin.
     """
+    margin = _margin_of(tree, margin)
     joints = tree.Joints
     if states is None:
         values = tuple(float(joint.state) for joint in joints)
@@ -713,12 +842,12 @@ def tree_clearance(tree, states=None, names=None) -> ClearanceReport:
         values = _clipped(_checked_states(states, ranges, "states"), ranges)
         joints, links = tree._configured(values)
     r = float(tree.r)
-    found = tree_pair_distances(joints, links, tree.Parents, r, reach=math.inf)
+    found = tree_pair_distances(joints, links, tree.Parents, r, reach=math.inf, margin=margin)
     if found is None:
-        return ClearanceReport(True, math.inf, (), None, values)
+        return ClearanceReport(True, math.inf, (), None, values, margin, r)
     clearance = found[2] - 2.0 * r
     order = np.argsort(clearance, kind="stable")
-    limit = -CONTACT_TOLERANCE * r
+    limit = clear_limit(r, margin)
 
     def make(q: int) -> CollidingPair:
         return _pair_at(found, q, float(clearance[q]), joints, names)
@@ -731,7 +860,57 @@ def tree_clearance(tree, states=None, names=None) -> ClearanceReport:
         pair = make(int(q))
         pairs.setdefault((pair.first, pair.second), pair)
     best = float(clearance[order[0]])
-    return ClearanceReport(best >= limit, best, tuple(pairs.values()), closest, values)
+    ok = best >= limit
+    note = _junction_note(tree, closest) if ok else ""
+    return ClearanceReport(ok, best, tuple(pairs.values()), closest, values, margin, r, note)
+
+
+def _junction_note(tree, pair: CollidingPair) -> str:
+    """When ``pair`` (the closest parts of a clear tree) are two tubes leaving the same
+    branching joint: "; closest where the tubes leaving joint J come out of its junction"
+    (they touch there by construction: the junction covers them up to where they are the
+    margin apart), else ""."""
+    from kinegami.joints import Waypoint
+
+    if any(e < 1 or e % 2 == 0 for e in pair.elements):
+        return ""
+    parents, joints = tree.Parents, tree.Joints
+    children = [0] * len(parents)
+    for p in parents:
+        if p >= 0:
+            children[p] += 1
+
+    def top(k: int) -> int | None:  # the child of a branching joint whose tube k continues
+        while k > 0:
+            parent = parents[k]
+            if children[parent] > 1:
+                return k
+            if not isinstance(joints[parent], Waypoint):
+                return None
+            k = parent
+        return None
+
+    a, b = (top((e + 1) // 2) for e in pair.elements)
+    if a is None or b is None or a == b or parents[a] != parents[b]:
+        return ""
+    return f"; closest where the tubes leaving joint {parents[a]} come out of its junction"
+
+
+class _ChainMotion:
+    """A chain's :class:`ClearanceEngine` with a margin: the queries :func:`sweep` asks."""
+
+    def __init__(self, engine: ClearanceEngine, margin: float):
+        self.engine, self.margin = engine, margin
+        self.ranges = engine.ranges
+
+    def check_states(self, states, name: str = "states") -> np.ndarray:
+        return self.engine.check_states(states, name)
+
+    def worst(self, Q: np.ndarray) -> tuple[np.ndarray, list]:
+        return self.engine.worst(Q, self.margin)
+
+    def free_intervals(self, states: np.ndarray, resolution: int = 64) -> tuple:
+        return self.engine.free_intervals(states, resolution, self.margin)
 
 
 class TreeMotion:
@@ -746,9 +925,10 @@ class TreeMotion:
     #: Bisection steps that refine each end of a free interval after the grid scan.
     BISECTIONS = 24
 
-    def __init__(self, tree, names=None):
+    def __init__(self, tree, names=None, margin: float = 0.0):
         self._tree = tree
         self._names = None if names is None else tuple(names)
+        self.margin = check_margin(margin)
         self._parents = tree.Parents
         self.r = float(tree.r)
         self.ranges = np.array([joint.stateRange() for joint in tree.Joints], dtype=float)
@@ -759,15 +939,16 @@ class TreeMotion:
         return _checked_states(states, self.ranges, name)
 
     def _pair(self, values) -> CollidingPair | None:
-        """The deepest overlap at the configuration ``values``, or None when it is clear."""
+        """The closest pair closer than the margin at the configuration ``values``, or None
+        when it is clear."""
         joints, links = self._tree._configured(_clipped(values, self.ranges))
-        found = tree_pair_distances(joints, links, self._parents, self.r)
+        found = tree_pair_distances(joints, links, self._parents, self.r, margin=self.margin)
         if found is None:
             return None
         dist = found[2]
         q = int(np.argmin(dist))
         clearance = float(dist[q]) - 2.0 * self.r
-        if clearance >= -CONTACT_TOLERANCE * self.r:
+        if clearance >= clear_limit(self.r, self.margin):
             return None
         return _pair_at(found, q, clearance, joints, self._names)
 

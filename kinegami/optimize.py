@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinegami.bodies import tree_worst_overlap, worst_overlap
+from kinegami.bodies import check_margin, tree_worst_overlap, worst_overlap
 from kinegami.chain import KinematicChain, PlacementWarning
 from kinegami.errors import (
     ClearanceWarning,
@@ -51,16 +51,19 @@ def _objective(chain: KinematicChain, kind: str) -> float:
 
 
 def _worst(chain: KinematicChain | KinematicTree):
-    """The deepest overlap of a chain or a tree (an Overlap), or None when it is clear."""
+    """The closest pair of parts of a chain or a tree closer than its ``margin`` (an
+    Overlap), or None when it is clear with that margin."""
     if isinstance(chain, KinematicTree):
-        return tree_worst_overlap(chain.Joints, chain.Links, chain.Parents, chain.r)
-    return worst_overlap(chain.Joints, chain.Links, chain.r)
+        return tree_worst_overlap(chain.Joints, chain.Links, chain.Parents, chain.r,
+                                  margin=chain.margin)  # fmt: skip
+    return worst_overlap(chain.Joints, chain.Links, chain.r, margin=chain.margin)
 
 
 def _overlap(chain: KinematicChain | KinematicTree) -> float:
-    """Depth of the deepest overlap (0 when the chain is clear)."""
+    """How much closer than its margin the closest pair of parts is (the overlap depth with
+    margin 0; 0 when the chain is clear)."""
     found = _worst(chain)
-    return 0.0 if found is None else -found.clearance
+    return 0.0 if found is None else chain.margin - found.clearance
 
 
 def _neighbours(chain, j: int) -> list[int]:
@@ -234,6 +237,7 @@ class _Layers:
     def __init__(self, chain, joints: list, options: list, restarts: bool, parents=None):
         self.r = chain.r
         self.max_angle = chain.maxAnglePerElbow
+        self.margin = chain.margin
         self.base = joints
         self.parents = parents  # None: a chain; else the parent of every joint (a tree)
         self.junctions = False  # trees: also require every junction's sockets to fit
@@ -315,9 +319,10 @@ class _Layers:
                 tree = KinematicTree.from_joints(chosen, self.parents, self.max_angle)
             except NoPathError as error:
                 return None, error.joint
+            tree.margin = self.margin
             tree.requireClearance = require
             return tree, 0
-        chain = KinematicChain(self.joints[0][choice[0]], self.max_angle)
+        chain = KinematicChain(self.joints[0][choice[0]], self.max_angle, margin=self.margin)
         for j in range(1, len(choice)):
             if chain.append(self.joints[j][choice[j]], False, False, True, True) is None:
                 return None, j
@@ -398,7 +403,7 @@ def _motion_collision(chain: KinematicChain, motion) -> tuple[int, int] | None:
         return None
     Q = np.tile([j.state for j in chain.Joints], (movable_states.shape[0], 1))
     Q[:, movable] = movable_states
-    clearance, pairs = engine_for(chain).worst(Q)
+    clearance, pairs = engine_for(chain).worst(Q, chain.margin)
     if float(np.mean(np.isfinite(clearance))) <= limit + 1e-12:
         return None
     counts: dict = {}
@@ -543,7 +548,7 @@ def _colliding_fraction(chain: KinematicChain, movable_states: np.ndarray) -> fl
     Q = np.tile([j.state for j in chain.Joints], (movable_states.shape[0], 1))
     Q[:, movable] = movable_states
     engine = engine_for(chain)
-    return float(np.mean(engine.colliding(Q))) if Q.shape[0] else 0.0
+    return float(np.mean(engine.colliding(Q, chain.margin))) if Q.shape[0] else 0.0
 
 
 def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
@@ -602,6 +607,9 @@ def _input_problem(chain, motion_task, junctions: bool) -> tuple[str, str] | Non
     """Why the input cannot compete with the starts' results: (what the result needs, what
     the input does), or None when it is a valid result itself."""
     if _overlap(chain) != 0.0:
+        found = _worst(chain)
+        if found is not None and found.clearance >= 0.0:
+            return "", "has parts closer than the margin"
         return "", "passes through itself"
     if motion_task is not None and _motion_collision(chain, motion_task) is not None:
         return (" and collides no more often in motion",
@@ -626,12 +634,14 @@ def compact(
     starts: int = 4,
     samples: int = 200,
     junctions: bool = True,
+    margin: float | None = None,
 ) -> KinematicChain | KinematicTree:
     """A shorter chain (or tree) with the same kinematics that does not pass through itself.
 
     Every joint keeps its type, parameters and axis line (joints only slide along and roll
-    about their axes); waypoints may move, appear or disappear. The result is clear at the
-    chain's current states, and never longer than the input when the input is clear.
+    about their axes); waypoints may move, appear or disappear. The result is clear with the
+    margin at the chain's current states (its closest parts at least ``margin`` apart), and
+    never longer than the input when the input is clear with that margin.
 
     Parameters
     ----------
@@ -667,6 +677,9 @@ def compact(
     junctions : bool
         Trees only: also require that every printed junction can be made, i.e. each branch
         child's socket fits on its link (:func:`kinegami.tree.sheets.junction_problems`).
+    margin : float, optional
+        The clearance required between the parts (chain units, >= 0; folded sheets have a
+        thickness); default: ``chain.margin``. The result's ``margin`` is this value.
 
     Raises
     ------
@@ -703,6 +716,11 @@ def compact(
     starts = check_int("starts", starts, minimum=1)
     samples = check_int("samples", samples, minimum=1)
     progress = check_progress(progress)
+    if margin is not None:
+        margin = check_margin(margin)
+        if margin != chain.margin:
+            chain = copy.copy(chain)  # the caller's chain keeps its own margin
+            chain.margin = margin
     motion_task = None
     if motion:
         movable_states = _motion_configurations(chain, samples, seed)
@@ -723,8 +741,9 @@ def compact(
     if problem is None:
         found.append((_objective(chain, objective), 0.0, starts, copy.copy(chain)))
     if not found:
+        with_margin = f" with margin {chain.margin:g}" if chain.margin else ""
         raise CompactionError(
-            f"compact found no design that is clear of itself{problem[0]} (the input "
+            f"compact found no design that is clear of itself{with_margin}{problem[0]} (the input "
             f"{problem[1]} and {starts} start(s) could not fix it); try more starts or another "
             "seed"
         )

@@ -41,7 +41,13 @@ from kinegami.design.limits import (
     too_many,
 )
 from kinegami.design.poses import pose_from_json, to_radians
-from kinegami.design.schema import PLACEMENT_KEYS, check_schema, check_top_level
+from kinegami.design.schema import (
+    PLACEMENT_KEYS,
+    VERSIONS,
+    check_schema,
+    check_top_level,
+    version_problem,
+)
 from kinegami.design.trees import (
     TreeSpecification,
     check_tree_fields,
@@ -76,7 +82,6 @@ __all__ = [
 ]
 
 FORMAT = "kinegami-design"
-VERSIONS = (1, 2)
 UNITS = ("mm", "cm", "m", "in")
 DEFAULT_TWIST_PORTION = 0.2
 
@@ -488,7 +493,7 @@ def _check_header(document, file) -> None:
     version = document["version"]
     if isinstance(version, bool) or version not in VERSIONS:
         raise DesignError(
-            f"unsupported version; supported versions: {supported}",
+            version_problem(version),
             field="version",
             value=version,
             file=file,
@@ -509,6 +514,7 @@ class _Plan:
     states: list | None
     names: tuple = ()  # the "name" of every entry of "joints" (None where it has none)
     require_clearance: bool = False  # the design's "requireClearance"
+    margin: float = 0.0  # the design's "margin" (version 3; design units)
     tree: bool = False  # build a KinematicTree (version 2)
     parents: tuple = ()  # per entry of "joints", the entry it is added to (-1: the root)
     specification: TreeSpecification | None = None  # a joint specification to construct
@@ -761,6 +767,7 @@ def _check_document(document, file) -> _Plan:
     return _Plan(
         numSides, r, units, chain_options, joints, dh, edits, states, names,
         require_clearance=document.get("requireClearance", False),
+        margin=float(document.get("margin", 0.0)),
         tree=fields.tree, parents=fields.parents, specification=specification,
     )  # fmt: skip
 
@@ -883,7 +890,8 @@ def _reason(message: str | None, plan: _Plan, default: str) -> str:
 
 def _build_from_joints(plan: _Plan, file) -> tuple[KinematicChain | KinematicTree, list]:
     root, _ = plan.joints[0]
-    options = dict(plan.chain_options, requireClearance=plan.require_clearance)
+    options = dict(plan.chain_options, requireClearance=plan.require_clearance,
+                   margin=plan.margin)  # fmt: skip
     kind = KinematicTree if plan.tree else KinematicChain
     try:
         chain, _ = _recorded(lambda: kind(root, **options), json_path(["joints", 0]), file)
@@ -938,10 +946,12 @@ def _build_from_specification(plan: _Plan, file) -> tuple[KinematicTree, list]:
         raise DesignError(
             f"the tree construction failed: {message}", field=field, file=file
         ) from None
+    tree.margin = plan.margin
     if plan.require_clearance:
         from kinegami.bodies import tree_worst_overlap
 
-        found = tree_worst_overlap(tree.Joints, tree.Links, tree.Parents, tree.r)
+        found = tree_worst_overlap(tree.Joints, tree.Links, tree.Parents, tree.r,
+                                   margin=plan.margin)  # fmt: skip
         if found is not None:
             raise DesignError(
                 f"the tree of the joint specification passes through itself ({found})"
@@ -977,10 +987,11 @@ def _build_from_dh(plan: _Plan, file) -> tuple[KinematicChain, list]:
         else:
             field = "dh"
         raise DesignError(message, field=field, file=file) from None
+    chain.margin = plan.margin
     if plan.require_clearance:
         from kinegami.bodies import worst_overlap
 
-        found = worst_overlap(chain.Joints, chain.Links, chain.r)
+        found = worst_overlap(chain.Joints, chain.Links, chain.r, margin=plan.margin)
         if found is not None:  # placement warns only when it adds an overlap
             raise DesignError(
                 f"the chain of the DH table passes through itself ({found}){_REQUIRED}",

@@ -119,6 +119,22 @@ _PARENT_TEXT = (
 )
 
 
+#: The versions of the format this kinegami reads (3 adds ``"margin"``).
+VERSIONS = (1, 2, 3)
+
+
+def version_problem(version) -> str:
+    """Why ``version`` (the value of a design's ``"version"``, not one of :data:`VERSIONS`) is
+    refused, in words: newer than this kinegami reads, or not a version at all."""
+    supported = ", ".join(map(str, VERSIONS))
+    if isinstance(version, int) and not isinstance(version, bool) and version > max(VERSIONS):
+        from kinegami import __version__
+
+        return (f"version {version} is newer than this kinegami ({__version__}) reads (versions "
+                f"{supported}); upgrade kinegami to read it")  # fmt: skip
+    return f"unsupported version; supported versions: {supported}"
+
+
 def _version_2_field(document) -> str:
     for key in ("structure", "placement"):
         if isinstance(document, dict) and key in document:
@@ -308,14 +324,17 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
         if name == "op":
             known = ", ".join(EDIT_OPS)
             return fail(f"unknown edit op {shown(value)}; known: {known}", value=value)
+        if path == ["version"] and error.validator_value == [2, 3]:  # a field of version 2
+            return fail(f"{_version_2_field(document)} needs \"version\": 2 (or 3)",
+                        value=value)  # fmt: skip
         if path == ["version"]:
-            return fail("unsupported version; supported versions: 1, 2", value=value)
+            return fail(version_problem(value), value=value)
         return fail(f"must be one of {_quoted(expected)}", value=value)
     if keyword == "const":
         if path == ["format"]:
             return fail("not a kinegami design: format must be 'kinegami-design'", value=value)
-        if path == ["version"] and error.validator_value == 2:  # a field of version 2
-            return fail(f"{_version_2_field(document)} needs \"version\": 2", value=value)
+        if path == ["version"] and error.validator_value == 3:  # a field of version 3
+            return fail("'margin' (a field of version 3) needs \"version\": 3", value=value)
         if path == ["placement", "method"]:
             return fail(f"unknown placement method {shown(value)}; known: wafr2024", value=value)
         return fail(f"must be {format_value(expected)}", value=value)

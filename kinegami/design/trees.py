@@ -28,6 +28,7 @@ from kinegami.validation import shorten
 
 __all__ = [
     "VERSION_2_FIELDS",
+    "VERSION_3_FIELDS",
     "SPECIFICATION_METHODS",
     "TreeFields",
     "TreeSpecification",
@@ -40,6 +41,8 @@ __all__ = [
 
 #: Top-level fields that need version 2.
 VERSION_2_FIELDS = ("structure", "placement")
+#: Top-level fields that need version 3 (which has every field of version 2).
+VERSION_3_FIELDS = ("margin",)
 #: Methods of ``"placement"``: the tree constructions a joint specification can ask for.
 SPECIFICATION_METHODS = ("wafr2024",)
 #: Joint keys that a joint specification does not have (the construction places the joints).
@@ -49,10 +52,20 @@ _PLACED_BY_CONSTRUCTION = ("safe", "fixedPosition", "fixedOrientation")
 def check_version_features(document: dict, file=None) -> None:
     """A DesignError for the first version-2 field of a design that says ``"version": 1``.
 
-    Runs on the top-level shape only (``joints`` a list); cheap. The JSON Schema says the
-    same for other validators.
+    Also the first version-3 field (``"margin"``) of a design that says 1 or 2. Runs on the
+    top-level shape only (``joints`` a list); cheap. The JSON Schema says the same for other
+    validators.
     """
-    if document.get("version") != 1:
+    version = document.get("version")
+    for key in VERSION_3_FIELDS:
+        if key in document and version in (1, 2):
+            raise DesignError(
+                f"'{key}' is a field of version 3 of the format: write \"version\": 3 "
+                f"(version {version} has no {key})",
+                field=key,
+                file=file,
+            )
+    if version != 1:
         return
     for key in VERSION_2_FIELDS:
         if key in document:

@@ -10,7 +10,8 @@ design (see :func:`kinegami.design.reader.origin_of`). A chain with ``requireCle
 written with ``"requireClearance": true``. A chain is written as version 1, exactly as before
 trees existed; a :class:`~kinegami.tree.KinematicTree` as version 2 with ``"structure": "tree"``
 and every non-root joint's ``"parent"`` (its name when it has one, else its index), so that
-loading gives a tree again, whatever its shape.
+loading gives a tree again, whatever its shape. A chain or tree whose ``margin`` is not 0 is
+written as version 3 with its ``"margin"``; every other one exactly as before.
 """
 
 from __future__ import annotations
@@ -82,8 +83,9 @@ def _matrix(T) -> list[list[float]]:
 
 def _overlap(assembly):
     if isinstance(assembly, KinematicTree):
-        return tree_worst_overlap(assembly.Joints, assembly.Links, assembly.Parents, assembly.r)
-    return worst_overlap(assembly.Joints, assembly.Links, assembly.r)
+        return tree_worst_overlap(assembly.Joints, assembly.Links, assembly.Parents, assembly.r,
+                                  margin=assembly.margin)  # fmt: skip
+    return worst_overlap(assembly.Joints, assembly.Links, assembly.r, margin=assembly.margin)
 
 
 def design_to_dict(
@@ -106,7 +108,9 @@ def design_to_dict(
 
     Poses are those of the state-0 configuration (computed on a copy of the chain); non-zero
     states are listed in ``"states"`` (radians for revolute joints, lengths for prismatic).
-    Angles are in radians (``"angleUnits": "rad"``). ``"requireClearance": true`` is written
+    Angles are in radians (``"angleUnits": "rad"``). A chain whose ``margin`` is not 0 is
+    written as version 3 with its ``"margin"`` (design units); with margin 0 the version is 1
+    or 2 as before. ``"requireClearance": true`` is written
     when ``chain.requireClearance``; such a chain must be clear at its states and at state 0,
     where loading builds it (InvalidParameterError otherwise). If the chain was loaded from a design
     whose joints have names, each joint keeps its ``"name"`` (as long as the chain's joints
@@ -143,7 +147,9 @@ def design_to_dict(
                     f"itself {where} ({found}): loading it would fail; set requireClearance "
                     "to False or move it clear"
                 )
-    document = {"format": FORMAT, "version": 2 if tree else 1}
+    margin = float(chain.margin)
+    # version 3 only when it says something older readers do not know: the margin
+    document = {"format": FORMAT, "version": 3 if margin else 2 if tree else 1}
     if name is not None:
         document["name"] = name
     if description is not None:
@@ -157,6 +163,8 @@ def design_to_dict(
     )
     if chain.requireClearance:
         document["requireClearance"] = True
+    if margin:
+        document["margin"] = margin
     if twistPortion is not None:
         document["twistPortion"] = check_twist_portion(twistPortion)
     if tree:

@@ -58,8 +58,9 @@ class KinematicTree(_JointAssembly):
         root: Joint,
         maxAnglePerElbow: float = np.pi / 2,
         requireClearance: bool = False,
+        margin: float = 0.0,
     ):
-        super().__init__(root, maxAnglePerElbow, requireClearance)
+        super().__init__(root, maxAnglePerElbow, requireClearance, margin)
         self._parents: list[int] = [-1]
 
     @classmethod
@@ -130,7 +131,7 @@ class KinematicTree(_JointAssembly):
         tree: InvalidParameterError, as for ``KinematicTree(EndTip(...))``."""
         if not isinstance(chain, KinematicChain):
             raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
-        tree = cls(chain.Joints[0], chain.maxAnglePerElbow, chain.requireClearance)
+        tree = cls(chain.Joints[0], chain.maxAnglePerElbow, chain.requireClearance, chain.margin)
         tree._commit(list(chain.Joints), list(chain.Links), chain.boundingBall,
                      list(chain.Parents))  # fmt: skip
         return tree
@@ -174,7 +175,8 @@ class KinematicTree(_JointAssembly):
 
     def _overlap(self, joints, links, parents, since: int = 0):
         parents = self._parents if parents is None else parents
-        return tree_worst_overlap(joints, links, parents, self.r, since=since)
+        return tree_worst_overlap(joints, links, parents, self.r, since=since,
+                                  margin=self.margin)  # fmt: skip
 
     def _commit(self, joints, links, ball=None, parents=None):
         super()._commit(joints, links, ball)
@@ -362,12 +364,13 @@ class KinematicTree(_JointAssembly):
         return joints, links
 
     # --- output --------------------------------------------------------------------------------
-    def clearance(self, states=None):
-        """Self-intersection at the current states or at ``states`` (one per joint): a
-        ClearanceReport (``.ok``, ``.min_clearance``, ``.pairs``); see docs/trees.md."""
+    def clearance(self, states=None, margin=None):
+        """Self-intersection at the current states or at ``states`` (one per joint), with
+        ``margin`` (default: :attr:`margin`): a ClearanceReport (``.ok``, ``.min_clearance``,
+        ``.pairs``, ``.verdict()``); see docs/trees.md."""
         from kinegami.clearance import tree_clearance
 
-        return tree_clearance(self, states)
+        return tree_clearance(self, states, margin=margin)
 
     def show(self, **options):
         """Draw the tree in 3D with matplotlib; returns (figure, axes). See kinegami.viz."""
