@@ -2,20 +2,24 @@
 
 While a document has unsaved changes, :class:`Autosaver` writes its design file text, a second
 after the last change, to an autosave file (atomically, through
-:func:`kinegami._atomic.write_atomic`, so a crash leaves the previous autosave whole):
+:func:`kinegami._atomic.write_atomic`, so a crash leaves the previous autosave whole), in the
+user's data folder (``$XDG_DATA_HOME/kinegami`` or ``~/.local/share/kinegami``), never beside
+the design (where it would land in the user's own repository):
 
-* next to the design it was opened from: ``.<name>.json.autosave`` beside ``<name>.json``;
+* for a design file: ``autosaves/<name>-<hash>.autosave``, the hash of the design's absolute
+  path (so two ``arm.json`` in different folders have different autosaves);
 * for a design with no file on the server (the starter design, an example, an upload):
-  ``untitled.json.autosave`` in the user's data folder, ``$XDG_DATA_HOME/kinegami`` or
-  ``~/.local/share/kinegami``.
+  ``untitled.json.autosave``.
 
 An explicit save removes the autosave, and so does going back (undo) to the saved document.
-On start, :func:`find_recovery` offers back an autosave that is newer than its design. The
-autosave is a design file: ``kinegami validate`` reads it. See docs/editor.md.
+On start, :func:`find_recovery` offers back an autosave that is newer than its design (also
+one an earlier version wrote beside the design, ``.<name>.autosave``). The autosave is a
+design file: ``kinegami validate`` reads it. See docs/editor.md.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
 import threading
 import time
@@ -33,12 +37,15 @@ __all__ = [
     "autosave_path",
     "data_folder",
     "find_recovery",
+    "legacy_autosave_path",
 ]
 
 #: Seconds without a change before the autosave is written.
 AUTOSAVE_DELAY = 1.0
 #: Name of the autosave of a design with no file, in the data folder.
 UNTITLED = "untitled.json.autosave"
+#: The data folder's subfolder of the autosaves of design files.
+AUTOSAVES = "autosaves"
 
 
 def data_folder() -> Path:
@@ -50,9 +57,19 @@ def data_folder() -> Path:
 
 
 def autosave_path(design: str | os.PathLike | None) -> Path:
-    """Where the autosave of the design file ``design`` goes (None: a design with no file)."""
+    """Where the autosave of the design file ``design`` goes (None: a design with no file):
+    in the data folder, keyed by the design's absolute path (its name, then 16 hex digits of
+    the SHA-256 of the path)."""
     if design is None:
         return data_folder() / UNTITLED
+    design = Path(os.path.abspath(os.fspath(design)))
+    digest = hashlib.sha256(os.fsencode(design)).hexdigest()[:16]
+    return data_folder() / AUTOSAVES / f"{design.name}-{digest}.autosave"
+
+
+def legacy_autosave_path(design: str | os.PathLike) -> Path:
+    """Where earlier versions wrote the autosave of ``design``: ``.<name>.autosave`` beside it
+    (only read, to offer it back once)."""
     design = Path(os.fspath(design))
     return design.with_name(f".{design.name}.autosave")
 
@@ -66,6 +83,11 @@ class Recovery:
     mtime: float
     document: Document
 
+    @property
+    def legacy(self) -> bool:
+        """Whether it is an autosave an earlier version wrote beside the design."""
+        return self.design is not None and self.path == legacy_autosave_path(self.design)
+
     def describe(self) -> str:
         """E.g. ``unsaved changes to arm.json from 2024-05-01 14:03``."""
         when = time.strftime("%Y-%m-%d %H:%M", time.localtime(self.mtime))
@@ -75,18 +97,23 @@ class Recovery:
 
 def find_recovery(design: str | os.PathLike | None) -> Recovery | None:
     """The autosave of ``design`` when there is one newer than the design (None otherwise,
-    also when it cannot be read as a design file)."""
+    also when it cannot be read as a design file): the data folder's, else one an earlier
+    version wrote beside the design."""
     design = None if design is None else Path(os.fspath(design))
-    path = autosave_path(design)
-    try:
-        mtime = path.stat().st_mtime
-        if design is not None and design.exists() and mtime <= design.stat().st_mtime:
-            return None
-        text = path.read_text(encoding="utf-8")
-        document = Document.loads(text, path)
-    except (OSError, ValueError, UnicodeError):
-        return None
-    return Recovery(path, design, mtime, document)
+    paths = [autosave_path(design)]
+    if design is not None:
+        paths.append(legacy_autosave_path(design))
+    for path in paths:
+        try:
+            mtime = path.stat().st_mtime
+            if design is not None and design.exists() and mtime <= design.stat().st_mtime:
+                continue
+            text = path.read_text(encoding="utf-8")
+            document = Document.loads(text, path)
+        except (OSError, ValueError, UnicodeError):
+            continue
+        return Recovery(path, design, mtime, document)
+    return None
 
 
 class Autosaver:

@@ -24,6 +24,7 @@ from kinegami.design.reader import UNITS
 from kinegami.editor.document import Document, fork_chain, joint_parameters
 from kinegami.editor.units import angle_text
 from kinegami.errors import (
+    Cancelled,
     ClearanceWarning,
     EditorCommandError,
     KinegamiError,
@@ -61,6 +62,8 @@ __all__ = [
     "SetOptions",
     "FitJunctions",
     "ReplaceDocument",
+    "LongCommand",
+    "Computed",
     "JOINT_TYPES",
     "PLACEMENTS",
     "KEEP",
@@ -230,7 +233,7 @@ class _Run:
             warnings.simplefilter("always")
             try:
                 result = call()
-            except CommandError:
+            except (CommandError, Cancelled):
                 raise
             except (KinegamiError, ValueError, TypeError, IndexError, ArithmeticError) as error:
                 _fail(f"{what}: {_reason(str(error))}")
@@ -888,8 +891,65 @@ def _kept_by_compact(chain) -> list[int]:
             if i == 0 or type(joint) is not Waypoint or len(children[i]) > 1]  # fmt: skip
 
 
+class LongCommand(Command):
+    """A command whose heavy part may run elsewhere (the editor runs it in a worker process,
+    with progress and Cancel; docs/editor.md#background-jobs).
+
+    :meth:`compute` is the heavy part, given the chain (or tree) only and a ``progress``
+    callback (docs/progress.md); it returns a picklable ``(result, warnings)``. :meth:`finish`
+    makes the new document of ``document`` from that result, quickly. :meth:`apply` does both
+    here; :class:`Computed` is the command that applies a result computed elsewhere.
+    """
+
+    def check(self, document: Document) -> None:
+        """Refuse ``document`` before any heavy work (raises CommandError)."""
+
+    def compute(self, chain, progress=False) -> tuple[Any, tuple[str, ...]]:
+        """``(result, warnings)`` of the heavy part for ``chain`` (raises CommandError, or
+        :class:`~kinegami.errors.Cancelled` when ``progress`` returned False)."""
+        run = _Run()
+        result = run(self.label, lambda: self._compute(chain, progress))
+        return result, tuple(run.warnings)
+
+    @abc.abstractmethod
+    def _compute(self, chain, progress):
+        """The library call (any process)."""
+
+    @abc.abstractmethod
+    def finish(self, document: Document, computed: tuple[Any, tuple[str, ...]]) -> Outcome:
+        """The outcome for ``document`` of :meth:`compute`'s result for its chain."""
+
+    def apply(self, document: Document) -> Outcome:
+        self.check(document)
+        return self.finish(document, self.compute(document.chain))
+
+
+@dataclass(frozen=True, eq=False)
+class Computed(Command):
+    """A :class:`LongCommand` whose heavy part was computed elsewhere for ``source``: applying
+    it makes ``command``'s document of ``source`` (whatever the document is now: a view that
+    lets edits happen meanwhile asks first), one step in the undo history."""
+
+    command: LongCommand
+    source: Document
+    computed: tuple
+
+    @property
+    def label(self) -> str:  # type: ignore[override]
+        return self.command.label
+
+    def apply(self, document: Document) -> Outcome:
+        outcome = self.command.finish(self.source, self.computed)
+        if document is not self.source:  # joints matched by value, not by the source's indices
+            return Outcome(outcome.document, outcome.selected, outcome.warnings)
+        return outcome
+
+    def describe(self) -> str:
+        return self.command.describe()
+
+
 @dataclass(frozen=True)
-class Compact(Command):
+class Compact(LongCommand):
     """Replace the chain (or tree) by a shorter one with the same kinematics and no collisions
     (:func:`kinegami.optimize.compact`, docs/clearance.md; a tree's sockets fit afterwards);
     names follow their joints. ``motion`` is for chains only."""
@@ -903,19 +963,16 @@ class Compact(Command):
 
     label: ClassVar[str] = "compact"
 
-    def apply(self, document: Document) -> Outcome:
+    def _compute(self, chain, progress):
         from kinegami.optimize import compact
 
-        run = _Run()
+        return compact(chain, seed=self.seed, motion=self.motion, executor=self.executor,
+                       time_limit=self.time_limit, progress=progress, objective=self.objective,
+                       starts=self.starts)  # fmt: skip
+
+    def finish(self, document: Document, computed) -> Outcome:
+        new, warned = computed
         chain = document.chain
-        new = run(
-            "compact",
-            lambda: compact(
-                chain, seed=self.seed, motion=self.motion, executor=self.executor,
-                time_limit=self.time_limit, progress=False, objective=self.objective,
-                starts=self.starts,
-            ),
-        )  # fmt: skip
         old_kept, new_kept = _kept_by_compact(chain), _kept_by_compact(new)
         old_types = [type(chain.Joints[i]) for i in old_kept]
         new_types = [type(new.Joints[i]) for i in new_kept]
@@ -925,8 +982,9 @@ class Compact(Command):
         sources: list = [None] * len(new.Joints)
         for i, k in zip(new_kept, old_kept, strict=True):
             names[i], sources[i] = document.names[k], k
-        return Outcome(document.replaced(chain=new, names=tuple(names)), None,
-                       run.clear_warning(new), tuple(sources))  # fmt: skip
+        clear = tuple(warned) if warned and not new.clearance().ok else ()
+        return Outcome(document.replaced(chain=new, names=tuple(names)), None, clear,
+                       tuple(sources))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -1009,24 +1067,29 @@ class SetOptions(Command):
 
 
 @dataclass(frozen=True)
-class FitJunctions(Command):
+class FitJunctions(LongCommand):
     """Slide the branch children of a tree whose printed junction socket would not fit on
     their link, along their axes (:func:`kinegami.tree.sheets.fit_junctions`: the kinematics
     stay, no new collision): what ``kinegami build`` does before it makes the sheets."""
 
     label: ClassVar[str] = "fit junctions"
 
-    def apply(self, document: Document) -> Outcome:
-        from kinegami.tree.sheets import fit_junctions
-
+    def check(self, document: Document) -> None:
         if not document.is_tree:
             _fail("fit junctions: a chain has no junctions (a tree has one at every joint "
                   "with several children)")  # fmt: skip
-        run = _Run()
-        fitted, moves = run("fit junctions", lambda: fit_junctions(document.chain))
+
+    def _compute(self, chain, progress):
+        from kinegami.tree.sheets import fit_junctions
+
+        return fit_junctions(chain, progress=progress)
+
+    def finish(self, document: Document, computed) -> Outcome:
+        (fitted, moves), warned = computed
         if not moves:
             _fail("fit junctions: every junction's socket fits already; nothing to slide")
-        return Outcome(document.replaced(chain=fitted), moves[0][0], run.clear_warning(fitted),
+        clear = tuple(warned) if warned and not fitted.clearance().ok else ()
+        return Outcome(document.replaced(chain=fitted), moves[0][0], clear,
                        tuple(range(len(fitted.Joints))))  # fmt: skip
 
 

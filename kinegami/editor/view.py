@@ -27,11 +27,22 @@ from typing import Any
 import numpy as np
 
 from kinegami.editor import sheet_drawing
-from kinegami.editor.background import Debounced, ProcessWorker
-from kinegami.editor.commands import ReplaceDocument, RollJoint, SetJointStates, SlideJoint
+from kinegami.editor.background import Debounced, JobProcess, ProcessWorker
+from kinegami.editor.commands import (
+    Compact,
+    Computed,
+    FitJunctions,
+    LongCommand,
+    ReplaceDocument,
+    RollJoint,
+    SetJointStates,
+    SlideJoint,
+)
 from kinegami.editor.document import Document
+from kinegami.editor.jobs import MOTION_SAMPLES, TREE_MOTION_SAMPLES, motion_check
 from kinegami.editor.model import Change, CommandResult, EditorModel
-from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError
+from kinegami.editor.page_script import run_javascript, unsaved_changes_script
+from kinegami.errors import Cancelled, InvalidParameterError, InvalidTypeError, KinegamiError
 
 __all__ = ["EditorView", "DOWNLOADS", "SHEET_FORMATS", "MAX_UPLOAD_BYTES", "gallery",
            "download_data"]  # fmt: skip
@@ -60,6 +71,8 @@ PATTERN_PANEL_WIDTH = 460
 #: The animation: seconds of one back-and-forth sweep, and the most frames a second.
 ANIMATION_PERIOD = 4.0
 ANIMATION_FPS = 20.0
+#: Seconds each start of the Compact button's compaction may search.
+COMPACT_TIME_LIMIT = 30.0
 
 
 def gallery(folder: Path = GALLERY_DIR) -> dict[str, Path]:
@@ -193,6 +206,25 @@ def _matrix(wxyz) -> np.ndarray:
 
 
 @dataclass
+class Job:
+    """A long job of a tab (Compact, a motion check, Fit junctions) while it runs: what it
+    is, the document it started from, its progress and its cancel flag."""
+
+    label: str  # "compact", "motion check", "fit junctions"
+    title: str  # what the panel says while it runs: "Compacting"
+    unit: str  # its steps: "starts", "configurations", "sockets"
+    model: EditorModel
+    source: Document
+    cancel: threading.Event = field(default_factory=threading.Event)
+    finished: threading.Event = field(default_factory=threading.Event)
+    started: float = field(default_factory=time.monotonic)
+    done: int = 0
+    total: int = 0
+    #: How it ended: "done", "cancelled", "failed" or "dropped" (None while it runs).
+    outcome: str | None = None
+
+
+@dataclass
 class _Node:
     """The scene nodes of one joint or link: its meshes in its own frame."""
 
@@ -222,13 +254,16 @@ class EditorView:
     worker : a :class:`~kinegami.editor.background.ProcessWorker` that fits a tree's junctions
         for the pattern panel (seconds of work) away from the tab's lock and the interpreter
         lock; None: fitted in the panel's thread, holding the tab's lock.
+    background : run long jobs (Compact, the motion check, Fit junctions) in the tab's own
+        :class:`~kinegami.editor.background.JobProcess` (False: in a thread of this process,
+        which holds the interpreter lock meanwhile; tests).
     """
 
     def __init__(self, target: Any, model: EditorModel | None = None, *,
                  autosave_for: Callable | None = None, recovery=None,
                  on_recovery: Callable[[str], None] | None = None,
                  pattern_delay: float = PATTERN_DELAY,
-                 worker: ProcessWorker | None = None):  # fmt: skip
+                 worker: ProcessWorker | None = None, background: bool = True):  # fmt: skip
         self.target = target
         self.scene = target.scene
         self.gui = target.gui
@@ -261,6 +296,16 @@ class EditorView:
         self._sheet_lines: dict = {}  # id of a tree sheet's pattern -> (pattern, SheetLines)
         self._pattern_redraw = Debounced(self.redraw_pattern, pattern_delay,
                                          name="kinegami-pattern")  # fmt: skip
+        self._jobs = JobProcess() if background else None
+        self._job: Job | None = None
+        #: A finished job's command waiting for an answer (the design changed meanwhile).
+        self.pending_result: Computed | None = None
+        self._motion_document: Document | None = None
+        self._stale_modal = None  # asks whether a result for an older document applies
+        self._unsaved_modal = None  # asks what to do with unsaved changes before an open
+        #: The open waiting for an answer about unsaved changes: (document, message), or None.
+        self.pending_open: tuple[Document, str] | None = None
+        self._unsaved_shown: bool | None = None  # what the page was last told
         self._build_panel()
         self._build_pattern_panel()
         self.scene.add_frame("/world", axes_length=2.0 * self._r, axes_radius=0.04 * self._r)
@@ -269,6 +314,7 @@ class EditorView:
         self.frame_camera()
         self._pattern_redraw.trigger()
         self._recovery_modal = None
+        self._sync_unsaved()
         if recovery is not None:
             self.offer_recovery(recovery, on_recovery)
 
@@ -292,6 +338,7 @@ class EditorView:
         self._redraw_all()
         self.frame_camera()
         self._pattern_redraw.trigger()
+        self._sync_unsaved()
 
     def frame_camera(self) -> None:
         """Point a browser tab's camera at the whole chain (a server target has none)."""
@@ -306,11 +353,17 @@ class EditorView:
         camera.look_at = centre
 
     def close(self) -> None:
-        """Stop listening to the model (the tab closed); a pending autosave is written."""
+        """Stop listening to the model (the tab closed); a pending autosave is written and a
+        running job is stopped (its result dropped)."""
         with self.lock:
             self.stop_animation()
             self._unsubscribe()
             self._closed = True
+            job = self._job
+        if job is not None:
+            job.cancel.set()
+        if self._jobs is not None:
+            self._jobs.close()
         self._pattern_redraw.close()
         if self.autosave is not None:
             self.autosave.flush()
@@ -358,6 +411,17 @@ class EditorView:
                 self.autosave.discard()
             elif change.kind != "preview":
                 self.autosave.record(self.model.base_document, self.model.dirty, self)
+        if (change.kind != "preview" and self._motion.visible
+                and self.model.base_document is not self._motion_document):  # fmt: skip
+            self._motion.visible = False  # the motion check was of another document
+        self._sync_unsaved()
+
+    def _sync_unsaved(self) -> None:
+        """Tell the page whether closing it now would lose unsaved changes (it then warns)."""
+        dirty = self.model.dirty
+        if dirty != self._unsaved_shown:
+            self._unsaved_shown = dirty
+            run_javascript(self.target, unsaved_changes_script(dirty))
 
     # --- scene --------------------------------------------------------------------------------
     def _new_uid(self) -> int:
@@ -636,6 +700,12 @@ class EditorView:
     def _build_panel(self) -> None:
         gui = self.gui
         self._message = gui.add_markdown("")
+        # a running job: what it does, its progress and its Cancel button (hidden otherwise)
+        self._job_text = gui.add_markdown("", visible=False)
+        self._job_bar = gui.add_progress_bar(0.0, animated=True, visible=False)
+        self._job_cancel = gui.add_button("Cancel", color="red", visible=False,
+                                          hint="stop the running job; nothing changes")  # fmt: skip
+        self._job_cancel.on_click(lambda _: self.cancel_job())
         with gui.add_folder("Edit"):
             undo_redo = gui.add_button_group("History", ("Undo", "Redo"))
             undo_redo.on_click(lambda e: self.act(self._undo if e.target.value == "Undo"
@@ -685,14 +755,23 @@ class EditorView:
             self._animate.on_click(lambda _: self.toggle_animation())
         with gui.add_folder("Clearance"):
             self._clearance = gui.add_markdown("")
-            compact = gui.add_button("Compact")
-            compact.on_click(lambda _: self.act(lambda: self.model.compact(time_limit=30.0)))
+            compact = gui.add_button(
+                "Compact", hint="a shorter design with the same kinematics, clear of itself "
+                "(runs in the background: Cancel stops it, Undo takes it back)",
+            )  # fmt: skip
+            compact.on_click(lambda _: self.compact())
+            check = gui.add_button(
+                "Check motion", hint="sample random configurations of the joints and report "
+                "how often the design passes through itself (runs in the background)",
+            )  # fmt: skip
+            check.on_click(lambda _: self.check_motion())
+            self._motion = gui.add_markdown("", visible=False)
             self._fit = gui.add_button(
                 "Fit junctions", visible=self.model.is_tree,
                 hint="slide the joints whose junction socket does not fit along their axes, "
                 "as kinegami build does (the kinematics stay)",
             )  # fmt: skip
-            self._fit.on_click(lambda _: self.act(self.model.fit_junctions))
+            self._fit.on_click(lambda _: self.fit_junctions())
         with gui.add_folder("File"):
             self._save_file = gui.add_button(
                 "Save to " + (self.model.path.name if self.model.path else "file"),
@@ -830,6 +909,202 @@ class EditorView:
         self.stop_animation()
         return self.run(self.model.set_state(index, state))
 
+    # --- background jobs ----------------------------------------------------------------------
+    @property
+    def job(self) -> Job | None:
+        """The running job, or None."""
+        return self._job
+
+    def compact(self, **options) -> Job | None:
+        """Compact the design in the background (the Compact button; ``options`` of
+        :class:`~kinegami.editor.commands.Compact`, each start limited to
+        :data:`COMPACT_TIME_LIMIT` seconds unless given): the result is one command."""
+        options.setdefault("time_limit", COMPACT_TIME_LIMIT)
+        try:
+            command = Compact(**options)
+        except TypeError as error:
+            self._say(f"**Refused:** compact: {error}")
+            return None
+        return self.run_command_job(command, "Compacting", "starts")
+
+    def fit_junctions(self) -> Job | None:
+        """Fit a tree's junction sockets in the background (the Fit junctions button)."""
+        return self.run_command_job(FitJunctions(), "Fitting the junctions", "sockets")
+
+    def check_motion(self, samples: int | None = None) -> Job | None:
+        """Sample random configurations in the background and show how often the design
+        passes through itself (the Check motion button; ``samples`` default
+        :data:`~kinegami.editor.jobs.MOTION_SAMPLES`, for a tree
+        :data:`~kinegami.editor.jobs.TREE_MOTION_SAMPLES`). Nothing changes."""
+        with self.lock:
+            document = self.model.base_document
+        if samples is None:
+            samples = TREE_MOTION_SAMPLES if document.is_tree else MOTION_SAMPLES
+
+        def finish(job: Job, text: str) -> None:
+            self._motion.content = text
+            self._motion.visible = True
+            self._motion_document = job.source
+            self._say(f"motion check: {job.total} configurations tested")
+
+        return self.start_job("motion check", "Checking the motion", "configurations",
+                              motion_check, (document.chain, document.names, int(samples)),
+                              finish)  # fmt: skip
+
+    def run_command_job(self, command: LongCommand, title: str, unit: str) -> Job | None:
+        """Run a long command's heavy part in the background; its result is applied as one
+        command (:class:`~kinegami.editor.commands.Computed`) when the design is still the
+        one it started from, else the tab asks first (:meth:`resolve_result`)."""
+        with self.lock:
+            self.stop_animation()
+            document = self.model.base_document
+            try:
+                command.check(document)
+            except KinegamiError as error:
+                self._say(f"**Refused:** {error}")
+                return None
+
+        def finish(job: Job, computed) -> None:
+            result = Computed(command, job.source, computed)
+            if self.model.base_document is job.source:
+                self.act(lambda: self.model.apply(result))
+            else:
+                self._ask_result(job, result)
+
+        return self.start_job(command.label, title, unit, command.compute, (document.chain,),
+                              finish)  # fmt: skip
+
+    def start_job(self, label: str, title: str, unit: str, func: Callable, args: tuple,
+                  finish: Callable[[Job, Any], None]) -> Job | None:  # fmt: skip
+        """Run ``func(*args, progress=...)`` in the tab's job process (docs/progress.md), with
+        a progress bar and a Cancel button; ``finish(job, result)`` runs under the tab's lock
+        when it is done (not when it was cancelled or failed, or the tab opened another
+        design meanwhile). One job at a time: None (and a reason shown) while one runs."""
+        with self.lock:
+            if self._closed:
+                return None
+            if self._job is not None:
+                self._say(f"**Refused:** {self._job.label} is running: wait for it or Cancel it")
+                return None
+            self.stop_animation()
+            job = Job(label, title, unit, self.model, self.model.base_document)
+            self._job = job
+            self._show_job(job)
+        thread = threading.Thread(target=self._run_job, args=(job, func, args, finish),
+                                  name=f"kinegami-{label.replace(' ', '-')}",
+                                  daemon=True)  # fmt: skip
+        thread.start()
+        return job
+
+    def cancel_job(self) -> bool:
+        """Stop the running job (the Cancel button): nothing changes. False when none runs."""
+        job = self._job
+        if job is None:
+            return False
+        job.cancel.set()
+        self._job_text.content = f"**{job.title}**: cancelling..."
+        return True
+
+    def _run_job(self, job: Job, func: Callable, args: tuple, finish: Callable) -> None:
+        def progress(done: int, total: int) -> bool:
+            self._job_progress(job, done, total)
+            return not job.cancel.is_set()
+
+        result = error = None
+        try:
+            if self._jobs is not None:
+                result = self._jobs.run(func, args, progress, job.cancel)
+            else:
+                result = func(*args, progress=progress)
+            outcome = "done"
+        except Cancelled:
+            outcome = "cancelled"
+        except Exception as exc:  # noqa: BLE001 - a failed job is a message, not a crash
+            outcome, error = "failed", exc
+        try:
+            with self.lock:
+                if self._job is job:
+                    self._job = None
+                    self._hide_job()
+                if self._closed or self.model is not job.model:
+                    outcome = "dropped"  # the tab closed or opened another design
+                elif outcome == "cancelled":
+                    self._say(f"{job.label} cancelled: the design is unchanged")
+                elif outcome == "failed":
+                    reason = str(error) or type(error).__name__
+                    if not reason.startswith(job.label):
+                        reason = f"{job.label}: {reason}"
+                    self._say(f"**Refused:** {reason}")
+                else:
+                    finish(job, result)
+        finally:
+            job.outcome = outcome
+            job.finished.set()
+
+    def _job_words(self, job: Job) -> str:
+        seconds = int(time.monotonic() - job.started)
+        if job.total:
+            return f"**{job.title}**: {job.done} of {job.total} {job.unit}, {seconds} s"
+        return f"**{job.title}**: {seconds} s"
+
+    def _job_progress(self, job: Job, done: int, total: int) -> None:
+        """A progress report of ``job`` (from its thread; widgets are sent only on change)."""
+        job.done, job.total = int(done), int(total)
+        if self._job is not job or job.cancel.is_set():
+            return
+        value = min(100.0, max(0.0, 100.0 * done / total)) if total > 0 else 0.0
+        if abs(float(self._job_bar.value) - value) > 0.05:
+            self._job_bar.value = value
+        words = self._job_words(job)
+        if self._job_text.content != words:
+            self._job_text.content = words
+
+    def _show_job(self, job: Job) -> None:
+        self._job_text.content = f"**{job.title}**: starting..."
+        self._job_bar.value = 0.0
+        for widget in (self._job_text, self._job_bar, self._job_cancel):
+            widget.visible = True
+        self._say(f"{job.label}: running in the background (Cancel stops it)")
+
+    def _hide_job(self) -> None:
+        for widget in (self._job_text, self._job_bar, self._job_cancel):
+            widget.visible = False
+
+    def _ask_result(self, job: Job, command: Computed) -> None:
+        """Ask whether a result computed for an earlier document replaces the current one."""
+        self._close_result_question()
+        gui = self.gui
+        with gui.add_modal(f"{job.label.capitalize()} finished") as modal:
+            gui.add_markdown(
+                f"The design changed while {job.label} ran. **Apply** replaces it by the "
+                f"result for the design as it was when {job.label} started (your later changes "
+                "are one Undo away); **Discard** drops the result."
+            )  # fmt: skip
+            buttons = gui.add_button_group("Result", ("Apply", "Discard"))
+        self._stale_modal = modal
+        self.pending_result = command
+        buttons.on_click(lambda event: self.resolve_result(str(event.target.value).lower()))
+        self._say(f"{job.label} finished for an earlier version of the design: apply it?")
+
+    def _close_result_question(self) -> None:
+        if self._stale_modal is not None:
+            self._stale_modal.close()
+            self._stale_modal = None
+        self.pending_result = None
+
+    @_locked
+    def resolve_result(self, choice: str) -> CommandResult | None:
+        """Answer the question of :meth:`run_command_job`: ``"apply"`` (one command, undoable)
+        or ``"discard"``."""
+        command = self.pending_result
+        self._close_result_question()
+        if command is None:
+            return None
+        if choice == "apply":
+            return self.act(lambda: self.model.apply(command))
+        self._say(f"{command.label}: the result was dropped; the design is as you left it")
+        return None
+
     # --- files --------------------------------------------------------------------------------
     @_locked
     def download(self, suffix: str) -> tuple[str, bytes] | None:
@@ -853,7 +1128,8 @@ class EditorView:
 
     @_locked
     def open_example(self, stem: str) -> bool:
-        """Edit a gallery design (by its stem; only files of the gallery can be opened)."""
+        """Edit a gallery design (by its stem; only files of the gallery can be opened). With
+        unsaved changes the tab asks first (:meth:`answer_unsaved`) and returns False."""
         path = gallery().get(stem)
         if path is None:
             self._say(f"**Refused:** no gallery design named {stem!r}")
@@ -867,7 +1143,8 @@ class EditorView:
 
     @_locked
     def upload(self, name: str, content: bytes) -> bool:
-        """Edit an uploaded design file (parsed as a design only; at most MAX_UPLOAD_BYTES)."""
+        """Edit an uploaded design file (parsed as a design only; at most MAX_UPLOAD_BYTES).
+        With unsaved changes the tab asks first (:meth:`answer_unsaved`) and returns False."""
         if len(content) > MAX_UPLOAD_BYTES:
             self._say(f"**Refused:** {name!r} is {len(content)} bytes; the limit is "
                       f"{MAX_UPLOAD_BYTES} (16 MiB)")  # fmt: skip
@@ -880,8 +1157,72 @@ class EditorView:
         return self._open(document, f"opened {name}")
 
     def _open(self, document: Document, text: str) -> bool:
+        if self.model.dirty:
+            self._ask_unsaved(document, text)
+            return False
+        self._replace_model(document, text)
+        return True
+
+    def _replace_model(self, document: Document, text: str) -> None:
+        job = self._job
+        if job is not None:
+            job.cancel.set()  # its result is of the design being closed: dropped
+            text += f" ({job.label} stopped)"
+        self._close_result_question()
         self.set_model(EditorModel(document))
         self._say(text)
+
+    def _ask_unsaved(self, document: Document, text: str) -> None:
+        """Ask what to do with the unsaved changes before opening ``document``."""
+        self._close_unsaved_question()
+        self.pending_open = (document, text)
+        what = text.removeprefix("opened ")
+        where = (f"to {self.model.path.name}" if self.model.path is not None
+                 else "as a download (Save design)")  # fmt: skip
+        gui = self.gui
+        with gui.add_modal("Unsaved changes") as modal:
+            gui.add_markdown(
+                f"This design has unsaved changes. Before opening {what}: **Save** them "
+                f"({where}), **Discard** them, or **Cancel** (nothing is opened)."
+            )  # fmt: skip
+            buttons = gui.add_button_group("Unsaved changes", ("Save", "Discard", "Cancel"))
+        self._unsaved_modal = modal
+        buttons.on_click(lambda event: self.answer_unsaved(str(event.target.value).lower()))
+        self._say(f"unsaved changes: save, discard or cancel before opening {what}")
+
+    def _close_unsaved_question(self) -> None:
+        if self._unsaved_modal is not None:
+            self._unsaved_modal.close()
+            self._unsaved_modal = None
+        self.pending_open = None
+
+    @_locked
+    def answer_unsaved(self, choice: str) -> bool:
+        """Answer the question an open with unsaved changes asked: ``"save"`` (to the design
+        file, or as a download for a design with no file on the server; the open goes on
+        only when that worked), ``"discard"`` (the changes and their autosave are dropped)
+        or ``"cancel"`` (nothing is opened). Returns whether the design was opened."""
+        pending = self.pending_open
+        self._close_unsaved_question()
+        if pending is None:
+            return False
+        if choice == "cancel":
+            self._say(f"nothing opened: the design with its unsaved changes stays "
+                      f"({pending[1].removeprefix('opened ')} was not opened)")  # fmt: skip
+            return False
+        if choice == "save":
+            if self.model.path is not None:
+                if not self.save_file().ok:
+                    return False  # the reason is shown; the design stays
+            elif self.download(".json") is None:
+                return False
+        elif choice == "discard":
+            if self.autosave is not None:  # removed when this tab wrote it last
+                self.autosave.record(self.model.base_document, False, self)
+        else:
+            raise InvalidParameterError(f"choice must be 'save', 'discard' or 'cancel', got "
+                                        f"{choice!r}")  # fmt: skip
+        self._replace_model(*pending)
         return True
 
     @_locked
@@ -1163,7 +1504,12 @@ class EditorView:
         if choice == "recover":
             command = ReplaceDocument(recovery.document, f"recover the autosave "
                                                          f"({recovery.describe()})")  # fmt: skip
-            return self.act(lambda: self.model.apply(command))
+            result = self.act(lambda: self.model.apply(command))
+            if result.ok and recovery.legacy and self.autosave is not None:
+                self.autosave.flush()  # now in the data folder: the old one beside the design goes
+                if self.autosave.path.exists():
+                    recovery.path.unlink(missing_ok=True)
+            return result
         try:
             recovery.path.unlink()
         except FileNotFoundError:

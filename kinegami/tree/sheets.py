@@ -624,6 +624,7 @@ def fit_junctions(
     *,
     trunks: Mapping[int, int] | None = None,
     options: ConnectorOptions | None = None,
+    progress=False,
 ) -> tuple[KinematicTree, list[tuple[int, float]]]:
     """A copy of ``tree`` in which every branch child's socket fits, and the slides made.
 
@@ -631,6 +632,10 @@ def fit_junctions(
     follows), by the smallest of :data:`FIT_SLIDES` that makes it fit without making the tree
     pass through itself more than before: the axes, hence the kinematics, stay as they were.
     ``tree`` is not changed. Returns ``(tree, [(joint, slide in the tree's length units), ...])``.
+    ``progress`` (docs/progress.md): ``progress(done, total)`` as the sockets that did not fit
+    are fitted (total: their count so far), and after each slide tried; returning False
+    stops with :class:`~kinegami.errors.Cancelled` (default False: no report; True: a bar on
+    stderr).
 
     Raises
     ------
@@ -644,9 +649,11 @@ def fit_junctions(
     import warnings
 
     from kinegami.errors import ClearanceWarning, PlacementWarning
+    from kinegami.progress import Progress, check_progress
 
     _check_tree(tree)
     options = _check_connector_options(options)
+    progress = check_progress(progress)
     fitted = copy.copy(tree)
     moves: list[tuple[int, float]] = []
 
@@ -654,16 +661,20 @@ def fit_junctions(
         report = t.clearance()
         return 0.0 if report.ok else -report.min_clearance
 
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), Progress(progress, 0, desc="fit junctions",
+                                             unit="socket") as bar:  # fmt: skip
         warnings.simplefilter("ignore", ClearanceWarning)
         warnings.simplefilter("ignore", PlacementWarning)
         for _ in range(len(tree.Joints)):
             problems = junction_problems(fitted, trunks=trunks, options=options)
+            bar.total = max(bar.total, len(moves) + len(problems))
+            bar.check()
             if not problems:
                 return fitted, moves
             child, reason = problems[0]
             before = depth(fitted)
             for slide in FIT_SLIDES:
+                bar.check()
                 trial = copy.copy(fitted)
                 if not trial.translateJointAlongAxisOfMotion(child, slide * tree.r):
                     continue
@@ -674,6 +685,7 @@ def fit_junctions(
                     continue
                 fitted = trial
                 moves.append((child, slide * tree.r))
+                bar.update()
                 break
             else:
                 raise InvalidParameterError(

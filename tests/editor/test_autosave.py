@@ -16,6 +16,7 @@ from kinegami.editor.autosave import (
     autosave_path,
     data_folder,
     find_recovery,
+    legacy_autosave_path,
 )
 from kinegami.editor.background import Debounced
 from tests.editor.helpers import EXAMPLE1, example_model
@@ -23,9 +24,10 @@ from tests.editor.helpers import EXAMPLE1, example_model
 
 @pytest.fixture
 def design(tmp_path):
-    """A copy of examples/designs/example1.json to edit (its autosave goes beside it)."""
+    """A copy of examples/designs/example1.json to edit (its autosave's folder exists)."""
     path = tmp_path / "arm.json"
     shutil.copyfile(EXAMPLE1, path)
+    autosave_path(path).parent.mkdir(parents=True, exist_ok=True)
     return path
 
 
@@ -35,8 +37,13 @@ def _age(path, seconds: float) -> None:
 
 
 # --- where ------------------------------------------------------------------------------------
-def test_the_autosave_goes_beside_the_design(design):
-    assert autosave_path(design) == design.parent / ".arm.json.autosave"
+def test_the_autosave_goes_to_the_data_folder_keyed_by_the_designs_path(design, data_home):
+    path = autosave_path(design)
+    assert path.parent == data_home / "kinegami" / "autosaves"
+    assert path.name.startswith("arm.json-") and path.name.endswith(".autosave")
+    other = design.parent / "copy" / "arm.json"  # the same name in another folder
+    assert autosave_path(other) != path and autosave_path(other).parent == path.parent
+    assert autosave_path(os.path.relpath(design)) == path  # the absolute path is the key
 
 
 def test_a_design_with_no_file_autosaves_in_the_data_folder(monkeypatch, tmp_path):
@@ -57,7 +64,7 @@ def test_a_dirty_document_is_written_as_a_design_file(design):
     assert not autosave_path(design).exists()  # not before the pause
     saver.flush()
     assert Document.load(autosave_path(design)).design_text == model.document.design_text
-    assert sorted(os.listdir(design.parent)) == [".arm.json.autosave", "arm.json"]
+    assert sorted(os.listdir(design.parent)) == ["arm.json"]  # nothing beside the design
 
 
 def test_many_changes_make_one_write_after_the_pause(design):
@@ -111,7 +118,7 @@ def test_the_autosave_is_written_atomically(design, monkeypatch):
     saver.flush()
     assert "No space left" in saver.error
     assert autosave_path(design).read_text(encoding="utf-8") == "the last autosave"
-    assert sorted(os.listdir(design.parent)) == [".arm.json.autosave", "arm.json"]
+    assert sorted(os.listdir(autosave_path(design).parent)) == [autosave_path(design).name]
 
 
 # --- recovery ---------------------------------------------------------------------------------
@@ -141,6 +148,19 @@ def test_an_unreadable_autosave_is_not_offered(design, text):
 
 def test_no_autosave_no_recovery(design):
     assert find_recovery(design) is None
+
+
+def test_an_autosave_an_earlier_version_left_beside_the_design_is_offered(design):
+    model = example_model()
+    model.slide("revolute", 0.5)
+    _age(design, 60.0)
+    legacy = legacy_autosave_path(design)
+    assert legacy == design.parent / ".arm.json.autosave"
+    legacy.write_text(model.document.design_text, encoding="utf-8")
+    recovery = find_recovery(design)
+    assert recovery is not None and recovery.path == legacy and recovery.legacy
+    autosave_path(design).write_text(example_model().document.design_text, encoding="utf-8")
+    assert find_recovery(design).path == autosave_path(design)  # the data folder's first
 
 
 # --- debounced work ---------------------------------------------------------------------------

@@ -13,6 +13,7 @@ pytest.importorskip("viser")
 
 from kinegami.cli import main  # noqa: E402
 from kinegami.editor import EditorModel  # noqa: E402
+from kinegami.editor.autosave import autosave_path  # noqa: E402
 from kinegami.editor.server import EditorServer  # noqa: E402
 from kinegami.editor.view import (  # noqa: E402
     COLLIDING_COLOR,
@@ -339,13 +340,15 @@ def _edited(server) -> tuple:
     return view, view.model.document.design_text
 
 
-def test_edits_are_autosaved_beside_the_design(design):
+def test_edits_are_autosaved_in_the_data_folder_never_beside_the_design(design, data_home):
     server = EditorServer(design, port=0)
     try:
         view, text = _edited(server)
-        autosave = design.parent / ".arm.json.autosave"
+        autosave = autosave_path(design)
         assert autosave.read_text(encoding="utf-8") == text
+        assert autosave.parent == data_home / "kinegami" / "autosaves"
         assert design.read_bytes() == EXAMPLE1.read_bytes()
+        assert sorted(p.name for p in design.parent.iterdir()) == ["arm.json"]
     finally:
         server.stop()
 
@@ -357,7 +360,7 @@ def test_save_to_file_writes_the_design_and_removes_the_autosave(design):
         assert view._save_file.visible and view._save_file.label == "Save to arm.json"
         assert view.save_file().ok
         assert design.read_text(encoding="utf-8") == text
-        assert not (design.parent / ".arm.json.autosave").exists()
+        assert not autosave_path(design).exists()
         assert not view.model.dirty
     finally:
         server.stop()
@@ -394,7 +397,7 @@ def test_discarding_the_offer_removes_the_autosave(design):
     try:
         view = again.new_view(again.server)
         view.choose_recovery(again.recovery, "discard")
-        assert not (design.parent / ".arm.json.autosave").exists()
+        assert not autosave_path(design).exists()
         assert view.model.document is again.document
     finally:
         again.stop()
@@ -415,12 +418,11 @@ def test_recover_starts_every_tab_from_the_autosave(design):
         again.stop()
 
 
-def test_without_a_file_the_autosave_is_in_the_data_folder(monkeypatch, tmp_path):
-    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+def test_without_a_file_the_autosave_is_in_the_data_folder(data_home):
     server = EditorServer(port=0)
     try:
         view, text = _edited(server)
-        autosave = tmp_path / "data" / "kinegami" / "untitled.json.autosave"
+        autosave = data_home / "kinegami" / "untitled.json.autosave"
         assert autosave.read_text(encoding="utf-8") == text
         assert not view._save_file.visible and not view.save_file().ok
         view.download(".json")  # with no file on the server, the download is the save
@@ -429,17 +431,16 @@ def test_without_a_file_the_autosave_is_in_the_data_folder(monkeypatch, tmp_path
         server.stop()
 
 
-def test_a_design_opened_in_the_browser_autosaves_in_the_data_folder(monkeypatch, tmp_path,
-                                                                     design):  # fmt: skip
-    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+def test_a_design_opened_in_the_browser_autosaves_in_the_data_folder(data_home, design):
     server = EditorServer(design, port=0)
     try:
         view = server.new_view(server.server)
         assert view.open_example("puma")
         assert view.act(lambda: view.model.slide(1, 0.5)).ok
         view.autosave.flush()
-        assert (tmp_path / "data" / "kinegami" / "untitled.json.autosave").exists()
-        assert not (design.parent / ".arm.json.autosave").exists()
+        assert (data_home / "kinegami" / "untitled.json.autosave").exists()
+        assert not autosave_path(design).exists()
+        assert sorted(p.name for p in design.parent.iterdir()) == ["arm.json"]
         assert not view._save_file.visible
     finally:
         server.stop()

@@ -1,0 +1,14 @@
+"""Every editor test gets its own data folder (``XDG_DATA_HOME``), so that autosaves never go
+to the real one of the user running the tests."""
+
+from __future__ import annotations
+
+import pytest
+
+
+@pytest.fixture(autouse=True)
+def data_home(tmp_path_factory, monkeypatch):
+    """The data folder's parent: ``$XDG_DATA_HOME`` for this test (a fresh folder)."""
+    path = tmp_path_factory.mktemp("data")
+    monkeypatch.setenv("XDG_DATA_HOME", str(path))
+    return path
