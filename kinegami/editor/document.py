@@ -245,8 +245,17 @@ class Document:
 
     @cached_property
     def clearance(self):
-        """The chain's (or tree's) ClearanceReport at its states (docs/clearance.md)."""
-        return self.chain.clearance()
+        """The chain's (or tree's) ClearanceReport at its states, with its margin and the parts
+        named (kinegami.clearance.clearance_report: the verdict build and check give)."""
+        from kinegami.clearance import clearance_report
+
+        return clearance_report(self.chain, names=self.names)
+
+    @cached_property
+    def verdict(self) -> str:
+        """The clearance verdict in one line, worded as ``kinegami build`` and ``kinegami check``
+        print it (lengths in mm and the design's units; docs/clearance.md)."""
+        return self.clearance.verdict(self.units)
 
     @cached_property
     def joint_table(self) -> tuple[JointRow, ...]:

@@ -9,9 +9,10 @@ from kinegami.editor import Document, EditorModel
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE1 = ROOT / "examples" / "designs" / "example1.json"
-#: The paper's hand (12 joints, 3 leaves; the fingers leave the root waypoint) and a two-finger
-#: gripper (10 joints, 2 leaves; the fingers leave the palm, joint 3).
-HAND = ROOT / "examples" / "designs" / "hand.json"
+#: The paper's hand as published (12 joints, 3 leaves; the fingers leave the root waypoint; the
+#: gallery's examples/designs/hand.json has the palm slid so that its socket fits) and a
+#: two-finger gripper (10 joints, 2 leaves; the fingers leave the palm, joint 3).
+HAND = ROOT / "tests" / "design" / "data" / "papers_hand.json"
 GRIPPER = ROOT / "examples" / "designs" / "gripper.json"
 
 #: What the editor shows of the paper's hand: its parents, its sheets (one per leaf: the middle
@@ -29,7 +30,7 @@ def example_model() -> EditorModel:
 
 
 def hand_model() -> EditorModel:
-    """A model editing examples/designs/hand.json (the paper's hand, every joint named)."""
+    """A model editing the paper's hand as published (every joint named)."""
     return EditorModel.open(HAND)
 
 

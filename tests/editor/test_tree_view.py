@@ -53,7 +53,7 @@ def test_the_hands_colliding_parts_are_red(view):
     assert pair.elements == (2, 9)
     assert view.colour_of("joint", 1) == COLLIDING_COLOR
     assert view.colour_of("link", 5) == COLLIDING_COLOR
-    assert "self-intersecting" in view._clearance.content
+    assert "self-intersects" in view._clearance.content
 
 
 def test_animate_sweeps_the_trees_joints_and_gives_the_states_back(view):

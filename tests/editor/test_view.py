@@ -103,9 +103,12 @@ def test_selection_highlights_and_fills_the_panel(view):
 def test_configuration_sliders_span_the_state_ranges(view):
     rows = [row for row in view.model.joint_table() if row.movable]
     assert len(view._sliders) == len(rows)
-    for ((index, _), handle), row in zip(view._sliders, rows, strict=True):
+    for ((index, kind, _, _), handle), row in zip(view._sliders, rows, strict=True):
         assert index == row.index
-        assert (handle.min, handle.max) == pytest.approx(row.state_range)
+        if kind == "PrismaticJoint":  # in the design's units (cm)
+            assert (handle.min, handle.max) == pytest.approx(row.state_range)
+        else:  # in degrees
+            assert (handle.min, handle.max) == pytest.approx(np.degrees(row.state_range))
 
 
 def test_colliding_parts_are_red():
@@ -121,7 +124,7 @@ def test_colliding_parts_are_red():
         kind, index = ("joint", element // 2) if element % 2 == 0 else ("link", (element + 1) // 2)
         if not (kind == "joint" and index == view.model.selected):
             assert view.colour_of(kind, index) == COLLIDING_COLOR
-        assert "self-intersecting" in view._clearance.content
+        assert "self-intersects" in view._clearance.content
     finally:
         server.stop()
 
