@@ -141,6 +141,15 @@ def test_the_pages_with_examples_are_found():
     assert len(python_blocks((ROOT / "README.md").read_text(encoding="utf-8"))) >= 1
 
 
+def test_no_python_hides_under_another_fence_language():
+    """Python is fenced ```python (and then run); pages that are not meant to run use bash,
+    console or text, never a Python-looking name this test would not run."""
+    hidden = {"py", "py3", "python3", "pycon", "ipython", "pyi"}
+    for path in [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]:
+        languages = re.findall(r"^[ \t]*```[ \t]*([\w+-]+)", path.read_text(encoding="utf-8"), re.M)
+        assert not hidden & {language.lower() for language in languages}, path
+
+
 def test_python_blocks_are_extracted_as_written():
     text = "a\n```python\nx = 1\n```\n\n1. item\n\n   ```python\n   y = x\n   ```\n"
     text += "```bash\nls\n```\n"
