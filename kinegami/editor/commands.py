@@ -733,8 +733,12 @@ class SetJointPose(Command):
         P = _pose("pose", self.pose, chain.r)
         propagate = _flag("propagate", self.propagate)
         old = np.asarray(chain.Joints[j].pose_matrix, dtype=float)
-        T = P @ np.linalg.inv(old)
-        T[3] = (0.0, 0.0, 0.0, 1.0)
+        if np.array_equal(P[:3, :3], old[:3, :3]):  # a move only: the rotation stays exact
+            T = np.eye(4)
+            T[:3, 3] = P[:3, 3] - old[:3, 3]
+        else:
+            T = P @ np.linalg.inv(old)
+            T[3] = (0.0, 0.0, 0.0, 1.0)
         run = _Run()
         new = fork_chain(chain)
         run(

@@ -39,9 +39,25 @@ from kinegami.editor.commands import (
     SlideJoint,
 )
 from kinegami.editor.document import Document
+from kinegami.editor.framing import Framing, box_corners, frame_box, grid_for_box, nice_step
 from kinegami.editor.jobs import MOTION_SAMPLES, TREE_MOTION_SAMPLES, motion_check
+from kinegami.editor.keys import keys_script, shortcuts_markdown
 from kinegami.editor.model import Change, CommandResult, EditorModel
 from kinegami.editor.page_script import run_javascript, unsaved_changes_script
+from kinegami.editor.units import (
+    DEGREE,
+    angle_text,
+    length_text,
+    parameter_from_display,
+    parameter_to_display,
+    parameter_unit,
+    pose_from_display,
+    pose_to_display,
+    state_from_display,
+    state_text,
+    state_to_display,
+    state_unit,
+)
 from kinegami.errors import Cancelled, InvalidParameterError, InvalidTypeError, KinegamiError
 
 __all__ = ["EditorView", "DOWNLOADS", "SHEET_FORMATS", "MAX_UPLOAD_BYTES", "gallery",
@@ -71,6 +87,9 @@ PATTERN_PANEL_WIDTH = 460
 #: The animation: seconds of one back-and-forth sweep, and the most frames a second.
 ANIMATION_PERIOD = 4.0
 ANIMATION_FPS = 20.0
+#: The vertical field of view assumed when the tab has not reported its camera (radians;
+#: three.js's and viser's default).
+DEFAULT_FOV = math.radians(75.0)
 #: Seconds each start of the Compact button's compaction may search.
 COMPACT_TIME_LIMIT = 30.0
 
@@ -233,6 +252,9 @@ class _Node:
     handles: list = field(default_factory=list)
     frame: Any = None
     sent: int = 0  # how many times its meshes were sent
+    lo: Any = None  # its meshes' box in its own frame (3-vectors; None before any mesh)
+    hi: Any = None
+    matrix: Any = None  # its frame now (4x4, world)
 
 
 class EditorView:
@@ -306,11 +328,25 @@ class EditorView:
         #: The open waiting for an answer about unsaved changes: (document, message), or None.
         self.pending_open: tuple[Document, str] | None = None
         self._unsaved_shown: bool | None = None  # what the page was last told
+        #: The camera framing last computed (:class:`~kinegami.editor.framing.Framing`) and
+        #: the grid (:class:`~kinegami.editor.framing.GridLayout`), sized to the design.
+        self.framing: Framing | None = None
+        self.grid = None
+        self._grid_handle = None
+        self._world_axes = None
+        self._drag_cancelled = False  # Escape during a handle drag: its end applies nothing
+        #: What Escape does to an open dialog, the latest last (it calls and removes it).
+        self.dialog_cancels: list[Callable[[], None]] = []
+        self._joint_fields: dict = {}  # the Selected joint folder's typed fields
+        self._joint_fields_key = None
+        self._shown_fields: dict = {}  # field -> (value shown, exact value)
         self._build_panel()
         self._build_pattern_panel()
-        self.scene.add_frame("/world", axes_length=2.0 * self._r, axes_radius=0.04 * self._r)
+        self._build_help_panel()
+        self.send_shortcuts()
         self._unsubscribe = self.model.subscribe(self._on_change)
         self._redraw_all()
+        self._size_scene()
         self.frame_camera()
         self._pattern_redraw.trigger()
         self._recovery_modal = None
@@ -336,21 +372,83 @@ class EditorView:
         self._save_file.visible = model.path is not None
         self._clear_scene()
         self._redraw_all()
+        self._drag_cancelled = False
+        self._size_scene()
         self.frame_camera()
         self._pattern_redraw.trigger()
         self._sync_unsaved()
 
-    def frame_camera(self) -> None:
-        """Point a browser tab's camera at the whole chain (a server target has none)."""
+    def frame_camera(self) -> Framing:
+        """Point a browser tab's camera at the whole design (every mesh drawn) and set its
+        clipping planes and zoom limits to the design's size (docs/editor.md, Framing).
+        Returns the framing (kept in :attr:`framing`); a server target (tests) has no camera
+        and only gets it computed for a 75° view of aspect 1."""
+        lo, hi = self.design_box()
         camera = getattr(self.target, "camera", None)
-        if camera is None:
-            return
-        ball = self.model.chain.boundingBall
-        centre, radius = np.asarray(ball.c, dtype=float), float(ball.r) + self._r
-        direction = np.array([1.0, -1.2, 0.8]) / np.linalg.norm([1.0, -1.2, 0.8])
-        camera.up_direction = (0.0, 0.0, 1.0)
-        camera.position = centre + 2.6 * radius * direction
-        camera.look_at = centre
+        fov, aspect = DEFAULT_FOV, 1.0
+        if camera is not None:
+            with contextlib.suppress(AssertionError, AttributeError, TypeError, ValueError):
+                fov = float(camera.fov) if 0.0 < float(camera.fov) < math.pi else DEFAULT_FOV
+                width, height = float(camera.image_width), float(camera.image_height)
+                if width > 0.0 and height > 0.0:
+                    aspect = width / height
+        framing = frame_box(lo, hi, fov, aspect)
+        self.framing = framing
+        if camera is not None:
+            camera.far = framing.far
+            camera.near = framing.near
+            camera.max_orbit_distance = framing.max_distance
+            camera.min_orbit_distance = framing.min_distance
+            camera.up_direction = framing.up
+            camera.position = framing.position
+            camera.look_at = framing.look_at
+        return framing
+
+    @_locked
+    def frame_all(self) -> Framing:
+        """The Frame all button (and the F key): the whole design in view."""
+        framing = self.frame_camera()
+        units = self.model.document.units
+        self._say(f"framed all: {length_text(2.0 * framing.radius, units)} across, seen from "
+                  f"{length_text(framing.distance, units)}")  # fmt: skip
+        return framing
+
+    def design_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """The box around every mesh drawn (world coordinates, in the design's units)."""
+        points = []
+        for node in self._joints + self._links:
+            if node is None or node.lo is None or node.matrix is None:
+                continue
+            M = np.asarray(node.matrix, dtype=float)
+            points.append(box_corners(node.lo, node.hi) @ M[:3, :3].T + M[:3, 3])
+        if not points:  # nothing drawn: the joints' origins, a tube radius around them
+            origins = np.array([j.pose_matrix[:3, 3] for j in self.model.chain.Joints])
+            return origins.min(0) - self._r, origins.max(0) + self._r
+        corners = np.concatenate(points)
+        return corners.min(0), corners.max(0)
+
+    def _size_scene(self) -> None:
+        """Size the grid, the world axes and the joint handle to the design (on start and
+        whenever another design is opened): a grid under the design, its lines at round
+        numbers of the design's units; axes one grid section long."""
+        grid = grid_for_box(*self.design_box())
+        self.grid = grid
+        if self._grid_handle is not None:
+            self._grid_handle.remove()
+        if self._world_axes is not None:
+            self._world_axes.remove()
+        self._grid_handle = self.scene.add_grid(
+            "/grid", width=grid.width, height=grid.width, plane="xy", cell_size=grid.cell,
+            section_size=grid.section, position=grid.centre, cell_color=(210, 210, 210),
+            section_color=(150, 150, 150), fade_distance=20.0 * grid.width,
+        )  # fmt: skip
+        self._world_axes = self.scene.add_frame("/world", axes_length=grid.section,
+                                                axes_radius=0.02 * grid.section)  # fmt: skip
+        if self._gizmo is not None:
+            self._gizmo.scale = 3.0 * self._r
+        step = nice_step(0.5 * self._r)
+        self._step.value, self._step.step = step, nice_step(0.1 * self._r)
+        self._update_units()
 
     def close(self) -> None:
         """Stop listening to the model (the tab closed); a pending autosave is written and a
@@ -460,6 +558,7 @@ class EditorView:
         for part in joint_parts(joint, i):
             name = f"/chain/joint{node.uid}/{part.side or 'body'}"
             node.handles.append(self._add_mesh(name, part, pose, JOINT_COLOR, node))
+            self._grow(node, part.vertices, pose)
         node.sent += 1
         return node
 
@@ -473,6 +572,7 @@ class EditorView:
         for part in link_parts(link, i, chain.numSides, self.model.document.twist_portion):
             name = f"/chain/link{node.uid}/{part.side}"
             node.handles.append(self._add_mesh(name, part, frame, LINK_COLOR, None))
+            self._grow(node, part.vertices, frame)
         node.sent += 1
         return node
 
@@ -506,6 +606,18 @@ class EditorView:
 
     def _move(self, node: _Node, frame: np.ndarray) -> None:
         node.frame.wxyz, node.frame.position = _wxyz(frame[:3, :3]), frame[:3, 3]
+        node.matrix = frame
+
+    @staticmethod
+    def _grow(node: _Node, vertices: np.ndarray, frame: np.ndarray) -> None:
+        """Widen a node's box (in its own frame) by a mesh's world ``vertices``."""
+        if not len(vertices):
+            return
+        local = (np.asarray(vertices, dtype=float) - frame[:3, 3]) @ frame[:3, :3]
+        lo, hi = local.min(0), local.max(0)
+        node.lo = lo if node.lo is None else np.minimum(node.lo, lo)
+        node.hi = hi if node.hi is None else np.maximum(node.hi, hi)
+        node.matrix = frame
 
     def _update_scene(self, change: Change) -> None:
         chain = self.model.chain
@@ -632,6 +744,14 @@ class EditorView:
 
     def _on_gizmo(self, event) -> None:
         phase = getattr(event, "phase", "end")
+        if phase == "start":
+            self._drag_cancelled = False
+        elif self._drag_cancelled:  # Escape cancelled this drag: the rest of it is ignored
+            if phase == "end":
+                with self.lock:
+                    self._drag_cancelled = False
+                    self._update_gizmo()  # the handle goes back to the joint
+            return
         position = np.asarray(self._gizmo.position, dtype=float)
         wxyz = tuple(self._gizmo.wxyz)
         self._drag_latest = drag = next(self._drags)  # later events make earlier ones stale
@@ -704,10 +824,15 @@ class EditorView:
         self._job_cancel = gui.add_button("Cancel", color="red", visible=False,
                                           hint="stop the running job; nothing changes")  # fmt: skip
         self._job_cancel.on_click(lambda _: self.cancel_job())
+        with gui.add_folder("View"):
+            self._frame_button = gui.add_button("Frame all", hint="F: the whole design in view")
+            self._frame_button.on_click(lambda _: self.frame_all())
+            self._view_text = gui.add_markdown("")
         with gui.add_folder("Edit"):
-            undo_redo = gui.add_button_group("History", ("Undo", "Redo"))
-            undo_redo.on_click(lambda e: self.act(self._undo if e.target.value == "Undo"
-                                                  else self._redo))  # fmt: skip
+            self._undo_button = gui.add_button("Undo", hint="Ctrl+Z")
+            self._undo_button.on_click(lambda _: self.act(self._undo))
+            self._redo_button = gui.add_button("Redo", hint="Ctrl+Shift+Z or Ctrl+Y")
+            self._redo_button.on_click(lambda _: self.act(self._redo))
             self._propagate = gui.add_checkbox(
                 "Propagate",
                 initial_value=self.model.propagate,
@@ -719,7 +844,10 @@ class EditorView:
             self._joint_list = gui.add_dropdown("Joint", ("(none)",))
             self._joint_list.on_update(self._on_joint_list)
             self._joint_info = gui.add_markdown("")
-            self._step = gui.add_number("Slide by", initial_value=0.5, step=0.1)
+            self._step = gui.add_number(
+                f"Slide by ({self.model.document.units})", initial_value=0.5, step=0.1,
+                hint="the distance of - slide and + slide, in the design's units",
+            )  # fmt: skip
             slide = gui.add_button_group("Slide", ("- slide", "+ slide"))
             slide.on_click(
                 lambda e: self.act(
@@ -742,8 +870,16 @@ class EditorView:
                 "a branch makes it a tree)",
             )  # fmt: skip
             branch.on_click(lambda _: self.add_branch(str(self._kind.value)))
-            delete = gui.add_button("Delete selected joint", color="red")
-            delete.on_click(lambda _: self.act(self.model.delete))
+            self._delete_button = gui.add_button("Delete selected joint", color="red",
+                                                 hint="Delete")  # fmt: skip
+            self._delete_button.on_click(lambda _: self.act(self.model.delete))
+            self._escape_button = gui.add_button(
+                "Deselect", hint="Escape: close a dialog, else cancel a handle drag, else "
+                "deselect",
+            )  # fmt: skip
+            self._escape_button.on_click(lambda _: self.escape())
+        #: The selected joint's pose, parameters and state as typed fields (filled per joint)
+        self._joint_folder = gui.add_folder("Selected joint")
         self._config = gui.add_folder("Configuration")
         with self._config:
             self._animate = gui.add_button(
@@ -779,6 +915,7 @@ class EditorView:
             self._save_file.on_click(lambda _: self.save_file())
             save = gui.add_button("Save design (download)")
             save.on_click(lambda _: self.download(".json"))
+            self._download_design = save
             self._sheet = gui.add_dropdown(
                 "Sheet", self._sheet_options(), visible=self.model.is_tree,
                 hint="which sheet of the tree Download DXF, SVG and FOLD give",
@@ -831,6 +968,8 @@ class EditorView:
             self._joint_info.content = self._joint_text()
             self._clearance.content = self._clearance_text
             self._update_sliders(structure)
+            self._update_joint_fields()
+            self._update_units()
             tree = self.model.is_tree
             for widget in (self._fit, self._sheet, self._junctions):
                 if widget.visible != tree:
@@ -861,44 +1000,68 @@ class EditorView:
         if selected is None:
             return "No joint selected: click one."
         row = self.model.joint_table()[selected]
-        lines = [f"**{selected}: {row.type}** {row.name or ''}", "", f"state {row.state:.4g} in "
-                 f"[{row.state_range[0]:.4g}, {row.state_range[1]:.4g}]", ""]  # fmt: skip
+        units = self.model.document.units
+        if row.movable:
+            lo, hi = (state_text(row.type, v, units) for v in row.state_range)
+            motion = f"state {state_text(row.type, row.state, units)} in [{lo}, {hi}]"
+        else:
+            motion = "no motion of its own"
+        lines = [f"**{selected}: {row.type}** {row.name or ''}", "", motion, ""]
         if self.model.is_tree:
             kids = ", ".join(map(str, row.children)) or "none (a leaf)"
             parent = "none (the root)" if row.parent < 0 else str(row.parent)
             lines[4:4] = [f"parent {parent}; children {kids}", ""]
-        lines += [f"- {k}: {v:.4g}" if isinstance(v, float) else f"- {k}: {v}"
-                  for k, v in row.parameters.items()]  # fmt: skip
+        lines += [f"- {k}: {self._parameter_text(k, v)}" for k, v in row.parameters.items()]
         return "\n".join(lines)
 
+    def _parameter_text(self, key: str, value) -> str:
+        unit = parameter_unit(key, self.model.document.units)
+        if unit == "deg":
+            return angle_text(value)
+        if unit:
+            return length_text(value, unit)
+        return str(value)
+
     def _update_sliders(self, structure: bool) -> None:
+        """The Configuration sliders: one per movable joint, a revolute joint's in degrees,
+        a prismatic joint's in the design's units (the ends are marked with their unit)."""
         rows = [row for row in self.model.joint_table() if row.movable]
-        keys = [(row.index, row.state_range) for row in rows]
+        units = self.model.document.units
+        keys = [(row.index, row.type, row.state_range, units) for row in rows]
         if structure or [s[0] for s in self._sliders] != keys:
             for _, handle in self._sliders:
                 handle.remove()
             self._sliders = []
             with self._config:
-                for row in rows:
-                    lo, hi = (float(v) for v in row.state_range)
+                for key, row in zip(keys, rows, strict=True):
+                    lo, hi = (state_to_display(row.type, v) for v in row.state_range)
+                    marks = [(lo, state_text(row.type, row.state_range[0], units)),
+                             (hi, state_text(row.type, row.state_range[1], units))]  # fmt: skip
+                    if lo < 0.0 < hi:
+                        marks.insert(1, (0.0, "0"))
                     handle = self.gui.add_slider(
                         f"{row.index}: {row.name or row.type}", min=lo, max=hi,
-                        step=(hi - lo) / 200.0, initial_value=float(row.state),
+                        step=(hi - lo) / 200.0, marks=tuple(marks),
+                        initial_value=min(max(state_to_display(row.type, row.state), lo), hi),
+                        hint=f"the state of joint {row.index}, in "
+                        f"{'degrees' if state_unit(row.type, units) == 'deg' else units}",
                     )  # fmt: skip
                     handle.on_update(lambda _, i=row.index, h=handle: self._on_slider(i, h))
-                    self._sliders.append(((row.index, row.state_range), handle))
+                    self._sliders.append((key, handle))
             return
-        for (index, _), handle in self._sliders:
-            state = float(self.model.joint_table()[index].state)
-            if abs(float(handle.value) - state) > 1e-12:
-                handle.value = state
+        table = self.model.joint_table()
+        for (index, kind, _, _), handle in self._sliders:
+            shown = state_to_display(kind, table[index].state)
+            if abs(float(handle.value) - shown) > 1e-9:
+                handle.value = shown
 
     @_locked
     def _on_slider(self, index: int, handle) -> None:
         if self._syncing or self._animation is not None:
             return
-        state = float(handle.value)
-        if abs(state - float(self.model.joint_table()[index].state)) > 1e-12:
+        row = self.model.joint_table()[index]
+        state = state_from_display(row.type, float(handle.value))
+        if abs(state - float(row.state)) > 1e-12:
             self.set_state(index, state)
 
     @_locked
@@ -906,6 +1069,249 @@ class EditorView:
         """Set a joint's state (what its Configuration slider does)."""
         self.stop_animation()
         return self.run(self.model.set_state(index, state))
+
+    # --- typed values -------------------------------------------------------------------------
+    def _input_digits(self) -> int:
+        """Decimals of a typed length: a thousandth of the tube radius, at least."""
+        return max(0, 3 - math.floor(math.log10(self._r)))
+
+    def _update_joint_fields(self) -> None:
+        """The Selected joint folder: the selected joint's pose (position in the design's
+        units, fixed-axis XYZ angles in degrees), its parameters and its state as typed
+        fields, each group with its Set button. Rebuilt when the joint's type or the units
+        change, refilled after every change."""
+        selected = self.model.selected
+        row = None if selected is None else self.model.joint_table()[selected]
+        units = self.model.document.units
+        key = None if row is None else (row.type, tuple(row.parameters), row.movable, units,
+                                        self._input_digits())  # fmt: skip
+        if key != self._joint_fields_key:
+            for handle in self._joint_fields.values():
+                handle.remove()
+            self._joint_fields, self._shown_fields = {}, {}
+            self._joint_fields_key = key
+            with self._joint_folder:
+                if row is None:
+                    self._joint_fields["none"] = self.gui.add_markdown(
+                        "Select a joint to type its pose, parameters and state."
+                    )
+                else:
+                    self._build_joint_fields(row, units)
+        if row is not None:
+            self._fill_joint_fields(row)
+
+    def _build_joint_fields(self, row, units: str) -> None:
+        gui, fields = self.gui, self._joint_fields
+        digits = self._input_digits()
+        fields["position"] = gui.add_vector3(
+            f"Position ({units})", (0.0, 0.0, 0.0), step=10.0 ** -digits,
+            hint="the joint's origin in world coordinates, in the design's units",
+        )  # fmt: skip
+        fields["orientation"] = gui.add_vector3(
+            f"Orientation ({DEGREE})", (0.0, 0.0, 0.0), step=1e-4,
+            hint="fixed-axis XYZ angles in degrees: roll about x, then pitch about y, then yaw "
+            "about z (world axes); for a revolute or prismatic joint z is its axis of motion",
+        )  # fmt: skip
+        fields["set pose"] = gui.add_button(
+            "Set pose", hint="put the joint at the typed pose (undoable); Propagate moves the "
+            "later joints with it; for a revolute or prismatic joint this changes its axis, "
+            "i.e. the kinematics",
+        )  # fmt: skip
+        fields["set pose"].on_click(lambda _: self.set_typed_pose())
+        for key in row.parameters:
+            unit = parameter_unit(key, units)
+            label = f"{key} ({unit})" if unit and unit != "deg" else key
+            if unit == "deg":
+                label = f"{key} ({DEGREE})"
+            step = 1 if not unit else (1e-4 if unit == "deg" else 10.0 ** -digits)
+            fields[f"parameter {key}"] = gui.add_number(label, 0.0, step=step)
+        if row.parameters:
+            fields["set parameters"] = gui.add_button(
+                "Set parameters", hint="the joint's new parameters (undoable); its pose and "
+                "state stay, its links are solved again",
+            )  # fmt: skip
+            fields["set parameters"].on_click(lambda _: self.set_typed_parameters())
+        if row.movable:
+            unit = state_unit(row.type, units)
+            fields["state"] = gui.add_number(
+                f"State ({DEGREE if unit == 'deg' else unit})", 0.0,
+                step=1e-4 if unit == "deg" else 10.0 ** -digits,
+            )  # fmt: skip
+            fields["set state"] = gui.add_button("Set state", hint="the joint's new state "
+                                                 "(undoable)")  # fmt: skip
+            fields["set state"].on_click(lambda _: self.set_typed_state())
+
+    def _show(self, name: str, exact, digits: int) -> None:
+        """Fill a field with ``exact`` (a number or a triple) rounded to ``digits``, and
+        remember both (a typed value equal to the one shown means: keep the exact one)."""
+        if isinstance(exact, tuple | list | np.ndarray):
+            shown = tuple(round(float(v), digits) + 0.0 for v in exact)
+        else:
+            shown = round(float(exact), digits) + 0.0 if digits else exact
+        handle = self._joint_fields[name]
+        if handle.value != shown:
+            handle.value = shown
+        self._shown_fields[name] = (shown, exact)
+
+    def _fill_joint_fields(self, row) -> None:
+        digits = self._input_digits()
+        position, angles = pose_to_display(row.pose)
+        self._show("position", position, digits)
+        self._show("orientation", angles, 4)
+        for key, value in row.parameters.items():
+            unit = parameter_unit(key, self.model.document.units)
+            self._show(f"parameter {key}", parameter_to_display(key, value),
+                       0 if not unit else (4 if unit == "deg" else digits))  # fmt: skip
+        if row.movable:
+            unit = state_unit(row.type, self.model.document.units)
+            self._show("state", state_to_display(row.type, row.state), 4 if unit == "deg"
+                       else digits)  # fmt: skip
+
+    def _typed(self, name: str, value=None):
+        """A field's typed value; where it still shows what was filled in, the exact value
+        (so an untouched field does not round the design)."""
+        value = self._joint_fields[name].value if value is None else value
+        shown, exact = self._shown_fields.get(name, (None, None))
+        if isinstance(value, tuple | list | np.ndarray):
+            if shown is None:
+                return tuple(value)
+            return tuple(e if float(v) == s else v for v, s, e in zip(value, shown, exact,
+                                                                      strict=True))  # fmt: skip
+        return exact if shown is not None and value == shown else value
+
+    def _no_selection(self, action: str) -> CommandResult | None:
+        if self.model.selected is None or not self._joint_fields.get("set pose"):
+            return self.run(CommandResult(False, action, f"{action}: no joint is selected; "
+                                          "select one first"))  # fmt: skip
+        return None
+
+    @_locked
+    def set_typed_pose(self, position=None, angles=None) -> CommandResult:
+        """Put the selected joint at a typed pose (the Set pose button): ``position`` in the
+        design's units and fixed-axis XYZ ``angles`` in degrees (default: the fields). A
+        field left as filled in keeps the exact value (an unchanged orientation keeps the
+        joint's exact rotation). One undoable command; a refused pose changes nothing."""
+        refused = self._no_selection("set pose")
+        if refused is not None:
+            return refused
+        typed_position = self._typed("position", position)
+        typed_angles = self._typed("orientation", angles)
+        current = np.asarray(self.model.joint_table()[self.model.selected].pose, dtype=float)
+        try:
+            pose = pose_from_display(typed_position, typed_angles)
+        except KinegamiError as error:
+            return self.run(CommandResult(False, "set pose", f"set pose: {error}"))
+        if self._shown_fields.get("orientation", (None, None))[1] == tuple(typed_angles):
+            pose[:3, :3] = current[:3, :3]  # untouched: the exact rotation
+        if np.array_equal(pose, current):
+            self._say("set pose: the typed pose is the joint's pose; nothing to change")
+            return CommandResult(False, "set pose", "the typed pose is the joint's pose")
+        return self.act(lambda: self.model.set_pose(None, pose))
+
+    @_locked
+    def set_typed_parameters(self, values: dict | None = None) -> CommandResult:
+        """Give the selected joint its typed parameters (the Set parameters button; angles in
+        degrees, lengths in the design's units; ``values`` default: the fields). Only the
+        fields that differ from the joint's are sent; one undoable command."""
+        refused = self._no_selection("set parameters")
+        if refused is not None:
+            return refused
+        row = self.model.joint_table()[self.model.selected]
+        changed = {}
+        for key in row.parameters:
+            given = None if values is None or key not in values else values[key]
+            if values is not None and key not in values:
+                continue
+            typed = self._typed(f"parameter {key}", given)
+            shown, exact = self._shown_fields.get(f"parameter {key}", (None, None))
+            if typed is exact:
+                continue
+            changed[key] = parameter_from_display(key, typed)
+        if values is not None:  # unknown names go on: the command names them
+            changed.update({k: v for k, v in values.items() if k not in row.parameters})
+        if not changed:
+            self._say("set parameters: every typed value is the joint's; nothing to change")
+            return CommandResult(False, "set parameters", "no parameter differs")
+        return self.act(lambda: self.model.set_parameters(None, **changed))
+
+    @_locked
+    def set_typed_state(self, value=None) -> CommandResult:
+        """Set the selected joint's state to a typed value (the Set state button; degrees for
+        a revolute joint, the design's units for a prismatic one). One undoable command."""
+        refused = self._no_selection("set state")
+        if refused is not None:
+            return refused
+        row = self.model.joint_table()[self.model.selected]
+        if not row.movable:
+            return self.run(CommandResult(False, "set state", f"set state: joint {row.index} "
+                                          f"({row.type}) has no motion"))  # fmt: skip
+        typed = self._typed("state", value)
+        shown, exact = self._shown_fields.get("state", (None, None))
+        state = row.state if typed is exact else state_from_display(row.type, typed)
+        self.stop_animation()
+        return self.run(self.model.set_state(None, state))
+
+    def _update_units(self) -> None:
+        """Labels that name the design's units (the slide step, the grid)."""
+        units = self.model.document.units
+        label = f"Slide by ({units})"
+        if self._step.label != label:
+            self._step.label = label
+        grid = self.grid
+        if grid is not None:
+            text = (f"Lengths in **{units}**, angles in degrees. Grid: "
+                    f"{length_text(grid.cell, units)} cells, {length_text(grid.section, units)} "
+                    f"sections (the world axes are one section long: x red, y green, z "
+                    f"blue).")  # fmt: skip
+            if self._view_text.content != text:
+                self._view_text.content = text
+
+    # --- keys ---------------------------------------------------------------------------------
+    def _build_help_panel(self) -> None:
+        with self.gui.add_folder("Shortcuts", expand_by_default=False):
+            self._shortcuts = self.gui.add_markdown(shortcuts_markdown())
+
+    def send_shortcuts(self) -> bool:
+        """Put the keyboard shortcuts in the tab (docs/editor.md, Keyboard shortcuts): each
+        key clicks the button that does the same. False when the tab cannot run scripts."""
+        from kinegami.editor.page_script import run_javascript
+
+        targets = {
+            "undo": [self._undo_button], "redo": [self._redo_button],
+            "delete": [self._delete_button], "frame": [self._frame_button],
+            "save": [self._save_file, self._download_design], "escape": [self._escape_button],
+        }  # fmt: skip
+        return run_javascript(self.target, keys_script(targets))
+
+    @_locked
+    def escape(self) -> str:
+        """What Escape does (and the Deselect button): close the latest dialog (the one
+        asking about unsaved changes answers Cancel; the recovery dialog leaves the autosave
+        to be offered again), else cancel a handle drag in progress (the design stays as it
+        was before it), else deselect. Returns ``"dialog"``, ``"drag"``, ``"deselect"`` or
+        ``"nothing"``."""
+        if self.dialog_cancels:
+            self.dialog_cancels.pop()()
+            return "dialog"
+        if getattr(self, "_unsaved_modal", None) is not None and hasattr(self, "answer_unsaved"):
+            self.answer_unsaved("cancel")
+            return "dialog"
+        if getattr(self, "_recovery_modal", None) is not None:
+            self._recovery_modal.close()
+            self._recovery_modal = None
+            self._say("the autosave is kept: it is offered again when the editor starts")
+            return "dialog"
+        if self._dragging:
+            self._dragging = False
+            self._drag_cancelled = True
+            self.model.end_preview()
+            self._update_gizmo()
+            self._say("drag cancelled: nothing changed")
+            return "drag"
+        if self.model.selected is not None:
+            self.model.select(None)
+            return "deselect"
+        return "nothing"
 
     # --- background jobs ----------------------------------------------------------------------
     @property

@@ -225,7 +225,8 @@ def test_a_refused_typed_state_names_both_units_and_keeps_the_document():
     assert model.document is document and snapshot(model.document) == before
     lo, hi = model.chain.Joints[2].stateRange()
     result = model.set_state(2, hi + 1.0)
-    assert not result.ok and f"(a length, {model.document.units}), got" in result.reason, result.reason
+    assert not result.ok
+    assert f"(a length, {model.document.units}), got" in result.reason, result.reason
 
 
 def test_the_puma_is_in_mm_and_its_states_read_in_degrees():
@@ -234,3 +235,11 @@ def test_the_puma_is_in_mm_and_its_states_read_in_degrees():
     row = next(row for row in model.joint_table() if row.movable)
     lo, hi = (u.state_to_display(row.type, v) for v in row.state_range)
     assert (lo, hi) == (pytest.approx(-90.0), pytest.approx(90.0))
+
+
+def test_a_typed_move_keeps_the_joints_rotation_bit_for_bit():
+    model = example_model()
+    target = model.chain.Joints[4].pose_matrix.copy()
+    target[:3, 3] += (0.125, 0.0, -0.25)
+    assert model.set_pose(4, target).ok
+    assert np.array_equal(model.chain.Joints[4].pose_matrix[:3, :3], target[:3, :3])

@@ -103,9 +103,12 @@ def test_selection_highlights_and_fills_the_panel(view):
 def test_configuration_sliders_span_the_state_ranges(view):
     rows = [row for row in view.model.joint_table() if row.movable]
     assert len(view._sliders) == len(rows)
-    for ((index, _), handle), row in zip(view._sliders, rows, strict=True):
+    for ((index, kind, _, _), handle), row in zip(view._sliders, rows, strict=True):
         assert index == row.index
-        assert (handle.min, handle.max) == pytest.approx(row.state_range)
+        if kind == "PrismaticJoint":  # in the design's units (cm)
+            assert (handle.min, handle.max) == pytest.approx(row.state_range)
+        else:  # in degrees
+            assert (handle.min, handle.max) == pytest.approx(np.degrees(row.state_range))
 
 
 def test_colliding_parts_are_red():
