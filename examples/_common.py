@@ -95,26 +95,28 @@ def save_figure(fig, path: Path, dpi: int, tight: bool = False) -> Path:
     return write_bytes_atomic(path, buffer.getvalue())
 
 
-def draw_chain(chain, zoom: float = ZOOM):
-    """The gallery's 3D view of a chain: fixed figure size and camera; returns the figure."""
+def draw_chain(chain, zoom: float = ZOOM, units: str | None = None):
+    """The gallery's 3D view of a chain: fixed figure size and camera, a scale bar in ``units``
+    (the design's; None: units of r); returns the figure."""
     import matplotlib.pyplot as plt
 
     fig = plt.figure(figsize=CHAIN_FIGSIZE)
     ax = fig.add_axes((0.0, 0.0, 1.0, 1.0), projection="3d")
-    chain.show(ax=ax, showJointPoses=False)
+    chain.show(ax=ax, showJointPoses=False, units=units)
     ax.view_init(**VIEW)
     box = [np.ptp(limits) for limits in (ax.get_xlim3d(), ax.get_ylim3d(), ax.get_zlim3d())]
     ax.set_box_aspect(box, zoom=zoom)
     return fig
 
 
-def draw_tree(tree):
+def draw_tree(tree, units: str | None = None):
     """The gallery's 3D view of a tree: the chains' view, magnified by TREE_ZOOM."""
-    return draw_chain(tree, zoom=TREE_ZOOM)
+    return draw_chain(tree, zoom=TREE_ZOOM, units=units)
 
 
-def draw_pattern(pattern):
-    """The crease pattern drawing (valley folds red, mountain folds blue); returns the figure.
+def draw_pattern(pattern, units: str | None = None):
+    """The crease pattern drawing (valley folds red, mountain folds blue, a scale bar in
+    ``units``); returns the figure.
 
     Sized like ``pattern.show()`` (6 inches wide, taller for longer sheets, at most 12 inches)
     but drawn into a figure made here, so that no window opens even on a screen.
@@ -124,18 +126,21 @@ def draw_pattern(pattern):
     side = pattern.width / pattern.numSides
     aspect = pattern.height / (pattern.width + side)  # the sheet includes half a glue tab each side
     fig, ax = plt.subplots(figsize=(6.0, min(max(2.5, 6.0 * aspect + 1.0), 12.0)))
-    pattern.show(ax=ax)
+    pattern.show(ax=ax, units=units)
     return fig
 
 
-def save_outputs(chain, name: str, folder: Path) -> list[Path]:
-    """Write ``<name>.png`` (3D), ``<name>_pattern.png`` and ``<name>.dxf`` into ``folder``."""
+def save_outputs(chain, name: str, folder: Path, units: str = "mm") -> list[Path]:
+    """Write ``<name>.png`` (3D), ``<name>_pattern.png`` and ``<name>.dxf`` into ``folder``;
+    ``units``: the chain's length unit (the pictures' scale bars; the DXF at true size)."""
     folder = Path(folder)
     pattern = chain.creasePattern()
     return [
-        save_figure(draw_chain(chain), folder / f"{name}.png", CHAIN_DPI),
-        save_figure(draw_pattern(pattern), folder / f"{name}_pattern.png", PATTERN_DPI, tight=True),
-        Path(pattern.save(dxfName=folder / f"{name}.dxf")),
+        save_figure(draw_chain(chain, units=units), folder / f"{name}.png", CHAIN_DPI),
+        save_figure(
+            draw_pattern(pattern, units), folder / f"{name}_pattern.png", PATTERN_DPI, tight=True
+        ),
+        Path(pattern.save(dxfName=folder / f"{name}.dxf", units=units)),
     ]
 
 
@@ -180,7 +185,8 @@ def save_tree_outputs(tree, name: str, folder: Path, poses=None, fabrication=Non
     for every sheet k of ``tree`` into ``folder``, and ``<name>_<pose>.png`` for every entry of
     ``poses`` (pose name -> one state per joint; the tree is not changed).
     ``fabrication``: the tree's sheets if already made (default: :func:`tree_sheets`);
-    ``units``: the tree's length unit, so that the DXF sheets are true size."""
+    ``units``: the tree's length unit, so that the DXF sheets are true size (and the pictures'
+    scale bars name it)."""
     import copy
     import warnings
 
@@ -189,11 +195,11 @@ def save_tree_outputs(tree, name: str, folder: Path, poses=None, fabrication=Non
     folder = Path(folder)
     if fabrication is None:
         fabrication, _ = tree_sheets(tree)
-    written = [save_figure(draw_tree(tree), folder / f"{name}.png", CHAIN_DPI)]
+    written = [save_figure(draw_tree(tree, units), folder / f"{name}.png", CHAIN_DPI)]
     for sheet in fabrication.sheets:
         stem = folder / f"{name}_sheet_{sheet.index}"
-        written.append(save_figure(draw_pattern(sheet.pattern), Path(f"{stem}_pattern.png"),
-                                   PATTERN_DPI, tight=True))  # fmt: skip
+        written.append(save_figure(draw_pattern(sheet.pattern, units),
+                                   Path(f"{stem}_pattern.png"), PATTERN_DPI, tight=True))  # fmt: skip
         written.append(Path(sheet.pattern.save(dxfName=Path(f"{stem}.dxf"), units=units)))
     for pose, states in (poses or {}).items():
         posed = copy.copy(tree)
@@ -201,7 +207,8 @@ def save_tree_outputs(tree, name: str, folder: Path, poses=None, fabrication=Non
             warnings.simplefilter("ignore", ClearanceWarning)  # drawn as it is; checked apart
             if not posed.setJointStates(states):
                 raise ValueError(f"pose {pose!r}: a state is outside its joint's range")
-        written.append(save_figure(draw_tree(posed), folder / f"{name}_{pose}.png", CHAIN_DPI))
+        written.append(save_figure(draw_tree(posed, units), folder / f"{name}_{pose}.png",
+                                   CHAIN_DPI))  # fmt: skip
     return written
 
 

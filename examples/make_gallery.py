@@ -5,9 +5,10 @@
 For every design file ``examples/designs/<name>.json`` (or only the names given), this loads the
 chain or tree with the design loader and writes, into ``docs/images/gallery/`` (or FOLDER):
 
-* ``<name>.png``: the 3D view, 640 x 560 pixels, the same camera for every entry;
+* ``<name>.png``: the 3D view, 640 x 560 pixels, the same camera for every entry, with a scale
+  bar in the design's ``units``;
 * for a chain, ``<name>_pattern.png``: its crease pattern (valley folds red, mountain folds
-  blue);
+  blue), axes and scale bar in the design's ``units``;
 * for a tree, ``<name>_sheet_<k>_pattern.png``: the crease pattern of every sheet k, as
   ``kinegami build`` cuts the tree (one sheet per leaf, branch joints slid where their junction
   sockets need room), and ``<name>_<pose>.png``: the 3D view in every named configuration of
@@ -49,7 +50,7 @@ from _common import (  # noqa: E402
 )
 
 from kinegami import ClearanceWarning, KinematicTree, PlacementWarning  # noqa: E402
-from kinegami.design import DesignError, load_design  # noqa: E402
+from kinegami.design import DesignError, load_design_with_info  # noqa: E402
 
 DESIGNS = EXAMPLES / "designs"
 GALLERY = EXAMPLES.parent / "docs" / "images" / "gallery"
@@ -72,13 +73,15 @@ def poses_of(name: str) -> dict:
     return dict(getattr(module, "POSES", {}))
 
 
-def draw_tree_entry(tree: KinematicTree, name: str, folder: Path) -> list[Path]:
-    """The 3D view of a tree, every sheet's crease pattern and the script's poses."""
+def draw_tree_entry(tree: KinematicTree, name: str, folder: Path, units: str) -> list[Path]:
+    """The 3D view of a tree, every sheet's crease pattern and the script's poses (scale bars
+    in the design's ``units``)."""
     fabrication, _ = tree_sheets(tree)
-    written = [save_figure(draw_tree(tree), folder / f"{name}.png", CHAIN_DPI)]
+    written = [save_figure(draw_tree(tree, units), folder / f"{name}.png", CHAIN_DPI)]
     for sheet in fabrication.sheets:
         path = folder / f"{name}_sheet_{sheet.index}_pattern.png"
-        written.append(save_figure(draw_pattern(sheet.pattern), path, PATTERN_DPI, tight=True))
+        picture = draw_pattern(sheet.pattern, units)
+        written.append(save_figure(picture, path, PATTERN_DPI, tight=True))
     for pose, states in poses_of(name).items():
         posed = copy.copy(tree)
         with warnings.catch_warnings():
@@ -87,7 +90,8 @@ def draw_tree_entry(tree: KinematicTree, name: str, folder: Path) -> list[Path]:
         if not moved:
             raise DesignError(f"pose {pose!r}: a state is outside its joint's range",
                               field="POSES", file=EXAMPLES / f"{name}.py")  # fmt: skip
-        written.append(save_figure(draw_tree(posed), folder / f"{name}_{pose}.png", CHAIN_DPI))
+        written.append(save_figure(draw_tree(posed, units), folder / f"{name}_{pose}.png",
+                                   CHAIN_DPI))  # fmt: skip
     return written
 
 
@@ -96,13 +100,13 @@ def draw_entry(name: str, folder: Path) -> list[Path]:
     with warnings.catch_warnings():
         warnings.simplefilter("error", PlacementWarning)
         warnings.simplefilter("ignore", ClearanceWarning)  # the gallery states the clearance
-        chain = load_design(DESIGNS / f"{name}.json")
+        chain, info = load_design_with_info(DESIGNS / f"{name}.json")
         if isinstance(chain, KinematicTree):
-            return draw_tree_entry(chain, name, folder)
+            return draw_tree_entry(chain, name, folder, info.units)
     return [
-        save_figure(draw_chain(chain), folder / f"{name}.png", CHAIN_DPI),
+        save_figure(draw_chain(chain, units=info.units), folder / f"{name}.png", CHAIN_DPI),
         save_figure(
-            draw_pattern(chain.creasePattern()),
+            draw_pattern(chain.creasePattern(), info.units),
             folder / f"{name}_pattern.png",
             PATTERN_DPI,
             tight=True,

@@ -128,6 +128,8 @@ CHAIN_PLOT_DEFAULTS = MappingProxyType(
         "showCollisions": False,
         "showJunctions": False,
         "junctionColor": junctionColor,
+        "units": None,
+        "showScaleBar": True,
         "block": None,
         "ax": None,
     }

@@ -30,6 +30,7 @@ from kinegami.validation import (
 )
 from kinegami.viz import chain_geometry as geo
 from kinegami.viz._backend import show_if_interactive
+from kinegami.viz.scale import check_units, length_text, nice_length, unit_text
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -80,6 +81,8 @@ ARTIST_GIDS = {
     "collision-parts": "the colliding parts (showCollisions): their mesh parts, in red",
     "collision-lines": "closest points of every colliding pair, joined (NaN between pairs)",
     "collision-points": "the closest points themselves (showCollisions)",
+    "scale-bar": "a bar of a round length with end ticks, on the floor of the drawing's box "
+    "(showScaleBar, without showAxisGrids)",
 }
 
 _BOOL_OPTIONS = (
@@ -95,6 +98,7 @@ _BOOL_OPTIONS = (
     "showAxisGrids",
     "showCollisions",
     "showJunctions",
+    "showScaleBar",
 )
 _COLOR_OPTIONS = (
     "xColor",
@@ -132,6 +136,7 @@ def resolve_chain_options(options: dict[str, Any]) -> dict[str, Any]:
     for name in _SCALE_OPTIONS:
         check_positive(name, opts[name])
     check_in_range("surfaceOpacity", opts["surfaceOpacity"], 0.0, 1.0, True, True)
+    opts["units"] = check_units(opts["units"])
     ax = opts["ax"]
     if ax is not None and getattr(ax, "name", None) != "3d":
         raise InvalidTypeError(
@@ -174,12 +179,14 @@ class _Scene:
         self.ax = ax
         self.art3d = art3d
         self.points: list[np.ndarray] = []
+        self.gids: list[str] = []  # the gid of the artist of each entry of points
 
-    def _extent(self, pts) -> None:
+    def _extent(self, pts, gid: str) -> None:
         pts = np.asarray(pts, dtype=float).reshape(-1, 3)
         pts = pts[np.all(np.isfinite(pts), axis=1)]
         if len(pts):
             self.points.append(np.stack([pts.min(axis=0), pts.max(axis=0)]))
+            self.gids.append(gid)
 
     def polygons(self, polys, gid, facecolor, alpha, edgecolor="none", linewidth=0.0, shade=False):
         """One Poly3DCollection of a list of (k, 3) polygons (or a (q, k, 3) array)."""
@@ -188,7 +195,7 @@ class _Scene:
         if len(polys) == 0:
             return None
         for poly in polys if isinstance(polys, list) else [polys]:
-            self._extent(poly)
+            self._extent(poly, gid)
         shading = _shading(geo.face_normals(polys)) if shade else 1.0
         kwargs = {
             "facecolors": _shaded(to_rgba(facecolor, alpha), shading),
@@ -210,7 +217,7 @@ class _Scene:
         if len(segs) == 0:
             return None
         for seg in segs:
-            self._extent(seg)
+            self._extent(seg, gid)
         collection = self.art3d.Line3DCollection(
             list(segs), colors=color, linewidths=linewidth, linestyles=linestyle
         )
@@ -225,7 +232,7 @@ class _Scene:
             return None
         gap = np.full((1, 3), np.nan)
         pts = np.vstack([row for p in pieces for row in (p, gap)][:-1])
-        self._extent(pts)
+        self._extent(pts, gid)
         (line,) = self.ax.plot(pts[:, 0], pts[:, 1], pts[:, 2], color=color, **kwargs)
         line.set_gid(gid)
         return line
@@ -234,8 +241,8 @@ class _Scene:
         """One quiver of arrows from ``origins`` (k, 3) along ``vectors`` (k, 3)."""
         if len(origins) == 0:
             return None
-        self._extent(origins)
-        self._extent(origins + vectors)
+        self._extent(origins, gid)
+        self._extent(origins + vectors, gid)
         o, v = origins, vectors
         quiver = self.ax.quiver(
             o[:, 0],
@@ -256,7 +263,7 @@ class _Scene:
         pts = np.asarray(pts, dtype=float).reshape(-1, 3)
         if len(pts) == 0:
             return None
-        self._extent(pts)
+        self._extent(pts, gid)
         (line,) = self.ax.plot(
             pts[:, 0],
             pts[:, 1],
@@ -527,6 +534,43 @@ def _legend(ax, opts, frame_axes: bool, link_axes: bool):
         ax.legend(handles=handles, loc="upper right")
 
 
+#: Artists that reach past the robot (lines of reference, balls, the plane): the scale bar is
+#: placed under the rest.
+_NOT_THE_ROBOT = ("joint-axes", "link-rotation-axes", "joint-spheres", "chain-sphere",
+                  "global-frame-x", "global-frame-y", "global-frame-z", "ground-plane")  # fmt: skip
+
+
+def _draw_scale_bar(scene, units: str | None) -> None:
+    """A bar of a round length (1, 2 or 5 times a power of ten, at most 0.3 of the robot's
+    largest extent) under the robot, centred below the box around its drawn parts, along that
+    box's longer horizontal side, with end ticks and its length written past its end."""
+    boxes = [b for b, gid in zip(scene.points, scene.gids, strict=True)
+             if gid not in _NOT_THE_ROBOT] or scene.points  # fmt: skip
+    if not boxes:
+        return
+    stacked = np.vstack(boxes)
+    low, high = stacked.min(axis=0), stacked.max(axis=0)
+    span = float((high - low).max())
+    if span <= 0.0:
+        return
+    length = nice_length(0.3 * span)
+    axis = 0 if high[0] - low[0] >= high[1] - low[1] else 1
+    start = 0.5 * (low + high)
+    start[2] = low[2]
+    start[axis] -= 0.5 * length
+    start[1 - axis] = low[1] if axis == 0 else high[0]  # the front edge in the default view
+    end = start.copy()
+    end[axis] += length
+    tick = np.array([0.0, 0.0, 0.08 * length])
+    pieces = [np.array([start, end]), np.array([start, start + tick]), np.array([end, end + tick])]
+    scene.polyline(pieces, "scale-bar", "black", linewidth=1.5)
+    beyond = end.copy()
+    beyond[axis] += 0.1 * length
+    label = scene.ax.text(*beyond, length_text(length, units), ha="left", va="center",
+                          fontsize=9)  # fmt: skip
+    label.set_gid("scale-bar-label")
+
+
 def _set_equal_limits(ax, scene, had_data: bool, r: float):
     """Limits around everything drawn and a box aspect equal to the data ranges."""
     boxes = list(scene.points)
@@ -556,7 +600,12 @@ def show_chain(chain: KinematicChain | KinematicTree, **options) -> tuple[Figure
         Lengths scale with the tube radius r: frames are r long, axes of motion
         p -+ jointAxisScale r z, the world frame globalAxisScale r, the ground plane
         [-groundPlaneScale r, groundPlaneScale r]^2 in cells of r. ``ax`` draws into an existing
-        3D axes; ``block`` is passed to ``plt.show``.
+        3D axes; ``block`` is passed to ``plt.show``. ``units`` (``'mm'``, ``'cm'``, ``'m'``,
+        ``'in'``; a design file's ``units``) names the unit of the lengths in the axis labels
+        (``"x (mm)"``) and on the scale bar; None (default) says ``units of r``. The scale bar
+        (``showScaleBar``, default True) is drawn when the axes are not (``showAxisGrids``
+        False): a bar of a round length on the floor of the drawing's box, labelled
+        ``"20 mm"``.
 
     Returns
     -------
@@ -638,12 +687,15 @@ def _show(chain, opts, junction_meshes=()) -> tuple[Figure, Axes3D]:
         ax.set_title(title, y=1.0 if opts["showAxisGrids"] else 0.95)
 
     _legend(ax, opts, opts["showJointPoses"] or opts["showGlobalFrame"], link_axes)
+    if opts["showScaleBar"] and not opts["showAxisGrids"]:
+        _draw_scale_bar(scene, opts["units"])
     _set_equal_limits(ax, scene, had_data, chain.r)
     if opts["showAxisGrids"]:
         ax.set_axis_on()
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-        ax.set_zlabel("z")
+        unit = unit_text(opts["units"])
+        ax.set_xlabel(f"x ({unit})")
+        ax.set_ylabel(f"y ({unit})")
+        ax.set_zlabel(f"z ({unit})")
     else:
         ax.set_axis_off()
     show_if_interactive(created, opts["block"])

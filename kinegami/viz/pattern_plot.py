@@ -20,6 +20,7 @@ from kinegami.validation import (
     resolve_options,
 )
 from kinegami.viz._backend import show_if_interactive
+from kinegami.viz.scale import check_units, length_text, nice_length, unit_text
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -44,6 +45,8 @@ PATTERN_PLOT_DEFAULTS = MappingProxyType(
         "showCreasesOnCut": True,
         "linewidth": 1.0,
         "title": None,
+        "units": None,
+        "showScaleBar": True,
         "ax": None,
         "block": None,
     }
@@ -56,10 +59,12 @@ PATTERN_ARTIST_GIDS = {
     "boundary": "the nominal tube x in [0, W] (LineCollection)",
     "cut": "the sheet outline x in [-b/2, W + b/2] (LineCollection)",
     "glue-tab": "the two copies of the starting panel (Rectangle patches)",
+    "scale-bar": "a bar of a round length under the sheet's right end (Line2D, showScaleBar)",
+    "scale-bar-label": "its length and unit, under it (Annotation)",
 }
 
 _COLOR_OPTIONS = ("valleyColor", "mountainColor", "boundaryColor", "cutColor", "glueTabColor")
-_BOOL_OPTIONS = ("showGlueTab", "showBoundary", "showCut", "showCreasesOnCut")
+_BOOL_OPTIONS = ("showGlueTab", "showBoundary", "showCut", "showCreasesOnCut", "showScaleBar")
 
 
 def _resolve_options(options: dict[str, Any]) -> dict[str, Any]:
@@ -74,6 +79,7 @@ def _resolve_options(options: dict[str, Any]) -> dict[str, Any]:
     check_positive("linewidth", opts["linewidth"])
     check_in_range("glueTabOpacity", opts["glueTabOpacity"], 0.0, 1.0, True, True)
     opts["block"] = check_bool("block", opts["block"], none=True)
+    opts["units"] = check_units(opts["units"])
     if opts["title"] is not None and not isinstance(opts["title"], str):
         raise InvalidTypeError(f"title must be None or a string, got {opts['title']!r}")
     ax = opts["ax"]
@@ -110,6 +116,13 @@ def show_pattern(pattern: TubularPattern, **options: Any) -> tuple[Figure, Axes]
         Line width in points (default 1).
     title : str, optional
         Axes title.
+    units : {'mm', 'cm', 'm', 'in'}, optional
+        The unit of the pattern's lengths (a design file's ``units``), named in the axis labels
+        and on the scale bar; None (default) says ``units of r``.
+    showScaleBar : bool, optional
+        Draw a bar of a round length (1, 2 or 5 times a power of ten, at most 0.4 of the
+        sheet's width) under the sheet's right end, its length written under it (default
+        True).
     ax : matplotlib.axes.Axes, optional
         Draw into this 2D axes instead of a new figure.
     block : bool, optional
@@ -192,12 +205,32 @@ def show_pattern(pattern: TubularPattern, **options: Any) -> tuple[Figure, Axes]
         ax.add_collection(lines)
     xmin, ymin, xmax, ymax = sheet.bounds
     pad = 0.05 * (xmax - xmin)  # a margin of a few percent of the sheet's width
+    bottom = ymin - pad
+    if opts["showScaleBar"]:
+        bottom = _draw_scale_bar(ax, sheet.bounds, pad, opts["units"])
     ax.set_xlim(xmin - pad, xmax + pad)
-    ax.set_ylim(ymin - pad, ymax + pad)
+    ax.set_ylim(bottom, ymax + pad)
     ax.set_aspect("equal")
-    ax.set_xlabel("x (around the tube)")
-    ax.set_ylabel("y (along the tube)")
+    unit = unit_text(opts["units"])
+    ax.set_xlabel(f"x around the tube ({unit})")
+    ax.set_ylabel(f"y along the tube ({unit})")
     if opts["title"] is not None:
         ax.set_title(opts["title"])
     show_if_interactive(created, opts["block"])
     return fig, ax
+
+
+def _draw_scale_bar(ax, bounds, pad: float, units: str | None) -> float:
+    """A bar of a round length, its right end under the sheet's right edge, in a strip added
+    below the sheet, with its length written under it (right-aligned with it: the text may be
+    longer than the bar); returns the new lower y limit."""
+    xmin, ymin, xmax, ymax = bounds
+    length = nice_length(0.4 * (xmax - xmin))
+    strip = 0.06 * max(xmax - xmin, ymax - ymin)  # room for the bar and a line of text
+    y = ymin - pad - 0.2 * strip
+    ax.plot([xmax - length, xmax], [y, y], color="black", linewidth=2.0, solid_capstyle="butt",
+            gid="scale-bar")  # fmt: skip
+    ax.annotate(length_text(length, units), (xmax, y), xytext=(0.0, -3.0),
+                textcoords="offset points", ha="right", va="top", fontsize=9,
+                gid="scale-bar-label")  # fmt: skip
+    return ymin - pad - strip

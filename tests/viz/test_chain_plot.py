@@ -123,7 +123,8 @@ def test_optional_parts_appear_only_when_asked(example_1a, option, gids):
 
 
 def test_hidden_parts_are_not_drawn(example_1a):
-    _, ax = example_1a.show(showJointPoses=False, showJointSurface=False, showLinkSurface=False)
+    _, ax = example_1a.show(showJointPoses=False, showJointSurface=False, showLinkSurface=False,
+                            showScaleBar=False)  # fmt: skip
     assert _gids(ax) == {"link-path", "link-path-markers"}
 
 
@@ -411,8 +412,9 @@ def test_a_connector_that_cannot_be_made_is_left_out_with_a_warning():
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ClearanceWarning)
-        # the paper's hand as designed: the palm's tube has no room for its socket
-        hand = load_design(Path(__file__).resolve().parents[2] / "examples/designs/hand.json")
+        # the paper's hand as published: the palm's tube has no room for its socket
+        root = Path(__file__).resolve().parents[2]
+        hand = load_design(root / "tests" / "design" / "data" / "papers_hand.json")
     with pytest.warns(UserWarning, match="showJunctions: the junctions are not drawn.*joint 1"):
         fig, ax = show_chain(hand, showJunctions=True)
     assert "junctions" not in _collection_gids(ax)
