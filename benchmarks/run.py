@@ -3,6 +3,10 @@
 Prints one table: what was measured, the median time (and the scale numbers for the 48-joint
 safe chains). Goals (from the issues) are printed beside the measurements; they are goals,
 not assertions: tests never time anything.
+
+The whole run takes minutes; a line on stderr names each group of measurements as it starts
+and its seconds when it ends (``[8/10] compact, 16-joint safe chains ... 95.1 s``), so the
+table on stdout stays as it is. ``--only WORD`` runs the groups whose name contains WORD.
 """
 
 from __future__ import annotations
@@ -11,10 +15,13 @@ import argparse
 import contextlib
 import io
 import statistics
+import sys
 import tempfile
 import time
 import warnings
+from collections.abc import Callable
 from pathlib import Path
+from typing import TextIO
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -28,6 +35,8 @@ from kinegami import (
 )
 from kinegami.geometry.csc import solve_csc, solve_csc_all
 from kinegami.joints import _catalog_pattern
+
+DESIGNS = Path(__file__).resolve().parents[1] / "examples" / "designs"
 
 
 def _median_seconds(fn, repeat: int) -> float:
@@ -108,9 +117,9 @@ def same_axes_compact(chain: KinematicChain) -> KinematicChain:
 
 
 def clearance_rows(compact_seeds: int) -> list[tuple[str, str, str]]:
-    """Clearance engine speed; safe placement clear at scale; compaction against its goals."""
+    """Clearance engine speed; safe placement clear at scale; with ``compact_seeds`` > 0 also
+    :func:`compaction_rows`."""
     from kinegami.clearance import engine_for, sweep
-    from kinegami.optimize import compact, tube_length
 
     rows: list[tuple[str, str, str]] = []
     chain = compact_chain(32)
@@ -140,6 +149,15 @@ def clearance_rows(compact_seeds: int) -> list[tuple[str, str, str]]:
 
     if compact_seeds <= 0:
         return rows
+    return rows + compaction_rows(compact_seeds)
+
+
+def compaction_rows(compact_seeds: int) -> list[tuple[str, str, str]]:
+    """Compaction of random 16-joint safe chains against its goals, and of the gallery's
+    designs."""
+    from kinegami.optimize import compact, tube_length
+
+    rows: list[tuple[str, str, str]] = []
     ratios_safe, ratios_tight, ratios_same, times, clear = [], [], [], [], 0
     for seed in range(compact_seeds):
         safe, tight = chain_pair(seed)
@@ -164,10 +182,9 @@ def clearance_rows(compact_seeds: int) -> list[tuple[str, str, str]]:
     rows.append(("  / compact placement, same axes (max, median, min)", spread(ratios_same),
                  "-"))  # fmt: skip
     rows.append(("  clear after compaction", f"{clear}/{compact_seeds}", "all"))
-    designs = Path(__file__).resolve().parents[1] / "examples" / "designs"
     from kinegami.design import load_design
 
-    for path in sorted(designs.glob("*.json")):
+    for path in sorted(DESIGNS.glob("*.json")):
         with warnings.catch_warnings():  # the paper's hand as designed touches itself (docs)
             warnings.simplefilter("ignore")
             design = load_design(path)
@@ -186,7 +203,7 @@ def tree_rows() -> list[tuple[str, str, str]]:
     from kinegami.design import load_design
     from kinegami.optimize import compact
 
-    path = Path(__file__).resolve().parents[1] / "examples" / "designs" / "algorithmic_hand.json"
+    path = DESIGNS / "algorithmic_hand.json"
     t0 = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -216,14 +233,9 @@ def tree_rows() -> list[tuple[str, str, str]]:
     return rows
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--seeds", type=int, default=10, help="random 48-joint safe chains")
-    parser.add_argument("--compact-seeds", type=int, default=20,
-                        help="random 16-joint chains compacted (0 skips compaction)")  # fmt: skip
-    args = parser.parse_args(argv)
+def csc_rows() -> list[tuple[str, str, str]]:
+    """CSC Dubins paths: one solve, every path, the most paths of one frame pair."""
     rows: list[tuple[str, str, str]] = []
-
     rng = np.random.default_rng(1)
     pairs = []
     while len(pairs) < 200:
@@ -241,7 +253,12 @@ def main(argv: list[str] | None = None) -> None:
     rows.append(("CSC solve_csc_all (every path), one link", f"{t * 1e6:.0f} us", "<= 1 ms"))
     most = max(len(solve_csc_all(np.zeros(3), d1, p2, d2, 1.0)) for p2, d1, d2 in pairs)
     rows.append(("  most paths for one of those frame pairs", str(most), "-"))
+    return rows
 
+
+def edit_rows() -> list[tuple[str, str, str]]:
+    """A 32-joint compact chain: its build, propagated edits and state changes."""
+    rows: list[tuple[str, str, str]] = []
     t = _median_seconds(lambda: compact_chain(), 3)
     rows.append(("32-joint compact build", f"{t * 1e3:.1f} ms", "-"))
 
@@ -269,9 +286,13 @@ def main(argv: list[str] | None = None) -> None:
         warnings.simplefilter("ignore")
         t = _median_seconds(states, 5) / 20
     rows.append(("state change, 32 joints (mean of 20)", f"{t * 1e3:.2f} ms", "< 5 ms"))
+    return rows
 
+
+def pattern_rows(fresh: list[KinematicChain]) -> list[tuple[str, str, str]]:
+    """The first creasePattern() of chains never patterned, and DXF, SVG, FOLD saves."""
+    rows: list[tuple[str, str, str]] = []
     # each call on a chain never patterned before, with the joint-pattern cache emptied
-    fresh = [compact_chain(seed=seed) for seed in range(5)]
     first_calls = []
     for built in fresh:
         _catalog_pattern.cache_clear()
@@ -298,18 +319,20 @@ def main(argv: list[str] | None = None) -> None:
         target = Path(folder) / "chain.fold"
         t = _median_seconds(lambda: pattern.save(str(target)), 5)
         rows.append(("FOLD save, same pattern", f"{t * 1e3:.1f} ms", "-"))
+    return rows
 
-    # design files, DH tables, the command line and the exporters of the registry
-    from kinegami import export
+
+def design_rows(chain: KinematicChain) -> list[tuple[str, str, str]]:
+    """Design files (``chain``: a 32-joint chain), the PUMA's DH table and its shortening."""
     from kinegami.design import load_design, save_design
     from kinegami.optimize import shorten_by_axis_translations
 
-    designs = Path(__file__).resolve().parents[1] / "examples" / "designs"
-    t = _median_seconds(lambda: load_design(designs / "example1.json"), 5)
+    rows: list[tuple[str, str, str]] = []
+    t = _median_seconds(lambda: load_design(DESIGNS / "example1.json"), 5)
     rows.append(("load examples/designs/example1.json", f"{t * 1e3:.1f} ms", "-"))
     with tempfile.TemporaryDirectory() as folder:
         target = Path(folder) / "chain.json"
-        t = _median_seconds(lambda: save_design(fresh[0], target), 5)
+        t = _median_seconds(lambda: save_design(chain, target), 5)
         rows.append(("save_design, 32-joint chain", f"{t * 1e3:.1f} ms", "-"))
         t = _median_seconds(lambda: load_design(target), 5)
         rows.append(("load_design, 32-joint chain (fixed poses)", f"{t * 1e3:.1f} ms", "-"))
@@ -324,43 +347,113 @@ def main(argv: list[str] | None = None) -> None:
     shorten_by_axis_translations(puma)
     rows.append((f"  shortened {before:.0f} -> {puma.totalPathLength():.0f} mm",
                  f"{(time.perf_counter() - t0) * 1e3:.0f} ms", "-"))  # fmt: skip
+    return rows
+
+
+def export_rows(chain: KinematicChain) -> list[tuple[str, str, str]]:
+    """The registry's exporters on ``chain`` (a 32-joint chain) and ``kinegami build``."""
+    from kinegami import export
+
+    rows: list[tuple[str, str, str]] = []
     with tempfile.TemporaryDirectory() as folder:
         for suffix in (".fold", ".pdf", ".stl", ".obj", ".urdf"):
             target = Path(folder) / f"chain{suffix}"
-            export(fresh[0], target)  # first call imports the exporter
-            t = _median_seconds(lambda target=target: export(fresh[0], target), 3)
+            export(chain, target)  # first call imports the exporter
+            t = _median_seconds(lambda target=target: export(chain, target), 3)
             rows.append((f"export {suffix}, 32-joint chain", f"{t * 1e3:.1f} ms", "-"))
         from kinegami.cli import main as cli_main
 
         with contextlib.redirect_stdout(io.StringIO()):
             t0 = time.perf_counter()
-            cli_main(["build", str(designs / "example1.json"), "-o", folder])
+            cli_main(["build", str(DESIGNS / "example1.json"), "-o", folder])
         rows.append(("kinegami build example1.json (DXF, SVG, 2 PNGs)",
                      f"{(time.perf_counter() - t0) * 1e3:.0f} ms", "-"))  # fmt: skip
+    return rows
 
+
+def safe_chain_rows(seeds: int) -> list[tuple[str, str, str]]:
+    """48-joint safe chains: their build time, failed appends, size per joint."""
     balls, paths, fails, times = [], [], 0, []
-    for seed in range(args.seeds):
+    for seed in range(seeds):
         t0 = time.perf_counter()
         built, failures = safe_chain(seed)
         times.append(time.perf_counter() - t0)
         fails += failures
         balls.append(built.boundingBall.r / 48)
         paths.append(built.totalPathLength() / 48)
-    rows.append(
-        (
-            f"48-joint safe chain ({args.seeds} seeds), time",
-            f"{statistics.median(times) * 1e3:.0f} ms",
-            "-",
-        )
-    )
-    rows.append(("  failed appends", str(fails), "0"))
-    rows.append(("  ball radius per joint (max)", f"{max(balls):.2f} r", "<= 10 r"))
-    rows.append(("  path length per joint (max)", f"{max(paths):.2f} r", "<= 60 r"))
+    return [
+        (f"48-joint safe chain ({seeds} seeds), time",
+         f"{statistics.median(times) * 1e3:.0f} ms", "-"),
+        ("  failed appends", str(fails), "0"),
+        ("  ball radius per joint (max)", f"{max(balls):.2f} r", "<= 10 r"),
+        ("  path length per joint (max)", f"{max(paths):.2f} r", "<= 60 r"),
+    ]  # fmt: skip
 
-    rows += clearance_rows(args.compact_seeds)
-    if args.compact_seeds:
-        rows += tree_rows()
-    rows += __import__("startup").rows()  # benchmarks/startup.py: fresh processes
+
+Rows = list[tuple[str, str, str]]
+
+
+def run_steps(steps: list[tuple[str, Callable[[], Rows]]], stream: TextIO | None = None) -> Rows:
+    """Run every ``(name, rows function)`` in order and return all their rows; report on
+    ``stream`` (default stderr) each step as it starts (``[3/12] name ...``) and the seconds it
+    took when it ends, so that a long run is not silent."""
+    stream = sys.stderr if stream is None else stream
+    rows: Rows = []
+    for k, (name, step) in enumerate(steps, start=1):
+        print(f"[{k}/{len(steps)}] {name} ...", end="", file=stream, flush=True)
+        t0 = time.perf_counter()
+        try:
+            rows += step()
+        except BaseException:
+            print(" failed", file=stream, flush=True)
+            raise
+        print(f" {time.perf_counter() - t0:.1f} s", file=stream, flush=True)
+    return rows
+
+
+def steps(seeds: int, compact_seeds: int) -> list[tuple[str, Callable[[], Rows]]]:
+    """The measurements of the table, in its order: (what is measured, its rows function)."""
+    shared: dict[str, list[KinematicChain]] = {}
+
+    def fresh() -> list[KinematicChain]:  # 32-joint compact chains, built once
+        if "fresh" not in shared:
+            shared["fresh"] = [compact_chain(seed=seed) for seed in range(5)]
+        return shared["fresh"]
+
+    out: list[tuple[str, Callable[[], Rows]]] = [
+        ("CSC paths", csc_rows),
+        ("32-joint compact chain: build, edits, states", edit_rows),
+        ("crease patterns and DXF, SVG, FOLD saves", lambda: pattern_rows(fresh())),
+        ("design files, DH table", lambda: design_rows(fresh()[0])),
+        ("exporters and kinegami build", lambda: export_rows(fresh()[0])),
+        (f"48-joint safe chains ({seeds} seeds)", lambda: safe_chain_rows(seeds)),
+        ("clearance engine and safe chains' clearance", lambda: clearance_rows(0)),
+    ]
+    if compact_seeds > 0:
+        out += [
+            (f"compact, 16-joint safe chains ({compact_seeds} seeds) and the gallery",
+             lambda: compaction_rows(compact_seeds)),
+            ("algorithmic hand: construction and compaction", tree_rows),
+        ]  # fmt: skip
+    out.append(("start-up, fresh processes", lambda: __import__("startup").rows()))
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--seeds", type=int, default=10, help="random 48-joint safe chains")
+    parser.add_argument("--compact-seeds", type=int, default=20,
+                        help="random 16-joint chains compacted (0 skips compaction)")  # fmt: skip
+    parser.add_argument("--only", action="append", default=[], metavar="WORD",
+                        help="run only the measurements whose name (as the progress lines "
+                             "show it) contains WORD (repeatable)")  # fmt: skip
+    args = parser.parse_args(argv)
+    chosen = steps(args.seeds, args.compact_seeds)
+    if args.only:
+        chosen = [s for s in chosen if any(w.lower() in s[0].lower() for w in args.only)]
+        if not chosen:
+            parser.error(f"--only {' '.join(args.only)}: no measurement has that in its name")
+    rows = run_steps(chosen)
 
     width = max(len(r[0]) for r in rows)
     print(f"{'measurement':<{width}}  {'result':>12}  goal")
