@@ -8,7 +8,9 @@ Run: ``python examples/example1.py [folder]``.
 
 Lengths are in units of r, and the paper's r = 1 is 1 cm (as in examples/designs/example1.json,
 whose sheet ``kinegami build`` prints in mm). The listing's ``pattern.save`` writes the DXF with
-save()'s default of 1 unit = 1 mm; ``pattern.save(dxfName=..., units="cm")`` would give true size.
+save()'s default of 1 unit = 1 mm, a tenth of the size; the line after it, which is not the
+paper's, writes the same file again with ``units="cm"``, so the DXF you get is true size (in mm,
+``$INSUNITS`` = mm: the sheet is 70.7 mm wide, five sides of 14.1 mm).
 """
 
 import os
@@ -71,6 +73,7 @@ chain.show(showGlobalFrame=True) #Figure 5(d)
 save_figure("figure5d_example1B.png")
 pattern = chain.creasePattern()
 pattern.save(dxfName="examplePatterns/example1.dxf")
+pattern.save(dxfName="examplePatterns/example1.dxf", units="cm")  # not the paper's: true size
 written.append(OUTPUT / "examplePatterns" / "example1.dxf")
 
 # ---- Example 1C ------------------------------------------------------------------------
@@ -91,7 +94,8 @@ print(f"Example 1: {len(chain.Joints)} joints, total path length "
 print(f"  crease pattern: {pattern.width:.3f} cm x {pattern.height:.3f} cm, without the glue tab")
 print(f"  sheet: {xmax - xmin:.3f} cm x {ymax - ymin:.3f} cm with the glue tab "
       f"(kinegami build prints it as {10 * (xmax - xmin):.1f} mm x {10 * (ymax - ymin):.1f} mm)")
-print("  (the listing's DXF counts 1 unit as 1 mm, save()'s default; units='cm' gives true size)")
+print("  examplePatterns/example1.dxf is true size (1 unit = 1 cm, written in mm); the listing's "
+      "own save counts 1 unit as 1 mm, save()'s default, and is written over")
 print("wrote:")
 for path in written:
     print(f"  {path}")
