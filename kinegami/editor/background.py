@@ -29,6 +29,9 @@ __all__ = ["Debounced", "JobProcess", "ProcessWorker"]
 PROGRESS_INTERVAL = 0.1
 #: Seconds a cancelled job may take to stop by itself before its process is stopped.
 CANCEL_GRACE = 1.0
+#: How much lower the job process's CPU priority is (Unix ``nice``; the processes it starts,
+#: e.g. compaction's, inherit it).
+JOB_NICENESS = 10
 
 
 class Debounced:
@@ -179,6 +182,8 @@ def _job_main(conn, cancel) -> None:
     ``("done" | "cancelled" | "error", job, value)``; return when the server end closes."""
     if hasattr(os, "setsid"):
         os.setsid()  # its own process group: stopping it stops the processes it started too
+    if hasattr(os, "nice"):
+        os.nice(JOB_NICENESS)  # the server and the browser come first when cores are busy
     while True:
         try:
             job, func, args = conn.recv()

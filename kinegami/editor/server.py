@@ -9,7 +9,8 @@ Every tab (viser client) gets an :class:`~kinegami.editor.view.EditorView` over 
 :class:`~kinegami.editor.model.EditorModel` of the starting design; the design is read once,
 on the server, from the path given on the command line. Browsers can only upload design
 files' contents, never name server paths: the only files the server writes are that design
-(the Save button) and its autosave (:mod:`kinegami.editor.autosave`). See docs/editor.md.
+(the Save button) and its autosave in the user's data folder
+(:mod:`kinegami.editor.autosave`). See docs/editor.md.
 """
 
 from __future__ import annotations
