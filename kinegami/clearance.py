@@ -43,7 +43,7 @@ from kinegami.bodies import (
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.segments import segment_distances
-from kinegami.validation import check_int, check_real, shown
+from kinegami.validation import check_int, check_real, shorten, shown
 
 __all__ = [
     "CONTACT_TOLERANCE",
@@ -55,6 +55,7 @@ __all__ = [
     "SweepReport",
     "chain_clearance",
     "tree_clearance",
+    "clearance_report",
     "sweep",
     "ClearanceEngine",
     "TreeMotion",
@@ -669,6 +670,30 @@ def engine_for(chain, names=None) -> ClearanceEngine:
 
 def _current(chain) -> np.ndarray:
     return np.array([joint.state for joint in chain.Joints], dtype=float)
+
+
+def clearance_report(assembly, names=None, margin=None, states=None) -> ClearanceReport:
+    """The one clearance verdict of a chain or a tree: what ``kinegami build``, ``kinegami
+    check``, ``kinegami compact`` and the editor report (:meth:`ClearanceReport.verdict` words
+    it).
+
+    Parameters
+    ----------
+    assembly : KinematicChain or KinematicTree
+    names : sequence of str or None, optional
+        Joint names for the parts (each shown on one line, at most 80 characters).
+    margin : float, optional
+        The clearance required (chain units, >= 0); default: ``assembly.margin``.
+    states : sequence of float, optional
+        A configuration; default: the current states.
+    """
+    from kinegami.chain import KinematicChain
+
+    if names is not None:
+        names = tuple(None if name is None else shorten(name) for name in names)
+    if isinstance(assembly, KinematicChain):
+        return chain_clearance(assembly, states, names, margin)
+    return tree_clearance(assembly, states, names, margin)
 
 
 def _margin_of(chain, margin) -> float:

@@ -206,8 +206,7 @@ def _summary(job: BuildJob, design: str) -> list[str]:
         f"  sheet: {_sheet_size(job)}",
         f"  total tube length: {tube * factor:.1f} mm "
         f"(links {links_length * factor:.1f} mm, joints {joints_length * factor:.1f} mm)",
-        "  clearance: "
-        + _printable(_clearance_summary(job.clearance, _Lengths(chain.r, info.units))),
+        _verdict_line(job.clearance, info),
     ]
 
 
@@ -232,48 +231,26 @@ def _joint_names(chain) -> tuple | None:
 
 
 def _clearance(chain):
-    from kinegami.clearance import chain_clearance, tree_clearance
+    """The clearance report of a chain or a tree at its states with its own ``margin`` (which
+    ``--margin`` sets), the parts named with the joint names: the one verdict build, check,
+    compact, the editor and the library give (kinegami.clearance.ClearanceReport.verdict)."""
+    from kinegami.clearance import clearance_report
 
-    if _is_tree(chain):
-        return tree_clearance(chain, names=_joint_names(chain))
-    return chain_clearance(chain, names=_joint_names(chain))
+    return clearance_report(chain, names=_joint_names(chain))
 
 
-class _Lengths:
-    """Lengths of a design in words: in millimetres as ``build`` prints every size, with the
-    design's own unit beside them when it is not mm; to about r / 100."""
+def _verdict_line(report, info) -> str:
+    """The summary's clearance line, the same in build, check and compact: "  clearance: " and
+    the report's verdict (lengths in mm and the design's unit)."""
+    return "  clearance: " + _printable(report.verdict(info.units))
 
-    def __init__(self, r: float, units: str):
-        import math
 
-        self.units = units
-        self.factor = UNITS_IN_MM[units]
-        self.mm_digits = max(0, 2 - math.floor(math.log10(r * self.factor)))
-        self.own_digits = max(0, 2 - math.floor(math.log10(r)))
+def _lengths(r: float, units: str):
+    """Lengths of a design in words (kinegami.clearance.Lengths: mm, and the design's unit
+    beside them when it is not mm; to about r / 100)."""
+    from kinegami.clearance import Lengths
 
-    @staticmethod
-    def _fixed(value: float, digits: int) -> str:
-        value = round(value, digits)
-        return f"{value if value else 0.0:.{digits}f}"  # no "-0.00"
-
-    def mm(self, value: float) -> str:
-        """``value`` (design units) in mm only: "9.9 mm"."""
-        return f"{self._fixed(value * self.factor, self.mm_digits)} mm"
-
-    def __call__(self, value: float) -> str:
-        """``value`` (design units) in mm and in the design's unit: "9.9 mm (0.99 cm)"."""
-        if self.units == "mm":
-            return self.mm(value)
-        return f"{self.mm(value)} ({self._fixed(value, self.own_digits)} {self.units})"
-
-    def span(self, low: float, high: float) -> str:
-        """An interval: "-8.8 to 12.4 mm (-0.88 to 1.24 cm)"."""
-        f, d = self.factor, self.mm_digits
-        text = f"{self._fixed(low * f, d)} to {self._fixed(high * f, d)} mm"
-        if self.units != "mm":
-            d = self.own_digits
-            text += f" ({self._fixed(low, d)} to {self._fixed(high, d)} {self.units})"
-        return text
+    return Lengths(r, units)
 
 
 def _angle_span(low: float, high: float) -> str:
@@ -282,46 +259,26 @@ def _angle_span(low: float, high: float) -> str:
     return f"{math.degrees(low):.1f} to {math.degrees(high):.1f} deg"
 
 
-def _junction_note(tree, report) -> str:
-    """For a clear tree whose closest parts are two tubes leaving the same branching joint:
-    "; closest where the tubes leaving joint J come out of its junction" (they touch there by
-    construction: the junction covers them up to where they are 2r apart), else ""."""
-    from kinegami.joints import Waypoint
+def _margin(args: argparse.Namespace, chain) -> None:
+    """Apply ``--margin`` (the design's units; default: the design's own "margin") to the
+    chain or tree, before anything is judged."""
+    text = getattr(args, "margin", None)
+    if text is None:
+        return
+    import math
 
-    pair = report.closest
-    if not report.ok or pair is None or any(e < 1 or e % 2 == 0 for e in pair.elements):
-        return ""
+    from kinegami.validation import shorten
 
-    def top(k: int) -> int | None:  # the child of a branching joint whose tube k continues
-        while k > 0:
-            parent = tree.Parents[k]
-            if len(tree.Children[parent]) > 1:
-                return k
-            if not isinstance(tree.Joints[parent], Waypoint):
-                return None
-            k = parent
-        return None
-
-    a, b = (top((e + 1) // 2) for e in pair.elements)
-    if a is None or b is None or a == b or tree.Parents[a] != tree.Parents[b]:
-        return ""
-    return f"; closest where the tubes leaving joint {tree.Parents[a]} come out of its junction"
-
-
-def _clearance_summary(report, lengths: _Lengths, own_units: bool = False) -> str:
-    """The build summary's clearance: "9.9 mm (clear)" or "-0.35 mm: self-intersects (A and
-    B)", in mm like the other sizes of the summary (``own_units``: and in the design's unit,
-    as ``check`` prints lengths)."""
-    length = lengths if own_units else lengths.mm
-    if report.closest is None:
-        return "clear (no two parts are far enough apart along the tube to collide)"
-    if report.ok:
-        return f"{length(report.min_clearance)}{': clear' if own_units else ' (clear)'}"
-    first = report.pairs[0]
-    more = f"; {len(report.pairs)} pairs overlap" if len(report.pairs) > 1 else ""
-    return (
-        f"{length(report.min_clearance)}: self-intersects ({first.first} and {first.second}{more})"
-    )
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0.0):
+        raise CommandError(
+            f"--margin: must be a number >= 0 (the clearance required between parts, in the "
+            f"design's units), got {shorten(text)!r}"
+        )
+    chain.margin = value
 
 
 # --- commands ----------------------------------------------------------------------------------
@@ -428,7 +385,9 @@ def _write_tree_pictures(fabrication, folder: Path, stem: str) -> list[Path]:
     return written
 
 
-def _tree_summary(tree, info, design: str, fabrication, moves) -> list[str]:
+def _tree_summary(tree, info, design: str, fabrication, moves, written=None) -> list[str]:
+    """The summary of a tree's build; ``written``: the clearance report of the design file as
+    written, when the build slid joints (then it is not the tree built)."""
     from collections import Counter
 
     from kinegami.export.tree_build import sheet_labels
@@ -448,8 +407,7 @@ def _tree_summary(tree, info, design: str, fabrication, moves) -> list[str]:
         f"  tube: {tree.numSides} sides, r = {tree.r * factor:g} mm",
         f"  total tube length: {(links_length + joints_length) * factor:.1f} mm "
         f"(links {links_length * factor:.1f} mm, joints {joints_length * factor:.1f} mm)",
-        "  clearance: " + _printable(_clearance_summary(report, _Lengths(tree.r, info.units))
-                                     + _junction_note(tree, report)),
+        _verdict_line(report, info),
         f"  sheets: {len(fabrication.sheets)} (one per leaf)",
     ]  # fmt: skip
     labels = sheet_labels(fabrication, names, info.units)
@@ -467,6 +425,12 @@ def _tree_summary(tree, info, design: str, fabrication, moves) -> list[str]:
     for joint, slide in moves:
         lines.append(f"  note: joint {joint} slid {slide * factor:.1f} mm along its axis so that "
                      "its socket fits (the kinematics are unchanged)")  # fmt: skip
+    if written is not None:
+        lines.append("  note: the clearance above is that of the tree as built, with the slides; "
+                     "'kinegami check' and the editor judge the design file as written: "
+                     f"{_printable(written.verdict(info.units))} (write the slides into the "
+                     "design, or let 'kinegami compact' write a design whose sockets fit, and "
+                     "they judge the same tree)")  # fmt: skip
     return lines
 
 
@@ -502,7 +466,7 @@ def _takeoff_summary(fabrication, info) -> list[str]:
     """The build summary's lines on folded take-offs (none for printed connectors only)."""
     if not fabrication.takeoffs and not fabrication.notes:
         return []
-    lengths = _Lengths(fabrication.tree.r, info.units)
+    lengths = _lengths(fabrication.tree.r, info.units)
     lines = [f"  take-offs: {len(fabrication.takeoffs)} (folded)"]
     for t in fabrication.takeoffs:
         lines.append(
@@ -560,14 +524,12 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
             fabrication = fabricate(fitted, twistPortion=info.twistPortion, junction=kind)
     except KinegamiError as error:
         raise CommandError(f"{args.design}: {error}") from None
-    lines = _tree_summary(fitted, info, args.design, fabrication, moves)
+    written = _clearance(tree) if moves else None
+    lines = _tree_summary(fitted, info, args.design, fabrication, moves, written)
     lines += _takeoff_summary(fabrication, info)
     report = _clearance(fitted)
     if not report.ok:
-        first = report.pairs[0]
-        _warn(args.command, f"{args.design} self-intersects at its states: {first.first} and "
-                            f"{first.second} overlap (the files are written all the same; "
-                            "'kinegami check' lists every pair)")  # fmt: skip
+        _warn(args.command, _overlap_warning(report, info, args.design))
     staging = _open_staging(args.command, out)
     try:
         try:
@@ -601,6 +563,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     out = Path(args.output)
     _check_output(out)
     chain, info = _load(args.design)
+    _margin(args, chain)
     if _is_tree(chain):
         return _build_tree(args, chain, info, stem, out)
     if args.junctions is not None:
@@ -611,7 +574,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     _check_pattern(job)
     lines = _summary(job, args.design)
     if not job.clearance.ok:
-        _warn(args.command, _overlap_warning(job, args.design))
+        _warn(args.command, _overlap_warning(job.clearance, info, args.design))
     # write everything into a hidden staging folder in the target, then publish it as one
     # transaction (kinegami.export.publish): a failure or an interrupt leaves the folder as
     # it was, and a build killed earlier is recovered first
@@ -753,15 +716,11 @@ def cmd_validate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _overlap_warning(job: BuildJob, design: str) -> str:
-    report = job.clearance
-    first = report.pairs[0]
-    more = f"; {len(report.pairs)} pairs overlap" if len(report.pairs) > 1 else ""
-    depth = _Lengths(job.chain.r, job.info.units).mm(-first.clearance)
+def _overlap_warning(report, info, design: str) -> str:
+    """The warning of a build whose design is not clear at its states: its verdict."""
     return (
-        f"{design} self-intersects at its states: {first.first} and {first.second} overlap "
-        f"by {depth}{more} (the files are written all the same; 'kinegami check' lists every "
-        "pair)"
+        f"{design} at its states: {report.verdict(info.units)} (the files are written all the "
+        "same; 'kinegami check' lists every pair)"
     )
 
 
@@ -807,6 +766,8 @@ def _check_json(chain, info, design, report, motion, seed) -> dict:
         "units": info.units,
         "r": chain.r,
         "ok": report.ok,
+        "margin": report.margin,
+        "verdict": report.verdict(info.units),
         "min_clearance": report.min_clearance if report.closest is not None else None,
         "closest": None if report.closest is None else _pair_json(report.closest),
         "pairs": [_pair_json(pair) for pair in report.pairs],
@@ -842,28 +803,27 @@ def _check_json(chain, info, design, report, motion, seed) -> dict:
 def _check_lines(chain, info, design, report, motion, seed) -> list[str]:
     from kinegami.joints import RevoluteJoint
 
-    lengths = _Lengths(chain.r, info.units)
+    lengths = _lengths(chain.r, info.units)
     title = f"{_printable(info.name)} ({design})" if info.name else design
     lines = []
     if report.ok:
         lines.append(f"{title}: clear at its states")
-        if report.closest is None:
-            lines.append("  minimum clearance: none (no two parts are far enough apart along the "
-                         "tube to collide)")  # fmt: skip
-        else:
-            closest = report.closest
-            lines.append(f"  minimum clearance: {lengths(report.min_clearance)}, between "
-                         f"{closest.first} and {closest.second}"
-                         + (_junction_note(chain, report) if _is_tree(chain) else ""))  # fmt: skip
+        lines.append(_verdict_line(report, info))
     else:
         count = len(report.pairs)
-        lines.append(f"{title}: self-intersects at its states "
-                     f"({count} pair{'s' if count > 1 else ''} of parts overlap)")  # fmt: skip
-        lines.append(f"  minimum clearance: {lengths(report.min_clearance)}")
-        lines.append("  overlapping parts (deepest first):")
+        overlap = sum(1 for pair in report.pairs if pair.clearance < 0.0)
+        plural = "s" if count > 1 else ""
+        what = (f"{count} pair{plural} of parts overlap" if overlap == count
+                else f"{count} pair{plural} of parts closer than the margin "
+                f"{lengths.exact(report.margin)}")  # fmt: skip
+        lines.append(f"{title}: {'self-intersects' if overlap else 'not clear'} at its states "
+                     f"({what})")  # fmt: skip
+        lines.append(_verdict_line(report, info))
+        lines.append("  parts closer than the margin (closest first):")
         for pair in report.pairs[:LISTED_PAIRS]:
-            lines.append(f"    {pair.first} and {pair.second}: overlap "
-                         f"{lengths(-pair.clearance)}")  # fmt: skip
+            how = (f"overlap {lengths(-pair.clearance)}" if pair.clearance < 0.0
+                   else f"{lengths(pair.clearance)} apart")  # fmt: skip
+            lines.append(f"    {pair.first} and {pair.second}: {how}")
         if count > LISTED_PAIRS:
             lines.append(f"    ... and {count - LISTED_PAIRS} more (--json lists them all)")
     if motion is None:
@@ -908,6 +868,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     samples = None if args.motion is None else _integer("--motion", args.motion, 1, MAX_MOTION)
     seed = _integer("--seed", args.seed, 0)
     chain, info = _load(args.design)
+    _margin(args, chain)
     names = _joint_names(chain)
     report = _clearance(chain)
     motion = None if samples is None else sweep(chain, samples, seed, names=names)
@@ -982,7 +943,7 @@ def _compaction_lines(job: BuildJob, before: BuildJob | None = None) -> list[str
     from kinegami.optimize import tube_length
 
     chain = job.chain
-    lengths = _Lengths(chain.r, job.info.units)
+    lengths = _lengths(chain.r, job.info.units)
     counts = Counter(type(joint).__name__ for joint in chain.Joints)
     kinds = ", ".join(f"{count} {name}" for name, count in counts.items())
     if _is_tree(chain):
@@ -1005,7 +966,7 @@ def _compaction_lines(job: BuildJob, before: BuildJob | None = None) -> list[str
         f"    joints: {len(chain.Joints)} ({kinds})",
         f"    total tube length: {tube}",
         f"    sheet{'s' if _is_tree(chain) else ''}: {sheet}",
-        f"    clearance: {_clearance_summary(job.clearance, lengths, own_units=True)}",
+        "  " + _verdict_line(job.clearance, job.info),
     ]
 
 
@@ -1019,6 +980,7 @@ def cmd_compact(args: argparse.Namespace) -> int:
     out = Path(args.output)
     _check_design_output(out, args.design, args.force)
     chain, info = _load(args.design)
+    _margin(args, chain)
     before = BuildJob(chain, info)
     if not _is_tree(chain):  # a tree's sheets are checked by build
         _check_pattern(before)
@@ -1034,7 +996,8 @@ def cmd_compact(args: argparse.Namespace) -> int:
         _check_pattern(after)
     title = f"{_printable(info.name)} ({args.design})" if info.name else args.design
     lines = [
-        f"{title}: compacted (seed {seed}{', motion kept' if args.motion else ''})",
+        f"{title}: compacted (seed {seed}{', motion kept' if args.motion else ''}, margin "
+        f"{_lengths(chain.r, info.units).exact(chain.margin)})",
         "  before:",
         *_compaction_lines(before),
         "  after:",
@@ -1102,6 +1065,11 @@ def make_parser() -> argparse.ArgumentParser:
         "branch's sheet a skirt with glue tabs), auto (take-offs where they can be made, "
         "connectors elsewhere)",
     )  # fmt: skip
+    build.add_argument(
+        "--margin", metavar="M", default=None,
+        help="the clearance required between parts, in the design's units (a number >= 0; "
+        "default: the design's \"margin\", or 0: parts that touch are clear)",
+    )  # fmt: skip
     build.set_defaults(run=cmd_build)
 
     show = commands.add_parser(
@@ -1161,6 +1129,11 @@ def make_parser() -> argparse.ArgumentParser:
     check.add_argument(
         "--json", action="store_true", help="print one JSON object instead (see docs/cli.md)"
     )
+    check.add_argument(
+        "--margin", metavar="M", default=None,
+        help="the clearance required between parts, in the design's units (a number >= 0; "
+        "default: the design's \"margin\", or 0: parts that touch are clear)",
+    )  # fmt: skip
     check.set_defaults(run=cmd_check)
 
     compact = commands.add_parser(
@@ -1192,6 +1165,12 @@ def make_parser() -> argparse.ArgumentParser:
     compact.add_argument(
         "--force", action="store_true", help="allow OUT to be DESIGN itself (replaced atomically)"
     )
+    compact.add_argument(
+        "--margin", metavar="M", default=None,
+        help="the clearance required between parts, in the design's units (a number >= 0; "
+        "default: the design's \"margin\", or 0: parts that touch are clear); the compacted "
+        "design keeps its closest parts at least this far apart and is written with it",
+    )  # fmt: skip
     compact.set_defaults(run=cmd_compact)
 
     edit = commands.add_parser(
@@ -1254,7 +1233,9 @@ def main(argv: list[str] | None = None) -> int:
             # numerical warnings of plotting libraries are not the user's business; the
             # design checks reject the inputs that would make kinegami's own numbers overflow
             warnings.simplefilter("ignore", RuntimeWarning)
-            warnings.showwarning = functools.partial(_show_warning, args.command)
+            # each distinct warning once per command (a picture, the PDF and every sheet may
+            # each draw the same missing glyph, say)
+            warnings.showwarning = functools.partial(_show_warning, args.command, set())
             return args.run(args)
     except (CommandError, KinegamiError) as error:
         _fail(args.command, str(error))
@@ -1315,15 +1296,20 @@ def _encoding_safe_output() -> None:
 _MISSING_GLYPH = re.compile(r"Glyph (\d+) \(.*\) missing from font\(s\) (.+?)\.?$")
 
 
-def _show_warning(command: str, message, category, filename, lineno, file=None, line=None):
+def _show_warning(command: str, shown_before: set, message, category, filename, lineno,
+                  file=None, line=None):  # fmt: skip
     """A warning that reaches the command line (a library's, or one kinegami does not report
-    itself): one line, ``kinegami COMMAND: warning: ...``, not Python's two-line form."""
+    itself): one line, ``kinegami COMMAND: warning: ...``, not Python's two-line form; each
+    distinct line once per command (``shown_before``: the lines said so far)."""
     text = str(message)
     glyph = _MISSING_GLYPH.match(text)
     if glyph:
         char = chr(int(glyph.group(1)))
         text = (f"the font {glyph.group(2)} has no {char!r} (U+{ord(char):04X}): the PDF and the "
                 "pictures draw it as an empty box")  # fmt: skip
+    if text in shown_before:
+        return
+    shown_before.add(text)
     _warn(command, text)
 
 

@@ -86,7 +86,7 @@ ALGORITHMIC_HAND_TOLERANCE = 1e-3
 #: link length and the clearance at the design's states (None: it passes through itself), as
 #: printed there (design units, 2 decimals).
 TREE_TABLE = {
-    "hand": (12, 3, 1, 32.28, None),
+    "hand": (12, 3, 1, 33.80, 0.00),
     "algorithmic_hand": (16, 3, 1, 754.59, 0.00),
     "quadruped": (18, 4, 2, 774.99, 0.05),
     "gripper": (10, 2, 1, 285.28, 0.17),

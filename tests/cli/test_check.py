@@ -30,8 +30,8 @@ FOLD_BACK_PAIRS = [
     ("link 1, straight tube", "link 3, straight tube"),
     ("link 1, straight tube", "link 3, second elbow"),
 ]
-JSON_KEYS = {"design", "name", "units", "r", "ok", "min_clearance", "closest", "pairs", "states",
-             "motion"}  # fmt: skip
+JSON_KEYS = {"design", "name", "units", "r", "ok", "margin", "verdict", "min_clearance",
+             "closest", "pairs", "states", "motion"}  # fmt: skip
 MOTION_KEYS = {"samples", "seed", "colliding", "colliding_fraction", "worst_pairs",
                "free_intervals"}  # fmt: skip
 INTERVAL_KEYS = {"joint", "type", "name", "kind", "state", "range", "free"}
@@ -106,8 +106,8 @@ def test_a_clear_design_exits_0_with_its_minimum_clearance():
     mm, cm = report.min_clearance * 10.0, report.min_clearance
     closest = report.closest
     assert lines[1] == (
-        f"  minimum clearance: {mm:.1f} mm ({cm:.2f} cm), between {closest.first} and "
-        f"{closest.second}"
+        f"  clearance: clear with margin 0 mm (0 cm): minimum clearance {mm:.1f} mm ({cm:.2f} "
+        f"cm), between {closest.first} and {closest.second}"
     )
     assert len(lines) == 2
 
@@ -119,8 +119,10 @@ def test_a_self_intersecting_design_exits_3_and_names_every_pair(colliding):
     lines = result.stdout.splitlines()
     title = f"Fold back ({colliding})"
     assert lines[0] == f"{title}: self-intersects at its states (4 pairs of parts overlap)"
-    assert lines[1] == "  minimum clearance: -0.10 mm"
-    assert lines[2] == "  overlapping parts (deepest first):"
+    assert lines[1] == ("  clearance: self-intersects, parts closer than the margin 0 mm: minimum "
+                        "clearance -0.10 mm, between joint 0, StartTip 'base' and link 3, second "
+                        "elbow; 4 pairs of parts")  # fmt: skip
+    assert lines[2] == "  parts closer than the margin (closest first):"
     _, _, _, report = library(colliding)
     assert [(p.first, p.second) for p in report.pairs] == FOLD_BACK_PAIRS
     assert lines[3:] == [
@@ -132,13 +134,14 @@ def test_a_self_intersecting_design_exits_3_and_names_every_pair(colliding):
 def test_the_same_design_2_1_r_apart_is_clear(tmp_path):
     result = run("check", write(tmp_path / "apart.json", fold_back(2.1)))
     assert result.returncode == 0, result.stdout + result.stderr
-    assert "minimum clearance: 0.10 mm, between joint 0, StartTip 'base' and" in result.stdout
+    assert "minimum clearance 0.10 mm, between joint 0, StartTip 'base' and" in result.stdout
 
 
 def test_a_design_with_nothing_to_test_is_clear():
     result = run("check", PLANAR)
     assert result.returncode == 0
-    assert "minimum clearance: none (no two parts are far enough apart" in result.stdout
+    assert ("  clearance: clear with margin 0 mm: no two parts are far enough apart along the "
+            "tube to collide") in result.stdout  # fmt: skip
 
 
 # --- --motion --------------------------------------------------------------------------------
@@ -200,6 +203,7 @@ def test_json_has_the_library_numbers():
     assert data["design"] == str(EXAMPLE1)
     assert (data["name"], data["units"], data["r"]) == ("Example 1", "cm", 1.0)
     assert data["ok"] is True and data["pairs"] == []
+    assert data["margin"] == 0.0 and data["verdict"] == report.verdict("cm")
     # lengths in the design's units, as the library gives them
     assert data["min_clearance"] == report.min_clearance
     assert set(data["closest"]) == PAIR_KEYS
@@ -331,7 +335,8 @@ def test_build_prints_the_clearance_of_a_clear_design(tmp_path):
     result = run("build", EXAMPLE1, "-o", tmp_path / "out", "--formats", "dxf")
     assert result.returncode == 0, result.stderr
     assert result.stderr == ""
-    assert f"  clearance: {report.min_clearance * 10:.1f} mm (clear)\n" in result.stdout
+    assert (f"  clearance: {report.verdict('cm')}\n") in result.stdout
+    assert f"minimum clearance {report.min_clearance * 10:.1f} mm (" in report.verdict("cm")
 
 
 def test_build_warns_and_still_builds_a_self_intersecting_design(tmp_path, colliding):
@@ -339,16 +344,16 @@ def test_build_warns_and_still_builds_a_self_intersecting_design(tmp_path, colli
     result = run("build", colliding, "-o", out, "--formats", "dxf")
     assert result.returncode == 0, result.stderr
     assert [p.name for p in out.iterdir()] == ["fold_back.dxf"]
-    assert ("  clearance: -0.10 mm: self-intersects (joint 0, StartTip 'base' and link 3, "
-            "second elbow; 4 pairs overlap)\n") in result.stdout  # fmt: skip
+    verdict = ("self-intersects, parts closer than the margin 0 mm: minimum clearance -0.10 mm, "
+               "between joint 0, StartTip 'base' and link 3, second elbow; 4 pairs of parts")
+    assert f"  clearance: {verdict}\n" in result.stdout
     warning = result.stderr.strip().splitlines()
     assert len(warning) == 1
-    assert warning[0].startswith(f"kinegami build: warning: {colliding} self-intersects at its "
-                                 "states: joint 0, StartTip 'base' and link 3, second elbow "
-                                 "overlap by 0.10 mm")  # fmt: skip
+    assert warning[0].startswith(f"kinegami build: warning: {colliding} at its states: {verdict} "
+                                 "(the files are written all the same")  # fmt: skip
 
 
 def test_build_of_a_design_with_nothing_to_test(tmp_path):
     result = run("build", PLANAR, "-o", tmp_path / "out", "--formats", "dxf")
     assert result.returncode == 0
-    assert "  clearance: clear (no two parts are far enough apart" in result.stdout
+    assert "  clearance: clear with margin 0 mm: no two parts are far enough apart" in result.stdout

@@ -70,7 +70,7 @@ def test_compact_writes_a_clear_design_with_the_same_axis_lines(compacted):
 def test_compact_prints_before_and_after(compacted):
     result, out = compacted
     lines = result.stdout.splitlines()
-    assert lines[0] == f"Example 1 ({EXAMPLE1}): compacted (seed 3)"
+    assert lines[0] == f"Example 1 ({EXAMPLE1}): compacted (seed 3, margin 0 mm (0 cm))"
     assert lines[1] == "  before:" and lines[6] == "  after:"
     before, after = load_design(EXAMPLE1), load_design(out)
     # lengths as `check` prints them: mm, then the design's cm
@@ -81,7 +81,7 @@ def test_compact_prints_before_and_after(compacted):
     for k in (4, 9):
         assert lines[k].startswith("    sheet: ") and "mm with the glue tab" in lines[k]
     for k in (5, 10):
-        assert lines[k].startswith("    clearance: ") and lines[k].endswith(": clear")
+        assert lines[k].startswith("    clearance: clear with margin 0 mm (0 cm): minimum ")
     assert lines[-1] == f"  written: {out}"
 
 

@@ -13,6 +13,8 @@ import pytest
 from .helpers import ROOT, main_in_process
 
 HAND = ROOT / "examples" / "designs" / "hand.json"  # the paper's hand: 3 leaves, 1 junction
+#: The paper's hand as published (the gallery's has the palm slid so that its socket fits).
+PAPERS_HAND = ROOT / "tests" / "design" / "data" / "papers_hand.json"
 
 SHEET_FILES = {f"hand_sheet_{k}{suffix}" for k in range(3) for suffix in (".dxf", ".svg", ".fold")}
 PICTURES = {"hand_3d.png", *(f"hand_sheet_{k}_pattern.png" for k in range(3))}
@@ -64,11 +66,30 @@ def test_the_summary_lists_the_sheets_and_the_junctions(hand_build):
         assert f"    sheet {k}: joints " in text
     assert "junctions: 1 (printed connectors)" in text
     assert "junction 0: at joint 0, children 1, 5, 8" in text
-    assert "clearance:" in text and "(clear)" in text
+    assert "  clearance: clear with margin 0 mm (0 cm): minimum clearance 0.0 mm" in text
     # its closest parts touch where the junction ends (it covers them up to 2 r apart): said
-    assert "(clear); closest where the tubes leaving joint 0 come out of its junction" in text
-    # the palm slides along its axis so that its socket fits, and the summary says so
-    assert "note: joint 1 slid" in text
+    assert "; closest where the tubes leaving joint 0 come out of its junction\n" in text
+    # the gallery's hand has the palm's fitting slide written in: nothing slides, and the tree
+    # judged is the tree built
+    assert "slid" not in text
+
+
+def test_a_build_that_slides_a_joint_says_so_and_gives_both_verdicts(tmp_path):
+    """The paper's hand as published: the palm's socket fits only after build slides it by
+    -3 r; the summary judges the tree built and names the verdict of the file as written
+    (what check and the editor say)."""
+    import contextlib
+    import io
+
+    stdout = io.StringIO()
+    with contextlib.redirect_stdout(stdout):
+        assert main_in_process("build", PAPERS_HAND, "-o", tmp_path, "--formats", "dxf") == 0
+    text = stdout.getvalue()
+    assert "  clearance: clear with margin 0 mm (0 cm): minimum clearance 0.0 mm" in text
+    assert "note: joint 1 slid -30.0 mm along its axis so that its socket fits" in text
+    assert ("judge the design file as written: self-intersects, parts closer than the margin "
+            "0 mm (0 cm): minimum clearance -2.5 mm (-0.25 cm), between joint 1, RevoluteJoint "
+            "'palm', proximal half and link 5, straight tube") in " ".join(text.split())
 
 
 def test_the_urdf_of_a_tree_build_is_one_kinematic_tree(hand_build):
@@ -177,8 +198,10 @@ def test_the_takeoff_summary_lists_where_each_branch_leaves(takeoff_build):
     _, _, text = takeoff_build
     assert "junctions: 0 (printed connectors)" in text
     assert "take-offs: 2 (folded)" in text
-    assert "take-off A: joint 1 leaves joint 8's link through face 0" in text
-    assert "take-off B: joint 5 leaves joint 8's link through face 2" in text
+    # the palm slid down its axis (as the gallery's hand is): the palm's branch leaves through
+    # face 2, the pointer's through face 0
+    assert "take-off A: joint 1 leaves joint 8's link through face 2" in text
+    assert "take-off B: joint 5 leaves joint 8's link through face 0" in text
     assert "hole A in sheet 0, sheet 2 starts with its skirt (4 glue tabs)" in text
     assert "folded body with the take-off links:" in text
     assert "cut out hole A (sheet 2's skirt glues in)" in text

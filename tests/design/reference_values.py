@@ -1,6 +1,7 @@
 """Reference numbers of the tree designs (the paper's hand and the algorithmic hand)."""
 
-#: examples/designs/hand.json: the paper's three-finger hand, every joint at its exact pose.
+#: tests/design/data/papers_hand.json: the paper's three-finger hand as published, every joint
+#: at its exact pose (examples/designs/hand.json: the palm slid -3 r so that its socket fits).
 HAND_PARENTS = (-1, 0, 1, 2, 3, 0, 5, 6, 0, 8, 9, 10)
 HAND_CHILDREN_OF_ROOT = (1, 5, 8)
 HAND_TOTAL_LINK_LENGTH = 32.276748

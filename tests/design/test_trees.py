@@ -1,5 +1,6 @@
 """Trees in design files (version 2): parents, loading as a KinematicTree, saving, errors,
-the paper's hand (examples/designs/hand.json) and joint specifications."""
+the paper's hand (tests/design/data/papers_hand.json; the gallery's hand.json with its fitting)
+and joint specifications."""
 
 from __future__ import annotations
 
@@ -38,7 +39,10 @@ from kinegami.tree import KinematicTree
 from . import _MIDDLE, DATA, PI, _joint, _pose, joint_parameters, located, pose_error
 from . import reference_values as ref
 
-HAND = Path(__file__).resolve().parents[2] / "examples" / "designs" / "hand.json"
+#: The paper's hand as published, and the gallery's hand: the same with the palm slid -3 r
+#: along its axis, the slide kinegami build's fitting makes so that its socket fits.
+HAND = DATA / "papers_hand.json"
+GALLERY_HAND = Path(__file__).resolve().parents[2] / "examples" / "designs" / "hand.json"
 ALGORITHMIC_HAND = DATA / "algorithmic_hand.json"
 FIXED = dict(relative=True, safe=False, fixedPosition=True, fixedOrientation=True)
 
@@ -131,6 +135,23 @@ def test_the_hand_loads_as_a_tree_with_the_papers_numbers():
 
 def test_the_hand_is_its_python_listing_bit_for_bit():
     assert_same_tree_bits(_quietly(load_design, HAND), _quietly(hand_listing))
+
+
+def test_the_gallery_hand_is_the_papers_hand_as_build_fits_it():
+    """One design, one verdict: the gallery's hand.json is the tree kinegami build makes of
+    the paper's hand (fit_junctions slides the palm by -3 r), so build, check, the editor and
+    the library judge the tree that is fabricated."""
+    from kinegami.tree.sheets import fit_junctions, junction_problems
+
+    paper, gallery = _quietly(load_design, HAND), _quietly(load_design, GALLERY_HAND)
+    fitted, moves = _quietly(fit_junctions, paper)
+    assert moves == [(1, -3.0)]
+    assert pose_error(gallery, fitted) <= 1e-12
+    assert gallery.Parents == fitted.Parents
+    assert junction_problems(gallery) == [] and fit_junctions(gallery)[1] == []
+    assert gallery.clearance().ok and not paper.clearance().ok
+    assert paper.clearance().min_clearance == pytest.approx(-0.25, abs=1e-9)
+    assert origin_of(gallery).names == origin_of(paper).names
 
 
 def test_the_hand_keeps_its_names():
