@@ -338,7 +338,8 @@ class EditorView:
         #: What Escape does to an open dialog, the latest last (it calls and removes it).
         self.dialog_cancels: list[Callable[[], None]] = []
         self._joint_fields: dict = {}  # the Selected joint folder's typed fields
-        self._joint_fields_key = None
+        self._joint_fields_key: Any = ()  # () until the folder is first filled
+        self._filled_for: int | None = None  # the joint the fields were last filled for
         self._shown_fields: dict = {}  # field -> (value shown, exact value)
         self._build_panel()
         self._build_pattern_panel()
@@ -443,7 +444,7 @@ class EditorView:
             section_color=(150, 150, 150), fade_distance=20.0 * grid.width,
         )  # fmt: skip
         self._world_axes = self.scene.add_frame("/world", axes_length=grid.section,
-                                                axes_radius=0.02 * grid.section)  # fmt: skip
+                                                axes_radius=0.01 * grid.section)  # fmt: skip
         if self._gizmo is not None:
             self._gizmo.scale = 3.0 * self._r
         step = nice_step(0.5 * self._r)
@@ -1097,8 +1098,13 @@ class EditorView:
                     )
                 else:
                     self._build_joint_fields(row, units)
+                self._filled_for = None  # new fields: filled in
         if row is not None:
-            self._fill_joint_fields(row)
+            force = row.index != self._filled_for
+            self._filled_for = row.index
+            self._fill_joint_fields(row, force)
+        else:
+            self._filled_for = None
 
     def _build_joint_fields(self, row, units: str) -> None:
         gui, fields = self.gui, self._joint_fields
@@ -1141,31 +1147,34 @@ class EditorView:
                                                  "(undoable)")  # fmt: skip
             fields["set state"].on_click(lambda _: self.set_typed_state())
 
-    def _show(self, name: str, exact, digits: int) -> None:
+    def _show(self, name: str, exact, digits: int, force: bool) -> None:
         """Fill a field with ``exact`` (a number or a triple) rounded to ``digits``, and
-        remember both (a typed value equal to the one shown means: keep the exact one)."""
+        remember both (a typed value equal to the one shown means: keep the exact one). A
+        field whose value did not change keeps what the user is typing, unless ``force``
+        (another joint)."""
         if isinstance(exact, tuple | list | np.ndarray):
             shown = tuple(round(float(v), digits) + 0.0 for v in exact)
         else:
             shown = round(float(exact), digits) + 0.0 if digits else exact
         handle = self._joint_fields[name]
-        if handle.value != shown:
+        before = self._shown_fields.get(name, (None, None))[0]
+        if (force or before != shown) and handle.value != shown:
             handle.value = shown
         self._shown_fields[name] = (shown, exact)
 
-    def _fill_joint_fields(self, row) -> None:
+    def _fill_joint_fields(self, row, force: bool) -> None:
         digits = self._input_digits()
         position, angles = pose_to_display(row.pose)
-        self._show("position", position, digits)
-        self._show("orientation", angles, 4)
+        self._show("position", position, digits, force)
+        self._show("orientation", angles, 4, force)
         for key, value in row.parameters.items():
             unit = parameter_unit(key, self.model.document.units)
             self._show(f"parameter {key}", parameter_to_display(key, value),
-                       0 if not unit else (4 if unit == "deg" else digits))  # fmt: skip
+                       0 if not unit else (4 if unit == "deg" else digits), force)  # fmt: skip
         if row.movable:
             unit = state_unit(row.type, self.model.document.units)
-            self._show("state", state_to_display(row.type, row.state), 4 if unit == "deg"
-                       else digits)  # fmt: skip
+            self._show("state", state_to_display(row.type, row.state),
+                       4 if unit == "deg" else digits, force)  # fmt: skip
 
     def _typed(self, name: str, value=None):
         """A field's typed value; where it still shows what was filled in, the exact value

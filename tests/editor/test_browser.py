@@ -117,7 +117,7 @@ def test_selecting_a_joint_selects_it_and_highlights_its_modules(tab, tmp_path):
     page.get_by_role("combobox", name="Joint", exact=True).click()
     page.get_by_role("option", name="4: RevoluteJoint 'revolute'").click()
     wait_for(lambda: view.model.selected == 4, "joint 4 selected on the server")
-    page.get_by_text("state 0 in [-1.571, 1.571]").wait_for()
+    page.get_by_text("state 0° in [-90°, 90°]").wait_for()
     page.locator("rect.kinegami-highlight").first.wait_for()
     page.locator("svg[aria-label='crease pattern, selected joint']").wait_for()
     page.get_by_text("close-up: joint 4 (RevoluteJoint 'revolute')").wait_for()

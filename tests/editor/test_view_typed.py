@@ -229,3 +229,15 @@ def test_example1_opens_with_its_own_framing():
         view.close()
     finally:
         server.stop()
+
+
+def test_a_field_being_typed_survives_other_changes_but_not_another_selection(view):
+    view.act(lambda: view.model.select(2))
+    view._joint_fields["state"].value = -30.0  # typed, not set yet
+    assert view.act(lambda: view.model.rename(2, "shoulder")).ok  # the state did not change
+    assert view._joint_fields["state"].value == -30.0
+    assert view.set_typed_state().ok
+    assert view.model.chain.Joints[2].state == pytest.approx(math.radians(-30.0))
+    view._joint_fields["state"].value = 10.0
+    view.act(lambda: view.model.select(3))  # another joint: its own values
+    assert view._joint_fields["state"].value == 0.0
