@@ -1918,6 +1918,9 @@ class EditorView:
             command = ReplaceDocument(recovery.document, f"recover the autosave "
                                                          f"({recovery.describe()})")  # fmt: skip
             result = self.act(lambda: self.model.apply(command))
+            if result.ok:  # another design, maybe of another size: grid and camera follow
+                self._size_scene()
+                self.frame_camera()
             if result.ok and recovery.legacy and self.autosave is not None:
                 self.autosave.flush()  # now in the data folder: the old one beside the design goes
                 if self.autosave.path.exists():

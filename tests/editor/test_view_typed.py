@@ -241,3 +241,17 @@ def test_a_field_being_typed_survives_other_changes_but_not_another_selection(vi
     view._joint_fields["state"].value = 10.0
     view.act(lambda: view.model.select(3))  # another joint: its own values
     assert view._joint_fields["state"].value == 0.0
+
+
+def test_recovering_an_autosave_of_another_size_resizes_the_grid_and_framing(view, tmp_path):
+    """The tab shows the PUMA; the autosave it recovers is Example 1 (as if the design file
+    had been replaced): one undoable step, and the grid and the camera follow."""
+    from kinegami.editor import Document
+    from kinegami.editor.autosave import Recovery
+
+    puma = (view.grid.section, view.framing.radius)
+    recovery = Recovery(tmp_path / "x.autosave", None, 0.0, Document.load(EXAMPLE1))
+    assert view.choose_recovery(recovery, "recover").ok
+    assert view.grid.section == 2.0 and view.framing.radius < puma[1] / 20.0
+    points_lo, points_hi = view.design_box()
+    assert (points_hi - points_lo).max() < 20.0  # cm: Example 1's box
