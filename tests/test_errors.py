@@ -70,6 +70,7 @@ HIERARCHY = {
     "PublishError": (OSError,),
     "ExporterUnavailableError": (ImportError,),
     "FoldExportError": (ValueError,),
+    "Cancelled": (Exception,),
     "PlacementWarning": (UserWarning,),
     "ClearanceWarning": (UserWarning,),
 }
