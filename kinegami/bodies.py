@@ -37,6 +37,8 @@ from __future__ import annotations
 
 import functools
 import math
+import operator
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -487,22 +489,94 @@ def _joint_arrays(joint, j: int, r: float) -> tuple:
     return _arrays(rows), rows
 
 
-def _chain_arrays(joints, links, r: float) -> tuple:
-    """The chain's capsules as arrays (starts, ends, bodies, turnings without the hinges), the
-    row of every capsule (for its labels) and the index of every joint's first capsule."""
-    starts, ends, bodies, turns = [], [], [], []
+@dataclass(frozen=True)
+class _ChainArrays:
+    """The capsules of a chain's first ``len(joints)`` joints as arrays (see
+    :func:`_chain_arrays`), with what extending them needs: the turning after the last joint."""
+
+    joints: tuple
+    links: tuple
+    r: float
+    starts: np.ndarray
+    ends: np.ndarray
+    bodies: np.ndarray
+    turns: np.ndarray
+    elements: np.ndarray
+    rows: tuple
+    first: tuple
+    turning: float
+    #: cumulative hinge turning up to body b at index b + 1 (:func:`_kink_prefix`)
+    kinks: np.ndarray
+    #: total turning of every capsule, hinges included (non-decreasing along the tube)
+    tau: np.ndarray
+    centre: np.ndarray
+    half: np.ndarray
+    #: the parts (runs of one element): first capsule, ball centre and radius, turning range
+    block_starts: np.ndarray
+    block_centre: np.ndarray
+    block_radius: np.ndarray
+    block_tau_min: np.ndarray
+    block_tau_max: np.ndarray
+
+
+#: The last few chains' arrays, so that a chain extended by a few joints (placement's
+#: candidates, a chain built joint by joint) computes only its new parts' capsules.
+_ARRAY_MEMO: list[_ChainArrays] = []
+_ARRAY_MEMO_SIZE = 8
+_ARRAY_MEMO_LOCK = threading.Lock()
+
+
+def _longest_known_prefix(joints, links, r: float) -> _ChainArrays | None:
+    """The memo entry of the longest prefix of (joints, links), the very same objects."""
+    best = None
+    with _ARRAY_MEMO_LOCK:
+        entries = list(_ARRAY_MEMO)
+    for entry in entries:
+        k = len(entry.joints)
+        if entry.r != r or k > len(joints) or (best is not None and k <= len(best.joints)):
+            continue
+        if all(map(operator.is_, entry.joints, joints[:k])) and all(
+            map(operator.is_, entry.links, links[1:k])
+        ):
+            best = entry
+    return best
+
+
+def _chain_arrays(joints, links, r: float) -> _ChainArrays:
+    """The chain's capsules as arrays (starts, ends, bodies, turnings without the hinges, the
+    element of every capsule: 2 j for joint j, 2 j - 1 for the link into it), the row of every
+    capsule (for its labels) and the index of every joint's first capsule.
+
+    The arrays of a prefix of the chain computed before (the same joint and link objects) are
+    reused, so extending a chain by a few joints costs what the new joints cost (plus copying
+    arrays), not a pass over the whole chain.
+    """
+    known = _longest_known_prefix(joints, links, r)
+    if known is not None and len(known.joints) == len(joints):
+        return known
+    k0 = 0 if known is None else len(known.joints)
+    starts, ends, bodies, turns, elements = [], [], [], [], []
     rows: list = []
     first: list[int] = []
     turning = 0.0
     count = 0
-    for j, joint in enumerate(joints):
+    if known is not None:
+        starts, ends = [known.starts], [known.ends]
+        bodies, turns, elements = [known.bodies], [known.turns], [known.elements]
+        first = list(known.first)
+        turning = known.turning
+        count = len(known.rows)
+    for j in range(k0, len(joints)):
+        joint = joints[j]
         if j > 0:
             (A, B, body, turn), link_rows, total = _link_arrays(links[j], j, r, 0.2)
-            starts.append(A)
-            ends.append(B)
-            bodies.append(body)
-            turns.append(turn + turning)
-            rows += link_rows
+            if len(link_rows):
+                starts.append(A)
+                ends.append(B)
+                bodies.append(body)
+                turns.append(turn + turning)
+                elements.append(np.full(len(link_rows), 2 * j - 1, dtype=np.int64))
+                rows += link_rows
             turning += total
             count += len(link_rows)
         first.append(count)
@@ -512,13 +586,97 @@ def _chain_arrays(joints, links, r: float) -> tuple:
             ends.append(B)
             bodies.append(body)
             turns.append(turn + turning)
+            elements.append(np.full(len(joint_rows), 2 * j, dtype=np.int64))
             rows += joint_rows
             count += len(joint_rows)
-    if not rows:
+    all_rows = tuple(rows) if known is None else known.rows + tuple(rows)
+    if not all_rows:
         empty = np.zeros((0, 3))
-        return empty, empty, np.zeros(0, dtype=np.int64), np.zeros(0), rows, first
-    return (np.concatenate(starts), np.concatenate(ends), np.concatenate(bodies),
-            np.concatenate(turns), rows, first)  # fmt: skip
+        arrays = (empty, empty, np.zeros(0, dtype=np.int64), np.zeros(0),
+                  np.zeros(0, dtype=np.int64))  # fmt: skip
+    else:
+        arrays = tuple(np.concatenate(part) for part in (starts, ends, bodies, turns, elements))
+    a, b, body, turn, element = arrays
+    # what the new rows add (the prefix's values are reused): hinge turnings, totals, balls
+    n_old = 0 if known is None else len(known.rows)
+    kinks_new = [abs(j.state) if isinstance(j, RevoluteJoint) else 0.0 for j in joints[k0:]]
+    kinks = np.concatenate([[0.0] if known is None else known.kinks,
+                            (0.0 if known is None else known.kinks[-1]) + np.cumsum(kinks_new)])
+    a_new, b_new = a[n_old:], b[n_old:]
+    tau_new = turn[n_old:] + kinks[body[n_old:] + 1]
+    centre_new = 0.5 * (a_new + b_new)
+    half_new = 0.5 * np.sqrt(((b_new - a_new) ** 2).sum(axis=1))
+    e_new = element[n_old:]
+    S_new = e_new.size
+    if S_new:
+        local = np.flatnonzero(np.r_[True, e_new[1:] != e_new[:-1]])
+        sizes = np.diff(np.r_[local, S_new])
+        c = np.add.reduceat(centre_new, local, axis=0) / sizes[:, None]
+        spread = np.sqrt(((centre_new - np.repeat(c, sizes, axis=0)) ** 2).sum(axis=1))
+        rho = np.maximum.reduceat(spread + half_new, local)
+        t_min, t_max = tau_new[local], np.maximum.reduceat(tau_new, local)
+    else:
+        local, c, rho = np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0)
+        t_min = t_max = np.zeros(0)
+    derived = [kinks, tau_new, centre_new, half_new, local + n_old, c, rho, t_min, t_max]
+    if known is not None:
+        old = (known.tau, known.centre, known.half, known.block_starts, known.block_centre,
+               known.block_radius, known.block_tau_min, known.block_tau_max)  # fmt: skip
+        derived[1:] = [np.concatenate([x, y]) for x, y in zip(old, derived[1:], strict=True)]
+    for array in (*arrays, *derived):
+        array.flags.writeable = False
+    result = _ChainArrays(tuple(joints), tuple(links[1:len(joints)]), r, *arrays, all_rows,
+                          tuple(first), turning, *derived)  # fmt: skip
+    with _ARRAY_MEMO_LOCK:
+        _ARRAY_MEMO.insert(0, result)
+        del _ARRAY_MEMO[_ARRAY_MEMO_SIZE:]
+    return result
+
+
+def _new_part_pairs(arrays: _ChainArrays, start_new: int, reach: float):
+    """The tested capsule pairs (i < j, j >= start_new, turning between them >= pi) whose
+    balls come within ``reach``: only what can pair with a new capsule is looked at, first the
+    parts by turning, then the parts' balls against each new capsule's ball, then the capsules
+    of the parts that are near."""
+    tau, starts = arrays.tau, arrays.block_starts
+    S = tau.size
+    none = np.zeros(0, dtype=np.int64)
+    if start_new >= S:
+        return none, none
+    centre, half = arrays.centre, arrays.half
+    # parts that turn by pi before the last new capsule: a prefix of the parts
+    limit = float(tau[-1]) - math.pi + TURN_TOLERANCE
+    E_old = int(np.searchsorted(arrays.block_tau_min, limit, side="right"))
+    if E_old == 0:
+        return none, none
+    J = np.arange(start_new, S)
+    a, b = arrays.starts, arrays.ends
+    c, rho = arrays.block_centre[:E_old], arrays.block_radius[:E_old]
+    # a part's ball against a new capsule's segment (tighter than its ball for long segments)
+    near = _point_segment_distance(c[:, None, :], a[None, J], b[None, J]) - rho[:, None] < reach
+    near &= arrays.block_tau_min[:E_old, None] <= tau[None, J] - math.pi + TURN_TOLERANCE
+    e, jj = np.nonzero(near)
+    if e.size == 0:
+        return none, none
+    ends = np.r_[starts[1:], S]
+    sizes = ends[e] - starts[e]
+    offset = np.repeat(np.cumsum(sizes) - sizes, sizes)
+    i = np.repeat(starts[e], sizes) + np.arange(int(sizes.sum())) - offset
+    j = np.repeat(J[jj], sizes)
+    ok = (j > i) & (tau[j] >= tau[i] + math.pi - TURN_TOLERANCE)
+    i, j = i[ok], j[ok]
+    ok = _point_segment_distance(centre[i], a[j], b[j]) - half[i] < reach
+    return i[ok], j[ok]
+
+
+def _point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance from points ``p`` to segments [a, b] (broadcast over leading axes)."""
+    ab = b - a
+    length2 = np.einsum("...k,...k->...", ab, ab)
+    t = np.einsum("...k,...k->...", p - a, ab) / np.where(length2 > 0.0, length2, 1.0)
+    foot = a + np.clip(t, 0.0, 1.0)[..., None] * ab
+    d = p - foot
+    return np.sqrt(np.einsum("...k,...k->...", d, d))
 
 
 def _kink_prefix(joints) -> np.ndarray:
@@ -550,14 +708,14 @@ class Overlap:
                 f"the margin {self.margin:.4g}")  # fmt: skip
 
 
-def _near_pairs(rows, tau, first, centre, half, reach: float) -> tuple[np.ndarray, np.ndarray]:
+def _near_pairs(element, tau, first, centre, half, reach: float) -> tuple[np.ndarray, np.ndarray]:
     """Tested capsule pairs (i < j, j >= first[i]) whose segment balls come within ``reach``.
 
-    Two levels: a ball around each part (the rows of one element, which are contiguous) prunes
-    whole blocks of pairs before the segments' own balls are compared.
+    ``element`` (S,) is each capsule's part (the rows of one part are contiguous). Two
+    levels: a ball around each part prunes whole blocks of pairs before the segments' own
+    balls are compared.
     """
-    S = len(rows)
-    element = np.fromiter((row[5] for row in rows), dtype=np.int64, count=S)
+    S = element.size
     starts = np.flatnonzero(np.r_[True, element[1:] != element[:-1]])
     ends = np.r_[starts[1:], S]
     sizes = ends - starts
@@ -603,25 +761,24 @@ def worst_overlap(
     or later (or of the link into it) are measured: placement checks an extension without
     re-checking the chain it extends.
     """
-    a, b, body, tau, rows, first_rows = _chain_arrays(joints, links, r)
+    arrays = _chain_arrays(joints, links, r)
+    a, b, rows, tau = arrays.starts, arrays.ends, arrays.rows, arrays.tau
     S = len(rows)
     if S < 2:
         return None
-    # the parts from the link into joint `since` on: the rows after joint since - 1's own
-    start_new = 0
     if since > 0:
-        start_new = first_rows[since - 1] + _joint_row_count(joints[since - 1], since - 1, r)
-    tau = tau + _kink_prefix(joints)[body + 1]
-    # turning is non-decreasing along the tube: the pairs (i, j >= first[i]) are the tested ones
-    first = np.maximum(
-        np.searchsorted(tau, tau + math.pi - TURN_TOLERANCE, side="left"), np.arange(S) + 1
-    )
-    first = np.maximum(first, start_new)
-    if int(np.maximum(S - first, 0).sum()) == 0:
-        return None
-    centre = 0.5 * (a + b)
-    half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
-    i, j = _near_pairs(rows, tau, first, centre, half, 2.0 * r + margin)
+        # the parts from the link into joint `since` on: the rows after joint since - 1's own
+        start_new = arrays.first[since - 1] + _joint_row_count(joints[since - 1], since - 1, r)
+        i, j = _new_part_pairs(arrays, start_new, 2.0 * r + margin)
+    else:
+        # turning is non-decreasing along the tube: the pairs (i, j >= first[i]) are tested
+        first = np.maximum(
+            np.searchsorted(tau, tau + math.pi - TURN_TOLERANCE, side="left"), np.arange(S) + 1
+        )
+        if int(np.maximum(S - first, 0).sum()) == 0:
+            return None
+        i, j = _near_pairs(arrays.elements, tau, first, arrays.centre, arrays.half,
+                           2.0 * r + margin)
     if i.size == 0:
         return None
     dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
@@ -908,7 +1065,7 @@ def tree_pair_distances(
     centre = 0.5 * (a + b)
     half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
     first = np.arange(S) + 1
-    i, j = _near_pairs(rows, tau, first, centre, half, reach)
+    i, j = _near_pairs(element, tau, first, centre, half, reach)
     if since > 0 and i.size:
         keep = (node[i] >= since) | (node[j] >= since)
         i, j = i[keep], j[keep]

@@ -219,15 +219,40 @@ class _JointAssembly:
         ``parents`` as :meth:`_extended` returns them (a chain ignores them)."""
         return worst_overlap(joints, links, self.r, since=since, margin=self._margin)
 
-    def _accept(self, what: str, joints, links, ball: Ball | None = None, parents=None) -> bool:
+    def _own_overlap(self):
+        """The deepest overlap of the chain as it is (an Overlap) or None, computed once per
+        committed set of lists (they are replaced, never changed, by every operation)."""
+        memo = self.__dict__.get("_overlap_memo")
+        if (memo is not None and memo[0] is self._joints and memo[1] is self._links
+                and memo[3] == self._margin):  # fmt: skip
+            return memo[2]
+        found = self._overlap(self._joints, self._links, self._parent_list())
+        self._overlap_memo = (self._joints, self._links, found, self._margin)
+        return found
+
+    def _accept(self, what: str, joints, links, ball: Ball | None = None, parents=None,
+                extends: bool = False) -> bool:  # fmt: skip
         """Commit the new lists unless they pass through themselves and the chain requires
         clearance (then warn PlacementWarning, keep the chain, return False); a commit that
-        leaves the chain self-intersecting emits a ClearanceWarning."""
-        found = self._overlap(joints, links, parents)
+        leaves the chain self-intersecting emits a ClearanceWarning.
+
+        ``extends``: the new lists are the chain's own followed by new joints (placement), so
+        only pairs with a new part are measured, against the chain's known deepest overlap:
+        the cost of a placement does not grow with the chain's length.
+        """
+        if extends and self._placement_adds_pairs_only:
+            first_new = len(self._joints)
+            found = self._overlap(joints, links, parents, first_new)
+            before = self._own_overlap()
+            if before is not None and (found is None or before.clearance < found.clearance):
+                found = before
+        else:
+            found = self._overlap(joints, links, parents)
         if found is not None and self._require_clearance:
             self._reject(f"{what} failed: the {self._noun} would pass through itself ({found})")
             return False
         self._commit(joints, links, ball, parents)
+        self._overlap_memo = (self._joints, self._links, found, self._margin)
         if found is not None:
             warnings.warn(
                 ClearanceWarning(
@@ -252,6 +277,9 @@ class _JointAssembly:
 
     #: What the messages call the assembly.
     _noun = "chain"
+    #: Whether placing a joint only adds pairs of parts to test (true of a chain; in a tree a
+    #: new sibling also changes the junction its older siblings share).
+    _placement_adds_pairs_only = True
 
     def _reject(self, message: str) -> None:
         warnings.warn(
@@ -398,7 +426,7 @@ class _JointAssembly:
         except KinegamiError as error:
             self._reject(f"{what} failed: {error}")
             return None
-        if not self._accept(what, joints, links, ball, parents):
+        if not self._accept(what, joints, links, ball, parents, extends=True):
             return None
         return len(joints) - 1
 

@@ -173,6 +173,9 @@ class KinematicTree(_JointAssembly):
     def _parent_list(self) -> list[int]:
         return list(self._parents)
 
+    #: A new sibling changes the junction its older siblings share: placement tests all pairs.
+    _placement_adds_pairs_only = False
+
     def _overlap(self, joints, links, parents, since: int = 0):
         parents = self._parents if parents is None else parents
         return tree_worst_overlap(joints, links, parents, self.r, since=since,
