@@ -390,6 +390,47 @@ def safe_chain_rows(seeds: int) -> list[tuple[str, str, str]]:
     ]  # fmt: skip
 
 
+def random_dh_table(n: int, seed: int = 1, r: float = 1.0) -> list[tuple[float, ...]]:
+    """n random DH rows (theta 0, alpha uniform in (-pi, pi], a and d uniform in [0, 4r])."""
+    rng = np.random.default_rng(seed)
+    return [(0.0, float(rng.uniform(-np.pi, np.pi)), float(rng.uniform(0, 4 * r)),
+             float(rng.uniform(0, 4 * r))) for _ in range(n)]  # fmt: skip
+
+
+def scale_rows() -> list[tuple[str, str, str]]:
+    """How builds grow with the design: safe random chains of 100, 200 and 400 joints, the
+    CPU time of one append early and late in a 400-joint chain, and a 1,000-row DH table."""
+    times = {}
+    for n in (100, 200, 400):
+        t0 = time.perf_counter()
+        safe_chain(0, n)
+        times[n] = time.perf_counter() - t0
+    # CPU time per append over joints 1-50 and 351-400 of one safe chain
+    rng = np.random.default_rng(0)
+    chain = KinematicChain(StartTip(4, 1.0, np.eye(4), 1.0))
+    marks = [time.process_time()]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for i in range(400):
+            chain.append(random_joint(i, random_pose(rng, 1.0)))
+            if i + 1 in (50, 350, 400):
+                marks.append(time.process_time())
+    early, late = (marks[1] - marks[0]) / 50, (marks[3] - marks[2]) / 50
+    t0 = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        KinematicChain.from_dh(random_dh_table(1000), 4, 1.0)
+    dh = time.perf_counter() - t0
+    return [
+        ("safe random chain, 100 / 200 / 400 joints",
+         f"{times[100]:.1f} / {times[200]:.1f} / {times[400]:.1f} s", "400 joints <= 10 s"),
+        ("  400 joints / 200 joints", f"{times[400] / times[200]:.2f}x", "<= 2.5x (near-linear)"),
+        ("  CPU per append: joints 1-50 / 351-400", f"{early * 1e3:.1f} / {late * 1e3:.1f} ms",
+         "late ~ early (no growth with length)"),
+        ("KinematicChain.from_dh, 1,000 random rows", f"{dh:.1f} s", "<= 30 s"),
+    ]  # fmt: skip
+
+
 Rows = list[tuple[str, str, str]]
 
 
@@ -427,6 +468,7 @@ def steps(seeds: int, compact_seeds: int) -> list[tuple[str, Callable[[], Rows]]
         ("design files, DH table", lambda: design_rows(fresh()[0])),
         ("exporters and kinegami build", lambda: export_rows(fresh()[0])),
         (f"48-joint safe chains ({seeds} seeds)", lambda: safe_chain_rows(seeds)),
+        ("scale: 100-400-joint safe chains, a 1,000-row DH table", scale_rows),
         ("clearance engine and safe chains' clearance", lambda: clearance_rows(0)),
     ]
     if compact_seeds > 0:
