@@ -651,11 +651,22 @@ def _new_part_pairs(arrays: _ChainArrays, start_new: int, reach: float):
         return none, none
     J = np.arange(start_new, S)
     a, b = arrays.starts, arrays.ends
-    c, rho = arrays.block_centre[:E_old], arrays.block_radius[:E_old]
-    # a part's ball against a new capsule's segment (tighter than its ball for long segments)
+    # one pass over the parts' balls against a ball around all new capsules, then each
+    # remaining part's ball against each new capsule's segment (tighter for long segments)
+    points = np.concatenate([a[J], b[J]])
+    middle = 0.5 * (points.min(axis=0) + points.max(axis=0))
+    spread = float(np.sqrt(((points - middle) ** 2).sum(axis=1)).max())
+    d = arrays.block_centre[:E_old] - middle
+    candidates = np.flatnonzero(
+        np.sqrt(np.einsum("ek,ek->e", d, d)) - arrays.block_radius[:E_old] - spread < reach
+    )
+    if candidates.size == 0:
+        return none, none
+    c, rho = arrays.block_centre[candidates], arrays.block_radius[candidates]
     near = _point_segment_distance(c[:, None, :], a[None, J], b[None, J]) - rho[:, None] < reach
-    near &= arrays.block_tau_min[:E_old, None] <= tau[None, J] - math.pi + TURN_TOLERANCE
+    near &= arrays.block_tau_min[candidates, None] <= tau[None, J] - math.pi + TURN_TOLERANCE
     e, jj = np.nonzero(near)
+    e = candidates[e]
     if e.size == 0:
         return none, none
     ends = np.r_[starts[1:], S]
