@@ -43,7 +43,7 @@ def test_schema_and_loader_agree_on_names():
     assert set(top) == {
         "format", "version", "name", "description", "units", "angleUnits", "numSides", "r",
         "maxAnglePerElbow", "twistPortion", "joints", "dh", "edits", "states", "requireClearance",
-        "structure", "placement",
+        "structure", "placement", "margin",
     }  # fmt: skip
     assert top["version"]["enum"] == list(design.VERSIONS)
     assert top["units"]["enum"] == list(design.UNITS)

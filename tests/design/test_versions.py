@@ -164,3 +164,79 @@ def test_version_2_designs_are_valid_for_a_plain_validator():
     validator = jsonschema.Draft202012Validator(design_schema())
     for path in (GALLERY / "hand.json", DATA / "algorithmic_hand.json"):
         validator.validate(json.loads(path.read_text(encoding="utf-8")))
+
+
+# --- version 3: the margin --------------------------------------------------------------------
+def test_a_margin_is_written_as_version_3_and_read_back():
+    chain = _quiet_load(GALLERY / "example1.json")
+    plain = design_to_dict(chain, name="x", units="cm")
+    chain.margin = 0.05
+    document = design_to_dict(chain, name="x", units="cm")
+    assert (document["version"], document["margin"]) == (3, 0.05)
+    assert {k: v for k, v in document.items() if k not in ("version", "margin")} == {
+        k: v for k, v in plain.items() if k != "version"
+    }
+    again = chain_from_dict(document)
+    assert type(again) is KinematicChain and again.margin == 0.05
+    # the same chain as without the margin, bit for bit
+    assert fingerprint(again) == fingerprint(chain_from_dict(plain))
+    assert design_to_dict(again, name="x", units="cm") == document
+    jsonschema.Draft202012Validator(design_schema()).validate(document)
+
+
+def test_a_tree_with_a_margin_is_version_3_and_stays_a_tree():
+    tree = _quiet_load(GALLERY / "gripper.json")
+    plain = design_to_dict(tree, name="x")
+    tree.margin = 0.2
+    document = design_to_dict(tree, name="x")
+    assert (document["version"], document["structure"], document["margin"]) == (3, "tree", 0.2)
+    again = chain_from_dict(document)
+    assert type(again) is KinematicTree and again.margin == 0.2
+    assert fingerprint(again) == fingerprint(chain_from_dict(plain))
+    jsonschema.Draft202012Validator(design_schema()).validate(document)
+
+
+def test_margin_0_writes_the_version_as_before():
+    """Old files round-trip unchanged: margin 0 (the default, or set) writes no margin and the
+    version of before (1 for chains, 2 for trees)."""
+    for name, version in (("example1.json", 1), ("gripper.json", 2)):
+        chain = _quiet_load(GALLERY / name)
+        chain.margin = 0.0
+        document = design_to_dict(chain, name="x")
+        assert document["version"] == version and "margin" not in document
+
+
+@pytest.mark.parametrize("version", [1, 2])
+def test_a_margin_in_an_older_version_is_refused_by_both_validators(version):
+    document = copy.deepcopy(_joints_design("example1.json"))
+    document.update(version=version, margin=0.1)
+    with pytest.raises(DesignError) as info:
+        chain_from_dict(document, "arm.json")
+    assert info.value.field == "margin"
+    assert "'margin' is a field of version 3" in info.value.reason
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.Draft202012Validator(design_schema()).validate(document)
+
+
+def test_version_2_fields_are_allowed_in_version_3():
+    document = json.loads((GALLERY / "gripper.json").read_text(encoding="utf-8"))
+    document.update(version=3, margin=0.0)
+    tree = _quiet_load_dict(document)
+    assert type(tree) is KinematicTree and tree.margin == 0.0
+    jsonschema.Draft202012Validator(design_schema()).validate(document)
+
+
+def _quiet_load_dict(document):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        return chain_from_dict(document)
+
+
+def test_a_newer_version_is_refused_in_one_line():
+    document = copy.deepcopy(_joints_design("example1.json"))
+    document["version"] = 9
+    with pytest.raises(DesignError) as info:
+        chain_from_dict(document, "arm.json")
+    text = str(info.value)
+    assert "\n" not in text and info.value.field == "version"
+    assert "version 9 is newer than this kinegami" in text and "(versions 1, 2, 3)" in text
