@@ -11,13 +11,12 @@ import json
 import warnings
 
 import pytest
+from gallery_designs import GALLERY
 
 from kinegami.clearance import clearance_report
 from kinegami.design import load_design, load_design_with_info
 from kinegami.design.reader import origin_of
 from kinegami.errors import ClearanceWarning
-
-from gallery_designs import GALLERY
 
 from .helpers import EXAMPLE1, ROOT, assert_clean_failure, main_in_process, run
 
@@ -140,5 +139,7 @@ def test_each_warning_is_said_once(tmp_path):
                                "dxf,pdf,png")  # fmt: skip
     assert code == 0
     lines = err.strip().splitlines()
-    assert lines == ["kinegami build: warning: the font DejaVu Sans has no '\N{RAISED HAND}' "
-                     "(U+270B): the PDF and the pictures draw it as an empty box"], lines  # fmt: skip
+    assert lines == [
+        "kinegami build: warning: the font DejaVu Sans has no '\N{RAISED HAND}' (U+270B): the "
+        "PDF and the pictures draw it as an empty box"
+    ], lines
