@@ -128,10 +128,8 @@ def version_problem(version) -> str:
     refused, in words: newer than this kinegami reads, or not a version at all."""
     supported = ", ".join(map(str, VERSIONS))
     if isinstance(version, int) and not isinstance(version, bool) and version > max(VERSIONS):
-        from kinegami import __version__
-
-        return (f"version {version} is newer than this kinegami ({__version__}) reads (versions "
-                f"{supported}); upgrade kinegami to read it")  # fmt: skip
+        return (f"version {version} is newer than this kinegami reads (versions {supported}); "
+                "upgrade kinegami to read it")  # fmt: skip
     return f"unsupported version; supported versions: {supported}"
 
 
