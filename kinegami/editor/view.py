@@ -396,10 +396,17 @@ class EditorView:
         framing = frame_box(lo, hi, fov, aspect)
         self.framing = framing
         if camera is not None:
-            camera.far = framing.far
-            camera.near = framing.near
-            camera.max_orbit_distance = framing.max_distance
-            camera.min_orbit_distance = framing.min_distance
+            # in an order that never has near > far or min > max (viser refuses min > max)
+            if framing.far >= camera.near:
+                camera.far, camera.near = framing.far, framing.near
+            else:
+                camera.near, camera.far = framing.near, framing.far
+            if framing.max_distance >= camera.min_orbit_distance:
+                camera.max_orbit_distance = framing.max_distance
+                camera.min_orbit_distance = framing.min_distance
+            else:
+                camera.min_orbit_distance = framing.min_distance
+                camera.max_orbit_distance = framing.max_distance
             camera.up_direction = framing.up
             camera.position = framing.position
             camera.look_at = framing.look_at

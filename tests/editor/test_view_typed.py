@@ -255,3 +255,59 @@ def test_recovering_an_autosave_of_another_size_resizes_the_grid_and_framing(vie
     assert view.grid.section == 2.0 and view.framing.radius < puma[1] / 20.0
     points_lo, points_hi = view.design_box()
     assert (points_hi - points_lo).max() < 20.0  # cm: Example 1's box
+
+
+class _Camera:
+    """A tab's camera as viser checks it: min <= max orbit distance, assignments recorded."""
+
+    fov, image_width, image_height = math.radians(75.0), 800, 900
+
+    def __init__(self):
+        self.near, self.far = 0.01, 1000.0
+        self._min, self._max = 0.01, 1e4
+        self.up_direction = self.position = self.look_at = None
+
+    @property
+    def min_orbit_distance(self):
+        return self._min
+
+    @min_orbit_distance.setter
+    def min_orbit_distance(self, value):
+        if value > self._max:
+            raise ValueError(f"min_orbit_distance ({value}) must be <= max ({self._max})")
+        self._min = value
+
+    @property
+    def max_orbit_distance(self):
+        return self._max
+
+    @max_orbit_distance.setter
+    def max_orbit_distance(self, value):
+        if value < self._min:
+            raise ValueError(f"max_orbit_distance ({value}) must be >= min ({self._min})")
+        self._max = value
+
+
+def test_the_camera_is_set_from_a_huge_design_to_a_tiny_one_and_back(view, monkeypatch):
+    """From the PUMA (mm) to Example 1 scaled to metres (1/1000 of its numbers) and back: the
+    zoom limits and clipping planes are set in an order viser accepts."""
+    from types import SimpleNamespace
+
+    camera = _Camera()
+    monkeypatch.setattr(view, "target", SimpleNamespace(camera=camera))
+    big = view.frame_camera()
+    assert (camera.near, camera.far) == (big.near, big.far)
+    limits = (camera.min_orbit_distance, camera.max_orbit_distance)
+    assert limits == (big.min_distance, big.max_distance)
+    tiny = np.array([[0.0, 0.0, 0.0], [0.012, 0.01, 0.013]])
+    monkeypatch.setattr(view, "design_box", lambda: (tiny[0], tiny[1]))
+    small = view.frame_camera()
+    assert small.max_distance < big.min_distance  # the order matters
+    limits = (camera.min_orbit_distance, camera.max_orbit_distance)
+    assert limits == (small.min_distance, small.max_distance)
+    assert camera.far == small.far and camera.near == small.near
+    assert_allclose(camera.look_at, tiny.mean(0))
+    monkeypatch.undo()
+    monkeypatch.setattr(view, "target", SimpleNamespace(camera=camera))
+    again = view.frame_camera()
+    assert camera.max_orbit_distance == again.max_distance
