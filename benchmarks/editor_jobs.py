@@ -10,8 +10,11 @@ sends the event, the server runs the command, redraws and sends the answer, the 
 Two interactions alternate: a joint picked in the Joint list (the text names it) and a state
 slider moved by a key press (the text gives the new state). They run with no job (idle), then
 while Compact runs (from the Compact button until it ends). Prints the count, median, 95th
-percentile and maximum per design and phase (milliseconds). See docs/editor.md (Background
-jobs).
+percentile and maximum per design, phase and interaction (milliseconds), and the longest
+stall of the server process in each phase: a thread that sleeps 10 ms at a time records by
+how much it wakes late (a computation holding the interpreter lock would show here). The load
+average is printed too: on a shared machine the figures follow it. See docs/editor.md
+(Background jobs).
 """
 
 from __future__ import annotations
@@ -96,12 +99,37 @@ def _interactions(page, view, joints: list[int]):
         k += 1
 
 
+class Stalls:
+    """A thread of this (the server's) process that sleeps 10 ms at a time and records how
+    late it wakes: ``worst(since)`` is the longest delay since then (milliseconds)."""
+
+    def __init__(self):
+        import threading
+
+        self.samples: list[tuple[float, float]] = []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            start = time.perf_counter()
+            time.sleep(0.01)
+            self.samples.append((start, (time.perf_counter() - start - 0.01) * 1e3))
+
+    def worst(self, since: float, until: float) -> float:
+        return max((late for t, late in self.samples if since <= t <= until), default=0.0)
+
+    def stop(self) -> None:
+        self._stop.set()
+
+
 def measure(name: str, path: Path, browser, idle: int = 12) -> dict:
     """``{(phase, interaction): [milliseconds, ...]}`` for the design ``path``."""
     from kinegami.editor.server import EditorServer
 
     server = EditorServer(path, port=0, autosave=False)
-    page = browser.new_page(viewport={"width": 1600, "height": 900})
+    page = browser.new_page(viewport={"width": 1280, "height": 720})
     try:
         page.goto(server.url)
         end = time.monotonic() + 120.0
@@ -118,12 +146,16 @@ def measure(name: str, path: Path, browser, idle: int = 12) -> dict:
         page.get_by_text("state ", exact=False).first.wait_for()
         actions = _interactions(page, view, joints)
         results: dict[tuple[str, str], list[float]] = {}
+        stalls = Stalls()
+        begun = time.perf_counter()
         for _ in range(idle):
             kind, prepare, act = next(actions)
             results.setdefault(("idle", kind), []).append(_latency(page, prepare, act))
             time.sleep(0.2)
+        idle_end = time.perf_counter()
         page.get_by_role("button", name="Compact", exact=True).click()
         started = time.monotonic()
+        job_begun = time.perf_counter()
         while view.job is None and time.monotonic() - started < 10.0:
             time.sleep(0.02)
         job = view.job
@@ -139,8 +171,11 @@ def measure(name: str, path: Path, browser, idle: int = 12) -> dict:
                 results.setdefault(("while compacting", kind), []).append(latency)
             time.sleep(0.2)
         seconds = time.monotonic() - started
+        stalls.stop()
         outcome = None if job is None else job.outcome
-        print(f"{name}: Compact ran {seconds:.1f} s ({outcome}; {view.message})", flush=True)
+        print(f"{name}: Compact ran {seconds:.1f} s ({outcome}; {view.message}); the server's "
+              f"longest stall: idle {stalls.worst(begun, idle_end):.0f} ms, while compacting "
+              f"{stalls.worst(job_begun, time.perf_counter()):.0f} ms", flush=True)  # fmt: skip
         return results
     finally:
         page.close()
@@ -154,8 +189,11 @@ def main(argv: list[str]) -> int:
     if reason is not None:
         print(f"cannot run: {reason}")
         return 1
+    import os
+
     names = argv or list(DESIGNS)
     rows = []
+    print("load average at the start: " + ", ".join(f"{v:.1f}" for v in os.getloadavg()))
     with headless_chromium.browser() as browser:
         for name in names:
             path = DESIGNS.get(name, Path(name))
@@ -169,6 +207,7 @@ def main(argv: list[str]) -> int:
     for name, phase, kind, n, median, p95, worst in rows:
         print(f"{name:<8} {phase:<17} {kind:<13} {n:>3} {median:>7.1f} {p95:>7.1f} "
               f"{worst:>7.1f}")  # fmt: skip
+    print("load average at the end: " + ", ".join(f"{v:.1f}" for v in os.getloadavg()))
     return 0
 
 

@@ -31,7 +31,7 @@ PROGRESS_INTERVAL = 0.1
 CANCEL_GRACE = 1.0
 #: How much lower the job process's CPU priority is (Unix ``nice``; the processes it starts,
 #: e.g. compaction's, inherit it).
-JOB_NICENESS = 10
+JOB_NICENESS = 5
 
 
 class Debounced:
