@@ -406,6 +406,27 @@ def test_discarding_the_offer_removes_the_autosave(design):
         again.stop()
 
 
+def test_an_old_autosave_beside_the_design_is_offered_and_moved_to_the_data_folder(design):
+    server = EditorServer(design, port=0)
+    try:
+        _, text = _edited(server)
+    finally:
+        server.stop()
+    legacy = design.parent / ".arm.json.autosave"  # where earlier versions wrote it
+    autosave_path(design).replace(legacy)
+    again = EditorServer(design, port=0)
+    try:
+        assert again.recovery is not None and again.recovery.path == legacy
+        view = again.new_view(again.server)
+        view.choose_recovery(again.recovery, "recover")
+        assert view.model.document.design_text == text and view.model.dirty
+        assert not legacy.exists()  # moved: now in the data folder
+        assert autosave_path(design).read_text(encoding="utf-8") == text
+        assert sorted(p.name for p in design.parent.iterdir()) == ["arm.json"]
+    finally:
+        again.stop()
+
+
 def test_recover_starts_every_tab_from_the_autosave(design):
     server = EditorServer(design, port=0)
     try:
