@@ -477,9 +477,11 @@ def _takeoff_summary(fabrication, info) -> list[str]:
         )
     if fabrication.takeoffs:
         overlap = fabrication.overlap(names=_joint_names(fabrication.tree))
-        body = "clear" if overlap is None else (
-            f"{lengths.mm(overlap.clearance)}: self-intersects ({overlap.first} and "
-            f"{overlap.second})"
+        margin = f"the margin {lengths.exact(fabrication.tree.margin)}"
+        body = f"clear with {margin}" if overlap is None else (
+            f"{'self-intersects, ' if overlap.clearance < 0.0 else ''}parts closer than "
+            f"{margin}: {lengths(overlap.clearance)}, between {overlap.first} and "
+            f"{overlap.second}"
         )  # fmt: skip
         lines.append(f"    folded body with the take-off links: {_printable(body)}")
     lines += [f"  note: {_printable(note)}" for note in fabrication.notes]

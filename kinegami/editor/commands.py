@@ -292,7 +292,8 @@ def _rebuilt(run: _Run, chain, joints: Sequence[Joint], keep: int = 0,
         kind = KinematicTree if _is_tree(chain) else KinematicChain
         new = run(
             "rebuilding the chain",
-            lambda: kind(root, angle, requireClearance=chain.requireClearance),
+            lambda: kind(root, angle, requireClearance=chain.requireClearance,
+                         margin=chain.margin),
         )
         start = 1
     for k in range(start, len(joints)):

@@ -280,15 +280,18 @@ def takeoff_body(tree, takeoffs: Sequence[BodyTakeoff], cache: dict | None = Non
 
 def takeoff_overlap(tree, takeoffs: Sequence[BodyTakeoff], names=None,
                     cache: dict | None = None) -> Overlap | None:  # fmt: skip
-    """The deepest overlap of the folded body with ``takeoffs`` (:func:`takeoff_body`, by the
-    rules of :func:`kinegami.bodies.tree_worst_overlap`), its parts named by the tree's joint
-    and link numbers (a cut trunk link's pieces as that link), or None when it is clear."""
+    """The closest pair of parts of the folded body with ``takeoffs`` (:func:`takeoff_body`, by
+    the rules of :func:`kinegami.bodies.tree_worst_overlap`) closer than the tree's ``margin``
+    (0: the deepest overlap), its parts named by the tree's joint and link numbers (a cut trunk
+    link's pieces as that link), or None when it is clear."""
+    margin = tree.margin
     if not takeoffs:
-        return tree_worst_overlap(tree.Joints, tree.Links, tree.Parents, tree.r, names=names)
+        return tree_worst_overlap(tree.Joints, tree.Links, tree.Parents, tree.r, names=names,
+                                  margin=margin)  # fmt: skip
     joints, links, parents, original = takeoff_body(tree, takeoffs, cache)
     if names is not None:
         names = [names[k] if k < len(names) else None for k in original]
-    found = tree_worst_overlap(joints, links, parents, tree.r, names=names)
+    found = tree_worst_overlap(joints, links, parents, tree.r, names=names, margin=margin)
     if found is None:
         return None
 

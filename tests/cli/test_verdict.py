@@ -143,3 +143,23 @@ def test_each_warning_is_said_once(tmp_path):
         "kinegami build: warning: the font DejaVu Sans has no '\N{RAISED HAND}' (U+270B): the "
         "PDF and the pictures draw it as an empty box"
     ], lines
+
+
+def test_the_editor_keeps_the_designs_margin_through_its_commands(tmp_path):
+    """A design with a margin, edited: every command's chain keeps it (the rebuild that a new
+    maxAnglePerElbow makes too), and the verdict states it; saving writes it back."""
+    from kinegami.editor import EditorModel
+
+    document = json.loads(EXAMPLE1.read_text())
+    document.update(version=3, margin=0.05)
+    design = tmp_path / "margin.json"
+    design.write_text(json.dumps(document))
+    model = EditorModel.open(design)
+    assert model.chain.margin == 0.05
+    assert model.set_options(maxAnglePerElbow=1.0).ok
+    assert model.chain.margin == 0.05
+    assert model.document.verdict.startswith("clear with margin 0.5 mm (0.05 cm): ")
+    assert model.slide(4, 0.5).ok and model.chain.margin == 0.05
+    assert model.save(tmp_path / "saved.json").ok
+    saved = json.loads((tmp_path / "saved.json").read_text())
+    assert (saved["version"], saved["margin"]) == (3, 0.05)
