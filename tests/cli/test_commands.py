@@ -156,7 +156,7 @@ BROKEN = {
         dict(DESIGN, joints=[*DESIGN["joints"][:2], {"type": "BallJoint"}]),
         ["joints[2]", "BallJoint", "RevoluteJoint"],
     ),
-    "wrong version": (dict(DESIGN, version=3), ["version", "3"]),
+    "wrong version": (dict(DESIGN, version=9), ["version", "9", "newer"]),
     "infeasible edit": (
         dict(DESIGN, edits=[{"op": "setJointState", "joint": 2, "state": 9}]),
         ["edits[0]"],

@@ -387,7 +387,7 @@ def test_save_defaults_to_the_opened_file(tmp_path):
 
 def test_loading_a_bad_file_is_a_reason_and_changes_nothing(model, tmp_path):
     bad = tmp_path / "bad.json"
-    bad.write_text('{"format": "kinegami-design", "version": 3}', encoding="utf-8")
+    bad.write_text('{"format": "kinegami-design", "version": 9}', encoding="utf-8")
     before = model.document
     result = model.load(bad)
     assert not result.ok and "version" in result.reason and "bad.json" in result.reason
