@@ -724,7 +724,9 @@ def test_hand_script_prints_the_grasps(script_runs):
     assert process.returncode == 0, err
     for grasp in ("spherical", "cylindrical"):
         line = next(line for line in out.splitlines() if line.startswith(f"{grasp} grasp"))
-        assert "middleEnd" in line and line.endswith("as folded: clear: minimum clearance 0.00347")
+        assert "middleEnd" in line and "as folded: clear with margin 0: minimum clearance " \
+            "0.00347, between link 5, straight tube and link 8, straight tube; closest where the " \
+            "tubes leaving joint 0 come out of its junction" in line
     assert "joint 1 slid -3.00 cm along its axis" in out
 
 
