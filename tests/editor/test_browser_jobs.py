@@ -136,10 +136,18 @@ def test_the_hand_moves_a_slider_while_compact_runs_and_cancel_keeps_it(served, 
 
 
 def _edit(page, view) -> None:
-    slider = page.get_by_role("slider").nth(1)  # 4: revolute
-    slider.focus()
-    slider.press("ArrowRight")
-    wait_for(lambda: view.model.dirty, "an unsaved edit on the server")
+    """Move a state slider by a key until the server's design is dirty (a slider of a design
+    just opened may be drawn again meanwhile, and a step may be refused: try the next)."""
+    for attempt in range(6):
+        slider = page.get_by_role("slider").nth(attempt % 2)
+        slider.focus()
+        slider.press("ArrowRight" if attempt < 4 else "ArrowLeft")
+        try:
+            wait_for(lambda: view.model.dirty, "an unsaved edit on the server", timeout=15.0)
+            return
+        except AssertionError:
+            continue
+    raise AssertionError(f"no slider key made an edit ({view.message})")
 
 
 def _open_puma(page) -> None:
