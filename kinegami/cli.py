@@ -81,12 +81,12 @@ def _write_pngs(job: BuildJob, paths: list[Path]) -> None:
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 
-    fig, _ = job.chain.show(block=False)
+    fig, _ = job.chain.show(block=False, units=job.info.units)
     try:
         fig.savefig(paths[0], dpi=150, bbox_inches="tight")
     finally:
         plt.close(fig)
-    fig, _ = job.pattern.show()
+    fig, _ = job.pattern.show(units=job.info.units)
     try:
         fig.savefig(paths[1], dpi=150, bbox_inches="tight")
     finally:
@@ -355,8 +355,10 @@ def _parse_tree_formats(text: str | None) -> list[str]:
     return known if "all" in names else list(dict.fromkeys(names))
 
 
-def _write_tree_pictures(fabrication, folder: Path, stem: str) -> list[Path]:
-    """The 3D picture of the tree and a picture of every sheet's pattern (PNG)."""
+def _write_tree_pictures(fabrication, folder: Path, stem: str, units: str | None = None
+                         ) -> list[Path]:  # fmt: skip
+    """The 3D picture of the tree and a picture of every sheet's pattern (PNG), lengths
+    labelled in ``units`` (the design's)."""
     import matplotlib
 
     matplotlib.use("Agg", force=True)
@@ -376,11 +378,11 @@ def _write_tree_pictures(fabrication, folder: Path, stem: str) -> list[Path]:
 
     # the tree as folded (take-off branches from their faces) with its connectors, when they
     # can be made here
-    view = fabrication.show(block=False, showJunctions=_importable("manifold3d")
+    view = fabrication.show(block=False, units=units, showJunctions=_importable("manifold3d")
                             and _importable("trimesh"))  # fmt: skip
     written = [save(view[0], folder / f"{stem}_3d.png")]
     for sheet in fabrication.sheets:
-        fig, _ = sheet.pattern.show()
+        fig, _ = sheet.pattern.show(units=units)
         written.append(save(fig, folder / f"{stem}_sheet_{sheet.index}_pattern.png"))
     return written
 
@@ -546,7 +548,7 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
                 names=_joint_names(fitted),
             )
             if "png" in formats:
-                _write_tree_pictures(fabrication, staging.new, stem)
+                _write_tree_pictures(fabrication, staging.new, stem, info.units)
         except KinegamiError as error:
             raise CommandError(f"{args.design}: {error}") from None
         except OSError as error:
@@ -611,9 +613,9 @@ def cmd_show(args: argparse.Namespace) -> int:
             "cannot open a window: matplotlib has no interactive backend here (no display?); "
             "use 'kinegami build DESIGN -o DIR' to write pictures instead"
         )
-    chain.show(block=False)
+    chain.show(block=False, units=info.units)
     if args.pattern:
-        chain.creasePattern(twistPortion=info.twistPortion).show()
+        chain.creasePattern(twistPortion=info.twistPortion).show(units=info.units)
     plt.show()
     return 0
 
@@ -647,7 +649,7 @@ def cmd_edit(args: argparse.Namespace) -> int:
         port = -1
     if not 0 <= port <= 65535:
         raise CommandError(f"--port must be an integer in [0, 65535], got {_printable(args.port)}")
-    from kinegami.editor.server import LOCAL_HOSTS, EditorServer
+    from kinegami.editor.server import EditorServer, is_local
 
     server = EditorServer(args.design, host=args.host, port=port, recover=args.recover)
     try:
@@ -669,9 +671,13 @@ def cmd_edit(args: argparse.Namespace) -> int:
         elif args.recover:
             _note("edit", "--recover: there is no autosave newer than the design; starting "
                           "from the design")  # fmt: skip
-        if args.host not in LOCAL_HOSTS:
-            _warn("edit", f"listening on {args.host}: anyone who can reach this machine on the "
-                          "network can open the editor and edit designs")  # fmt: skip
+        if not is_local(args.host):
+            saved = f"save {what}" if args.design else "download designs"
+            _warn("edit", f"listening on {_printable(args.host)}: anyone who can reach port "
+                          f"{server.port} of this machine and has the token can open the editor, "
+                          f"edit and {saved} (plain HTTP: the token crosses the network "
+                          "unencrypted); from another machine, open the address with this "
+                          "machine's name in place of its host")  # fmt: skip
         while True:
             time.sleep(3600)
     finally:
@@ -1182,13 +1188,15 @@ def make_parser() -> argparse.ArgumentParser:
         "address. Each browser tab edits its own copy of DESIGN (default: the starter design); "
         "designs are saved to DESIGN or downloaded, and unsaved changes are autosaved beside "
         "DESIGN (or in the user's data folder) and offered back on the next start. Listens on "
-        "127.0.0.1 unless --host says otherwise. Runs until Ctrl-C.",
+        "127.0.0.1 unless --host says otherwise; the printed address carries a secret token, and "
+        "requests without it, or from another site's page, are refused. Runs until Ctrl-C.",
     )
     edit.add_argument("design", metavar="DESIGN", nargs="?", help="design file (.json)")
     edit.add_argument("--port", metavar="P", default="8080", help="port (default: %(default)s; "
                       "0: a free one)")  # fmt: skip
     edit.add_argument("--host", metavar="H", default="127.0.0.1", help="address to listen on "
-                      "(default: %(default)s, this machine only)")  # fmt: skip
+                      "(default: %(default)s, this machine only; any other prints a warning: "
+                      "whoever can reach the port and has the token can edit)")  # fmt: skip
     edit.add_argument(
         "--recover",
         action="store_true",
