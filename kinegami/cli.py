@@ -654,6 +654,13 @@ def cmd_edit(args: argparse.Namespace) -> int:
     server = EditorServer(args.design, host=args.host, port=port, recover=args.recover)
     try:
         what = _printable(str(args.design)) if args.design else "the starter design"
+        if not is_local(args.host):
+            saved = f"save {what}" if args.design else "download designs"
+            _warn("edit", f"listening on {_printable(args.host)}: anyone who can reach port "
+                          f"{server.port} of this machine and has the token can open the editor, "
+                          f"edit and {saved} (plain HTTP: the token crosses the network "
+                          "unencrypted); from another machine, open the address with this "
+                          "machine's name in place of its host")  # fmt: skip
         print(f"kinegami edit: editing {what} at {server.url} (each tab edits its own copy; "
               "Ctrl-C stops)", flush=True)  # fmt: skip
         recovery = server.recovery
@@ -671,13 +678,6 @@ def cmd_edit(args: argparse.Namespace) -> int:
         elif args.recover:
             _note("edit", "--recover: there is no autosave newer than the design; starting "
                           "from the design")  # fmt: skip
-        if not is_local(args.host):
-            saved = f"save {what}" if args.design else "download designs"
-            _warn("edit", f"listening on {_printable(args.host)}: anyone who can reach port "
-                          f"{server.port} of this machine and has the token can open the editor, "
-                          f"edit and {saved} (plain HTTP: the token crosses the network "
-                          "unencrypted); from another machine, open the address with this "
-                          "machine's name in place of its host")  # fmt: skip
         while True:
             time.sleep(3600)
     finally:

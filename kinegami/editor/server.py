@@ -3,14 +3,16 @@
 >>> from kinegami.editor.server import EditorServer
 >>> server = EditorServer(port=0)  # doctest: +SKIP
 >>> server.url  # doctest: +SKIP
-'http://127.0.0.1:8080'
+'http://127.0.0.1:8080/?token=...'
 
 Every tab (viser client) gets an :class:`~kinegami.editor.view.EditorView` over a new
 :class:`~kinegami.editor.model.EditorModel` of the starting design; the design is read once,
 on the server, from the path given on the command line. Browsers can only upload design
 files' contents, never name server paths: the only files the server writes are that design
 (the Save button) and its autosave in the user's data folder
-(:mod:`kinegami.editor.autosave`). See docs/editor.md.
+(:mod:`kinegami.editor.autosave`). Only the holder of the token in :attr:`EditorServer.url`
+may use the server, and only from the editor's own page (:mod:`kinegami.editor.access`). See
+docs/editor.md.
 """
 
 from __future__ import annotations
@@ -22,6 +24,13 @@ import threading
 import warnings
 from pathlib import Path
 
+from kinegami.editor.access import (
+    TOKEN_PARAMETER,
+    Gate,
+    GuardError,
+    guard_viser,
+    is_loopback,
+)
 from kinegami.editor.autosave import Autosaver, Recovery, autosave_path, find_recovery
 from kinegami.editor.background import ProcessWorker
 from kinegami.editor.commands import ReplaceDocument
@@ -30,10 +39,19 @@ from kinegami.editor.model import EditorModel
 from kinegami.editor.view import EditorView, gallery
 from kinegami.errors import ClearanceWarning, ExporterUnavailableError
 
-__all__ = ["EditorServer", "LOCAL_HOSTS", "starting_document"]
+__all__ = ["EditorServer", "LOCAL_HOSTS", "is_local", "starting_document"]
 
-#: Hosts that only this machine can reach (any other --host gets a warning).
+#: The usual hosts that only this machine can reach (any loopback address is local too; any
+#: other --host gets a warning, see :func:`is_local`).
 LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
+#: Hosts that listen on every address of the machine: the printed address names this machine.
+_WILDCARD_HOSTS = {"0.0.0.0": "127.0.0.1", "::": "::1", "": "127.0.0.1"}
+
+
+def is_local(host: str) -> bool:
+    """Whether listening on ``host`` keeps the editor on this machine (``localhost`` or a
+    loopback address)."""
+    return host in LOCAL_HOSTS or is_loopback(host)
 
 
 def starting_document(design: str | os.PathLike | None = None) -> Document:
@@ -69,12 +87,18 @@ class EditorServer:
         :mod:`kinegami.editor.autosave`).
     recover : start every tab from the autosave found on start (when there is one) instead
         of asking.
+    token : the secret of :attr:`url` (None: a new random one).
+
+    Every request (page, asset, websocket) passes :class:`~kinegami.editor.access.Gate` first:
+    a foreign ``Origin`` or a missing or wrong token gets a 403 (docs/editor.md, Security).
     """
 
     def __init__(self, design: str | os.PathLike | None = None, host: str = "127.0.0.1",
                  port: int = 8080, *, autosave: bool = True,
-                 recover: bool = False):  # fmt: skip
+                 recover: bool = False, token: str | None = None):  # fmt: skip
         viser = _viser()
+        #: The access check of every request (its token is in :attr:`url`).
+        self.gate = Gate(token, local_only=is_local(host))
         self.document = starting_document(design)
         self.path = None if design is None else Path(os.fspath(design))
         self.views: dict[int, EditorView] = {}
@@ -91,9 +115,17 @@ class EditorServer:
         self.worker = ProcessWorker()
         if port == 0:
             port = _free_port(host)
-        with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the CLI prints its own
+        banner = contextlib.redirect_stdout(io.StringIO())  # viser's: the CLI prints its own
+        with banner, guard_viser(self.gate) as guarded:
             self.server = viser.ViserServer(host=host, port=port, label="kinegami edit",
                                             verbose=False)  # fmt: skip
+        if guarded() < 1:  # fail closed: never serve the editor unchecked
+            with contextlib.redirect_stdout(io.StringIO()):
+                self.server.stop()
+            self.worker.close()
+            raise GuardError(f"viser {viser.__version__} did not start its server through "
+                             "websockets.asyncio.server.serve: kinegami edit cannot check its "
+                             "requests and does not serve")  # fmt: skip
         self.server.on_client_connect(self._connect)
         self.server.on_client_disconnect(self._disconnect)
 
@@ -102,11 +134,20 @@ class EditorServer:
         return self.server.get_port()
 
     @property
-    def url(self) -> str:
+    def address(self) -> str:
+        """The server's address without the token (``http://host:port``; a wildcard --host
+        such as 0.0.0.0 as this machine's loopback address)."""
         host = self.server.get_host()
+        host = _WILDCARD_HOSTS.get(host, host)
         if ":" in host:
             host = f"[{host}]"
         return f"http://{host}:{self.port}"
+
+    @property
+    def url(self) -> str:
+        """The address to open in a browser: :attr:`address` with the token
+        (``http://127.0.0.1:8080/?token=...``)."""
+        return f"{self.address}/?{TOKEN_PARAMETER}={self.gate.token}"
 
     def autosaver(self, design: Path | None) -> Autosaver:
         """The one autosaver of a design file (None: of designs with no file), shared by the
