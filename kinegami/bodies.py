@@ -932,32 +932,99 @@ def _polyline_samples(points: np.ndarray, step: float) -> tuple[np.ndarray, np.n
     return points[k] + t[:, None] * d[k], s
 
 
+#: Most sample points junction_extent evaluates at once (bounds its temporary arrays).
+_JUNCTION_CHUNK = 65_536
+
+
 def junction_extent(
-    polyline: np.ndarray, own: tuple, siblings: tuple, r: float, margin: float = 0.0
+    polyline: np.ndarray, own: tuple, siblings: tuple, r: float, margin: float = 0.0,
+    limit: float = math.inf,
 ) -> float:
     """How far (along ``polyline``, from its start) a tube leaving a branching joint runs
     within 2r + ``margin`` of a sibling tube leaving the same frame: the distance along it of
     the last point of its capsules (``own``: segment starts and ends) that close to a sibling
     capsule (``siblings``), sampled every 0.02 r. The junction body covers the tube up to there
-    (docs/trees.md). 0 when nothing is that close."""
+    (docs/trees.md). 0 when nothing is that close. With ``limit``, the answer is wanted only up
+    to it: ``limit`` is returned as soon as the extent is known to reach it.
+
+    Only the samples that can be that close are evaluated (those within the finite cylinder of
+    radius 2r + margin around some sibling segment), a bounded number at a time, so tubes
+    1e6 r long cost no more memory than short ones (issue 29)."""
     a, b = siblings
     if a.shape[0] == 0 or own[0].shape[0] == 0:
         return 0.0
     starts, ends = own
     lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
     counts = np.maximum(2, np.ceil(lengths / (0.02 * r)).astype(np.int64) + 1)
-    owner = np.repeat(np.arange(starts.shape[0]), counts)
-    first = np.cumsum(counts) - counts
-    u = (np.arange(owner.size) - first[owner]) / (counts[owner] - 1)
-    points = starts[owner] + u[:, None] * (ends - starts)[owner]
-    t = _point_params(points[:, None, :], a[None], b[None])
-    nearest = a[None] + t[..., None] * (b - a)[None]
-    distance = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)
-    close = distance < (2.0 * r + margin) * (1.0 - CONTACT_TOLERANCE)
-    if not close.any():
+    reach = (2.0 * r + margin) * (1.0 - CONTACT_TOLERANCE)
+    found = -math.inf
+    for i, k0, k1 in _candidate_samples(starts, ends, counts, a, b, reach):
+        for c0 in range(k0, k1, _JUNCTION_CHUNK):
+            k = np.arange(c0, min(k1, c0 + _JUNCTION_CHUNK), dtype=np.int64)
+            u = k / (counts[i] - 1)
+            points = starts[i] + u[:, None] * (ends[i] - starts[i])
+            t = _point_params(points[:, None, :], a[None], b[None])
+            nearest = a[None] + t[..., None] * (b - a)[None]
+            distance = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)
+            close = distance < reach
+            if close.any():
+                found = max(found, float(_polyline_distance(points[close], polyline).max()))
+                if found + 0.02 * r >= limit:
+                    return limit
+    if found == -math.inf:
         return 0.0
-    along = _polyline_distance(points[close], polyline)
-    return float(along.max()) + 0.02 * r
+    return found + 0.02 * r
+
+
+def _candidate_samples(starts, ends, counts, a, b, reach: float):
+    """``(i, k0, k1)``: the sample indices k0 <= k < k1 of own segment i (sample k at
+    parameter k / (counts[i] - 1)) that may lie within ``reach`` of a sibling segment (a, b):
+    those inside the cylinder of radius ``reach`` around the sibling's line, between the planes
+    ``reach`` beyond its ends (a superset of the capsule), padded by two samples on each side
+    against rounding. Disjoint ranges, the last samples of the last segments first."""
+    d = ends - starts  # own directions (n, 3)
+    e = b - a
+    length = np.sqrt((e**2).sum(axis=1))
+    e = np.where(length[:, None] > 0.0, e / np.where(length > 0.0, length, 1.0)[:, None], 0.0)
+    rel = starts[:, None, :] - a[None]  # (n, m, 3)
+    t0 = (rel * e[None]).sum(axis=2)  # axial coordinate at u = 0 and its rate
+    t1 = (d[:, None, :] * e[None]).sum(axis=2)
+    w0 = rel - t0[..., None] * e[None]  # the part across the sibling's line
+    w1 = d[:, None, :] - t1[..., None] * e[None]
+    ww = (w1**2).sum(axis=2)
+    slack = reach * (1.0 + 1e-6) + 1e-9 * max(float(np.abs(rel).max()), 1.0)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        # across: |w0 + u w1| < slack, an interval around the nearest u
+        centre = np.where(ww > 0.0, -(w0 * w1).sum(axis=2) / np.where(ww > 0.0, ww, 1.0), 0.0)
+        gap = np.sqrt(((w0 + centre[..., None] * w1) ** 2).sum(axis=2))
+        half = np.where(ww > 0.0, np.sqrt(np.maximum(slack**2 - gap**2, 0.0) / ww), np.inf)
+        inside = gap < slack
+        lo, hi = centre - half, centre + half
+        # along: -slack < t0 + u t1 < length + slack
+        ua = (-slack - t0) / t1
+        ub = (length[None] + slack - t0) / t1
+        moving = t1 != 0.0
+        lo = np.where(moving, np.maximum(lo, np.minimum(ua, ub)), lo)
+        hi = np.where(moving, np.minimum(hi, np.maximum(ua, ub)), hi)
+        inside &= moving | ((t0 > -slack) & (t0 < length[None] + slack))
+    lo, hi = np.maximum(lo, 0.0), np.minimum(hi, 1.0)
+    inside &= lo <= hi
+    ranges = []
+    for i in range(starts.shape[0]):
+        steps = int(counts[i]) - 1
+        spans = sorted(
+            (max(0, math.floor(lo[i, j] * steps) - 2),
+             min(steps + 1, math.ceil(hi[i, j] * steps) + 3))
+            for j in np.flatnonzero(inside[i])
+        )  # fmt: skip
+        merged: list[list[int]] = []
+        for k0, k1 in spans:
+            if merged and k0 <= merged[-1][1]:
+                merged[-1][1] = max(merged[-1][1], k1)
+            else:
+                merged.append([k0, k1])
+        ranges += [(i, k0, k1) for k0, k1 in merged]
+    return reversed(ranges)
 
 
 def _point_params(points, a, b) -> np.ndarray:
@@ -1070,7 +1137,7 @@ def tree_pair_distances(
             theirs = np.isin(node, [m for m, top in branch_of.items() if top in kids and top != k])
             theirs &= is_link
             found = junction_extent(polylines[k], (a[mine], b[mine]), (a[theirs], b[theirs]), r,
-                                    margin)  # fmt: skip
+                                    margin, limit=JUNCTION_REACH * r)  # fmt: skip
             extent[k] = min(found, JUNCTION_REACH * r)
 
     centre = 0.5 * (a + b)
