@@ -216,8 +216,20 @@ class _JointAssembly:
     def _overlap(self, joints, links, parents, since: int = 0):
         """The closest pair of the given lists closer than the margin (an Overlap) or None;
         with ``since`` = k only pairs with a part of joint k or later (docs/clearance.md).
-        ``parents`` as :meth:`_extended` returns them (a chain ignores them)."""
-        return worst_overlap(joints, links, self.r, since=since, margin=self._margin)
+        ``parents`` as :meth:`_extended` returns them (a chain ignores them).
+
+        Placement tests its candidate (``since`` > 0) and then commits the same lists, which
+        are built for it and never changed: the last such answer is kept for that commit.
+        """
+        if since > 0:
+            last = self.__dict__.get("_placement_check")
+            if (last is not None and last[0] is joints and last[1] is links
+                    and last[2] == (since, self._margin)):  # fmt: skip
+                return last[3]
+        found = worst_overlap(joints, links, self.r, since=since, margin=self._margin)
+        if since > 0:
+            self._placement_check = (joints, links, (since, self._margin), found)
+        return found
 
     def _own_overlap(self):
         """The deepest overlap of the chain as it is (an Overlap) or None, computed once per
@@ -252,6 +264,7 @@ class _JointAssembly:
             self._reject(f"{what} failed: the {self._noun} would pass through itself ({found})")
             return False
         self._commit(joints, links, ball, parents)
+        self.__dict__.pop("_placement_check", None)
         self._overlap_memo = (self._joints, self._links, found, self._margin)
         if found is not None:
             warnings.warn(
