@@ -324,7 +324,9 @@ def test_without_the_check_the_editor_does_not_serve(monkeypatch, design):
         yield lambda: 0
 
     monkeypatch.setattr(server_module, "guard_viser", bypassed)
-    port = server_module._free_port("127.0.0.1")
+    with socket.socket() as free:
+        free.bind(("127.0.0.1", 0))
+        port = free.getsockname()[1]
     with pytest.raises(GuardError, match="cannot check its requests and does not serve"):
         server_module.EditorServer(design, port=port, autosave=False)
     with socket.socket() as probe:
@@ -379,6 +381,13 @@ def test_kinegami_edit_on_every_address_warns(design, data_home):
         url = urlsplit(printed_url(run["line"]))
         assert url.hostname == "127.0.0.1" and "token" in parse_qs(url.query)
         assert status(url, "/")[0] == 403
+        # reached under the machine's network name: that Host is fine, a foreign Origin is not
+        named = {"Host": f"mybox.example:{url.port}"}
+        assert status(url, f"/?{url.query}", named)[0] == 302
+        own = {**named, "Origin": f"http://mybox.example:{url.port}"}
+        assert status(url, f"/?{url.query}", own)[0] == 302
+        foreign = {**named, "Origin": f"http://127.0.0.1:{url.port}"}
+        assert status(url, f"/?{url.query}", foreign)[0] == 403
     assert "kinegami edit: warning: listening on 0.0.0.0: anyone who can reach port " in run[
         "stderr"]
     assert f"and has the token can open the editor, edit and save {design}" in run["stderr"]
