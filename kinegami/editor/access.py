@@ -23,11 +23,14 @@ import contextlib
 import http
 import ipaddress
 import secrets
+import string
 import threading
 from collections.abc import Callable, Iterator
 from http.cookies import CookieError, SimpleCookie
 from typing import Any
 from urllib.parse import parse_qsl, urlencode, urlsplit
+
+from kinegami.errors import InvalidParameterError, KinegamiError
 
 __all__ = [
     "COOKIE_PREFIX",
@@ -46,10 +49,11 @@ TOKEN_PARAMETER = "token"
 COOKIE_PREFIX = "kinegami-edit-"
 
 _FORBIDDEN = http.HTTPStatus.FORBIDDEN
+_TOKEN_CHARACTERS = frozenset(string.ascii_letters + string.digits + "-_")
 _SERVE_LOCK = threading.Lock()
 
 
-class GuardError(RuntimeError):
+class GuardError(KinegamiError, RuntimeError):
     """The access check could not be put in front of viser's requests (a viser or websockets
     version that does not start its server through ``websockets.asyncio.server.serve``)."""
 
@@ -103,21 +107,26 @@ class Gate:
     (``Sec-Fetch-Site``) that another page asks for it, other than by a top-level navigation
     (a script, an image, a frame); when the server listens on this machine only and the
     ``Host`` header names another one (a DNS rebinding); or when it has no valid token: the
-    ``token`` query parameter or this server's cookie. A page request
-    with a valid ``token`` parameter is answered with the cookie (HttpOnly, SameSite=Strict)
-    and a redirect to the same address without the token, so that the page's websocket
-    carries the cookie and the token does not stay in the address bar.
+    ``token`` query parameter or this server's cookie. A page request with a valid ``token``
+    parameter is answered with the cookie (HttpOnly, SameSite=Strict) and a redirect to the
+    page without the token, so that the page's websocket carries the cookie and the token does
+    not stay in the address bar.
 
     Parameters
     ----------
-    token : the secret (None: a new one from :func:`secrets.token_urlsafe`, 256 bits).
+    token : the secret (None: a new one from :func:`secrets.token_urlsafe`, 256 bits; else at
+        least 16 characters among letters, digits, ``-`` and ``_``).
     local_only : the server listens on a loopback address: refuse any other ``Host``.
     """
 
     def __init__(self, token: str | None = None, *, local_only: bool = True):
         self.token = secrets.token_urlsafe(32) if token is None else str(token)
-        if len(self.token) < 16:
-            raise ValueError(f"token: at least 16 characters, got {len(self.token)}")
+        others = not set(self.token) <= _TOKEN_CHARACTERS
+        if len(self.token) < 16 or others:  # the token itself is not repeated: it is a secret
+            raise InvalidParameterError(
+                "token must be at least 16 characters among letters, digits, '-' and '_', got "
+                f"{len(self.token)} characters" + (", some of them others" if others else "")
+            )
         self.local_only = bool(local_only)
         self._count_lock = threading.Lock()
         #: Requests refused so far (HTTP and websocket), and by reason.
@@ -155,7 +164,7 @@ class Gate:
                 return self._refuse(connection, "host", "the editor answers only its own "
                                                         "address on this machine")  # fmt: skip
         port = connection.local_address[1]
-        path, _, query = request.path.partition("?")
+        query = request.path.partition("?")[2]
         params = parse_qsl(query, keep_blank_values=True)
         given = [value for key, value in params if key == TOKEN_PARAMETER]
         upgrade = "websocket" in headers.get("Upgrade", "").lower()
@@ -166,7 +175,7 @@ class Gate:
                 return None
             rest = urlencode([(key, value) for key, value in params if key != TOKEN_PARAMETER])
             response = connection.respond(http.HTTPStatus.FOUND, "")
-            response.headers["Location"] = (path or "/") + (f"?{rest}" if rest else "")
+            response.headers["Location"] = "/" + (f"?{rest}" if rest else "")  # never off-site
             response.headers["Set-Cookie"] = (f"{self.cookie_name(port)}={self.token}; Path=/; "
                                               "HttpOnly; SameSite=Strict")  # fmt: skip
             response.headers["Cache-Control"] = "no-store"

@@ -68,8 +68,11 @@ def test_tokens_are_random_and_compared_whole():
     assert gate.valid(gate.token)
     assert not gate.valid(gate.token[:-1]) and not gate.valid(gate.token + "x")
     assert not gate.valid("") and not gate.valid(None) and not gate.valid("é" * 43)
-    with pytest.raises(ValueError, match="token: at least 16 characters, got 3"):
+    with pytest.raises(ValueError, match="token must be at least 16 characters among letters, "
+                                         "digits, '-' and '_', got 3 characters$"):  # fmt: skip
         Gate("abc")
+    with pytest.raises(ValueError, match="got 20 characters, some of them others"):
+        Gate("a" * 16 + "; x=")  # it goes into a Set-Cookie header
 
 
 # --- a running editor -----------------------------------------------------------------------
@@ -141,6 +144,8 @@ def test_the_printed_url_sets_a_strict_httponly_cookie_and_drops_the_token(serve
     assert headers["Set-Cookie"] == (f"kinegami-edit-{server.port}={server.gate.token}; Path=/; "
                                      "HttpOnly; SameSite=Strict")  # fmt: skip
     assert headers["Cache-Control"] == "no-store"
+    status, headers, _ = get(server, "//evil.example/" + token_query(server)[1:])
+    assert status == 302 and headers["Location"] == "/"  # never to another site
     status, headers, body = get(server, "/", cookie(server))
     assert status == 200 and body.startswith(b"<!doctype html>")
     assert headers["X-Frame-Options"] == "DENY"
