@@ -32,6 +32,7 @@ from kinegami import __version__, _startup
 from kinegami._record import Record
 from kinegami._startup import INTERRUPTED
 from kinegami.errors import KinegamiError
+from kinegami.limits import MAX_INTEGER_DIGITS, MAX_SAMPLES
 from kinegami.validation import shown, shown_path
 
 #: Millimetres per design length unit.
@@ -213,8 +214,9 @@ def _summary(job: BuildJob, design: str) -> list[str]:
 # --- clearance (`check` and the build summary) -------------------------------------------------
 #: Exit code of ``check`` when the design self-intersects at its states.
 SELF_INTERSECTS = 3
-#: Most configurations ``check --motion`` samples.
-MAX_MOTION = 1_000_000
+#: Most configurations ``check --motion`` samples (also at most MAX_SAMPLED_STATES / joints:
+#: docs/limits.md).
+MAX_MOTION = MAX_SAMPLES
 #: Most overlapping pairs ``check`` lists in words (``--json`` lists them all).
 LISTED_PAIRS = 20
 
@@ -732,15 +734,18 @@ def _overlap_warning(report, info, design: str) -> str:
     )
 
 
-def _integer(option: str, text: str, low: int, high: int | None = None) -> int:
+def _integer(option: str, text: str, low: int, high: int | None = None, why: str = "") -> int:
     """The integer value of an option given as ``text``, within [low, high], or a
-    CommandError naming the option, the value and the valid range."""
+    CommandError naming the option, the value, the valid range and ``why`` (a limit's reason,
+    docs/limits.md)."""
     import re
 
     from kinegami.validation import shorten
 
     valid = f"an integer >= {low}" if high is None else f"an integer in [{low}, {high}]"
-    if not re.fullmatch(r"[+-]?[0-9]{1,30}", text.strip()):
+    if why:
+        valid += f" ({why})"
+    if not re.fullmatch(rf"[+-]?[0-9]{{1,{MAX_INTEGER_DIGITS}}}", text.strip()):
         raise CommandError(f"{option}: must be {valid}, got {shorten(text)!r}")
     value = int(text)
     if value < low or (high is not None and value > high):
@@ -873,9 +878,16 @@ def cmd_check(args: argparse.Namespace) -> int:
 
     from kinegami.clearance import sweep
 
-    samples = None if args.motion is None else _integer("--motion", args.motion, 1, MAX_MOTION)
+    samples = None if args.motion is None else _integer(
+        "--motion", args.motion, 1, MAX_MOTION,
+        "each is a clearance test of the whole chain; kinegami.limits.MAX_SAMPLES",
+    )  # fmt: skip
     seed = _integer("--seed", args.seed, 0)
     chain, info = _load(args.design)
+    if samples is not None:
+        from kinegami.validation import check_samples
+
+        samples = check_samples("--motion", samples, len(chain.Joints))
     _margin(args, chain)
     names = _joint_names(chain)
     report = _clearance(chain)

@@ -42,7 +42,9 @@ from kinegami.validation import (
     check_in_range,
     check_int,
     check_length,
+    check_num_layers,
     check_num_sides,
+    check_num_sink_layers,
     check_radius,
     check_translation_part,
     shown,
@@ -427,7 +429,7 @@ class RevoluteJoint(Joint):
         )
         self._set_attribute("totalBendingAngle", B)
         self._set_attribute(
-            "numSinkLayers", check_int("numSinkLayers", numSinkLayers, minimum=1)
+            "numSinkLayers", check_num_sink_layers(numSinkLayers)
         )
         L = 2.0 * r * math.cos(math.pi / n) * math.tan(B / 4.0)
         super().__init__(n, r, L, Pose)
@@ -475,7 +477,7 @@ class PrismaticJoint(Joint):
         n = check_num_sides(numSides)
         r = check_radius(r)
         d = check_length("neutralLength", neutralLength, r)
-        self._set_attribute("numLayers", check_int("numLayers", numLayers, minimum=1))
+        self._set_attribute("numLayers", check_num_layers(numLayers))
         cone = check_in_range(
             "coneAngle",
             coneAngle,

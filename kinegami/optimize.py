@@ -36,7 +36,13 @@ from kinegami.joints import Waypoint
 from kinegami.progress import Progress, ProgressCallback, check_progress
 from kinegami.tree import KinematicTree
 from kinegami.tree.sheets import junction_problems
-from kinegami.validation import check_bool, check_int, check_positive
+from kinegami.validation import (
+    check_bool,
+    check_int,
+    check_positive,
+    check_samples,
+    check_starts,
+)
 
 __all__ = ["compact", "CompactionError", "shorten_by_axis_translations", "tube_length"]
 
@@ -713,8 +719,8 @@ def compact(
         time_limit = check_positive("time_limit", time_limit)
     if objective not in ("length", "ball"):
         raise InvalidParameterError(f"objective must be 'length' or 'ball', got {objective!r}")
-    starts = check_int("starts", starts, minimum=1)
-    samples = check_int("samples", samples, minimum=1)
+    starts = check_starts(starts)
+    samples = check_samples("samples", samples, len(chain.Joints))
     progress = check_progress(progress)
     if margin is not None:
         margin = check_margin(margin)

@@ -35,19 +35,21 @@ from kinegami._format import (  # noqa: F401  (also importable from here, their 
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError, ReadOnlyError
 
-#: Smallest and largest tube radius r (in the chain's length unit), as in design files.
-R_MIN = 1e-6
-R_MAX = 1e6
-#: Every length, distance and translation coordinate given to the API (and written in a design
-#: file) satisfies ``|value| <= LENGTH_FACTOR * r``. With r <= R_MAX, squares and products of
-#: such values stay far from the float range, and r stays well above their rounding error.
-LENGTH_FACTOR = 1e6
-#: Most polygon sides of a tube given to the API: far more than any foldable tube, and far below
-#: what would exhaust memory (at 256 sides, already, elbows and joints are too fine to resolve
-#: and say so). Design and joint-specification files allow at most FILE_NUM_SIDES_MAX.
-NUM_SIDES_MAX = 1024
-#: Most polygon sides in a design or joint-specification file (kinegami.design.limits).
-FILE_NUM_SIDES_MAX = 64
+# The bounds themselves live in kinegami.limits (docs/limits.md); they are importable from here
+# too, their old home.
+from kinegami.limits import (  # noqa: F401
+    FILE_NUM_SIDES_MAX,
+    LENGTH_FACTOR,
+    MAX_SAMPLED_STATES,
+    MAX_SAMPLES,
+    MAX_STARTS,
+    MIN_ANGLE_PER_ELBOW,
+    NUM_LAYERS_MAX,
+    NUM_SIDES_MAX,
+    NUM_SINK_LAYERS_MAX,
+    R_MAX,
+    R_MIN,
+)
 
 
 def check_bool(name: str, value, none: bool = False) -> bool | None:
@@ -226,10 +228,62 @@ def check_radius(value, name: str = "r") -> float:
 
 
 def check_max_angle_per_elbow(value) -> float:
-    """maxAnglePerElbow in (0, pi]."""
-    return check_in_range(
-        "maxAnglePerElbow", value, 0.0, math.pi, high_inclusive=True, range_text="(0, pi]"
-    )
+    """maxAnglePerElbow in [pi/180, pi] (radians): a link has ceil(turn / maxAnglePerElbow)
+    elbows, so a tiny value would ask for billions (kinegami.limits.MIN_ANGLE_PER_ELBOW)."""
+    value = check_real("maxAnglePerElbow", value)
+    if not MIN_ANGLE_PER_ELBOW <= value <= math.pi:
+        raise InvalidParameterError(
+            f"maxAnglePerElbow must lie in [pi/180, pi] (one degree to half a turn: each link "
+            f"has ceil(turn / maxAnglePerElbow) elbows, kinegami.limits.MIN_ANGLE_PER_ELBOW), "
+            f"got {value!r}"
+        )
+    return value
+
+
+def check_num_sink_layers(value) -> int:
+    """numSinkLayers of a revolute joint: an integer in [1, NUM_SINK_LAYERS_MAX] = [1, 32]."""
+    return _check_count(
+        "numSinkLayers", value, NUM_SINK_LAYERS_MAX, "NUM_SINK_LAYERS_MAX",
+        "the joint's pattern grows with every layer",
+    )  # fmt: skip
+
+
+def check_num_layers(value) -> int:
+    """numLayers of a prismatic joint: an integer in [1, NUM_LAYERS_MAX] = [1, 200]."""
+    return _check_count(
+        "numLayers", value, NUM_LAYERS_MAX, "NUM_LAYERS_MAX",
+        "the joint's pattern has about 3 numSides vertices per layer",
+    )  # fmt: skip
+
+
+def check_samples(name: str, value, joints: int) -> int:
+    """A number of sampled configurations of a chain of ``joints`` joints: an integer in
+    [1, MAX_SAMPLES], with ``value * joints <= MAX_SAMPLED_STATES`` (docs/limits.md)."""
+    n = _check_count(name, value, MAX_SAMPLES, "MAX_SAMPLES",
+                     "each is a clearance test of the whole chain")  # fmt: skip
+    if n * joints > MAX_SAMPLED_STATES:
+        raise InvalidParameterError(
+            f"{name}: {n} configurations of {joints} joints are {n * joints} sampled states, "
+            f"more than {MAX_SAMPLED_STATES} (they are held in memory at once; "
+            f"kinegami.limits.MAX_SAMPLED_STATES): use at most {MAX_SAMPLED_STATES // joints}"
+        )
+    return n
+
+
+def check_starts(value) -> int:
+    """The number of starts of a compaction: an integer in [1, MAX_STARTS]."""
+    return _check_count("starts", value, MAX_STARTS, "MAX_STARTS", "each is a whole search")
+
+
+def _check_count(name: str, value, maximum: int, constant: str, why: str) -> int:
+    """An integer in [1, maximum], or an error naming the value, the limit and ``why``."""
+    n = check_int(name, value, minimum=1)
+    if n > maximum:
+        raise InvalidParameterError(
+            f"{name} must be an integer in [1, {maximum}] ({why}; "
+            f"kinegami.limits.{constant}), got {shown(n)}"
+        )
+    return n
 
 
 def check_twist_portion(value) -> float:

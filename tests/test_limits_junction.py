@@ -8,6 +8,7 @@ can be close to a sibling, a bounded number at a time, with the same answers.
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 import textwrap
@@ -124,3 +125,86 @@ def test_a_tree_with_branches_1e6_r_long_builds_in_bounded_memory(far):
                           timeout=120)  # fmt: skip
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split() == ["KinematicTree", "True"]
+
+
+# --- the printed connector's sibling overlap (kinegami.tree.connector) -------------------------
+def _overlap_reference(links, r, step=None, distance=None) -> np.ndarray:
+    """sibling_overlap_lengths as first written: every sample of every link in one array."""
+    from kinegami.geometry.csc_centreline import csc_distances, csc_points
+
+    step = 0.01 * r if step is None else step
+    limit = 2.0 * r if distance is None else distance
+    out = np.zeros(len(links))
+    for k, link in enumerate(links):
+        others = [other.path for j, other in enumerate(links) if j != k]
+
+        def gap(sigma, path=link.path, others=others):
+            P = csc_points(path, sigma)
+            return np.min([csc_distances(q, P) for q in others], axis=0) - limit
+
+        count = max(1, math.ceil(link.length / step))
+        sigma = np.linspace(0.0, link.length, count + 1)
+        inside = np.nonzero(gap(sigma) < 0.0)[0]
+        if inside.size == 0:
+            continue
+        i = int(inside[-1])
+        if i == count:
+            out[k] = link.length
+            continue
+        lo, hi = float(sigma[i]), float(sigma[i + 1])
+        while hi - lo > 1e-12 * r:
+            mid = 0.5 * (lo + hi)
+            if gap(np.array([mid]))[0] < 0.0:
+                lo = mid
+            else:
+                hi = mid
+        out[k] = hi
+    return out
+
+
+def _random_links(rng, r):
+    from scipy.spatial.transform import Rotation
+    from spatialmath import SE3
+
+    from kinegami import LinkCSC, NoPathError
+
+    links = []
+    while len(links) < 3:
+        T = np.eye(4)
+        T[:3, :3] = Rotation.from_rotvec(rng.normal(size=3) * rng.uniform(0, 2)).as_matrix()
+        T[:3, 3] = rng.normal(size=3) * r * rng.uniform(1, 15)
+        T[0, 3] += 5 * r
+        try:
+            links.append(LinkCSC(r, SE3(), SE3(T, check=False)))
+        except NoPathError:
+            continue
+    return links[: int(rng.integers(2, 4))]
+
+
+def test_sibling_overlap_lengths_give_the_answers_of_sampling_everything():
+    from kinegami.tree.connector import sibling_overlap_lengths
+
+    rng = np.random.default_rng(2029)
+    for case in range(40):
+        r = 10 ** rng.uniform(-2, 2)
+        links = _random_links(rng, r)
+        distance = None if case % 2 else float(rng.uniform(2, 6)) * r
+        want = _overlap_reference(links, r, distance=distance)
+        got = sibling_overlap_lengths(links, r, distance=distance)
+        assert got.tolist() == want.tolist(), case
+
+
+def test_sibling_links_1e6_r_long_are_cheap():
+    """Two links 1e6 r long from one point, 12 r apart at their ends: 1e8 samples each asked
+    numpy for 2.2 GiB, and the bisection of the last crossing never ended (1e-12 r is below
+    the spacing of floats near 1.7e5)."""
+    from spatialmath import SE3
+
+    from kinegami import LinkCSC
+    from kinegami.tree.connector import sibling_overlap_lengths
+
+    a = LinkCSC(1, SE3(), SE3.Trans(1e6, 6, 0))
+    b = LinkCSC(1, SE3(), SE3.Trans(1e6, -6, 0))
+    got = sibling_overlap_lengths([a, b], 1.0)
+    # the centrelines are 2 apart where 12 sigma / 1e6 = 2 (their arcs are negligible)
+    np.testing.assert_allclose(got, [1e6 / 6, 1e6 / 6], rtol=1e-6)

@@ -16,17 +16,31 @@ The bounds keep every design cheap to build and free of numeric overflow:
   caps are checked while the file is parsed or before anything else is validated, so even a
   file of 16 MiB is rejected in a fraction of a second.
 
-The schema (schema.json) states the same integer, radius and count bounds, and the absolute
+The numbers live in :mod:`kinegami.limits` (docs/limits.md has the whole table). The schema
+(schema.json) states the same integer, radius and count bounds, and the absolute
 length bound ``LENGTH_FACTOR * R_MAX``; :func:`check_lengths` checks the bound relative to
 ``r``. The radius and length bounds are those of the Python API (:mod:`kinegami.validation`).
 """
 
 from __future__ import annotations
 
-import math
-
 from kinegami.design.errors import DesignError, json_path
-from kinegami.validation import FILE_NUM_SIDES_MAX, LENGTH_FACTOR, R_MAX, R_MIN
+from kinegami.limits import (
+    FILE_NUM_SIDES_MAX,
+    LENGTH_FACTOR,
+    MAX_DEPTH,
+    MAX_DH_ROWS,
+    MAX_EDITS,
+    MAX_FILE_BYTES,
+    MAX_JOINTS,
+    MAX_POSE_STEPS,
+    MAX_STATES,
+    MIN_ANGLE_PER_ELBOW,
+    NUM_LAYERS_MAX,
+    NUM_SINK_LAYERS_MAX,
+    R_MAX,
+    R_MIN,
+)
 
 __all__ = [
     "NUM_SIDES_MAX",
@@ -48,31 +62,9 @@ __all__ = [
     "too_deep",
 ]
 
-#: Largest number of polygon sides of the tube (joint-specification files share it).
+#: Largest number of polygon sides of the tube in a file (joint-specification files share it).
+#: The other bounds are those of kinegami.limits (docs/limits.md), imported above.
 NUM_SIDES_MAX = FILE_NUM_SIDES_MAX
-#: Largest number of sink layers of a revolute joint.
-NUM_SINK_LAYERS_MAX = 32
-#: Largest number of REBO layers of a prismatic joint.
-NUM_LAYERS_MAX = 200
-#: Smallest maxAnglePerElbow (radians): one degree.
-MIN_ANGLE_PER_ELBOW = math.pi / 180.0
-# R_MIN, R_MAX (imported): smallest and largest tube radius (file length units), 1e-6 and 1e6.
-# LENGTH_FACTOR (imported): every length and translation coordinate has |value| <= 1e6 r.
-#: Largest design file, in bytes (16 MiB).
-MAX_FILE_BYTES = 16 * 1024 * 1024
-#: Most entries of "joints" (loading takes about 15 ms per joint with safe placement).
-MAX_JOINTS = 1000
-#: Most rows of a DH table.
-MAX_DH_ROWS = 1000
-#: Most edits.
-MAX_EDITS = 1000
-#: Most states: one per joint of the built chain (safe placement adds a few waypoints per
-#: joint, at most four).
-MAX_STATES = 5 * MAX_JOINTS
-#: Most steps of a pose written as a list of steps.
-MAX_POSE_STEPS = 100
-#: Deepest nesting of lists and objects (the document itself is level 1; designs need 6).
-MAX_DEPTH = 32
 
 #: Length fields of joints (positive) and of the dh object.
 _JOINT_LENGTHS = ("length", "tubeLength", "neutralLength")

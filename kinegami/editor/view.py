@@ -59,12 +59,14 @@ from kinegami.editor.units import (
     state_unit,
 )
 from kinegami.errors import Cancelled, InvalidParameterError, InvalidTypeError, KinegamiError
+from kinegami.limits import MAX_FILE_BYTES
 
 __all__ = ["EditorView", "DOWNLOADS", "SHEET_FORMATS", "MAX_UPLOAD_BYTES", "gallery",
            "download_data"]  # fmt: skip
 
-#: The largest design file a browser may upload (bytes).
-MAX_UPLOAD_BYTES = 16 * 1024 * 1024
+#: The largest design file a browser may upload (bytes): that of any design file
+#: (kinegami.limits.MAX_FILE_BYTES, 16 MiB; docs/limits.md).
+MAX_UPLOAD_BYTES = MAX_FILE_BYTES
 #: Download buttons: label -> file suffix (through the export registry).
 DOWNLOADS = {"DXF": ".dxf", "SVG": ".svg", "FOLD": ".fold", "PDF": ".pdf", "STL": ".stl",
              "URDF": ".urdf"}  # fmt: skip
@@ -1570,7 +1572,7 @@ class EditorView:
                       f"{MAX_UPLOAD_BYTES} (16 MiB)")  # fmt: skip
             return False
         try:
-            document = Document.loads(content.decode("utf-8"))
+            document = Document.loads(content.decode("utf-8-sig"))  # as files are read
         except Exception as error:  # noqa: BLE001 - a bad upload is a message, not a crash
             self._say(f"**Refused:** {name!r} is not a design file: {error}")
             return False

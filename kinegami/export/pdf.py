@@ -45,6 +45,7 @@ import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export._options import resolve_sheet_options, sheet_lines
+from kinegami.limits import MAX_PDF_PAGES
 from kinegami.validation import check_int, check_nonnegative, check_positive
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -78,7 +79,7 @@ PDF_DEFAULTS = {
     "margin": 10.0,
     "overlap": 0.0,
     "scale_bar": 50.0,
-    "max_pages": 200,
+    "max_pages": MAX_PDF_PAGES,
     "title": "kinegami crease pattern",
 }
 

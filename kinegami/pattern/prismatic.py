@@ -23,7 +23,12 @@ from kinegami.pattern._prism import Prism, make_prism, wrap_x
 from kinegami.pattern.catalog import ModuleCounts
 from kinegami.pattern.tube import _tube
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
-from kinegami.validation import check_in_range, check_int, check_num_sides, check_positive
+from kinegami.validation import (
+    check_in_range,
+    check_num_layers,
+    check_num_sides,
+    check_positive,
+)
 
 __all__ = [
     "PrismaticJointPattern",
@@ -66,7 +71,7 @@ def rebo_geometry(prism: Prism, d: float, N: int, beta: float) -> REBOGeometry:
 def _check_rebo(numSides, r, neutralLength, numLayers, coneAngle, low: float):
     prism = make_prism(numSides, r)
     d = check_positive("neutralLength", neutralLength)
-    N = check_int("numLayers", numLayers, minimum=1)
+    N = check_num_layers(numLayers)
     if low > 0:
         beta = check_in_range(
             "coneAngle", coneAngle, low, 0.5 * math.pi, low_inclusive=True,

@@ -17,7 +17,7 @@ from kinegami.pattern._fold import FoldedFormError, assign, corners, translation
 from kinegami.pattern._prism import Prism, make_prism, periodic_dx
 from kinegami.pattern.catalog import ModuleCounts
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
-from kinegami.validation import check_in_range, check_int, check_positive
+from kinegami.validation import check_in_range, check_num_sink_layers, check_positive
 
 __all__ = [
     "EndTipPattern",
@@ -117,7 +117,7 @@ def RevoluteJointPattern(
     theta = check_in_range(
         "totalBendingAngle", totalBendingAngle, 0.0, 2.0 * math.pi, range_text="(0, 2 pi)"
     )
-    layers = check_int("numSinkLayers", numSinkLayers, minimum=1)
+    layers = check_num_sink_layers(numSinkLayers)
     h_r = prism.a * math.tan(theta / 4.0)
     geo = revolute_geometry(prism, h_r)
     _check_resolvable(prism, geo, "totalBendingAngle", theta)

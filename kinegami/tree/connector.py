@@ -160,23 +160,83 @@ def sibling_overlap_lengths(
             return np.min([csc_distances(q, P) for q in others], axis=0) - limit
 
         count = max(1, math.ceil(length / step))
-        sigma = np.linspace(0.0, length, count + 1)
-        inside = np.nonzero(gap(sigma) < 0.0)[0]
-        if inside.size == 0:  # cannot happen for links that start at one point
+        i = _last_inside(gap, length, count)
+        if i is None:  # cannot happen for links that start at one point
             continue
-        i = int(inside[-1])
         if i == count:
             out[k] = length
             continue
-        lo, hi = float(sigma[i]), float(sigma[i + 1])
+        lo, hi = (float(x) for x in _grid(length, count, np.array([i, i + 1])))
         while hi - lo > 1e-12 * r:
             mid = 0.5 * (lo + hi)
+            if not lo < mid < hi:  # adjacent floats (far out, 1e-12 r is below their spacing)
+                break
             if gap(np.array([mid]))[0] < 0.0:
                 lo = mid
             else:
                 hi = mid
         out[k] = hi
     return out
+
+
+#: Most samples :func:`sibling_overlap_lengths` evaluates at once (bounds its arrays).
+_OVERLAP_CHUNK = 16_384
+#: Index intervals this short are evaluated sample by sample rather than split further.
+_OVERLAP_LEAF = 32
+
+
+def _grid(length: float, count: int, k) -> np.ndarray:
+    """Samples ``k`` (an int array) of ``np.linspace(0, length, count + 1)``, bit for bit."""
+    sigma = np.asarray(k, dtype=float) * (length / count) + 0.0
+    sigma[np.asarray(k) == count] = length
+    return sigma
+
+
+def _gaps(gap, length: float, count: int, k: np.ndarray) -> np.ndarray:
+    """``gap`` at samples ``k``, at most :data:`_OVERLAP_CHUNK` at a time."""
+    return np.concatenate(
+        [gap(_grid(length, count, k[i : i + _OVERLAP_CHUNK]))
+         for i in range(0, k.size, _OVERLAP_CHUNK)] or [np.zeros(0)]
+    )  # fmt: skip
+
+
+def _last_inside(gap, length: float, count: int) -> int | None:
+    """The largest k in [0, count] with ``gap(sigma_k) < 0`` on the grid of :func:`_grid`,
+    or None: the answer of evaluating every sample, without evaluating most of them.
+
+    The index range is split at the middle of each interval: a middle inside makes everything
+    below it irrelevant; a middle outside by g excludes the samples within g of it in arc
+    length (the centreline moves at most as far as the arc length, so the distance to a
+    sibling changes at most as much). Links 1e6 r long (1e8 samples) thus cost about as much
+    as short ones, in bounded memory (issue 29)."""
+    spacing = length / count
+    best = -1
+    intervals = np.array([[0, count]], dtype=np.int64)
+    while intervals.size:
+        intervals = intervals[intervals[:, 1] > best]
+        intervals[:, 0] = np.maximum(intervals[:, 0], best + 1)
+        short = intervals[:, 1] - intervals[:, 0] < _OVERLAP_LEAF
+        if short.any():
+            k = np.concatenate([np.arange(a, b + 1) for a, b in intervals[short]])
+            inside = k[_gaps(gap, length, count, k) < 0.0]
+            if inside.size:
+                best = max(best, int(inside.max()))
+        intervals = intervals[~short]
+        if not intervals.size:
+            break
+        middle = (intervals[:, 0] + intervals[:, 1]) // 2
+        g = _gaps(gap, length, count, middle)
+        inside = g < 0.0
+        if inside.any():
+            best = max(best, int(middle[inside].max()))
+        reach = np.where(inside | (spacing <= 0.0), 0.0, g * (1.0 - 1e-9) / max(spacing, 1e-300))
+        skip = np.floor(np.minimum(reach, float(count + 1))).astype(np.int64)
+        lower = np.stack([intervals[:, 0], middle - 1 - skip], axis=1)
+        upper = np.stack([middle + 1 + skip, intervals[:, 1]], axis=1)
+        lower = lower[~inside]
+        intervals = np.concatenate([upper, lower])
+        intervals = intervals[intervals[:, 0] <= intervals[:, 1]]
+    return None if best < 0 else best
 
 
 def link_frame_at(link: LinkCSC, sigma: float) -> np.ndarray:

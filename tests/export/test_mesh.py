@@ -35,6 +35,7 @@ from kinegami.export.mesh import (
     write_stl,
 )
 from kinegami.geometry.frames import rotation_matrix
+from kinegami.limits import MIN_ANGLE_PER_ELBOW
 from kinegami.links import LinkCSC
 from kinegami.viz.chain_geometry import regular_polygon
 
@@ -334,6 +335,9 @@ def csc_link(r, theta1, psi1, s, theta2, psi2, roll=0.0, start=None, max_angle=m
     F[:3, 3] += s * F[:3, 0]
     F = arc(F, theta2, psi2)
     F[:3, :3] = F[:3, :3] @ rotation_matrix([1.0, 0.0, 0.0], roll)
+    if max_angle < MIN_ANGLE_PER_ELBOW:  # below what users may ask for (kinegami.limits): the
+        # link as the chain builds it between frames it computed, without the user's checks
+        return LinkCSC._between(r, max_angle, start, F)
     return LinkCSC(r, start, F, max_angle)
 
 

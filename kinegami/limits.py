@@ -1,0 +1,93 @@
+"""Every limit that keeps kinegami's work bounded, in one place (docs/limits.md).
+
+Each input is answered in bounded time and memory: what it may ask for is capped here, and the
+cap is enforced where the input enters (design files: :mod:`kinegami.design.limits`; the API:
+:mod:`kinegami.validation`; the command line: :mod:`kinegami.cli`; the editor: the design
+loader and its commands). A value beyond a cap is a one-line
+:class:`~kinegami.errors.InvalidParameterError` (or a DesignError for a file) naming the value,
+the limit and why. This module holds numbers only and imports nothing, so every layer may use
+it.
+"""
+
+from __future__ import annotations
+
+import math
+
+__all__ = [
+    "R_MIN",
+    "R_MAX",
+    "LENGTH_FACTOR",
+    "NUM_SIDES_MAX",
+    "FILE_NUM_SIDES_MAX",
+    "NUM_SINK_LAYERS_MAX",
+    "NUM_LAYERS_MAX",
+    "MIN_ANGLE_PER_ELBOW",
+    "MAX_FILE_BYTES",
+    "MAX_JOINTS",
+    "MAX_DH_ROWS",
+    "MAX_EDITS",
+    "MAX_STATES",
+    "MAX_POSE_STEPS",
+    "MAX_DEPTH",
+    "MAX_SAMPLES",
+    "MAX_SAMPLED_STATES",
+    "MAX_STARTS",
+    "MAX_PDF_PAGES",
+    "MAX_INTEGER_DIGITS",
+]
+
+# --- sizes and lengths (the API and design files) -----------------------------------------
+#: Smallest and largest tube radius r (in the chain's length unit).
+R_MIN = 1e-6
+R_MAX = 1e6
+#: Every length, distance and translation coordinate given to the API or written in a design
+#: file satisfies ``|value| <= LENGTH_FACTOR * r``: squares and products of such values stay far
+#: from the float range, and r stays well above their rounding error.
+LENGTH_FACTOR = 1e6
+#: Most polygon sides of a tube given to the API: at 256 sides already, elbows and joints are
+#: too fine to resolve and say so; a prismatic joint of 1024 sides and 200 layers has 6e5
+#: pattern vertices (2.6 s).
+NUM_SIDES_MAX = 1024
+#: Most polygon sides in a design or joint-specification file.
+FILE_NUM_SIDES_MAX = 64
+#: Most sink layers of a revolute joint: its pattern grows with their number (1e7 layers ran
+#: past a minute and 2 GB before any answer).
+NUM_SINK_LAYERS_MAX = 32
+#: Most REBO layers of a prismatic joint: its pattern has about 3 numSides vertices per layer.
+NUM_LAYERS_MAX = 200
+#: Smallest maxAnglePerElbow (radians; one degree): a link turning by theta has
+#: ceil(theta / maxAnglePerElbow) elbows, at most 360 per link; 1e-9 asked numpy for 167 GiB.
+MIN_ANGLE_PER_ELBOW = math.pi / 180.0
+
+# --- design files ------------------------------------------------------------------------------
+#: Largest design file, in bytes (16 MiB).
+MAX_FILE_BYTES = 16 * 1024 * 1024
+#: Most entries of "joints" of a design (loading takes about 15 ms per joint with safe
+#: placement; 1000 placed joints take about a minute).
+MAX_JOINTS = 1000
+#: Most rows of a DH table.
+MAX_DH_ROWS = 1000
+#: Most edits of a design (each re-solves links and the bounding ball).
+MAX_EDITS = 1000
+#: Most states: one per joint of the built chain (safe placement adds up to four waypoints per
+#: joint).
+MAX_STATES = 5 * MAX_JOINTS
+#: Most steps of a pose written as a list of steps.
+MAX_POSE_STEPS = 100
+#: Deepest nesting of lists and objects in a design (the document is level 1; designs need 6).
+MAX_DEPTH = 32
+
+# --- work asked for by options ---------------------------------------------------------------
+#: Most configurations one motion check samples (``check --motion N``, ``sweep(samples=)``,
+#: ``compact(samples=)``). Measured on a loaded 2-core machine: Example 1 (a chain) tests about
+#: 10,000 configurations a second, the quadruped (a tree) about 16.
+MAX_SAMPLES = 100_000
+#: Most sampled joint states held at once: configurations times the joints of the chain (the
+#: sampled configurations are one array, 8 bytes a state: 80 MB).
+MAX_SAMPLED_STATES = 10_000_000
+#: Most starts of one compaction (``compact(starts=)``): each is a whole search.
+MAX_STARTS = 64
+#: Default most pages of a PDF (``max_pages``; the user may raise it per export).
+MAX_PDF_PAGES = 200
+#: Most digits of an integer option on the command line (``--seed``, ``--motion``, ``--port``).
+MAX_INTEGER_DIGITS = 30
