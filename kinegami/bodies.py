@@ -71,6 +71,8 @@ __all__ = [
     "worst_overlap",
     "tree_worst_overlap",
     "tree_pair_distances",
+    "TreeCapsules",
+    "tree_capsules",
     "part_label",
     "junction_extent",
     "link_polyline",
@@ -1043,151 +1045,98 @@ def _polyline_distance(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
     return cumulative[k] + t[rows, k] * lengths[k]
 
 
-def tree_pair_distances(
-    joints, links, parents, r: float, since: int = 0, reach: float | None = None,
-    margin: float = 0.0,
-) -> tuple | None:
-    """The tested capsule pairs of a tree that come within ``reach`` (default 2r + ``margin``)
-    and their
-    distances (docs/trees.md): ``(i, j, distance, s, t, rows, a, b)`` with ``i``, ``j`` row
-    indices, ``s``, ``t`` the closest points' parameters, ``rows`` the capsule rows (labels)
-    and ``a``, ``b`` their end points; None when nothing is tested.
+@dataclass(frozen=True, eq=False)
+class TreeCapsules:
+    """The capsules of a tree at its current configuration and what its pair rule needs
+    (docs/trees.md); built by :func:`tree_capsules`. World coordinates, units of r.
 
-    Parts on one path from the root are tested as in a chain (when the centreline between
-    them turns by at least pi, hinges included). Parts on different branches are always tested,
-    except where two tubes leaving the same branching joint still run together within the
-    junction that joins them (:func:`junction_extent` of each, with ``margin``: the junction
-    covers them until they are the margin apart); on a chain the tested pairs are the chain's.
+    Attributes
+    ----------
+    r : float
+        Capsule radius.
+    starts, ends : numpy.ndarray, shape (S, 3)
+        Every capsule's segment, row by row in joint order (a joint's link, then the joint).
+    start_joint, end_joint : numpy.ndarray of int, shape (S,)
+        The joint whose distal side each end moves with (-1: the root's base).
+    turning : numpy.ndarray, shape (S,)
+        Turning of the centreline from the root along the path to the row, links only: at a
+        configuration every revolute joint on the path to ``start_joint`` (itself included)
+        adds |state|.
+    element, node : numpy.ndarray of int, shape (S,)
+        2 j (joint j) or 2 j - 1 (the link into j), and j.
+    rows : tuple
+        The capsule rows (their labels: :func:`part_label`).
+    parents : tuple of int
+    ancestor : numpy.ndarray of bool, shape (n, n)
+        ``ancestor[x, y]``: joint y is x or an ancestor of x.
+    is_link : numpy.ndarray of bool, shape (S,)
+    top : numpy.ndarray of int, shape (n,)
+        For a joint on the tube leaving a branching joint (its child, continued through
+        waypoints with one child): that child; else -1.
+    extent : numpy.ndarray, shape (n,)
+        The junction extent of each such child (:func:`junction_extent`, at most
+        ``JUNCTION_REACH`` r); 0 elsewhere.
+    along : numpy.ndarray, shape (S, 2)
+        For the link rows of those tubes: how far along the tube (from the branching frame)
+        each end of the row lies; nan elsewhere.
     """
-    parents = [int(p) for p in parents]
-    reach = 2.0 * r + margin if reach is None else reach
-    n = len(joints)
-    children: list[list[int]] = [[] for _ in range(n)]
-    for k in range(1, n):
-        children[parents[k]].append(k)
-    # turning along the path from the root: links, and revolute hinges by their states
-    link_total = np.zeros(n)
-    rows: list = []
-    pieces_a, pieces_b, owner_node, base_turn = [], [], [], []
-    for j in range(n):
-        if j > 0:
-            (A, B, body, turn), link_rows, total = _link_arrays(links[j], j, r, 0.2)
-            link_total[j] = total
-            if len(link_rows):
-                pieces_a.append(A)
-                pieces_b.append(B)
-                owner_node.append(np.full(len(link_rows), j))
-                base_turn.append(turn)
-                rows += link_rows
-        (A, B, body, turn), joint_rows = _joint_arrays(joints[j], j, r)
-        if len(joint_rows):
-            pieces_a.append(A)
-            pieces_b.append(B)
-            owner_node.append(np.full(len(joint_rows), j))
-            base_turn.append(turn)
-            rows += joint_rows
-    S = len(rows)
-    if S < 2:
-        return None
-    a = np.concatenate(pieces_a)
-    b = np.concatenate(pieces_b)
-    node = np.concatenate(owner_node)
-    own = np.concatenate(base_turn)
-    element = np.fromiter((row[5] for row in rows), dtype=np.int64, count=S)
-    body_a = np.fromiter((row[2] for row in rows), dtype=np.int64, count=S)
-    is_link = element % 2 == 1
-    path_links = np.zeros(n)  # link turning from the root to the end of joint j's link
-    kinks = np.zeros(n)  # hinge turning from the root to joint j's distal side
-    for j in range(n):
-        p = parents[j]
-        path_links[j] = link_total[j] + (path_links[p] if p >= 0 else 0.0)
-        kink = abs(joints[j].state) if isinstance(joints[j], RevoluteJoint) else 0.0
-        kinks[j] = kink + (kinks[p] if p >= 0 else 0.0)
-    parent_of = np.array(parents)
-    before = np.where(is_link, path_links[np.maximum(parent_of[node], 0)], path_links[node])
-    before = np.where(is_link & (parent_of[node] < 0), 0.0, before)
-    # the hinges before a part: a joint's distal half (body = its own index) moves after its
-    # own hinge; everything else of node j (its link, a proximal half) after its parent's
-    # (bodies are numbered as in a chain, where the parent of j is j - 1)
-    hinges_before = np.where(
-        body_a == node,
-        kinks[node],
-        np.where(parent_of[node] >= 0, kinks[np.maximum(parent_of[node], 0)], 0.0),
-    )
-    tau = own + before + hinges_before
 
-    # junctions: how far the tube to each child of a branching joint (continued through
-    # waypoints with one child, which add no part) runs with its siblings
-    extent = np.zeros(n)
-    polylines: dict[int, np.ndarray] = {}
-    branch_of: dict[int, int] = {}  # node -> the child of a branching joint it continues
-    for kids in children:
-        if len(kids) < 2:
-            continue
-        for k in kids:
-            path = [k]
-            while isinstance(joints[path[-1]], Waypoint) and len(children[path[-1]]) == 1:
-                path.append(children[path[-1]][0])
-            for node_k in path:
-                branch_of[node_k] = k
-            points = [link_polyline(links[node_k]) for node_k in path]
-            polylines[k] = np.concatenate([points[0]] + [pts[1:] for pts in points[1:]])
-        for k in kids:
-            mine = np.isin(node, [m for m, top in branch_of.items() if top == k]) & is_link
-            theirs = np.isin(node, [m for m, top in branch_of.items() if top in kids and top != k])
-            theirs &= is_link
-            found = junction_extent(polylines[k], (a[mine], b[mine]), (a[theirs], b[theirs]), r,
-                                    margin, limit=JUNCTION_REACH * r)  # fmt: skip
-            extent[k] = min(found, JUNCTION_REACH * r)
+    r: float
+    starts: np.ndarray
+    ends: np.ndarray
+    start_joint: np.ndarray
+    end_joint: np.ndarray
+    turning: np.ndarray
+    element: np.ndarray
+    node: np.ndarray
+    rows: tuple
+    parents: tuple
+    ancestor: np.ndarray
+    is_link: np.ndarray
+    top: np.ndarray
+    extent: np.ndarray
+    along: np.ndarray
 
-    centre = 0.5 * (a + b)
-    half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
-    first = np.arange(S) + 1
-    i, j = _near_pairs(element, tau, first, centre, half, reach)
-    if since > 0 and i.size:
-        keep = (node[i] >= since) | (node[j] >= since)
-        i, j = i[keep], j[keep]
-    if i.size == 0:
-        return None
+    @property
+    def count(self) -> int:
+        """Number of capsules."""
+        return int(self.starts.shape[0])
 
-    # one path from the root (one node an ancestor of the other): the chain rule; different
-    # branches: always, but two parts of the tubes leaving one branching joint only beyond
-    # the junction
-    ancestor = np.zeros((n, n), dtype=bool)  # ancestor[x, y]: y is x or an ancestor of x
-    for x in range(n):
-        ancestor[x, x] = True
-        if parents[x] >= 0:
-            ancestor[x] |= ancestor[parents[x]]
-    nx, ny = node[i], node[j]
-    same_path = ancestor[nx, ny] | ancestor[ny, nx]
-    tested = ~same_path | (np.abs(tau[j] - tau[i]) >= math.pi - TURN_TOLERANCE)
-    i, j, nx, ny, same_path = i[tested], j[tested], nx[tested], ny[tested], same_path[tested]
-    if i.size == 0:
-        return None
-    top = np.full(n, -1, dtype=np.int64)  # the child of a branching joint a node continues
-    for m, k in branch_of.items():
-        top[m] = k
-    parent_of_top = np.where(top >= 0, parent_of[np.maximum(top, 0)], -2)
-    junction = (~same_path & is_link[i] & is_link[j] & (top[nx] >= 0) & (top[ny] >= 0)
-                & (parent_of_top[nx] == parent_of_top[ny]))  # fmt: skip
-    dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
-    q = np.flatnonzero(junction)
-    if q.size:
-        # distances along each branch of the end points of its rows, once per row
-        along = np.full((S, 2), np.nan)
-        for k, line in polylines.items():
-            rows_k = np.flatnonzero((top[node] == k) & is_link)
-            if rows_k.size:
-                ends = np.concatenate([a[rows_k], b[rows_k]])
-                d = _polyline_distance(ends, line)
-                along[rows_k, 0], along[rows_k, 1] = d[: rows_k.size], d[rows_k.size :]
-        rest = np.full(q.size, np.inf)
-        rest_s, rest_t = s[q].copy(), t[q].copy()
+    def hinge_turning(self, joints) -> np.ndarray:
+        """(n,) the turning the revolute hinges add from the root to each joint's distal side
+        (itself included), at the states of ``joints``."""
+        n = len(self.parents)
+        kinks = np.zeros(n)
+        for j in range(n):
+            p = self.parents[j]
+            kink = abs(joints[j].state) if isinstance(joints[j], RevoluteJoint) else 0.0
+            kinks[j] = kink + (kinks[p] if p >= 0 else 0.0)
+        return kinks
+
+    def junction_pairs(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """Which of the row pairs (i, j) are two link rows of the tubes leaving one branching
+        joint (on different tubes): those are tested only beyond the junction."""
+        nx, ny = self.node[i], self.node[j]
+        same_path = self.ancestor[nx, ny] | self.ancestor[ny, nx]
+        top, parents = self.top, np.asarray(self.parents, dtype=np.int64)
+        parent_of_top = np.where(top >= 0, parents[np.maximum(top, 0)], -2)
+        return (~same_path & self.is_link[i] & self.is_link[j] & (top[nx] >= 0)
+                & (top[ny] >= 0) & (parent_of_top[nx] == parent_of_top[ny]))  # fmt: skip
+
+    def beyond_junction(self, i: np.ndarray, j: np.ndarray, a=None, b=None) -> tuple:
+        """``(distance, s, t)`` of junction pairs (i, j): the part of each row beyond its
+        junction against the whole other row, the closer of the two ways (inf when neither row
+        reaches beyond its junction); s, t along the whole rows. ``a``, ``b``: the rows'
+        segments (default: ``starts``, ``ends``)."""
+        a = self.starts if a is None else a
+        b = self.ends if b is None else b
+        rest = np.full(i.size, np.inf)
+        rest_s, rest_t = np.zeros(i.size), np.zeros(i.size)
         # the part of one row beyond its junction, against the whole other row (both ways);
         # the closest points are those of the parts tested (parameters along the whole rows)
-        for first_is_mine, (mine, other) in ((True, (i[q], j[q])), (False, (j[q], i[q]))):
-            e = extent[top[node[mine]]]
-            d0, d1 = along[mine, 0], along[mine, 1]
+        for first_is_mine, (mine, other) in ((True, (i, j)), (False, (j, i))):
+            e = self.extent[self.top[self.node[mine]]]
+            d0, d1 = self.along[mine, 0], self.along[mine, 1]
             beyond = np.maximum(d0, d1) > e
             span = d1 - d0
             u = np.clip(np.where(span != 0.0, (e - d0) / np.where(span != 0.0, span, 1.0), 0.0),
@@ -1214,9 +1163,210 @@ def tree_pair_distances(
             else:
                 rest_s = np.where(better, tt, rest_s)
                 rest_t = np.where(better, along_row, rest_t)
-        dist[q] = rest
-        s[q], t[q] = rest_s, rest_t
-    return i, j, dist, s, t, rows, a, b
+        return rest, rest_s, rest_t
+
+
+#: Junction extents of the last few trees, by the link objects they were computed from (a
+#: state change moves a junction's tubes rigidly: their extents stay).
+_EXTENT_MEMO: dict = {}
+_EXTENT_MEMO_SIZE = 64
+_EXTENT_MEMO_LOCK = threading.Lock()
+
+
+def _rigid_origins(links) -> tuple | None:
+    """The links these are rigid copies of when all moved by one transform (or none moved),
+    else None."""
+    origins, moves = [], []
+    for link in links:
+        origin, T = link.__dict__.get("_moved_from", (link, None))
+        origins.append(origin)
+        moves.append(T)
+    if all(T is None for T in moves):
+        return tuple(origins)
+    if any(T is None for T in moves) or not all(np.array_equal(T, moves[0]) for T in moves):
+        return None
+    return tuple(origins)
+
+
+def _junction_extents(kids: list, paths: dict, links, r: float, margin: float) -> dict:
+    """The junction extent (at most ``JUNCTION_REACH`` r) of every child in ``kids`` of one
+    branching joint; ``paths[k]``: the joints whose links make the tube leaving towards k.
+
+    The tubes of a junction move together (they all hang from the branching joint), so when
+    they are rigid copies of links seen before, the extents are those of the originals
+    (computed on the originals: the same answer whatever the configuration)."""
+    nodes = [m for k in kids for m in paths[k]]
+    origins = _rigid_origins([links[m] for m in nodes])
+    key = None
+    if origins is not None:
+        key = (tuple(map(id, origins)), tuple(nodes), tuple(len(paths[k]) for k in kids), r,
+               margin)  # fmt: skip
+        with _EXTENT_MEMO_LOCK:
+            hit = _EXTENT_MEMO.get(key)
+        if hit is not None and all(map(operator.is_, hit[0], origins)):
+            return hit[1]
+        source = dict(zip(nodes, origins, strict=True))
+    else:
+        source = {m: links[m] for m in nodes}
+    tubes = {}
+    for k in kids:
+        arrays = [_link_arrays(source[m], m, r, 0.2)[0] for m in paths[k]]
+        points = [link_polyline(source[m]) for m in paths[k]]
+        polyline = np.concatenate([points[0]] + [pts[1:] for pts in points[1:]])
+        tubes[k] = (polyline, np.concatenate([x[0] for x in arrays]),
+                    np.concatenate([x[1] for x in arrays]))  # fmt: skip
+    extents = {}
+    for k in kids:
+        others = [tubes[o] for o in kids if o != k]
+        a = np.concatenate([t[1] for t in others])
+        b = np.concatenate([t[2] for t in others])
+        found = junction_extent(tubes[k][0], (tubes[k][1], tubes[k][2]), (a, b), r, margin,
+                                limit=JUNCTION_REACH * r)
+        extents[k] = min(found, JUNCTION_REACH * r)
+    if key is not None:
+        with _EXTENT_MEMO_LOCK:
+            _EXTENT_MEMO[key] = (origins, extents)
+            while len(_EXTENT_MEMO) > _EXTENT_MEMO_SIZE:
+                del _EXTENT_MEMO[next(iter(_EXTENT_MEMO))]
+    return extents
+
+
+def tree_capsules(joints, links, parents, r: float, margin: float = 0.0) -> TreeCapsules:
+    """The :class:`TreeCapsules` of a tree (its joints, links and parent list) at its current
+    configuration, with the junctions of ``margin`` (docs/trees.md)."""
+    parents = tuple(int(p) for p in parents)
+    n = len(joints)
+    children: list[list[int]] = [[] for _ in range(n)]
+    for k in range(1, n):
+        children[parents[k]].append(k)
+    link_total = np.zeros(n)
+    rows: list = []
+    pieces_a, pieces_b, owner_node, base_turn = [], [], [], []
+    for j in range(n):
+        if j > 0:
+            (A, B, _, turn), link_rows, total = _link_arrays(links[j], j, r, 0.2)
+            link_total[j] = total
+            if len(link_rows):
+                pieces_a.append(A)
+                pieces_b.append(B)
+                owner_node.append(np.full(len(link_rows), j))
+                base_turn.append(turn)
+                rows += link_rows
+        (A, B, _, turn), joint_rows = _joint_arrays(joints[j], j, r)
+        if len(joint_rows):
+            pieces_a.append(A)
+            pieces_b.append(B)
+            owner_node.append(np.full(len(joint_rows), j))
+            base_turn.append(turn)
+            rows += joint_rows
+    S = len(rows)
+    if S:
+        a, b = np.concatenate(pieces_a), np.concatenate(pieces_b)
+        node = np.concatenate(owner_node).astype(np.int64)
+        own = np.concatenate(base_turn)
+    else:
+        a, b, node, own = np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0)
+    element = np.fromiter((row[5] for row in rows), dtype=np.int64, count=S)
+    body_a = np.fromiter((row[2] for row in rows), dtype=np.int64, count=S)
+    body_b = np.fromiter((row[3] for row in rows), dtype=np.int64, count=S)
+    is_link = element % 2 == 1
+    path_links = np.zeros(n)  # link turning from the root to the end of joint j's link
+    for j in range(n):
+        p = parents[j]
+        path_links[j] = link_total[j] + (path_links[p] if p >= 0 else 0.0)
+    parent_of = np.array(parents, dtype=np.int64)
+    before = np.where(is_link, path_links[np.maximum(parent_of[node], 0)], path_links[node])
+    before = np.where(is_link & (parent_of[node] < 0), 0.0, before)
+    # a joint's distal half (body = its own index) moves with the joint; everything else of
+    # joint j (its link, a proximal half) with its parent (rows number bodies as in a chain,
+    # where the parent of j is j - 1)
+    start_joint = np.where(body_a == node, node, parent_of[node])
+    end_joint = np.where(body_b == node, node, parent_of[node])
+
+    # junctions: how far the tube to each child of a branching joint (continued through
+    # waypoints with one child, which add no part) runs with its siblings
+    extent = np.zeros(n)
+    top = np.full(n, -1, dtype=np.int64)
+    polylines: dict[int, np.ndarray] = {}
+    for kids in children:
+        if len(kids) < 2:
+            continue
+        paths = {}
+        for k in kids:
+            path = [k]
+            while isinstance(joints[path[-1]], Waypoint) and len(children[path[-1]]) == 1:
+                path.append(children[path[-1]][0])
+            top[path] = k
+            paths[k] = path
+            points = [link_polyline(links[m]) for m in path]
+            polylines[k] = np.concatenate([points[0]] + [pts[1:] for pts in points[1:]])
+        for k, value in _junction_extents(kids, paths, links, r, margin).items():
+            extent[k] = value
+    # distances along each tube of the end points of its rows
+    along = np.full((S, 2), np.nan)
+    for k, line in polylines.items():
+        rows_k = np.flatnonzero((top[node] == k) & is_link)
+        if rows_k.size:
+            d = _polyline_distance(np.concatenate([a[rows_k], b[rows_k]]), line)
+            along[rows_k, 0], along[rows_k, 1] = d[: rows_k.size], d[rows_k.size :]
+    ancestor = np.zeros((n, n), dtype=bool)  # ancestor[x, y]: y is x or an ancestor of x
+    for x in range(n):
+        ancestor[x, x] = True
+        if parents[x] >= 0:
+            ancestor[x] |= ancestor[parents[x]]
+    caps = TreeCapsules(r, a, b, start_joint, end_joint, own + before, element, node,
+                        tuple(rows), parents, ancestor, is_link, top, extent, along)  # fmt: skip
+    for value in vars(caps).values():
+        if isinstance(value, np.ndarray):
+            value.setflags(write=False)
+    return caps
+
+
+def tree_pair_distances(
+    joints, links, parents, r: float, since: int = 0, reach: float | None = None,
+    margin: float = 0.0,
+) -> tuple | None:
+    """The tested capsule pairs of a tree that come within ``reach`` (default 2r + ``margin``)
+    and their distances (docs/trees.md): ``(i, j, distance, s, t, rows, a, b)`` with ``i``,
+    ``j`` row indices, ``s``, ``t`` the closest points' parameters, ``rows`` the capsule rows
+    (labels) and ``a``, ``b`` their end points; None when nothing is tested.
+
+    Parts on one path from the root are tested as in a chain (when the centreline between
+    them turns by at least pi, hinges included). Parts on different branches are always tested,
+    except where two tubes leaving the same branching joint still run together within the
+    junction that joins them (:func:`junction_extent` of each, with ``margin``: the junction
+    covers them until they are the margin apart); on a chain the tested pairs are the chain's.
+    """
+    reach = 2.0 * r + margin if reach is None else reach
+    caps = tree_capsules(joints, links, parents, r, margin)
+    S = caps.count
+    if S < 2:
+        return None
+    a, b, node = caps.starts, caps.ends, caps.node
+    kinks = caps.hinge_turning(joints)
+    tau = caps.turning + np.where(caps.start_joint >= 0, kinks[caps.start_joint], 0.0)
+    centre = 0.5 * (a + b)
+    half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
+    i, j = _near_pairs(caps.element, tau, np.arange(S) + 1, centre, half, reach)
+    if since > 0 and i.size:
+        keep = (node[i] >= since) | (node[j] >= since)
+        i, j = i[keep], j[keep]
+    if i.size == 0:
+        return None
+    # one path from the root (one node an ancestor of the other): the chain rule; different
+    # branches: always, but two parts of the tubes leaving one branching joint only beyond
+    # the junction
+    nx, ny = node[i], node[j]
+    same_path = caps.ancestor[nx, ny] | caps.ancestor[ny, nx]
+    tested = ~same_path | (np.abs(tau[j] - tau[i]) >= math.pi - TURN_TOLERANCE)
+    i, j = i[tested], j[tested]
+    if i.size == 0:
+        return None
+    dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
+    q = np.flatnonzero(caps.junction_pairs(i, j))
+    if q.size:
+        dist[q], s[q], t[q] = caps.beyond_junction(i[q], j[q])
+    return i, j, dist, s, t, caps.rows, a, b
 
 
 def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int = 0,

@@ -23,7 +23,9 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import operator
 import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -32,6 +34,8 @@ import numpy as np
 
 from kinegami.bodies import (
     CONTACT_TOLERANCE,
+    JOINT_FIXED,
+    JOINT_PRISMATIC,
     JOINT_REVOLUTE,
     TURN_TOLERANCE,
     CapsuleModel,
@@ -39,10 +43,11 @@ from kinegami.bodies import (
     check_margin,
     clear_limit,
     part_label,
-    tree_pair_distances,
+    tree_capsules,
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.segments import segment_distances
+from kinegami.joints import PrismaticJoint, RevoluteJoint
 from kinegami.validation import check_int, check_real, shorten, shown
 
 __all__ = [
@@ -58,6 +63,7 @@ __all__ = [
     "clearance_report",
     "sweep",
     "ClearanceEngine",
+    "TreeEngine",
     "TreeMotion",
     "engine_for",
 ]
@@ -271,10 +277,106 @@ def _rotations(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * K + c * (K @ K)
 
 
-def _ball(points: np.ndarray, r: float) -> tuple[np.ndarray, float]:
-    """A ball (centre, radius) containing every point of ``points`` (k, 3) grown by r."""
-    centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
-    return centre, float(np.sqrt(((points - centre) ** 2).sum(axis=1)).max()) + r
+#: Squared lengths below this are points (the value of :mod:`kinegami.geometry.segments`).
+_DEGENERATE = 1e-30
+
+
+def _dot(x1, y1, z1, x2, y2, z2):
+    return (x1 * x2 + z1 * z2) + y1 * y2  # the order numpy.einsum sums (..., 3) in
+
+
+def _segment_distances_xyz(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`~kinegami.geometry.segments.segment_distances` on end points given as three
+    coordinate arrays each (``a1 = (x, y, z)``, arrays of one shape): the same arithmetic in
+    the same order (the same bits), without the (..., 3) layout's overhead."""
+    d1 = [q - p for p, q in zip(a1, b1, strict=True)]
+    d2 = [q - p for p, q in zip(a2, b2, strict=True)]
+    w = [p - q for p, q in zip(a1, a2, strict=True)]
+    A, E, B = _dot(*d1, *d1), _dot(*d2, *d2), _dot(*d1, *d2)
+    C, F = _dot(*d1, *w), _dot(*d2, *w)
+    ok1 = A > _DEGENERATE
+    ok2 = E > _DEGENERATE
+    A_safe = np.where(ok1, A, 1.0)
+    E_safe = np.where(ok2, E, 1.0)
+    denom = A * E - B * B
+    proper = ok1 & ok2 & (denom > 1e-14 * A_safe * E_safe)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.where(proper, (B * F - C * E) / np.where(proper, denom, 1.0), 0.0)
+    s = np.clip(s, 0.0, 1.0)
+    t = np.where(ok2, np.clip((B * s + F) / E_safe, 0.0, 1.0), 0.0)
+    s = np.where(ok1, np.clip((B * t - C) / A_safe, 0.0, 1.0), 0.0)
+    t = np.where(ok2, np.clip((B * s + F) / E_safe, 0.0, 1.0), 0.0)
+
+    def gap(s, t):
+        e = [(p + s * u) - (q + t * v) for p, u, q, v in zip(a1, d1, a2, d2, strict=True)]
+        return np.sqrt((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2])  # numpy.linalg.norm's order
+
+    def param(point, a, d, dd, ok):  # point_segment_parameters
+        num = _dot(*(p - q for p, q in zip(point, a, strict=True)), *d)
+        return np.where(ok, np.clip(num / np.where(ok, dd, 1.0), 0.0, 1.0), 0.0)
+
+    best = gap(s, t)
+    zero = np.zeros_like(best)
+    for sc, tc in ((zero, param(a1, a2, d2, E, ok2)), (zero + 1.0, param(b1, a2, d2, E, ok2)),
+                   (param(a2, a1, d1, A, ok1), zero), (param(b2, a1, d1, A, ok1), zero + 1.0)):
+        dist = gap(sc, tc)
+        better = dist < best
+        best = np.where(better, dist, best)
+        s = np.where(better, sc, s)
+        t = np.where(better, tc, t)
+    return best, s, t
+
+
+#: Most capsules in one group (a part's run of capsules is split into groups this long).
+_GROUP_SIZE = 3
+
+#: Group pairs above which the broad phase finds near groups per configuration with a k-d
+#: tree instead of testing a precomputed list of every group pair (memory and time grow with
+#: the pairs that are near, not with all pairs).
+_GROUP_PAIRS_LISTED = 300_000
+
+#: Pair-configuration entries (group pairs, then capsule pairs) one batch holds at most.
+_BATCH_ENTRIES = 2_000_000
+
+
+class _Layout:
+    """Points that move with rigid bodies, sorted by body so that each body's are one slice:
+    ``column[p]`` is where point p lands in :meth:`move`'s arrays."""
+
+    def __init__(self, points: np.ndarray, body: np.ndarray):
+        order = np.argsort(body, kind="stable")
+        self.column = np.empty(order.size, dtype=np.int64)
+        self.column[order] = np.arange(order.size)
+        sorted_body = body[order]
+        cuts = np.flatnonzero(np.r_[True, sorted_body[1:] != sorted_body[:-1]]) \
+            if order.size else np.zeros(0, dtype=np.int64)  # fmt: skip
+        ends = np.r_[cuts[1:], order.size]
+        self.slices = [(int(sorted_body[a]), int(a), int(b), points[order[a:b]])
+                       for a, b in zip(cuts, ends, strict=True)]  # fmt: skip
+        self.size = order.size
+
+    def move(self, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """x, y and z of every point (K, size), moved by the body motions ``B`` (K, NB, 4, 4)."""
+        K = B.shape[0]
+        out = (np.empty((K, self.size)), np.empty((K, self.size)), np.empty((K, self.size)))
+        for b, lo, hi, P in self.slices:
+            if b == 0:  # the base does not move
+                for c in range(3):
+                    out[c][:, lo:hi] = P[:, c]
+                continue
+            R = B[:, b, :3, :, None]
+            for c in range(3):
+                out[c][:, lo:hi] = R[:, c, 0] * P[:, 0] + R[:, c, 1] * P[:, 1] \
+                    + R[:, c, 2] * P[:, 2] + R[:, c, 3]  # fmt: skip
+        return out
+
+
+def _moved(M: np.ndarray, row: np.ndarray, points: np.ndarray) -> tuple:
+    """x, y and z of ``points`` (n, 3) moved by the motions ``M[row]`` (rows of 16: flattened
+    4x4), the same arithmetic as :meth:`_Layout.move`."""
+    T = M[row]
+    return tuple(T[:, 4 * c] * points[:, 0] + T[:, 4 * c + 1] * points[:, 1]
+                 + T[:, 4 * c + 2] * points[:, 2] + T[:, 4 * c + 3] for c in range(3))  # fmt: skip
 
 
 class ClearanceEngine:
@@ -282,96 +384,269 @@ class ClearanceEngine:
 
     Configurations are absolute states, one per joint, as ``setJointStates`` takes them.
 
-    The capsules are grouped into rigid bodies (the parts between two movable joints). Pairs
-    inside one body never move relative to each other, so they are measured once. For pairs
-    of bodies, a ball around each body (fixed in the body) is the broad phase; the capsules of
-    two bodies whose balls are close are then tested capsule ball against capsule ball, and
-    exactly (segment distance) when those are close too.
+    The capsules are grouped into rigid bodies (the parts between two movable joints), and
+    within a body into *groups* (the capsules of one part that move together). Pairs inside
+    one body never move relative to each other, so they are measured once. For the others, a
+    ball around each group (fixed in its body) is the broad phase; the capsules of two groups
+    whose balls are close are then tested capsule ball against capsule ball, and exactly
+    (segment distance) when those are close too. Every step is batched over configurations
+    (docs/clearance.md, "The engine").
     """
 
     def __init__(self, chain, names=None):
+        from kinegami.chain import KinematicChain
+
+        if not isinstance(chain, KinematicChain):
+            raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
         self.model: CapsuleModel = capsule_model(chain, names)
         m = self.model
-        self.r = r = m.r
-        self.ranges = np.array([joint.stateRange() for joint in chain.Joints], dtype=float)
-        movable = np.nonzero(m.joint_kind != 0)[0]
-        self.movable = movable
-        # rigid body of every joint's distal side: number of movable joints up to it
-        body_of_joint = np.cumsum(m.joint_kind != 0)
-        body = np.concatenate([[0], body_of_joint])  # index j + 1; joint -1 (base) -> 0
-        self.body_a = body[m.start_body + 1]
-        self.body_b = body[m.end_body + 1]
-        kinds = m.joint_kind[movable]
-        self._revolute_m = kinds == JOINT_REVOLUTE
-        S = m.count
-        NB = movable.size + 1
-        self.bodies = NB
-        # most turning the hinges before body b can add (prefix over movable joints)
-        max_kink = np.where(
-            self._revolute_m, np.max(np.abs(self.ranges[movable]), axis=1), 0.0
-        ) if movable.size else np.zeros(0)  # fmt: skip
-        kink_prefix = np.concatenate([[0.0], np.cumsum(max_kink)])
-        # body balls (in the current configuration; they move with their body); a prismatic
-        # segment belongs to its proximal body, with its ball over the whole stroke
-        ext_lo = np.zeros(S)
-        ext_hi = np.zeros(S)
-        seg_body = self.body_a
-        axis = np.zeros((S, 3))
-        for s in np.nonzero(self.body_a != self.body_b)[0]:
-            j = int(movable[self.body_b[s] - 1])
-            lo, hi = self.ranges[j]
-            ext_lo[s] = lo - m.states[j]
-            ext_hi[s] = hi - m.states[j]
-            axis[s] = m.joint_axis[j]
-        points_by_body: list[list[np.ndarray]] = [[] for _ in range(NB)]
-        for s in range(S):
-            pts = points_by_body[seg_body[s]]
-            pts += [m.starts[s], m.ends[s]]
-            if ext_hi[s] != ext_lo[s]:
-                pts += [m.ends[s] + ext_lo[s] * axis[s], m.ends[s] + ext_hi[s] * axis[s]]
-        centres = np.zeros((NB, 3))
-        radii = np.zeros(NB)
-        for b, pts in enumerate(points_by_body):
-            if pts:
-                centres[b], radii[b] = _ball(np.array(pts), r)
-            else:
-                radii[b] = -np.inf  # an empty body never collides
-        self.body_centres = centres
-        self.body_radii = radii
-        # candidate pairs i < j whose turning gap can reach pi
-        i, j = np.triu_indices(S, 1)
-        gap_max = (
-            m.turning[j] - m.turning[i]
-            + kink_prefix[self.body_a[j]] - kink_prefix[self.body_a[i]]
+        joints = chain.Joints
+        self._setup(
+            r=m.r, starts=m.starts, ends=m.ends, start_joint=m.start_body, end_joint=m.end_body,
+            turning=m.turning, element=m.element, parents=np.arange(len(joints)) - 1,
+            kinds=m.joint_kind, points=m.joint_point, axes=m.joint_axis, states=m.states,
+            ranges=np.array([joint.stateRange() for joint in joints], dtype=float),
+            pieces=[(np.asarray(b, dtype=float), labels) for b, labels in m.pieces],
+            lengths=[float(np.linalg.norm(m.ends[s] - m.starts[s])) for s in range(m.count)],
         )  # fmt: skip
-        keep = gap_max >= math.pi - TURN_TOLERANCE
-        i, j = i[keep], j[keep]
-        bi, bj = seg_body[i], seg_body[j]
-        same = (bi == bj) & (self.body_a[i] == self.body_b[i]) & (self.body_a[j] == self.body_b[j])
-        # pairs inside one rigid body: measured once
-        self.static = None  # (clearance, pair index in static arrays) of the worst static pair
-        si, sj = i[same], j[same]
-        self._static_pairs = (si, sj)
-        if si.size:
-            d, s_, t_ = segment_distances(m.starts[si], m.ends[si], m.starts[sj], m.ends[sj])
-            self._static_clearance = d - 2.0 * r
-            self._static_st = (s_, t_)
+
+    # --- set-up ----------------------------------------------------------------------------
+    def _setup(self, *, r, starts, ends, start_joint, end_joint, turning, element, parents,
+               kinds, points, axes, states, ranges, pieces, lengths,
+               caps=None) -> None:  # fmt: skip
+        """Everything the queries need, from the capsules at the current configuration
+        (``caps``: a tree's :class:`~kinegami.bodies.TreeCapsules`, None for a chain)."""
+        self.r = r = float(r)
+        self.ranges = ranges
+        self._caps = caps
+        self._starts, self._ends = starts, ends
+        self._turning = turning
+        self._pieces, self._lengths = pieces, np.asarray(lengths, dtype=float)
+        self._element = element
+        self._states = np.asarray(states, dtype=float)
+        S = starts.shape[0]
+        J = len(parents)
+        self._S = S
+        # rigid bodies: the base (0) and one per movable joint, in joint order
+        body_of = np.zeros(J, dtype=np.int64)
+        body_joint, body_parent = [-1], [-1]
+        for k in range(J):
+            p = int(parents[k])
+            base = int(body_of[p]) if p >= 0 else 0
+            if kinds[k] != JOINT_FIXED:
+                body_of[k] = len(body_joint)
+                body_joint.append(k)
+                body_parent.append(base)
+            else:
+                body_of[k] = base
+        NB = len(body_joint)
+        self.bodies = NB
+        self.movable = np.array(body_joint[1:], dtype=np.int64)
+        self._body_parent = np.array(body_parent, dtype=np.int64)
+        self._chain_bodies = bool(np.all(self._body_parent[1:] == np.arange(NB - 1)))
+        bj = self.movable
+        self._revolute_b = kinds[bj] == JOINT_REVOLUTE
+        self._revolute_m = self._revolute_b  # (the name the tests knew)
+        self._any_revolute = bool(self._revolute_b.any())
+        ax = axes[bj]
+        K1 = np.zeros((bj.size, 3, 3))
+        K1[:, 0, 1], K1[:, 0, 2], K1[:, 1, 2] = -ax[:, 2], ax[:, 1], -ax[:, 0]
+        K1[:, 1, 0], K1[:, 2, 0], K1[:, 2, 1] = ax[:, 2], -ax[:, 1], ax[:, 0]
+        self._K1, self._K2 = K1, K1 @ K1
+        self._hinge_point, self._axis = points[bj], ax
+
+        def body(joint_index: np.ndarray) -> np.ndarray:
+            return np.where(joint_index >= 0, body_of[np.maximum(joint_index, 0)], 0)
+
+        ba, bb = body(np.asarray(start_joint)), body(np.asarray(end_joint))
+        self.body_a, self.body_b = ba, bb
+        # most turning the hinges up to each body can add
+        max_kink = np.where(self._revolute_b, np.max(np.abs(ranges[bj]), axis=1), 0.0) \
+            if bj.size else np.zeros(0)  # fmt: skip
+        kink_max = np.zeros(NB)
+        for b in range(1, NB):
+            kink_max[b] = kink_max[body_parent[b]] + max_kink[b - 1]
+        # groups: runs of capsules of one part with the same bodies at both ends; a capsule
+        # whose end slides (prismatic) is a group of its own with a ball over the stroke
+        spanning = ba != bb
+        if S:
+            change = np.r_[True, (element[1:] != element[:-1]) | (ba[1:] != ba[:-1])
+                           | (bb[1:] != bb[:-1]) | spanning[1:] | spanning[:-1]]  # fmt: skip
         else:
-            self._static_clearance = np.zeros(0)
-            self._static_st = (np.zeros(0), np.zeros(0))
-        # pairs across bodies, grouped by body pair (CSR)
-        di, dj = i[~same], j[~same]
-        lo_b = np.minimum(seg_body[di], seg_body[dj])
-        hi_b = np.maximum(seg_body[di], seg_body[dj])
-        code = lo_b * NB + hi_b
-        order = np.argsort(code, kind="stable")
-        di, dj, code = di[order], dj[order], code[order]
-        self.first, self.second = di, dj
-        pair_codes, starts, counts = np.unique(code, return_index=True, return_counts=True)
-        self.body_pair_lo = pair_codes // NB
-        self.body_pair_hi = pair_codes % NB
-        self.body_pair_start = starts
-        self.body_pair_count = counts
+            change = np.zeros(0, dtype=bool)
+        if S and _GROUP_SIZE:  # and at most _GROUP_SIZE capsules each
+            run = np.cumsum(change) - 1
+            within = np.arange(S) - np.flatnonzero(change)[run]
+            change |= within % _GROUP_SIZE == 0
+        gstart = np.flatnonzero(change)
+        gsize = np.diff(np.r_[gstart, S])
+        G = gstart.size
+        lo_pts = np.minimum(starts, ends)
+        hi_pts = np.maximum(starts, ends)
+        stroke = [np.zeros((0, 3))] * 2
+        if spanning.any():
+            sp = np.flatnonzero(spanning)
+            j = np.asarray(end_joint)[sp]
+            ext = ranges[j] - self._states[j][:, None]
+            stroke = [ends[sp] + ext[:, 0:1] * axes[j], ends[sp] + ext[:, 1:2] * axes[j]]
+            lo_pts[sp] = np.minimum(lo_pts[sp], np.minimum(*stroke))
+            hi_pts[sp] = np.maximum(hi_pts[sp], np.maximum(*stroke))
+        # half lengths (a sliding capsule's: the most its end can reach from its centre)
+        self._half = 0.5 * np.sqrt(((ends - starts) ** 2).sum(axis=1))
+        if spanning.any():
+            self._half[sp] += np.abs(ext).max(axis=1)
+        if G:
+            centre = 0.5 * (np.minimum.reduceat(lo_pts, gstart, axis=0)
+                            + np.maximum.reduceat(hi_pts, gstart, axis=0))  # fmt: skip
+            owner = np.repeat(np.arange(G), gsize)
+            far = np.maximum(np.sqrt(((starts - centre[owner]) ** 2).sum(axis=1)),
+                             np.sqrt(((ends - centre[owner]) ** 2).sum(axis=1)))  # fmt: skip
+            if spanning.any():
+                for p in stroke:
+                    far[sp] = np.maximum(far[sp], np.sqrt(((p - centre[owner[sp]]) ** 2).sum(1)))
+            radius = np.maximum.reduceat(far, gstart) + r
+            tau_lo = np.minimum.reduceat(turning, gstart)
+            tau_hi = np.maximum.reduceat(turning, gstart)
+        else:
+            centre, radius, tau_lo, tau_hi = np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0)
+            owner = np.zeros(0, dtype=np.int64)
+        self._gstart, self._gsize, self._group_of = gstart, gsize, owner
+        self._spanning = bool(spanning.any())
+        self._gcentre, self._gradius = centre, radius
+        self._gbody = ba[gstart]
+        self._gspan = spanning[gstart]
+        node = (element + 1) // 2
+        self._gnode = node[gstart]
+        self._gtau_lo, self._gtau_hi = tau_lo, tau_hi
+        self._gkink = kink_max[self._gbody]
+        self._ancestor = None if caps is None else caps.ancestor
+        self._max_radius = float(radius.max()) if G else 0.0
+        # tie order of pairs at equal clearance (as the one-configuration answers list them)
+        blocks = np.cumsum(np.r_[True, element[1:] != element[:-1]]) - 1 if S else owner
+        self._block, self._blocks = blocks, int(blocks[-1]) + 1 if S else 0
+        # the points the queries move, sorted by body: segment ends; capsule and group centres
+        self._end_points = _Layout(np.concatenate([starts, ends]), np.concatenate([ba, bb]))
+        self._centres = _Layout(np.concatenate([0.5 * (starts + ends), centre]),
+                                np.concatenate([ba, self._gbody]))  # fmt: skip
+        self._ccol = self._centres.column[:S]
+        self._gcol = self._centres.column[S:]
+        # group pairs: listed when few, else found per configuration
+        G2 = G * (G + 1) // 2
+        self._listed = G2 <= _GROUP_PAIRS_LISTED
+        static_groups = []
+        if self._listed:
+            g1, g2 = np.triu_indices(G)
+            feasible = self._feasible(g1, g2)
+            static = feasible & self._same_body(g1, g2)
+            static_groups.append((g1[static], g2[static]))
+            dynamic = feasible & ~static & (g1 != g2)
+            self._gp1, self._gp2 = g1[dynamic], g2[dynamic]
+            self._gp_same = self._same_path(self._gp1, self._gp2)
+            self._list_capsule_pairs(kink_max)
+        else:
+            for b in np.unique(self._gbody):
+                gs = np.flatnonzero(self._gbody == b)
+                a1, a2 = np.triu_indices(gs.size)
+                g1, g2 = gs[a1], gs[a2]
+                ok = self._feasible(g1, g2) & self._same_body(g1, g2)
+                static_groups.append((g1[ok], g2[ok]))
+        self._static_pairs_from(static_groups)
+
+    def _list_capsule_pairs(self, kink_max: np.ndarray) -> None:
+        """The capsule pairs of every listed group pair that the rule may test at some
+        configuration (as :meth:`_feasible`, capsule by capsule), grouped by group pair; group
+        pairs left without one are dropped."""
+        i, j, entry = self._expand(self._gp1, self._gp2)
+        same = self._gp_same[entry]
+        gap = self._turning[j] - self._turning[i] + kink_max[self.body_a[j]] \
+            - kink_max[self.body_a[i]]  # fmt: skip
+        ok = ~same | (gap >= math.pi - TURN_TOLERANCE)
+        i, j, entry = i[ok], j[ok], entry[ok]
+        count = np.bincount(entry, minlength=self._gp1.size)
+        used = count > 0
+        self._gp1, self._gp2 = self._gp1[used], self._gp2[used]
+        self._gp_same = self._gp_same[used]
+        self._cp_count = count[used]
+        self._cp_offset = np.cumsum(self._cp_count) - self._cp_count
+        self._cp_i, self._cp_j = i, j
+
+    def _same_path(self, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
+        """Whether groups g1, g2 lie on one path from the root (always, in a chain)."""
+        if self._ancestor is None:
+            return np.ones(g1.shape, dtype=bool)
+        n1, n2 = self._gnode[g1], self._gnode[g2]
+        return self._ancestor[n1, n2] | self._ancestor[n2, n1]
+
+    def _feasible(self, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
+        """Group pairs (g1 <= g2) that hold a pair the rule may test at some configuration:
+        on different branches, or turning by up to pi or more between them."""
+        gap = (self._gtau_hi[g2] - self._gtau_lo[g1] + self._gkink[g2] - self._gkink[g1])
+        return (gap >= math.pi - TURN_TOLERANCE) | ~self._same_path(g1, g2)
+
+    def _same_body(self, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
+        """Group pairs that never move relative to each other."""
+        return (self._gbody[g1] == self._gbody[g2]) & ~self._gspan[g1] & ~self._gspan[g2]
+
+    def _expand(self, g1: np.ndarray, g2: np.ndarray, k: np.ndarray | None = None):
+        """Capsule pairs (i < j) of group pairs (g1 <= g2), with their entry's index."""
+        n1, n2 = self._gsize[g1], self._gsize[g2]
+        count = n1 * n2
+        total = int(count.sum())
+        entry = np.repeat(np.arange(g1.size), count)
+        q = np.arange(total) - np.repeat(np.cumsum(count) - count, count)
+        n2r = n2[entry]
+        i = self._gstart[g1][entry] + q // n2r
+        j = self._gstart[g2][entry] + q % n2r
+        keep = i < j
+        return i[keep], j[keep], entry[keep]
+
+    def _static_pairs_from(self, groups: list) -> None:
+        """Measure the pairs inside rigid bodies once (a tree's junction pairs beyond their
+        junctions)."""
+        si, sj = [], []
+        for g1, g2 in groups:
+            for start in range(0, g1.size, 4096):
+                i, j, _ = self._expand(g1[start : start + 4096], g2[start : start + 4096])
+                same = self._pair_same_path(i, j)
+                ok = ~same | (self._turning[j] - self._turning[i] >= math.pi - TURN_TOLERANCE)
+                si.append(i[ok])
+                sj.append(j[ok])
+        i = np.concatenate(si) if si else np.zeros(0, dtype=np.int64)
+        j = np.concatenate(sj) if sj else np.zeros(0, dtype=np.int64)
+        order = np.lexsort((j, i))
+        i, j = i[order], j[order]
+        d, s, t = segment_distances(self._starts[i], self._ends[i], self._starts[j],
+                                    self._ends[j])  # fmt: skip
+        if self._caps is not None and i.size:
+            q = np.flatnonzero(self._caps.junction_pairs(i, j))
+            if q.size:
+                d[q], s[q], t[q] = self._caps.beyond_junction(i[q], j[q])
+        self._static_pairs = (i, j)
+        self._static_clearance = d - 2.0 * self.r
+        self._static_st = (s, t)
+        self._static_rank = self._rank(i, j, static=True)
+        self._static_best = None
+        if i.size:
+            self._static_best = int(np.lexsort((self._static_rank, self._static_clearance))[0])
+
+    def _pair_same_path(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        if self._ancestor is None:
+            return np.ones(i.shape, dtype=bool)
+        n1, n2 = (self._element[i] + 1) // 2, (self._element[j] + 1) // 2
+        return self._ancestor[n1, n2] | self._ancestor[n2, n1]
+
+    def _rank(self, i: np.ndarray, j: np.ndarray, static: bool = False) -> np.ndarray:
+        """The order in which pairs at equal clearance are taken (the one-configuration
+        answers' order): a chain's static pairs in their own order, the others by the bodies'
+        pair and then the capsules; a tree's all by parts, then capsules."""
+        S = max(self._S, 1)
+        if self._caps is None:
+            if static:
+                return np.arange(i.size, dtype=np.int64)
+            b1, b2 = self.body_a[i], self.body_a[j]
+            code = np.minimum(b1, b2) * self.bodies + np.maximum(b1, b2)
+            return (code * S + i) * S + j
+        return ((self._block[i] * self._blocks + self._block[j]) * S + i) * S + j
 
     # --- kinematics ------------------------------------------------------------------------
     def check_states(self, states, name: str = "states") -> np.ndarray:
@@ -380,161 +655,240 @@ class ClearanceEngine:
 
     def body_transforms(self, Q: np.ndarray) -> np.ndarray:
         """(K, bodies, 4, 4): world motion of every rigid body (0 = base) at each of the
-        configurations ``Q`` (K, J), relative to the chain's current configuration."""
-        m = self.model
-        K = Q.shape[0]
-        B = np.empty((K, self.bodies, 4, 4))
+        configurations ``Q`` (K, J), relative to the current configuration."""
+        Q = np.asarray(Q, dtype=float)
+        K, NB = Q.shape[0], self.bodies
+        B = np.empty((K, NB, 4, 4))
         B[:, 0] = np.eye(4)
-        for b, j in enumerate(self.movable, start=1):
-            delta = Q[:, j] - m.states[j]
-            if not np.any(delta):
-                B[:, b] = B[:, b - 1]
-                continue
-            M = np.zeros((K, 4, 4))
-            M[:, 3, 3] = 1.0
-            if m.joint_kind[j] == JOINT_REVOLUTE:
-                R = _rotations(m.joint_axis[j], delta)
-                p = m.joint_point[j]
-                M[:, :3, :3] = R
-                M[:, :3, 3] = p - R @ p
-            else:  # prismatic
-                M[:, :3, :3] = np.eye(3)
-                M[:, :3, 3] = delta[:, None] * m.joint_axis[j]
-            B[:, b] = B[:, b - 1] @ M
+        if NB == 1:
+            return B
+        bj = self.movable
+        delta = Q[:, bj] - self._states[bj]
+        rev = self._revolute_b
+        # revolute: Rodrigues' rotation about the hinge line; prismatic: a slide along z
+        s = np.where(rev, np.sin(delta), 0.0)[..., None, None]
+        c = np.where(rev, 1.0 - np.cos(delta), 0.0)[..., None, None]
+        R = np.eye(3) + s * self._K1 + c * self._K2
+        p = self._hinge_point
+        M = np.zeros((K, NB - 1, 4, 4))
+        M[..., 3, 3] = 1.0
+        M[..., :3, :3] = R
+        M[..., :3, 3] = np.where(rev[:, None], p - (R @ p[:, :, None])[..., 0],
+                                 delta[..., None] * self._axis)  # fmt: skip
+        parent = self._body_parent
+        for b in range(1, NB):
+            B[:, b] = B[:, parent[b]] @ M[:, b - 1]
         return B
 
-    def _segments(self, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        m = self.model
-        Ba = B[:, self.body_a]
-        Bb = B[:, self.body_b]
-        a = np.einsum("ksij,sj->ksi", Ba[..., :3, :3], m.starts) + Ba[..., :3, 3]
-        b = np.einsum("ksij,sj->ksi", Bb[..., :3, :3], m.ends) + Bb[..., :3, 3]
-        return a, b
+    def _segments_at(self, B: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Segment starts and ends (S, 3) at configuration k of the body motions ``B``."""
+        S = self._S
+        W = np.stack(self._end_points.move(B[k : k + 1]), axis=-1)[0, self._end_points.column]
+        return W[:S], W[S:]
 
     def segments(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """World segment end points (K, S, 3) twice, at configurations ``Q`` (K, J)."""
-        return self._segments(self.body_transforms(np.asarray(Q, dtype=float)))
+        layout = self._end_points
+        W = np.stack(layout.move(self.body_transforms(self._configurations(Q))), axis=-1)
+        W = W[:, layout.column]
+        S = self._S
+        return W[:, :S], W[:, S:]
+
+    def _kinks(self, Q: np.ndarray) -> np.ndarray:
+        """(K, bodies): the turning the revolute hinges add up to every body."""
+        K, NB = Q.shape[0], self.bodies
+        add = np.where(self._revolute_b[None, :], np.abs(Q[:, self.movable]), 0.0)
+        if self._chain_bodies:
+            return np.concatenate([np.zeros((K, 1)), np.cumsum(add, axis=1)], axis=1)
+        out = np.zeros((K, NB))
+        for b in range(1, NB):
+            out[:, b] = out[:, self._body_parent[b]] + add[:, b - 1]
+        return out
 
     def turning(self, Q: np.ndarray) -> np.ndarray:
         """(K, S) turning of the centreline up to every segment at configurations ``Q``."""
-        m = self.model
-        Qm = np.asarray(Q, dtype=float)[:, self.movable]
-        kinks = np.where(self._revolute_m[None, :], np.abs(Qm), 0.0)
-        prefix = np.concatenate([np.zeros((Qm.shape[0], 1)), np.cumsum(kinks, axis=1)], axis=1)
-        return m.turning[None, :] + prefix[:, self.body_a]
+        Q = self._configurations(Q)
+        return self._turning[None, :] + self._kinks(Q)[:, self.body_a]
+
+    def _configurations(self, Q) -> np.ndarray:
+        """``Q`` as a float array (a tree's states clamped into their ranges)."""
+        Q = np.asarray(Q, dtype=float)
+        if self._caps is not None:
+            Q = np.clip(Q, self.ranges[:, 0], self.ranges[:, 1])
+        return Q
 
     # --- the core query --------------------------------------------------------------------
-    def _candidates(self, Q: np.ndarray, threshold: float):
-        """Exact clearances of every tested pair across bodies whose capsule balls are within
-        ``threshold`` of each other, at configurations ``Q`` (K, J).
+    def _near_groups(self, xyz: tuple, threshold: float):
+        """(k, g1, g2, same path, n): the pairs of groups that move relative to each other
+        (and may be tested) whose balls come within ``threshold`` at configuration k (n: their
+        index in the list, when listed)."""
+        radius = self._gradius
+        if self._listed:
+            g1, g2 = self._gp1, self._gp2
+            c1, c2 = self._gcol[g1], self._gcol[g2]
+            d = [np.take(c, c1, axis=1) - np.take(c, c2, axis=1) for c in xyz]
+            reach = radius[g1] + radius[g2] + threshold
+            kk, n = np.nonzero(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= reach * reach)
+            return kk, g1[n], g2[n], self._gp_same[n], n
+        from scipy.spatial import cKDTree
 
-        Returns (k, pair, clearance, s, t, a, b): config index, index into first/second, the
-        clearance and closest-point parameters of each such pair, and the world segments.
+        out_k, out_1, out_2 = [], [], []
+        reach = 2.0 * self._max_radius + threshold
+        for k in range(xyz[0].shape[0]):
+            centres = np.stack([c[k, self._gcol] for c in xyz], axis=-1)
+            pairs = cKDTree(centres).query_pairs(reach, output_type="ndarray")
+            if pairs.size == 0:
+                continue
+            g1, g2 = pairs.min(axis=1), pairs.max(axis=1)
+            d = centres[g1] - centres[g2]
+            near = np.sqrt(np.einsum("gi,gi->g", d, d)) - radius[g1] - radius[g2] <= threshold
+            near &= self._feasible(g1, g2) & ~self._same_body(g1, g2)
+            out_k.append(np.full(int(near.sum()), k))
+            out_1.append(g1[near])
+            out_2.append(g2[near])
+        if not out_k:
+            none = np.zeros(0, dtype=np.int64)
+            return none, none, none, np.zeros(0, dtype=bool), none
+        g1, g2 = np.concatenate(out_1), np.concatenate(out_2)
+        return np.concatenate(out_k), g1, g2, self._same_path(g1, g2), None
+
+    def _candidates(self, Q: np.ndarray, threshold: float):
+        """Exact clearances of the tested pairs that move relative to each other and whose
+        capsule balls are within ``threshold`` of each other, at configurations ``Q`` (K, J).
+
+        Returns (k, i, j, clearance, s, t, xyz): configuration and capsule indices, the
+        clearance and closest-point parameters of each such pair, and :meth:`_world`'s points.
         """
         B = self.body_transforms(Q)
-        a, b = self._segments(B)
-        empty = (np.zeros(0, dtype=np.int64),) * 2 + (np.zeros(0),) * 3
-        if self.body_pair_lo.size == 0:
-            return (*empty, a, b)
-        centres = np.einsum("kbij,bj->kbi", B[..., :3, :3], self.body_centres) + B[..., :3, 3]
-        lo, hi = self.body_pair_lo, self.body_pair_hi
-        gap = np.sqrt(((centres[:, lo] - centres[:, hi]) ** 2).sum(axis=2))
-        near = gap - self.body_radii[lo] - self.body_radii[hi] <= threshold
-        kk, bp = np.nonzero(near)
+        none = np.zeros(0, dtype=np.int64)
+        empty = (none, none, none, np.zeros(0), np.zeros(0), np.zeros(0), B)
+        if self._listed and self._gp1.size == 0:
+            return empty
+        xyz = self._centres.move(B)
+        kk, g1, g2, same, n_gp = self._near_groups(xyz, threshold)
         if kk.size == 0:
-            return (*empty, a, b)
-        counts = self.body_pair_count[bp]
-        total = int(counts.sum())
-        k_rep = np.repeat(kk, counts)
-        offsets = np.repeat(self.body_pair_start[bp] - np.cumsum(counts) + counts, counts)
-        pair = offsets + np.arange(total)
-        S = self.model.count
-        flat_i = k_rep * S + self.first[pair]
-        flat_j = k_rep * S + self.second[pair]
-        # capsule balls first (centre and half-length per capsule and configuration)
-        centre = (0.5 * (a + b)).reshape(-1, 3)
-        half = (0.5 * np.sqrt(((b - a) ** 2).sum(axis=2))).reshape(-1)
-        d = np.take(centre, flat_i, axis=0) - np.take(centre, flat_j, axis=0)
-        lower = np.sqrt(np.einsum("ij,ij->i", d, d)) - half[flat_i] - half[flat_j]
-        keep = lower <= threshold + 2.0 * self.r
-        if self._revolute_m.any():
-            tau = self.turning(Q).reshape(-1)
-            keep &= tau[flat_j] - tau[flat_i] >= math.pi - TURN_TOLERANCE
-        idx = np.nonzero(keep)[0]
-        fi, fj = flat_i[idx], flat_j[idx]
-        af, bf = a.reshape(-1, 3), b.reshape(-1, 3)
-        dist, s, t = segment_distances(af[fi], bf[fi], af[fj], bf[fj])
-        return k_rep[idx], pair[idx], dist - 2.0 * self.r, s, t, a, b
+            return empty
+        if self._listed:
+            count = self._cp_count[n_gp]
+            entry = np.repeat(np.arange(n_gp.size), count)
+            pos = np.arange(entry.size) + np.repeat(self._cp_offset[n_gp] - np.cumsum(count)
+                                                    + count, count)  # fmt: skip
+            i, j = self._cp_i[pos], self._cp_j[pos]
+        else:
+            i, j, entry = self._expand(g1, g2)
+        k = kk[entry]
+        same = same[entry]
+        P = xyz[0].shape[1]
+        flat = [c.reshape(-1) for c in xyz]
+        NB = self.bodies
+        # capsule balls first: centre distance minus both half lengths (a sliding capsule's
+        # half length is its longest)
+        fi, fj = k * P + self._ccol[i], k * P + self._ccol[j]
+        d = [np.take(c, fi) - np.take(c, fj) for c in flat]
+        gap = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        keep = gap - self._half[i] - self._half[j] <= threshold + 2.0 * self.r
+        gap_turn = self._turning[j] - self._turning[i]
+        if self._any_revolute:
+            kink = self._kinks(Q).reshape(-1)
+            gap_turn = gap_turn + np.take(kink, k * NB + self.body_a[j]) \
+                - np.take(kink, k * NB + self.body_a[i])  # fmt: skip
+        keep &= ~same | (np.abs(gap_turn) >= math.pi - TURN_TOLERANCE)
+        n = np.flatnonzero(keep)
+        k, i, j = k[n], i[n], j[n]
+        # the segments of the pairs left, moved one by one
+        M = B.reshape(-1, 16)
+        ends = [_moved(M, k * NB + self.body_a[i], self._starts[i]),
+                _moved(M, k * NB + self.body_b[i], self._ends[i]),
+                _moved(M, k * NB + self.body_a[j], self._starts[j]),
+                _moved(M, k * NB + self.body_b[j], self._ends[j])]  # fmt: skip
+        dist, s, t = _segment_distances_xyz(*ends)
+        return k, i, j, dist - 2.0 * self.r, s, t, B
+
+    def _chunk(self) -> int:
+        """Configurations per batch (bounds the batch's pair-configuration entries)."""
+        per = max(self._gp1.size if self._listed else self._S, 1)
+        return int(min(1024, max(1, _BATCH_ENTRIES // per)))
+
+    # --- labels ----------------------------------------------------------------------------
+    def _texts(self, rows: np.ndarray, s: np.ndarray) -> list[str]:
+        """The part at parameter s of capsule row, in words, for every (row, s)."""
+        out: list[str] = [""] * rows.size
+        for row in np.unique(rows).tolist():
+            n = np.flatnonzero(rows == row)
+            breaks, labels = self._pieces[row]
+            if len(breaks) == 0:
+                for m in n.tolist():
+                    out[m] = self._named(row, labels[-1])
+                continue
+            at = s[n] * self._lengths[row]
+            below = at[:, None] < breaks[None, :]
+            piece = np.where(below.any(axis=1), below.argmax(axis=1), len(labels) - 1)
+            for m, p in zip(n.tolist(), piece.tolist(), strict=True):
+                out[m] = self._named(row, labels[p])
+        return out
+
+    def _named(self, row: int, text: str) -> str:
+        return text
+
+    def label(self, row: int, s: float) -> str:
+        """The part at parameter ``s`` in [0, 1] of capsule ``row``, in words."""
+        return self._texts(np.array([row]), np.array([float(s)]))[0]
 
     def _pair(self, i: int, j: int, s: float, t: float, a, b, clearance: float):
         p = a[i] + s * (b[i] - a[i])
         q = a[j] + t * (b[j] - a[j])
-        return CollidingPair(
-            self.model.label(i, s),
-            self.model.label(j, t),
-            float(clearance),
-            (tuple(map(float, p)), tuple(map(float, q))),
-            (int(self.model.element[i]), int(self.model.element[j])),
-        )
-
-    def _static_at(self, k_static: int, a, b) -> CollidingPair:
-        si, sj = self._static_pairs
-        s_, t_ = self._static_st
-        return self._pair(int(si[k_static]), int(sj[k_static]), s_[k_static], t_[k_static],
-                          a, b, self._static_clearance[k_static])  # fmt: skip
+        first, second = self._texts(np.array([i, j]), np.array([s, t], dtype=float))
+        return CollidingPair(first, second, float(clearance),
+                             (tuple(map(float, p)), tuple(map(float, q))),
+                             (int(self._element[i]), int(self._element[j])))  # fmt: skip
 
     # --- queries ---------------------------------------------------------------------------
-    def report(self, states, margin: float = 0.0) -> ClearanceReport:
-        """The :class:`ClearanceReport` at one configuration (absolute states, checked), with
-        ``margin`` (chain units, >= 0) the clearance required."""
-        q = self.check_states(states)
-        values = tuple(float(x) for x in q)
-        Q = q[None, :]
+    def worst_arrays(self, Q: np.ndarray, margin: float) -> tuple:
+        """The closest pair closer than ``margin`` at each configuration of ``Q`` (K, J):
+        ``(clearance, i, j, s, t)`` (K,) each; +inf and -1 where clear."""
+        Q = self._configurations(Q)
+        K = Q.shape[0]
+        out = np.full(K, np.inf)
+        oi = np.full(K, -1, dtype=np.int64)
+        oj = np.full(K, -1, dtype=np.int64)
+        os_, ot = np.zeros(K), np.zeros(K)
         limit = clear_limit(self.r, margin)
-        threshold = 4.0 * self.r + margin
-        while True:
-            k, pair, clearance, s, t, a, b = self._candidates(Q, threshold)
-            a0, b0 = a[0], b[0]
-            best = float(clearance.min()) if clearance.size else math.inf
-            if self._static_clearance.size:
-                best = min(best, float(self._static_clearance.min()))
-            if best <= threshold or threshold > 1e3 * self._extent():
-                break
-            threshold = max(2.0 * threshold, best)
-        entries = [
-            (float(c), ("d", int(p), float(si), float(ti)))
-            for c, p, si, ti in zip(clearance, pair, s, t, strict=True)
-        ]
-        entries += [(float(c), ("s", n)) for n, c in enumerate(self._static_clearance)]
-        if not entries:
-            return ClearanceReport(True, math.inf, (), None, values, margin, self.r)
-        entries.sort(key=lambda e: e[0])
+        n = self._static_best
+        static = n is not None and self._static_clearance[n] < limit
+        chain = self._caps is None
+        for start in range(0, K, self._chunk()):
+            Qc = Q[start : start + self._chunk()]
+            k, i, j, c, s, t, _ = self._candidates(Qc, margin)
+            hit = np.flatnonzero(c < limit)
+            k, i, j, c, s, t = k[hit], i[hit], j[hit], c[hit], s[hit], t[hit]
+            rank = self._rank(i, j)
+            if static:
+                si, sj = self._static_pairs
+                m = Qc.shape[0]
+                k = np.r_[k, np.arange(m)]
+                i, j = np.r_[i, np.full(m, si[n])], np.r_[j, np.full(m, sj[n])]
+                c = np.r_[c, np.full(m, self._static_clearance[n])]
+                s = np.r_[s, np.full(m, self._static_st[0][n])]
+                t = np.r_[t, np.full(m, self._static_st[1][n])]
+                rank = np.r_[rank, np.full(m, -1 if chain else self._static_rank[n])]
+            if k.size == 0:
+                continue
+            order = np.lexsort((rank, c, k))
+            first = order[np.r_[True, k[order][1:] != k[order][:-1]]]
+            kk = start + k[first]
+            out[kk], oi[kk], oj[kk] = c[first], i[first], j[first]
+            os_[kk], ot[kk] = s[first], t[first]
+        return out, oi, oj, os_, ot
 
-        def make(entry):
-            c, ref = entry
-            if ref[0] == "s":
-                return self._static_at(ref[1], a0, b0)
-            _, p, si, ti = ref
-            return self._pair(int(self.first[p]), int(self.second[p]), si, ti, a0, b0, c)
-
-        closest = make(entries[0])
-        pairs: dict[tuple[str, str], CollidingPair] = {}
-        for entry in entries:
-            if entry[0] >= limit:
-                break
-            pair = make(entry)
-            pairs.setdefault((pair.first, pair.second), pair)
-        min_clearance = entries[0][0]
-        return ClearanceReport(min_clearance >= limit, min_clearance, tuple(pairs.values()),
-                               closest, values, margin, self.r)  # fmt: skip
-
-    def _extent(self) -> float:
-        """Size of the chain (for the search radius of :meth:`report`)."""
-        m = self.model
-        if m.count == 0:
-            return self.r
-        pts = np.vstack([m.starts, m.ends])
-        return float(np.ptp(pts, axis=0).max()) + self.r
+    def _pairs_at(self, Q: np.ndarray, which: np.ndarray, found: tuple) -> list:
+        """CollidingPairs of the configurations ``which`` from :meth:`_worst_arrays`'s
+        ``found``."""
+        if which.size == 0:
+            return []
+        clearance, i, j, s, t = found
+        a, b = self.segments(Q[which])
+        return [self._pair(int(i[w]), int(j[w]), float(s[w]), float(t[w]), a[n], b[n],
+                           clearance[w]) for n, w in enumerate(which.tolist())]  # fmt: skip
 
     def worst(self, Q: np.ndarray, margin: float = 0.0) -> tuple[np.ndarray, list]:
         """Closest pair at each configuration of ``Q`` (K, J) that is closer than ``margin``
@@ -545,51 +899,92 @@ class ClearanceEngine:
         pairs[k] is the CollidingPair of that clearance, or None.
         """
         Q = np.asarray(Q, dtype=float)
-        K = Q.shape[0]
-        out = np.full(K, np.inf)
-        found: list = [None] * K
-        limit = clear_limit(self.r, margin)
-        static_worst = None
-        if self._static_clearance.size:
-            n = int(np.argmin(self._static_clearance))
-            if self._static_clearance[n] < limit:
-                static_worst = n
-        chunk = 256
-        for start in range(0, K, chunk):
-            Qc = Q[start : start + chunk]
-            k, pair, clearance, s, t, a, b = self._candidates(Qc, margin)
-            if static_worst is not None:
-                value = float(self._static_clearance[static_worst])
-                for local in range(Qc.shape[0]):
-                    out[start + local] = value
-                    found[start + local] = ("s", static_worst, local)
-            colliding = np.nonzero(clearance < limit)[0]
-            # the deepest overlap per configuration
-            order = colliding[np.argsort(clearance[colliding], kind="stable")]
-            for n in order:
-                kk = start + int(k[n])
-                if clearance[n] < out[kk]:
-                    out[kk] = clearance[n]
-                    found[kk] = ("d", int(pair[n]), float(s[n]), float(t[n]), int(k[n]))
-            for local in range(Qc.shape[0]):
-                ref = found[start + local]
-                if ref is None or isinstance(ref, CollidingPair):
-                    continue
-                if ref[0] == "s":
-                    found[start + local] = self._static_at(ref[1], a[local], b[local])
-                else:
-                    _, p, si, ti, kl = ref
-                    found[start + local] = self._pair(
-                        int(self.first[p]), int(self.second[p]), si, ti, a[kl], b[kl],
-                        out[start + local],
-                    )  # fmt: skip
-        return out, found
+        found = self.worst_arrays(Q, margin)
+        which = np.flatnonzero(np.isfinite(found[0]))
+        pairs: list = [None] * Q.shape[0]
+        for w, pair in zip(which.tolist(), self._pairs_at(Q, which, found), strict=True):
+            pairs[w] = pair
+        return found[0], pairs
 
     def colliding(self, Q: np.ndarray, margin: float = 0.0) -> np.ndarray:
         """(K,) True where the configuration has parts closer than ``margin`` (0: where it
         self-intersects)."""
-        clearance, _ = self.worst(Q, margin)
-        return np.isfinite(clearance)
+        return np.isfinite(self.worst_arrays(np.asarray(Q, dtype=float), margin)[0])
+
+    def tally(self, Q: np.ndarray, found: tuple) -> tuple[np.ndarray, tuple]:
+        """What :func:`sweep` reports of ``Q`` from :meth:`worst_arrays`'s ``found``: the
+        clearance at each configuration (+inf where clear) and up to 10 ``(pair, count)``: the
+        pairs of parts that were the deepest overlap of some configuration, deepest first."""
+        clearance, i, j, s, t = found
+        hit = np.flatnonzero(np.isfinite(clearance))
+        if hit.size == 0:
+            return clearance, ()
+        texts = self._texts(np.r_[i[hit], j[hit]], np.r_[s[hit], t[hit]])
+        names: dict[str, int] = {}
+        codes = np.array([names.setdefault(x, len(names)) for x in texts], dtype=np.int64)
+        key = codes[: hit.size] * len(names) + codes[hit.size :]
+        _, group, counts = np.unique(key, return_inverse=True, return_counts=True)
+        # per group: its first configuration, and the first configuration of its deepest
+        order = np.lexsort((hit, clearance[hit], group))
+        lead = np.r_[True, group[order][1:] != group[order][:-1]]
+        deepest = hit[order[lead]]
+        first_seen = np.full(counts.size, hit.size)
+        np.minimum.at(first_seen, group, np.arange(hit.size))
+        ranking = np.lexsort((first_seen, clearance[deepest]))[:10]
+        pairs = self._pairs_at(Q, deepest[ranking], found)
+        return clearance, tuple(zip(pairs, (int(c) for c in counts[ranking]), strict=True))
+
+    def report(self, states, margin: float = 0.0) -> ClearanceReport:
+        """The :class:`ClearanceReport` at one configuration (absolute states, checked), with
+        ``margin`` (chain units, >= 0) the clearance required."""
+        q = self.check_states(states)
+        Q = self._configurations(q[None, :])
+        values = tuple(float(x) for x in Q[0]) if self._caps is not None \
+            else tuple(float(x) for x in q)  # fmt: skip
+        limit = clear_limit(self.r, margin)
+        threshold = 4.0 * self.r + margin
+        static = self._static_clearance
+        static_min = float(static.min()) if static.size else math.inf
+        while True:
+            _, i, j, clearance, s, t, B = self._candidates(Q, threshold)
+            best = min(float(clearance.min()) if clearance.size else math.inf, static_min)
+            if best <= threshold or threshold > 1e3 * self._extent():
+                break
+            threshold = max(2.0 * threshold, best)
+        if clearance.size + static.size == 0:
+            return ClearanceReport(True, math.inf, (), None, values, margin, self.r)
+        si, sj = self._static_pairs
+        ci, cj = np.r_[i, si], np.r_[j, sj]
+        cc = np.r_[clearance, static]
+        cs, ct = np.r_[s, self._static_st[0]], np.r_[t, self._static_st[1]]
+        if self._caps is None:  # a chain's: moving pairs first, each kind in its order
+            order = np.lexsort((np.r_[self._rank(i, j), self._static_rank],
+                                np.r_[np.zeros(i.size), np.ones(si.size)], cc))  # fmt: skip
+        else:
+            order = np.lexsort((np.r_[self._rank(i, j), self._static_rank], cc))
+        a0, b0 = self._segments_at(B, 0)
+
+        def make(n: int) -> CollidingPair:
+            return self._pair(int(ci[n]), int(cj[n]), float(cs[n]), float(ct[n]), a0, b0,
+                              float(cc[n]))  # fmt: skip
+
+        closest = make(int(order[0]))
+        pairs: dict[tuple[str, str], CollidingPair] = {}
+        for n in order.tolist():
+            if cc[n] >= limit:
+                break
+            pair = make(n)
+            pairs.setdefault((pair.first, pair.second), pair)
+        min_clearance = float(cc[order[0]])
+        return ClearanceReport(min_clearance >= limit, min_clearance, tuple(pairs.values()),
+                               closest, values, margin, self.r)  # fmt: skip
+
+    def _extent(self) -> float:
+        """Size of the assembly (for the search radius of :meth:`report`)."""
+        if self._S == 0:
+            return self.r
+        pts = np.vstack([self._starts, self._ends])
+        return float(np.ptp(pts, axis=0).max()) + self.r
 
     def free_intervals(self, states: np.ndarray, resolution: int = 64,
                        margin: float = 0.0) -> tuple:  # fmt: skip
@@ -650,6 +1045,8 @@ class ClearanceEngine:
         return tuple(out)
 
 
+
+
 _ENGINES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -659,13 +1056,38 @@ def engine_for(chain, names=None) -> ClearanceEngine:
 
     if not isinstance(chain, KinematicChain):
         raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
-    key = (chain.Joints, chain.Links, None if names is None else tuple(names))
+    joints, links = chain.Joints, chain.Links
+    names = None if names is None else tuple(names)
     cached = _ENGINES.get(chain)
-    if cached is not None and cached[0] == key:
-        return cached[1]
+    if (cached is not None and cached[2] == names and _same_objects(cached[0], joints)
+            and _same_objects(cached[1], links)):  # fmt: skip
+        return cached[3]
     engine = ClearanceEngine(chain, names)
-    _ENGINES[chain] = (key, engine)
+    _ENGINES[chain] = (tuple(joints), tuple(links), names, engine)
     return engine
+
+
+_TREE_ENGINES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _tree_engine(tree, names=None, margin: float = 0.0) -> TreeEngine:
+    """The tree's :class:`TreeEngine` for ``names`` and ``margin``, cached until its joints,
+    links or parents change (a few per tree: one per margin and names asked for)."""
+    joints, links, parents = tree.Joints, tree.Links, tuple(tree.Parents)
+    names = None if names is None else tuple(names)
+    cached = _TREE_ENGINES.setdefault(tree, [])
+    for entry in cached:
+        if (entry[2:5] == (parents, names, margin) and _same_objects(entry[0], joints)
+                and _same_objects(entry[1], links)):  # fmt: skip
+            return entry[5]
+    engine = TreeEngine(tree, names, margin)
+    cached.insert(0, (tuple(joints), tuple(links), parents, names, margin, engine))
+    del cached[4:]
+    return engine
+
+
+def _same_objects(known: tuple, now) -> bool:
+    return len(known) == len(now) and all(map(operator.is_, known, now))
 
 
 def _current(chain) -> np.ndarray:
@@ -803,41 +1225,32 @@ def sweep(
         Q = np.array(
             [engine.check_states(c, f"configurations[{k}]") for k, c in enumerate(configurations)]
         )
-    clearance, pairs = _worst_with_progress(engine, Q, progress)
-    colliding = int(np.count_nonzero(np.isfinite(clearance)))
-    tally: dict[tuple[str, str], list] = {}
-    for pair in pairs:
-        if pair is None:
-            continue
-        entry = tally.setdefault((pair.first, pair.second), [pair, 0])
-        entry[1] += 1
-        if pair.clearance < entry[0].clearance:
-            entry[0] = pair
-    worst = sorted(tally.values(), key=lambda e: e[0].clearance)[:10]
+    found = _worst_with_progress(engine, Q, progress)
+    clearance, worst = engine.tally(Q, found)
     current = _current(chain)
     return SweepReport(
         samples=int(Q.shape[0]),
-        colliding=colliding,
-        worst_pairs=tuple((pair, count) for pair, count in worst),
+        colliding=int(np.count_nonzero(np.isfinite(clearance))),
+        worst_pairs=worst,
         free_intervals=engine.free_intervals(current, int(resolution)),
         states=tuple(float(x) for x in current),
         margin=margin,
     )
 
 
-def _worst_with_progress(engine, Q: np.ndarray, progress) -> tuple[np.ndarray, list]:
-    """``engine.worst(Q)`` in chunks, reporting each chunk to ``progress`` (may cancel)."""
+def _worst_with_progress(engine, Q: np.ndarray, progress) -> tuple:
+    """``engine.worst_arrays(Q)`` in chunks, reporting each chunk to ``progress`` (may
+    cancel)."""
     from kinegami.progress import Progress
 
-    chunk = 2048 if isinstance(engine, _ChainMotion) else 4
-    clearance, pairs = [], []
+    chunk = 4096
+    parts = []
     with Progress(progress, Q.shape[0], desc="sweep", unit="configuration") as bar:
         for start in range(0, Q.shape[0], chunk):
-            c, p = engine.worst(Q[start : start + chunk])
-            clearance.append(c)
-            pairs.extend(p)
-            bar.update(c.shape[0])
-    return np.concatenate(clearance), pairs
+            found = engine.worst_arrays(Q[start : start + chunk])
+            parts.append(found)
+            bar.update(found[0].shape[0])
+    return tuple(np.concatenate(column) for column in zip(*parts, strict=True))
 
 
 def tree_clearance(tree, states=None, names=None, margin=None) -> ClearanceReport:
@@ -858,36 +1271,13 @@ def tree_clearance(tree, states=None, names=None, margin=None) -> ClearanceRepor
         margin.
     """
     margin = _margin_of(tree, margin)
-    joints = tree.Joints
-    if states is None:
-        values = tuple(float(joint.state) for joint in joints)
-        links = tree.Links
-    else:
-        ranges = np.array([joint.stateRange() for joint in joints], dtype=float)
-        values = _clipped(_checked_states(states, ranges, "states"), ranges)
-        joints, links = tree._configured(values)
-    r = float(tree.r)
-    found = tree_pair_distances(joints, links, tree.Parents, r, reach=math.inf, margin=margin)
-    if found is None:
-        return ClearanceReport(True, math.inf, (), None, values, margin, r)
-    clearance = found[2] - 2.0 * r
-    order = np.argsort(clearance, kind="stable")
-    limit = clear_limit(r, margin)
-
-    def make(q: int) -> CollidingPair:
-        return _pair_at(found, q, float(clearance[q]), joints, names)
-
-    closest = make(int(order[0]))
-    pairs: dict[tuple[str, str], CollidingPair] = {}
-    for q in order:
-        if clearance[q] >= limit:
-            break
-        pair = make(int(q))
-        pairs.setdefault((pair.first, pair.second), pair)
-    best = float(clearance[order[0]])
-    ok = best >= limit
-    note = _junction_note(tree, closest) if ok else ""
-    return ClearanceReport(ok, best, tuple(pairs.values()), closest, values, margin, r, note)
+    engine = _tree_engine(tree, names, margin)
+    report = engine.report(_current(tree) if states is None else states, margin)
+    if report.ok and report.closest is not None:
+        note = _junction_note(tree, report.closest)
+        if note:
+            report = dataclasses.replace(report, note=note)
+    return report
 
 
 def _junction_note(tree, pair: CollidingPair) -> str:
@@ -931,18 +1321,68 @@ class _ChainMotion:
     def check_states(self, states, name: str = "states") -> np.ndarray:
         return self.engine.check_states(states, name)
 
-    def worst(self, Q: np.ndarray) -> tuple[np.ndarray, list]:
-        return self.engine.worst(Q, self.margin)
+    def worst_arrays(self, Q: np.ndarray) -> tuple:
+        return self.engine.worst_arrays(Q, self.margin)
+
+    def tally(self, Q: np.ndarray, found: tuple) -> tuple:
+        return self.engine.tally(Q, found)
 
     def free_intervals(self, states: np.ndarray, resolution: int = 64) -> tuple:
         return self.engine.free_intervals(states, resolution, self.margin)
 
 
+class TreeEngine(ClearanceEngine):
+    """:class:`ClearanceEngine` for a :class:`~kinegami.tree.KinematicTree` (its joints,
+    links and parents as they were when built, and one margin): the same queries with the pair
+    rule of trees (docs/trees.md).
+
+    Rigid bodies hang from their parent body in the tree. Parts on one path from the root are
+    tested as in a chain; parts on different branches always, except the tubes that leave one
+    branching joint inside its junction. Those tubes hang from the same body (the branching
+    joint's distal side, waypoints add no motion), so their junction, and the distance between
+    their parts beyond it, does not change with the configuration: they are measured once, at
+    the tree's current states. Configurations outside the ranges by rounding are clamped.
+    """
+
+    def __init__(self, tree, names=None, margin: float = 0.0):
+        joints = tree.Joints
+        r = float(tree.r)
+        caps = tree_capsules(joints, tree.Links, tree.Parents, r, check_margin(margin))
+        self._joints = tuple(joints)
+        self._names = None if names is None else tuple(names)
+        J = len(joints)
+        kinds = np.array([JOINT_REVOLUTE if isinstance(j, RevoluteJoint) else
+                          JOINT_PRISMATIC if isinstance(j, PrismaticJoint) else JOINT_FIXED
+                          for j in joints], dtype=np.int64)  # fmt: skip
+        poses = np.array([joint.pose_matrix for joint in joints]).reshape(J, 4, 4)
+        rows = caps.rows
+        self._setup(
+            r=r, starts=caps.starts, ends=caps.ends, start_joint=caps.start_joint,
+            end_joint=caps.end_joint, turning=caps.turning, element=caps.element,
+            parents=np.asarray(caps.parents, dtype=np.int64), kinds=kinds,
+            points=poses[:, :3, 3], axes=poses[:, :3, 2],
+            states=np.array([joint.state for joint in joints], dtype=float),
+            ranges=np.array([joint.stateRange() for joint in joints], dtype=float),
+            pieces=[(np.asarray(row[6], dtype=float), row[7]) for row in rows],
+            lengths=[float(np.linalg.norm(row[1] - row[0])) for row in rows], caps=caps,
+        )  # fmt: skip
+
+    def _named(self, row: int, text: str) -> str:
+        """``text`` with the joint's name (as :func:`~kinegami.bodies.part_label` words it)."""
+        element = int(self._element[row])
+        names = self._names
+        if names is not None and element % 2 == 0:
+            jj = element // 2
+            if jj < len(names) and names[jj] is not None:
+                plain = f"joint {jj}, {type(self._joints[jj]).__name__}"
+                text = text.replace(plain, f"{plain} '{names[jj]}'", 1)
+        return text
+
+
 class TreeMotion:
     """Clearance queries over the motion of a :class:`~kinegami.tree.KinematicTree` (what
-    :func:`sweep` uses for trees): the same queries as :class:`ClearanceEngine`, answered one
-    configuration at a time with the pair rule of trees (docs/trees.md), about 5 ms each for
-    the paper's hand.
+    :func:`sweep` uses for trees): the same queries as :class:`ClearanceEngine`, with the pair
+    rule of trees (docs/trees.md), batched over configurations by a :class:`TreeEngine`.
 
     Configurations are absolute states, one per joint in index order.
     """
@@ -951,75 +1391,71 @@ class TreeMotion:
     BISECTIONS = 24
 
     def __init__(self, tree, names=None, margin: float = 0.0):
-        self._tree = tree
-        self._names = None if names is None else tuple(names)
         self.margin = check_margin(margin)
-        self._parents = tree.Parents
-        self.r = float(tree.r)
-        self.ranges = np.array([joint.stateRange() for joint in tree.Joints], dtype=float)
+        self.engine = _tree_engine(tree, names, self.margin)
+        self.r = self.engine.r
+        self.ranges = self.engine.ranges
         self.movable = np.flatnonzero(self.ranges[:, 1] > self.ranges[:, 0])
 
     def check_states(self, states, name: str = "states") -> np.ndarray:
         """``states`` as a float array (one per joint, each within its range), or raise."""
         return _checked_states(states, self.ranges, name)
 
-    def _pair(self, values) -> CollidingPair | None:
-        """The closest pair closer than the margin at the configuration ``values``, or None
-        when it is clear."""
-        joints, links = self._tree._configured(_clipped(values, self.ranges))
-        found = tree_pair_distances(joints, links, self._parents, self.r, margin=self.margin)
-        if found is None:
-            return None
-        dist = found[2]
-        q = int(np.argmin(dist))
-        clearance = float(dist[q]) - 2.0 * self.r
-        if clearance >= clear_limit(self.r, self.margin):
-            return None
-        return _pair_at(found, q, clearance, joints, self._names)
+    def worst_arrays(self, Q: np.ndarray) -> tuple:
+        return self.engine.worst_arrays(Q, self.margin)
+
+    def tally(self, Q: np.ndarray, found: tuple) -> tuple:
+        return self.engine.tally(Q, found)
 
     def worst(self, Q: np.ndarray) -> tuple[np.ndarray, list]:
-        """Deepest overlap at each configuration of ``Q`` (K, J), unchecked: ``(clearance,
-        pairs)`` as :meth:`ClearanceEngine.worst` gives them (+inf and None where clear)."""
-        pairs = [self._pair(q) for q in np.asarray(Q, dtype=float)]
-        clearance = np.array([np.inf if p is None else p.clearance for p in pairs])
-        return clearance, pairs
+        """Closest pair closer than the margin at each configuration of ``Q`` (K, J),
+        unchecked: ``(clearance, pairs)`` as :meth:`ClearanceEngine.worst` gives them (+inf and
+        None where clear)."""
+        return self.engine.worst(Q, self.margin)
 
     def colliding(self, Q: np.ndarray) -> np.ndarray:
-        """(K,) True where the configuration self-intersects."""
-        return np.array([self._pair(q) is not None for q in np.asarray(Q, dtype=float)], bool)
+        """(K,) True where the configuration has parts closer than the margin."""
+        return self.engine.colliding(Q, self.margin)
 
     def free_intervals(self, states: np.ndarray, resolution: int = 64) -> tuple:
         """Per joint, the clear interval of its own state around ``states`` (see SweepReport):
         each side scanned on a grid of ``resolution`` steps up to the first colliding state,
-        then refined by :attr:`BISECTIONS` bisection steps."""
+        then refined by :attr:`BISECTIONS` bisection steps (every side at once)."""
         states = np.asarray(states, dtype=float)
-        if self._pair(states) is not None:
+        if self.colliding(states[None, :])[0]:
             return (None,) * len(states)
         out: list = [(float(v), float(v)) for v in states]
-
-        def clear_at(j: int, value: float) -> bool:
-            q = states.copy()
-            q[j] = value
-            return self._pair(q) is None
-
-        for j in self.movable.tolist():
-            ends = []
-            for target in self.ranges[j]:
-                good = float(states[j])
-                bad = None
-                for value in np.linspace(states[j], target, resolution + 1)[1:]:
-                    if not clear_at(j, float(value)):
-                        bad = float(value)
-                        break
-                    good = float(value)
-                if bad is not None:
-                    for _ in range(self.BISECTIONS):
-                        mid = 0.5 * (good + bad)
-                        if clear_at(j, mid):
-                            good = mid
-                        else:
-                            bad = mid
-                ends.append(good)
+        jobs = [(int(j), float(target)) for j in self.movable.tolist()
+                for target in self.ranges[j]]  # fmt: skip
+        if not jobs:
+            return tuple(out)
+        grids = [np.linspace(states[j], target, resolution + 1) for j, target in jobs]
+        Q = np.repeat(states[None, :], len(jobs) * resolution, axis=0)
+        for n, (j, _) in enumerate(jobs):
+            Q[n * resolution : (n + 1) * resolution, j] = grids[n][1:]
+        hits = self.colliding(Q).reshape(len(jobs), resolution)
+        good = np.empty(len(jobs))
+        bad = np.full(len(jobs), np.nan)
+        for n in range(len(jobs)):
+            first = np.flatnonzero(hits[n])
+            if first.size == 0:
+                good[n] = float(grids[n][-1])
+            else:
+                good[n] = float(grids[n][first[0]])
+                bad[n] = float(grids[n][first[0] + 1])
+        open_ = np.flatnonzero(~np.isnan(bad))
+        for _ in range(self.BISECTIONS):
+            if open_.size == 0:
+                break
+            mid = 0.5 * (good[open_] + bad[open_])
+            Q = np.repeat(states[None, :], open_.size, axis=0)
+            Q[np.arange(open_.size), [jobs[n][0] for n in open_.tolist()]] = mid
+            hit = self.colliding(Q)
+            bad[open_[hit]] = mid[hit]
+            good[open_[~hit]] = mid[~hit]
+        for n in range(0, len(jobs), 2):
+            j = jobs[n][0]
+            ends = (float(good[n]), float(good[n + 1]))
             out[j] = (min(ends), max(ends))
         return tuple(out)
 

@@ -1,0 +1,162 @@
+"""The batched clearance engines (chains: ClearanceEngine; trees: TreeEngine behind TreeMotion)
+against a slow reference kept here: at every configuration the design is set to it (a copy,
+the way setJointStates moves it), its capsules are built again from the moved joints and links,
+and every pair of capsules is measured by brute force with the pair rule (docs/clearance.md,
+docs/trees.md). The engines move capsules by rigid-body motions, prune pairs by balls and
+measure pairs inside one rigid body once; none of that is allowed to change an answer."""
+
+from __future__ import annotations
+
+import copy
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kinegami.clearance as clearance_module
+from kinegami import KinematicChain, RevoluteJoint
+from kinegami.bodies import (
+    TURN_TOLERANCE,
+    capsule_model,
+    clear_limit,
+    tree_capsules,
+)
+from kinegami.clearance import ClearanceEngine, TreeMotion, sweep
+from kinegami.design import load_design
+from kinegami.errors import ClearanceWarning
+from kinegami.geometry.segments import segment_distances
+
+DESIGNS = sorted((Path(__file__).parents[2] / "examples" / "designs").glob("*.json"))
+TOLERANCE = 1e-9  # in r
+
+
+def reference_clearance(design, q, margin: float) -> float:
+    """Smallest clearance over every tested pair of capsules at configuration ``q`` (inf when
+    nothing is tested), by brute force over all pairs of the capsules built at ``q``."""
+    r = float(design.r)
+    if isinstance(design, KinematicChain):
+        moved = copy.copy(design)
+        moved.requireClearance = False
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ClearanceWarning)
+            assert moved.setJointStates(list(q))
+        model = capsule_model(moved)
+        kinks = np.concatenate([[0.0], np.cumsum([
+            abs(j.state) if isinstance(j, RevoluteJoint) else 0.0 for j in moved.Joints])])
+        tau = model.turning + kinks[model.start_body + 1]
+        a, b = model.starts, model.ends
+        i, j = np.triu_indices(model.count, 1)
+        tested = tau[j] - tau[i] >= math.pi - TURN_TOLERANCE
+        i, j = i[tested], j[tested]
+        if i.size == 0:
+            return math.inf
+        return float(segment_distances(a[i], b[i], a[j], b[j])[0].min() - 2.0 * r)
+    ranges = np.array([joint.stateRange() for joint in design.Joints])
+    values = tuple(float(v) for v in np.clip(q, ranges[:, 0], ranges[:, 1]))
+    joints, links = design._configured(values)
+    caps = tree_capsules(joints, links, design.Parents, r, margin)
+    tau = caps.turning + np.where(caps.start_joint >= 0,
+                                  caps.hinge_turning(joints)[caps.start_joint], 0.0)
+    i, j = np.triu_indices(caps.count, 1)
+    nx, ny = caps.node[i], caps.node[j]
+    same_path = caps.ancestor[nx, ny] | caps.ancestor[ny, nx]
+    tested = ~same_path | (np.abs(tau[j] - tau[i]) >= math.pi - TURN_TOLERANCE)
+    i, j = i[tested], j[tested]
+    if i.size == 0:
+        return math.inf
+    dist = segment_distances(caps.starts[i], caps.ends[i], caps.starts[j], caps.ends[j])[0]
+    junction = np.flatnonzero(caps.junction_pairs(i, j))
+    dist[junction] = caps.beyond_junction(i[junction], j[junction])[0]
+    return float(dist.min() - 2.0 * r)
+
+
+def random_configurations(design, count: int, seed: int) -> np.ndarray:
+    ranges = np.array([joint.stateRange() for joint in design.Joints], dtype=float)
+    rng = np.random.default_rng(seed)
+    return ranges[:, 0] + (ranges[:, 1] - ranges[:, 0]) * rng.random((count, len(ranges)))
+
+
+def agree(found: float, expected: float, r: float) -> bool:
+    if math.isinf(expected) or math.isinf(found):
+        return found == expected
+    return abs(found - expected) <= TOLERANCE * r
+
+
+@pytest.mark.parametrize("path", DESIGNS, ids=lambda p: p.stem)
+def test_engines_agree_with_the_brute_force_reference(path):
+    """Every verdict and every depth of the batched engine (worst over a batch) and of the
+    one-configuration report equal the reference, with margin 0 and 0.5 r."""
+    design = load_design(path)
+    r = float(design.r)
+    chain = isinstance(design, KinematicChain)
+    Q = random_configurations(design, 24 if chain else 8, seed=3)
+    for margin in (0.0, 0.5 * r):
+        if chain:
+            worst, pairs = ClearanceEngine(design).worst(Q, margin)
+        else:
+            worst, pairs = TreeMotion(design, margin=margin).worst(Q)
+        for q, w, pair in zip(Q, worst, pairs, strict=True):
+            expected = reference_clearance(design, q, margin)
+            closer = expected < clear_limit(r, margin)
+            report = design.clearance(list(q), margin=margin)
+            assert agree(report.min_clearance, expected, r), (path.stem, margin, q)
+            assert report.ok is (not closer)
+            assert math.isfinite(w) is closer
+            if closer:
+                assert agree(w, expected, r)
+                assert pair.clearance == w
+                assert (pair.first, pair.second) == (report.pairs[0].first,
+                                                     report.pairs[0].second)
+
+
+def test_the_large_assembly_broad_phase_gives_the_same_answers(monkeypatch):
+    """Above a number of group pairs the engine finds near groups per configuration with a k-d
+    tree instead of a list of all group pairs: the same answers."""
+    design = load_design(DESIGNS[0].parent / "puma.json")
+    Q = random_configurations(design, 60, seed=5)
+    listed = ClearanceEngine(design)
+    monkeypatch.setattr(clearance_module, "_GROUP_PAIRS_LISTED", 0)
+    spatial = ClearanceEngine(design)
+    assert listed._listed and not spatial._listed
+    for margin in (0.0, 0.3):
+        a, pa = listed.worst(Q, margin)
+        b, pb = spatial.worst(Q, margin)
+        assert np.array_equal(np.isfinite(a), np.isfinite(b)) and np.isfinite(a).any()
+        assert np.allclose(a[np.isfinite(a)], b[np.isfinite(b)], rtol=0, atol=1e-12)
+        assert [p and (p.first, p.second) for p in pa] == [p and (p.first, p.second) for p in pb]
+    q = list(Q[0])
+    assert listed.report(q).min_clearance == pytest.approx(spatial.report(q).min_clearance,
+                                                           abs=1e-12)
+
+
+def test_segment_distance_kernel_is_the_shared_one_bit_for_bit():
+    """The engine's coordinate-array segment distances give the bits of
+    kinegami.geometry.segments.segment_distances, degenerate pairs included."""
+    rng = np.random.default_rng(0)
+    n = 4000
+    p = [rng.normal(size=(n, 3)) * rng.choice([1e-3, 1.0, 100.0], size=(n, 1)) for _ in range(4)]
+    p[1][:500] = p[0][:500]  # a point
+    p[3][500:1000] = p[2][500:1000] + 0.5 * (p[1][500:1000] - p[0][500:1000])  # parallel
+    p[2][1000:1500] = p[0][1000:1500] + 0.3 * (p[1][1000:1500] - p[0][1000:1500])  # collinear
+    p[3][1000:1500] = p[0][1000:1500] + 2.0 * (p[1][1000:1500] - p[0][1000:1500])
+    p[2][1500:2000] = p[0][1500:2000]  # touching ends
+    expected = segment_distances(*p)
+    found = clearance_module._segment_distances_xyz(*[tuple(x[:, c] for c in range(3))
+                                                      for x in p])
+    for e, f in zip(expected, found, strict=True):
+        assert np.array_equal(e, f)
+
+
+def test_sweep_of_a_tree_counts_as_one_configuration_reports():
+    """A tree's sweep (batched) counts exactly the configurations whose report is not clear,
+    and its deepest pair is the deepest of those reports."""
+    design = load_design(DESIGNS[0].parent / "hand.json")
+    Q = random_configurations(design, 40, seed=11)
+    result = sweep(design, configurations=[list(q) for q in Q])
+    reports = [design.clearance(list(q)) for q in Q]
+    assert result.colliding == sum(not rep.ok for rep in reports) > 0
+    deepest = min(rep.min_clearance for rep in reports)
+    assert result.worst_pairs[0][0].clearance == pytest.approx(deepest, abs=TOLERANCE)
+    assert sum(count for _, count in result.worst_pairs) <= result.colliding
