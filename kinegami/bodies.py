@@ -936,6 +936,8 @@ def _polyline_samples(points: np.ndarray, step: float) -> tuple[np.ndarray, np.n
 
 #: Most sample points junction_extent evaluates at once (bounds its temporary arrays).
 _JUNCTION_CHUNK = 65_536
+#: Most (own segment, sibling segment) pairs whose intervals are computed at once.
+_JUNCTION_PAIRS = 262_144
 
 
 def junction_extent(
@@ -951,7 +953,7 @@ def junction_extent(
 
     Only the samples that can be that close are evaluated (those within the finite cylinder of
     radius 2r + margin around some sibling segment), a bounded number at a time, so tubes
-    1e6 r long cost no more memory than short ones (issue 29)."""
+    1e6 r long cost no more memory than short ones (issue 29, docs/limits.md)."""
     a, b = siblings
     if a.shape[0] == 0 or own[0].shape[0] == 0:
         return 0.0
@@ -959,74 +961,99 @@ def junction_extent(
     lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
     counts = np.maximum(2, np.ceil(lengths / (0.02 * r)).astype(np.int64) + 1)
     reach = (2.0 * r + margin) * (1.0 - CONTACT_TOLERANCE)
+    first = np.cumsum(counts) - counts  # global index of each segment's first sample
+    low, high = _candidate_samples(starts, ends, counts, first, a, b, reach)
     found = -math.inf
-    for i, k0, k1 in _candidate_samples(starts, ends, counts, a, b, reach):
-        for c0 in range(k0, k1, _JUNCTION_CHUNK):
-            k = np.arange(c0, min(k1, c0 + _JUNCTION_CHUNK), dtype=np.int64)
-            u = k / (counts[i] - 1)
-            points = starts[i] + u[:, None] * (ends[i] - starts[i])
-            t = _point_params(points[:, None, :], a[None], b[None])
-            nearest = a[None] + t[..., None] * (b - a)[None]
-            distance = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)
-            close = distance < reach
-            if close.any():
-                found = max(found, float(_polyline_distance(points[close], polyline).max()))
-                if found + 0.02 * r >= limit:
-                    return limit
+    for index in _descending_chunks(low, high):
+        i = np.searchsorted(first, index, side="right") - 1
+        u = (index - first[i]) / (counts[i] - 1)
+        points = starts[i] + u[:, None] * (ends - starts)[i]
+        t = _point_params(points[:, None, :], a[None], b[None])
+        nearest = a[None] + t[..., None] * (b - a)[None]
+        distance = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)
+        close = distance < reach
+        if close.any():
+            found = max(found, float(_polyline_distance(points[close], polyline).max()))
+            if found + 0.02 * r >= limit:
+                return limit
     if found == -math.inf:
         return 0.0
     return found + 0.02 * r
 
 
-def _candidate_samples(starts, ends, counts, a, b, reach: float):
-    """``(i, k0, k1)``: the sample indices k0 <= k < k1 of own segment i (sample k at
-    parameter k / (counts[i] - 1)) that may lie within ``reach`` of a sibling segment (a, b):
-    those inside the cylinder of radius ``reach`` around the sibling's line, between the planes
-    ``reach`` beyond its ends (a superset of the capsule), padded by two samples on each side
-    against rounding. Disjoint ranges, the last samples of the last segments first."""
-    d = ends - starts  # own directions (n, 3)
+def _descending_chunks(low: np.ndarray, high: np.ndarray):
+    """The integers of the disjoint intervals [low, high) (sorted), highest first, in arrays
+    of at most :data:`_JUNCTION_CHUNK` (few of them: the scan may end early)."""
+    pieces: list[np.ndarray] = []
+    size = 0
+    for k in range(low.size - 1, -1, -1):
+        lo, hi = int(low[k]), int(high[k])
+        while hi > lo:
+            take = min(hi - lo, _JUNCTION_CHUNK - size)
+            pieces.append(np.arange(hi - take, hi, dtype=np.int64))
+            size += take
+            hi -= take
+            if size == _JUNCTION_CHUNK:
+                yield np.concatenate(pieces)
+                pieces, size = [], 0
+    if pieces:
+        yield np.concatenate(pieces)
+
+
+def _candidate_samples(starts, ends, counts, first, a, b, reach: float):
+    """Sorted disjoint intervals [low, high) of global sample indices (sample k of own segment
+    i is ``first[i] + k``, at parameter k / (counts[i] - 1)) that may lie within ``reach`` of
+    a sibling segment (a, b): those inside the cylinder of radius ``reach`` around the
+    sibling's line, between the planes ``reach`` beyond its ends (a superset of the capsule),
+    padded by two samples on each side against rounding."""
     e = b - a
     length = np.sqrt((e**2).sum(axis=1))
     e = np.where(length[:, None] > 0.0, e / np.where(length > 0.0, length, 1.0)[:, None], 0.0)
-    rel = starts[:, None, :] - a[None]  # (n, m, 3)
-    t0 = (rel * e[None]).sum(axis=2)  # axial coordinate at u = 0 and its rate
-    t1 = (d[:, None, :] * e[None]).sum(axis=2)
-    w0 = rel - t0[..., None] * e[None]  # the part across the sibling's line
-    w1 = d[:, None, :] - t1[..., None] * e[None]
-    ww = (w1**2).sum(axis=2)
-    slack = reach * (1.0 + 1e-6) + 1e-9 * max(float(np.abs(rel).max()), 1.0)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        # across: |w0 + u w1| < slack, an interval around the nearest u
-        centre = np.where(ww > 0.0, -(w0 * w1).sum(axis=2) / np.where(ww > 0.0, ww, 1.0), 0.0)
-        gap = np.sqrt(((w0 + centre[..., None] * w1) ** 2).sum(axis=2))
-        half = np.where(ww > 0.0, np.sqrt(np.maximum(slack**2 - gap**2, 0.0) / ww), np.inf)
-        inside = gap < slack
-        lo, hi = centre - half, centre + half
-        # along: -slack < t0 + u t1 < length + slack
-        ua = (-slack - t0) / t1
-        ub = (length[None] + slack - t0) / t1
-        moving = t1 != 0.0
-        lo = np.where(moving, np.maximum(lo, np.minimum(ua, ub)), lo)
-        hi = np.where(moving, np.minimum(hi, np.maximum(ua, ub)), hi)
-        inside &= moving | ((t0 > -slack) & (t0 < length[None] + slack))
-    lo, hi = np.maximum(lo, 0.0), np.minimum(hi, 1.0)
-    inside &= lo <= hi
-    ranges = []
-    for i in range(starts.shape[0]):
-        steps = int(counts[i]) - 1
-        spans = sorted(
-            (max(0, math.floor(lo[i, j] * steps) - 2),
-             min(steps + 1, math.ceil(hi[i, j] * steps) + 3))
-            for j in np.flatnonzero(inside[i])
-        )  # fmt: skip
-        merged: list[list[int]] = []
-        for k0, k1 in spans:
-            if merged and k0 <= merged[-1][1]:
-                merged[-1][1] = max(merged[-1][1], k1)
-            else:
-                merged.append([k0, k1])
-        ranges += [(i, k0, k1) for k0, k1 in merged]
-    return reversed(ranges)
+    slack = reach * (1.0 + 1e-6) + 1e-9 * max(
+        float(np.abs(starts).max()), float(np.abs(ends).max()), float(np.abs(a).max()), 1.0)
+    found_low, found_high = [], []
+    block = max(1, _JUNCTION_PAIRS // a.shape[0])
+    for s0 in range(0, starts.shape[0], block):
+        s, d = starts[s0 : s0 + block], (ends - starts)[s0 : s0 + block]
+        rel = s[:, None, :] - a[None]  # (n, m, 3)
+        t0 = (rel * e[None]).sum(axis=2)  # axial coordinate at u = 0 and its rate
+        t1 = (d[:, None, :] * e[None]).sum(axis=2)
+        w0 = rel - t0[..., None] * e[None]  # the part across the sibling's line
+        w1 = d[:, None, :] - t1[..., None] * e[None]
+        ww = (w1**2).sum(axis=2)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            # across: |w0 + u w1| < slack, an interval around the nearest u
+            centre = np.where(ww > 0.0, -(w0 * w1).sum(axis=2) / np.where(ww > 0.0, ww, 1.0),
+                              0.0)  # fmt: skip
+            gap = np.sqrt(((w0 + centre[..., None] * w1) ** 2).sum(axis=2))
+            half = np.where(ww > 0.0, np.sqrt(np.maximum(slack**2 - gap**2, 0.0) / ww), np.inf)
+            inside = gap < slack
+            lo, hi = centre - half, centre + half
+            # along: -slack < t0 + u t1 < length + slack
+            ua = (-slack - t0) / t1
+            ub = (length[None] + slack - t0) / t1
+            moving = t1 != 0.0
+            lo = np.where(moving, np.maximum(lo, np.minimum(ua, ub)), lo)
+            hi = np.where(moving, np.minimum(hi, np.maximum(ua, ub)), hi)
+            inside &= moving | ((t0 > -slack) & (t0 < length[None] + slack))
+        lo, hi = np.maximum(lo, 0.0), np.minimum(hi, 1.0)
+        inside &= lo <= hi
+        ii, jj = np.nonzero(inside)
+        steps = (counts[s0 : s0 + block] - 1)[ii].astype(float)
+        k0 = np.maximum(np.floor(lo[ii, jj] * steps) - 2.0, 0.0).astype(np.int64)
+        k1 = np.minimum(np.ceil(hi[ii, jj] * steps) + 3.0, steps + 1.0).astype(np.int64)
+        found_low.append(first[s0 : s0 + block][ii] + k0)
+        found_high.append(first[s0 : s0 + block][ii] + k1)
+    low, high = np.concatenate(found_low), np.concatenate(found_high)
+    if low.size == 0:
+        return low, high
+    order = np.argsort(low, kind="stable")
+    low, high = low[order], high[order]
+    reach_end = np.maximum.accumulate(high)
+    new = np.ones(low.size, dtype=bool)
+    new[1:] = low[1:] > reach_end[:-1]
+    starts_at = np.flatnonzero(new)
+    return low[starts_at], np.maximum.reduceat(high, starts_at)
 
 
 def _point_params(points, a, b) -> np.ndarray:
