@@ -431,6 +431,67 @@ def scale_rows() -> list[tuple[str, str, str]]:
     ]  # fmt: skip
 
 
+def _cpu_median(fn, repeat: int) -> float:
+    """Median CPU seconds of this process over ``repeat`` calls (time.process_time: the
+    machine's other jobs do not count, its 2 shared cores still slow memory and caches)."""
+    times = []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fn()
+        times.append(time.process_time() - t0)
+    return statistics.median(times)
+
+
+def engine_rows() -> list[tuple[str, str, str]]:
+    """Issue 29 section 4: the clearance engine fast enough to sample workspaces. CPU time
+    (process_time, median of repeats) of sweep per configuration on the PUMA, the 9-joint
+    spherical series and the trees, one configuration (design.clearance(q)), a tree's
+    setJointStates, and the engine of a 1,000-row DH table."""
+    from kinegami.clearance import ClearanceEngine, sweep
+    from kinegami.design import load_design
+
+    rows: list[tuple[str, str, str]] = []
+    for name, goal in (("puma", "<= 50 us (>= 20,000/s)"), ("spherical_series", "<= 100 us")):
+        design = load_design(DESIGNS / f"{name}.json")
+        sweep(design, samples=200)
+        t = _cpu_median(lambda d=design: sweep(d, samples=10000), 3) / 10000
+        rows.append((f"sweep, 10,000 samples, {name}, per configuration", f"{t * 1e6:.0f} us",
+                     goal))  # fmt: skip
+    puma = load_design(DESIGNS / "puma.json")
+    q = [joint.state for joint in puma.Joints]
+    puma.clearance(q)
+    t = _cpu_median(lambda: [puma.clearance(q) for _ in range(100)], 5) / 100
+    rows.append(("design.clearance(q), PUMA, one configuration", f"{t * 1e6:.0f} us",
+                 "<= 100 us"))  # fmt: skip
+    for name, goal in (("hand", "-"), ("quadruped", "-"),
+                       ("algorithmic_hand", "<= 1 ms")):  # fmt: skip
+        tree = load_design(DESIGNS / f"{name}.json")
+        sweep(tree, samples=10)
+        t = _cpu_median(lambda d=tree: sweep(d, samples=300), 1) / 300
+        rows.append((f"sweep, 300 samples, {name}, per configuration", f"{t * 1e3:.2f} ms", goal))
+    hand = load_design(DESIGNS / "algorithmic_hand.json")
+    ranges = np.array([joint.stateRange() for joint in hand.Joints])
+    rng = np.random.default_rng(0)
+    states = [list(ranges[:, 0] + (ranges[:, 1] - ranges[:, 0]) * rng.random(len(ranges)))
+              for _ in range(5)]  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        t = _cpu_median(lambda: [hand.setJointStates(s) for s in states], 3) / len(states)
+    rows.append(("setJointStates, algorithmic hand", f"{t * 1e3:.1f} ms", "<= 5 ms"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        chain = KinematicChain.from_dh(random_dh_table(1000), 4, 1.0)
+    t0 = time.process_time()
+    engine = ClearanceEngine(chain)
+    built = time.process_time() - t0
+    t0 = time.process_time()
+    engine.report([joint.state for joint in chain.Joints])
+    reported = time.process_time() - t0
+    rows.append(("ClearanceEngine, 1,000-row DH table: build / report",
+                 f"{built:.2f} / {reported:.1f} s", "near-linear, bounded memory"))  # fmt: skip
+    return rows
+
+
 Rows = list[tuple[str, str, str]]
 
 
@@ -470,6 +531,7 @@ def steps(seeds: int, compact_seeds: int) -> list[tuple[str, Callable[[], Rows]]
         (f"48-joint safe chains ({seeds} seeds)", lambda: safe_chain_rows(seeds)),
         ("scale: 100-400-joint safe chains, a 1,000-row DH table", scale_rows),
         ("clearance engine and safe chains' clearance", lambda: clearance_rows(0)),
+        ("clearance engine for workspaces: sweeps, one configuration, trees", engine_rows),
     ]
     if compact_seeds > 0:
         out += [

@@ -311,20 +311,23 @@ def _segment_distances_xyz(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.n
         e = [(p + s * u) - (q + t * v) for p, u, q, v in zip(a1, d1, a2, d2, strict=True)]
         return np.sqrt((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2])  # numpy.linalg.norm's order
 
-    def param(point, a, d, dd, ok):  # point_segment_parameters
-        num = _dot(*(p - q for p, q in zip(point, a, strict=True)), *d)
-        return np.where(ok, np.clip(num / np.where(ok, dd, 1.0), 0.0, 1.0), 0.0)
-
-    best = gap(s, t)
-    zero = np.zeros_like(best)
-    for sc, tc in ((zero, param(a1, a2, d2, E, ok2)), (zero + 1.0, param(b1, a2, d2, E, ok2)),
-                   (param(a2, a1, d1, A, ok1), zero), (param(b2, a1, d1, A, ok1), zero + 1.0)):
-        dist = gap(sc, tc)
-        better = dist < best
-        best = np.where(better, dist, best)
-        s = np.where(better, sc, s)
-        t = np.where(better, tc, t)
-    return best, s, t
+    # the four end-point-to-segment candidates at once: a1 and b1 against the second
+    # segment, a2 and b2 against the first (point_segment_parameters' arithmetic)
+    point = [np.stack(c) for c in zip(a1, b1, a2, b2, strict=True)]
+    base = [np.stack(c) for c in zip(a2, a2, a1, a1, strict=True)]
+    along = [np.stack(c) for c in zip(d2, d2, d1, d1, strict=True)]
+    dd, ok = np.stack([E, E, A, A]), np.stack([ok2, ok2, ok1, ok1])
+    num = _dot(*(p - q for p, q in zip(point, base, strict=True)), *along)
+    u = np.where(ok, np.clip(num / np.where(ok, dd, 1.0), 0.0, 1.0), 0.0)
+    zero = np.zeros_like(A)
+    sc = np.stack([zero, zero + 1.0, u[2], u[3]])
+    tc = np.stack([u[0], u[1], zero, zero + 1.0])
+    # the first smallest of the critical point and the four, in that order
+    every = np.concatenate([gap(s, t)[None], gap(sc, tc)])
+    pick = np.argmin(every, axis=0)[None]
+    s = np.take_along_axis(np.concatenate([s[None], sc]), pick, axis=0)[0]
+    t = np.take_along_axis(np.concatenate([t[None], tc]), pick, axis=0)[0]
+    return np.take_along_axis(every, pick, axis=0)[0], s, t
 
 
 #: Most capsules in one group (a part's run of capsules is split into groups this long).
@@ -354,10 +357,18 @@ class _Layout:
         self.slices = [(int(sorted_body[a]), int(a), int(b), points[order[a:b]])
                        for a, b in zip(cuts, ends, strict=True)]  # fmt: skip
         self.size = order.size
+        self.body = sorted_body
+        self.points = points[order]
 
     def move(self, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """x, y and z of every point (K, size), moved by the body motions ``B`` (K, NB, 4, 4)."""
         K = B.shape[0]
+        if K * len(self.slices) <= 64:  # few configurations: every point's motion gathered
+            M = B.reshape(K, -1, 16)[:, self.body]
+            P = self.points
+            return tuple(M[..., 4 * c] * P[:, 0] + M[..., 4 * c + 1] * P[:, 1]
+                         + M[..., 4 * c + 2] * P[:, 2] + M[..., 4 * c + 3]
+                         for c in range(3))  # fmt: skip
         out = (np.empty((K, self.size)), np.empty((K, self.size)), np.empty((K, self.size)))
         for b, lo, hi, P in self.slices:
             if b == 0:  # the base does not move
@@ -521,6 +532,12 @@ class ClearanceEngine:
         self._gkink = kink_max[self._gbody]
         self._ancestor = None if caps is None else caps.ancestor
         self._max_radius = float(radius.max()) if G else 0.0
+        # the k-d tree broad phase searches within twice the radius of most groups; the
+        # largest tenth is tested against every group
+        self._radius_cut = float(np.quantile(radius, 0.9)) if G else 0.0
+        self._is_large = radius > self._radius_cut
+        self._large_groups = np.flatnonzero(self._is_large)
+        self._small_groups = np.flatnonzero(~self._is_large)
         # tie order of pairs at equal clearance (as the one-configuration answers list them)
         blocks = np.cumsum(np.r_[True, element[1:] != element[:-1]]) - 1 if S else owner
         self._block, self._blocks = blocks, int(blocks[-1]) + 1 if S else 0
@@ -732,23 +749,29 @@ class ClearanceEngine:
             return kk, g1[n], g2[n], self._gp_same[n], n
         from scipy.spatial import cKDTree
 
+        large = self._large_groups
+        cut = self._radius_cut
         out_k, out_1, out_2 = [], [], []
-        reach = 2.0 * self._max_radius + threshold
         for k in range(xyz[0].shape[0]):
             centres = np.stack([c[k, self._gcol] for c in xyz], axis=-1)
-            pairs = cKDTree(centres).query_pairs(reach, output_type="ndarray")
-            if pairs.size == 0:
-                continue
-            g1, g2 = pairs.min(axis=1), pairs.max(axis=1)
+            small = self._small_groups
+            pairs = cKDTree(centres[small]).query_pairs(2.0 * cut + threshold,
+                                                        output_type="ndarray")  # fmt: skip
+            a, b = small[pairs[:, 0]], small[pairs[:, 1]]
+            if large.size:  # the largest groups against every group
+                d = centres[large][:, None, :] - centres[None, :, :]
+                reach = radius[large][:, None] + radius[None, :] + threshold
+                n1, n2 = np.nonzero(np.einsum("lgi,lgi->lg", d, d) <= reach * reach)
+                n1 = large[n1]
+                keep = (n1 != n2) & ~(self._is_large[n2] & (n2 < n1))  # each pair once
+                a, b = np.concatenate([a, n1[keep]]), np.concatenate([b, n2[keep]])
+            g1, g2 = np.minimum(a, b), np.maximum(a, b)
             d = centres[g1] - centres[g2]
             near = np.sqrt(np.einsum("gi,gi->g", d, d)) - radius[g1] - radius[g2] <= threshold
             near &= self._feasible(g1, g2) & ~self._same_body(g1, g2)
             out_k.append(np.full(int(near.sum()), k))
             out_1.append(g1[near])
             out_2.append(g2[near])
-        if not out_k:
-            none = np.zeros(0, dtype=np.int64)
-            return none, none, none, np.zeros(0, dtype=bool), none
         g1, g2 = np.concatenate(out_1), np.concatenate(out_2)
         return np.concatenate(out_k), g1, g2, self._same_path(g1, g2), None
 
@@ -768,6 +791,18 @@ class ClearanceEngine:
         kk, g1, g2, same, n_gp = self._near_groups(xyz, threshold)
         if kk.size == 0:
             return empty
+        if self._listed:
+            return (*self._pairs_of(Q, B, xyz, threshold, kk, g1, g2, same, n_gp), B)
+        # many groups: their capsule pairs a bounded number at a time
+        step = max(1, _BATCH_ENTRIES // int(max(self._gsize.max(), 1) ** 2))
+        parts = [self._pairs_of(Q, B, xyz, threshold, kk[n : n + step], g1[n : n + step],
+                                g2[n : n + step], same[n : n + step], None)
+                 for n in range(0, kk.size, step)]  # fmt: skip
+        return (*(np.concatenate(column) for column in zip(*parts, strict=True)), B)
+
+    def _pairs_of(self, Q, B, xyz, threshold: float, kk, g1, g2, same, n_gp) -> tuple:
+        """(k, i, j, clearance, s, t) of the capsule pairs of near group pairs (configuration
+        kk, groups g1 and g2, their listed index n_gp) whose balls are within ``threshold``."""
         if self._listed:
             count = self._cp_count[n_gp]
             entry = np.repeat(np.arange(n_gp.size), count)
@@ -796,18 +831,20 @@ class ClearanceEngine:
         n = np.flatnonzero(keep)
         k, i, j = k[n], i[n], j[n]
         # the segments of the pairs left, moved one by one
-        M = B.reshape(-1, 16)
-        ends = [_moved(M, k * NB + self.body_a[i], self._starts[i]),
-                _moved(M, k * NB + self.body_b[i], self._ends[i]),
-                _moved(M, k * NB + self.body_a[j], self._starts[j]),
-                _moved(M, k * NB + self.body_b[j], self._ends[j])]  # fmt: skip
+        m = k.size
+        points = np.concatenate([self._starts[i], self._ends[i], self._starts[j], self._ends[j]])
+        bodies = np.concatenate([self.body_a[i], self.body_b[i], self.body_a[j], self.body_b[j]])
+        x, y, z = _moved(B.reshape(-1, 16), np.tile(k, 4) * NB + bodies, points)
+        ends = [(x[n * m : (n + 1) * m], y[n * m : (n + 1) * m], z[n * m : (n + 1) * m])
+                for n in range(4)]  # fmt: skip
         dist, s, t = _segment_distances_xyz(*ends)
-        return k, i, j, dist - 2.0 * self.r, s, t, B
+        return k, i, j, dist - 2.0 * self.r, s, t
 
     def _chunk(self) -> int:
         """Configurations per batch (bounds the batch's pair-configuration entries)."""
-        per = max(self._gp1.size if self._listed else self._S, 1)
-        return int(min(1024, max(1, _BATCH_ENTRIES // per)))
+        if not self._listed:
+            return 1
+        return int(min(1024, max(1, _BATCH_ENTRIES // max(self._gp1.size, 1))))
 
     # --- labels ----------------------------------------------------------------------------
     def _texts(self, rows: np.ndarray, s: np.ndarray) -> list[str]:
@@ -942,7 +979,7 @@ class ClearanceEngine:
         values = tuple(float(x) for x in Q[0]) if self._caps is not None \
             else tuple(float(x) for x in q)  # fmt: skip
         limit = clear_limit(self.r, margin)
-        threshold = 4.0 * self.r + margin
+        threshold = (4.0 if self._listed else 0.5) * self.r + margin
         static = self._static_clearance
         static_min = float(static.min()) if static.size else math.inf
         while True:
@@ -954,14 +991,16 @@ class ClearanceEngine:
         if clearance.size + static.size == 0:
             return ClearanceReport(True, math.inf, (), None, values, margin, self.r)
         si, sj = self._static_pairs
-        ci, cj = np.r_[i, si], np.r_[j, sj]
-        cc = np.r_[clearance, static]
-        cs, ct = np.r_[s, self._static_st[0]], np.r_[t, self._static_st[1]]
+        ci, cj = np.concatenate([i, si]), np.concatenate([j, sj])
+        cc = np.concatenate([clearance, static])
+        cs = np.concatenate([s, self._static_st[0]])
+        ct = np.concatenate([t, self._static_st[1]])
+        rank = np.concatenate([self._rank(i, j), self._static_rank])
         if self._caps is None:  # a chain's: moving pairs first, each kind in its order
-            order = np.lexsort((np.r_[self._rank(i, j), self._static_rank],
-                                np.r_[np.zeros(i.size), np.ones(si.size)], cc))  # fmt: skip
+            kind = np.concatenate([np.zeros(i.size), np.ones(si.size)])
+            order = np.lexsort((rank, kind, cc))
         else:
-            order = np.lexsort((np.r_[self._rank(i, j), self._static_rank], cc))
+            order = np.lexsort((rank, cc))
         a0, b0 = self._segments_at(B, 0)
 
         def make(n: int) -> CollidingPair:
