@@ -22,6 +22,7 @@ inherit the matching builtin, so ``except ValueError`` keeps working (as ezdxf d
     +-- ExportError(OSError)                 a file could not be written
     |   +-- PublishError                     a build could not be published
     +-- Cancelled                            long work stopped by its progress callback
+    +-- GuardError(RuntimeError)             the editor could not guard its server
 
     UserWarning
     +-- PlacementWarning                     a placement, edit or state change was rejected
@@ -54,13 +55,22 @@ __all__ = [
     "ExporterUnavailableError",
     "FoldExportError",
     "Cancelled",
+    "GuardError",
     "PlacementWarning",
     "ClearanceWarning",
 ]
 
 
 class KinegamiError(Exception):
-    """Base class of every error kinegami raises on purpose."""
+    """Base class of every error kinegami raises on purpose.
+
+    ``str(error)`` is one line (docs/errors.md): a message that holds a line break (the repr of
+    a numpy array, say) is shown with each run of whitespace as one space.
+    """
+
+    def __str__(self) -> str:
+        text = super().__str__()
+        return text if text.splitlines() == [text] else " ".join(text.split())
 
 
 # --- parameters ----------------------------------------------------------------------------
@@ -121,6 +131,14 @@ class Cancelled(KinegamiError):  # noqa: N818 - the name users catch (as asyncio
     changed."""
 
 
+# --- the editor ------------------------------------------------------------------------------
+class GuardError(KinegamiError, RuntimeError):
+    """The editor's access check could not be put in front of viser's requests (a viser or
+    websockets version that does not start its server through
+    ``websockets.asyncio.server.serve``); the editor then does not serve at all. Also
+    ``kinegami.editor.access.GuardError``."""
+
+
 # --- design files --------------------------------------------------------------------------
 #: Marker for "no offending value" (``None`` is a valid JSON value: ``null``).
 _NO_VALUE = object()
@@ -176,7 +194,7 @@ class DesignError(KinegamiError, ValueError):
             text += f" (got {format_value(self.value)})"
         if self.file is not None:
             text = f"{self.file}: {text}"
-        return text
+        return text if text.splitlines() == [text] else " ".join(text.split())
 
     def __reduce__(self):
         return (_rebuild, (self.reason, self.field, self.has_value, self.value, self.file))

@@ -178,7 +178,7 @@ def pose_array(Pose, name: str = "Pose", r: float | None = None) -> np.ndarray:
     if not is_rigid_transform(T, tol=1e-8):
         raise InvalidParameterError(
             f"{name} must be a proper rigid transform (orthonormal rotation with determinant +1 "
-            f"and last row 0 0 0 1), got\n{T}"
+            f"and last row 0 0 0 1), got {shown(np.round(T, 6).tolist(), 200)}"
         )
     if r is not None:
         check_translation_part(name, T, r)

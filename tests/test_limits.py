@@ -144,3 +144,29 @@ def test_the_limits_are_numbers_that_keep_allocations_small():
     # a link has at most 2 arcs of at most 2 pi, so at most 720 elbows
     assert 2 * math.ceil(2 * math.pi / limits.MIN_ANGLE_PER_ELBOW) == 720
     assert np.isclose(limits.MIN_ANGLE_PER_ELBOW, math.radians(1))
+
+
+# --- one line -----------------------------------------------------------------------------------
+def test_a_kinegami_error_is_one_line_whatever_its_message_holds():
+    """Messages that held the repr of a numpy array printed several lines (a non-rigid Pose
+    printed five)."""
+    from kinegami.errors import DesignError, ExportError, InvalidTypeError
+
+    text = f"got {np.eye(3)!r}\r\n\u2028end"
+    for error in (KinegamiError(text), InvalidParameterError(text), InvalidTypeError(text),
+                  ExportError(text)):  # fmt: skip
+        assert str(error) == "got array([[1., 0., 0.], [0., 1., 0.], [0., 0., 1.]]) end"
+    assert str(InvalidParameterError("keeps  its  spaces")) == "keeps  its  spaces"
+    assert "\n" not in str(DesignError("a\nb", field="r", value="x\ny", file="d\n.json"))
+
+
+def test_a_pose_that_is_not_rigid_is_named_in_one_line():
+    with pytest.raises(InvalidParameterError) as info:
+        RevoluteJoint(4, 1, math.pi, np.diag([1.0, 2.0, 3.0, 1.0]))
+    _one_line(info, "Pose", "proper rigid transform", "[[1.0, 0.0, 0.0, 0.0], [0.0, 2.0")
+    from kinegami.pattern.folded import folded_vertices
+
+    chain = KinematicChain(StartTip(4, 1, SE3(), 1))
+    with pytest.raises(InvalidParameterError) as info:
+        folded_vertices(chain, frame=np.diag([1.0, 1.0, 2.0, 1.0]))
+    _one_line(info, "frame", "rigid")

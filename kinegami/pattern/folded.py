@@ -306,7 +306,9 @@ def _frame_array(frame) -> np.ndarray:
         and abs(np.linalg.det(R) - 1.0) < 1e-8
         and np.allclose(T[3], (0.0, 0.0, 0.0, 1.0))
     ):
-        raise InvalidParameterError(f"frame must be a proper rigid transform, got\n{T}")
+        raise InvalidParameterError(
+            f"frame must be a proper rigid transform, got {np.round(T, 6).tolist()}"
+        )
     return T
 
 
