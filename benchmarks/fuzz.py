@@ -572,6 +572,8 @@ def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEO
         state["queue"] = state["queue"][state["queue"].index(seed) + 1:]
         state["current"] = None
         result["cases"] += 1
+        if report and result["cases"] % 500 == 0:
+            report(f"{kind}: {result['cases']} cases done, {len(result['problems'])} problems")
 
     def stop(proc, status: str) -> None:
         state = running.pop(proc)
