@@ -65,7 +65,8 @@ def test_the_steps_cover_the_table_in_order(run):
     assert names[0] == "CSC paths" and names[-1] == "start-up, fresh processes"
     assert "compact, 16-joint safe chains (20 seeds) and the gallery" in names
     short = [name for name, _ in run.steps(3, 0)]  # no compaction: neither the chains' nor
-    assert len(short) == len(names) - 2 and not [n for n in short if "compact" in n.lower() and "16" in n]
+    assert len(short) == len(names) - 2
+    assert not [n for n in short if "compact" in n.lower() and "16" in n]
     assert "48-joint safe chains (3 seeds)" in short
 
 

@@ -179,7 +179,8 @@ def runs(request):
     """The pages of the selected tests, run side by side (one process per core): ``--dist
     loadfile`` gives this whole file to one worker."""
     selected = [item.callspec.params["page"] for item in request.session.items
-                if item.module is request.module and hasattr(item, "callspec")]  # fmt: skip
+                if getattr(item, "module", None) is request.module
+                and hasattr(item, "callspec")]  # fmt: skip
     pool = ThreadPoolExecutor(max_workers=os.cpu_count() or 1)
     futures = {page: pool.submit(run_page, page) for page in dict.fromkeys(selected)}
     yield futures

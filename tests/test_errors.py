@@ -71,6 +71,7 @@ HIERARCHY = {
     "ExporterUnavailableError": (ImportError,),
     "FoldExportError": (ValueError,),
     "Cancelled": (Exception,),
+    "GuardError": (RuntimeError,),
     "PlacementWarning": (UserWarning,),
     "ClearanceWarning": (UserWarning,),
 }

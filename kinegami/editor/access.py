@@ -30,7 +30,7 @@ from http.cookies import CookieError, SimpleCookie
 from typing import Any
 from urllib.parse import parse_qsl, urlencode, urlsplit
 
-from kinegami.errors import InvalidParameterError, KinegamiError
+from kinegami.errors import GuardError, InvalidParameterError
 
 __all__ = [
     "COOKIE_PREFIX",
@@ -51,11 +51,6 @@ COOKIE_PREFIX = "kinegami-edit-"
 _FORBIDDEN = http.HTTPStatus.FORBIDDEN
 _TOKEN_CHARACTERS = frozenset(string.ascii_letters + string.digits + "-_")
 _SERVE_LOCK = threading.Lock()
-
-
-class GuardError(KinegamiError, RuntimeError):
-    """The access check could not be put in front of viser's requests (a viser or websockets
-    version that does not start its server through ``websockets.asyncio.server.serve``)."""
 
 
 def is_loopback(host: str) -> bool:
