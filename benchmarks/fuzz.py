@@ -465,6 +465,80 @@ def cli_case(seed: int, folder: Path) -> str:
     return f"{args[0]}: status {status}"
 
 
+def editor_case(seed: int, folder: Path) -> str:
+    """A random design opened in the editor's model (kinegami.editor.EditorModel) and edited
+    by random commands: a refused command (``ok`` False) gives one line of reason and leaves
+    the design text and the chain bit-identical."""
+    import numpy as np
+
+    from kinegami.editor import EditorModel
+    from kinegami.editor.document import Document
+
+    rng = random.Random(seed ^ 0xED17)
+    try:
+        model = EditorModel(Document.loads(design_text(seed, small=True), "fuzz.json"))
+    except Exception as error:  # noqa: BLE001
+        _refusal(error)
+        return "refused"
+    r = model.chain.r
+    counts = {"ok": 0, "refused": 0}
+    for _ in range(rng.randrange(3, 9)):
+        size = len(model.chain.Joints)
+        k = rng.randrange(-1, size + 1)
+        pose = np.eye(4)
+        pose[:3, 3] = _translation(rng, r)
+        kind = rng.choice(("RevoluteJoint", "PrismaticJoint", "ExtendedRevoluteJoint",
+                           "Waypoint", "EndTip"))  # fmt: skip
+        parameters = rng.choice(({}, {"numSinkLayers": 33}, {"numLayers": 201},
+                                 {"tubeLength": 2e6 * r}, {"totalBendingAngle": 7.0},
+                                 {"numSinkLayers": 2}, {"neutralLength": 4 * r}))  # fmt: skip
+        if not set(parameters) <= {"RevoluteJoint": {"numSinkLayers", "totalBendingAngle"},
+                                   "PrismaticJoint": {"numLayers", "neutralLength"},
+                                   "ExtendedRevoluteJoint": {"numSinkLayers", "tubeLength",
+                                                             "totalBendingAngle"},
+                                   }.get(kind, set()) and rng.random() < 0.7:  # fmt: skip
+            parameters = {}
+        command = rng.choice(("add", "add", "branch", "delete", "slide", "roll", "state",
+                              "states", "parameters", "options", "all", "undo"))  # fmt: skip
+        before_text, before = model.to_design_text(), snapshot(model.chain)
+        try:
+            if command == "add":
+                result = model.add_joint(kind, parameters, pose, after=max(k, 0) % size)
+            elif command == "branch":
+                result = model.add_branch(kind, parameters, pose, parent=max(k, 0) % size)
+            elif command == "delete":
+                result = model.delete(k)
+            elif command == "slide":
+                result = model.slide(k, rng.choice((-2.0, 3.0, 1e6, 2e6)) * r)
+            elif command == "roll":
+                result = model.roll(k, rng.uniform(-7, 7))
+            elif command == "state":
+                result = model.set_state(k, rng.uniform(-4, 4))
+            elif command == "states":
+                result = model.set_states([rng.uniform(-1, 1) for _ in range(size)])
+            elif command == "parameters":
+                result = model.set_parameters(k, **(parameters or {"numSinkLayers": 40}))
+            elif command == "options":
+                result = model.set_options(maxAnglePerElbow=rng.choice((0.5, 1e-9, 0.0, 3.2)))
+            elif command == "all":
+                result = model.transform_all(pose)
+            else:
+                result = model.undo()
+        except Exception as error:  # noqa: BLE001
+            raise Violation(f"editor {command} raised {type(error).__name__}: "
+                            f"{str(error)[:300]}") from None  # fmt: skip
+        if result.ok:
+            counts["ok"] += 1
+            continue
+        counts["refused"] += 1
+        reason = result.reason or ""
+        if "\n" in reason:
+            raise Violation(f"editor {command}: a reason of several lines: {reason[:300]!r}")
+        if model.to_design_text() != before_text or snapshot(model.chain) != before:
+            raise Violation(f"a refused editor {command} changed the design ({reason[:200]})")
+    return f"edited: {counts['ok']} done, {counts['refused']} refused"
+
+
 def selftest_case(seed: int, folder: Path) -> str:
     """What the runner must catch (tests/design/test_fuzz_bounded.py): seed 0 passes, 1 hangs,
     2 runs out of memory, 3 fails with an error that is not a KinegamiError, 4 with a
@@ -472,7 +546,9 @@ def selftest_case(seed: int, folder: Path) -> str:
     from kinegami.errors import InvalidParameterError
 
     if seed == 1:
-        time.sleep(3600)
+        end = time.monotonic() + 3600
+        while time.monotonic() < end:  # busy: a hang is judged by CPU time
+            pass
     elif seed == 2:
         try:
             bytearray(64 * 2**30)
@@ -499,6 +575,7 @@ CASES = {
     "operations": operations_case,
     "operations:small": lambda seed, folder: operations_case(seed, folder, small=True),
     "cli": cli_case,
+    "editor": editor_case,
     "selftest": selftest_case,
 }
 
@@ -543,8 +620,9 @@ def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEO
     """Run the cases ``seeds`` of ``kind`` in ``workers`` processes; return the counts and
     every problem: ``{"cases", "ok", "problems": [(seed, status, detail)], "slowest"}``.
 
-    A case that runs past ``timeout`` seconds is a "hang" (its worker is killed and restarted
-    after it); a worker that dies is a "crash" on the case it was running."""
+    A case that uses more than ``timeout`` seconds of CPU (or runs for more than five times as
+    long, wall clock: the machine may be shared) is a "hang" (its worker is killed and
+    restarted after it); a worker that dies is a "crash" on the case it was running."""
     pending = list(seeds)
     per_worker = max(1, math.ceil(len(pending) / max(1, workers)))
     queues = [pending[i:i + per_worker] for i in range(0, len(pending), per_worker)]
@@ -556,7 +634,7 @@ def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEO
         if not queue:
             return
         proc = _spawn(kind, queue, memory, nice)
-        state = {"queue": queue, "current": None, "since": time.monotonic()}
+        state = {"queue": queue, "current": None, "since": time.monotonic(), "cpu": 0.0}
         running[proc] = state
         selector.register(proc.stdout, selectors.EVENT_READ, proc)
 
@@ -585,7 +663,7 @@ def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEO
         seed = state["current"]
         if seed is not None:
             problem(seed, status, err.strip().splitlines()[-1][:300] if err.strip() and
-                    status == "crash" else f"no answer within {timeout:g} s")  # fmt: skip
+                    status == "crash" else f"more than {timeout:g} s of CPU")  # fmt: skip
             finish_case(state, seed)
         start(state["queue"])
 
@@ -602,6 +680,7 @@ def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEO
             event = json.loads(line)
             if "start" in event:
                 state["current"], state["since"] = event["start"], time.monotonic()
+                state["cpu"] = _cpu_seconds(proc.pid)
                 continue
             if event["status"] == "ok":
                 result["ok"] += 1
@@ -612,9 +691,22 @@ def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEO
             finish_case(state, event["seed"])
         now = time.monotonic()
         for proc, state in list(running.items()):
-            if state["current"] is not None and now - state["since"] > timeout:
+            if state["current"] is None:
+                continue
+            wall = now - state["since"]
+            if wall > 5 * timeout or (wall > timeout
+                                      and _cpu_seconds(proc.pid) - state["cpu"] > timeout):
                 stop(proc, "hang")
     return result
+
+
+def _cpu_seconds(pid: int) -> float:
+    """CPU seconds (user and system) process ``pid`` has used (0 where /proc is missing)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def _seeds(start: int, count: int) -> list[int]:
@@ -626,6 +718,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--designs", type=int, default=10_000)
     parser.add_argument("--operations", type=int, default=10_000)
     parser.add_argument("--cli", type=int, default=0, help="command lines on random designs")
+    parser.add_argument("--editor", type=int, default=0, help="editor sessions")
     parser.add_argument("--seed", type=int, default=0, help="first seed")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--timeout", type=float, default=TIMEOUT)
@@ -633,7 +726,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--nice", type=int, default=10)
     args = parser.parse_args(argv)
     found = 0
-    kinds = (("design", args.designs), ("operations", args.operations), ("cli", args.cli))
+    kinds = (("design", args.designs), ("operations", args.operations), ("cli", args.cli),
+             ("editor", args.editor))
     for kind, count in kinds:
         if count <= 0:
             continue

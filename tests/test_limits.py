@@ -170,3 +170,42 @@ def test_a_pose_that_is_not_rigid_is_named_in_one_line():
     with pytest.raises(InvalidParameterError) as info:
         folded_vertices(chain, frame=np.diag([1.0, 1.0, 2.0, 1.0]))
     _one_line(info, "frame", "rigid")
+
+
+# --- positions a design file can hold --------------------------------------------------------
+def _far_design(step: float) -> dict:
+    joint = {"type": "Waypoint", "safe": False, "pose": [{"Trans": [step, 0, 0]}]}
+    return {"format": "kinegami-design", "version": 1, "numSides": 4, "r": 1,
+            "joints": [{"type": "StartTip", "length": 1.5}, joint, joint,
+                       {"type": "EndTip", "length": 1.5, "safe": False,
+                        "pose": [{"Trans": [3, 0, 0]}]}]}  # fmt: skip
+
+
+def test_a_design_whose_steps_add_up_beyond_1e6_r_is_refused():
+    """Each step within 1e6 r, two of them 1.8e6 r from the origin: such a chain could not be
+    written back (the writer holds every joint's position to 1e6 r)."""
+    from kinegami.design import DesignError, chain_from_dict, design_to_dict, dumps_design
+
+    chain = chain_from_dict(_far_design(4.5e5))  # 9e5 r: loads, and can be saved
+    dumps_design(design_to_dict(chain))
+    with pytest.raises(DesignError) as info:
+        chain_from_dict(_far_design(9e5), "far.json")
+    error = info.value
+    assert error.field == "joints[2]"
+    _one_line(info, "far.json: joints[2]: out of range: joint 2", "x = 1.8e+06", "LENGTH_FACTOR")
+
+
+def test_the_editor_refuses_a_command_that_puts_a_joint_beyond_1e6_r():
+    from kinegami.design import chain_from_dict
+    from kinegami.editor import EditorModel
+    from kinegami.editor.document import Document
+
+    model = EditorModel(Document.from_chain(chain_from_dict(_far_design(4e5))))
+    before = model.to_design_text()
+    far = np.eye(4)
+    far[0, 3] = 5e5  # the last joint, at x = 8e5 + 3 r, would go to 1.3e6 r
+    result = model.transform_all(far)
+    assert not result.ok and "beyond +-1e6 r" in result.reason and "\n" not in result.reason
+    assert model.to_design_text() == before
+    far[0, 3] = 1e5
+    assert model.transform_all(far).ok  # within the bound: done

@@ -58,6 +58,7 @@ __all__ = [
     "MAX_POSE_STEPS",
     "MAX_DEPTH",
     "check_lengths",
+    "position_problem",
     "too_many",
     "too_deep",
 ]
@@ -137,6 +138,29 @@ def check_lengths(document: dict, file=None) -> None:
             check(spec["distance"], ["edits", i, "distance"])
         if "transform" in spec:
             _check_pose(spec["transform"], ["edits", i, "transform"], check)
+
+
+def position_problem(chain) -> tuple[int, str] | None:
+    """``(joint index, reason)`` for the first joint of a built chain or tree that lies beyond
+    +-LENGTH_FACTOR r of the origin in some coordinate, or None.
+
+    Placement, edits and states compute positions from steps that each keep the bound, but
+    steps add up; a design file holds every joint's position, so such a chain could not be
+    saved as a design (docs/limits.md). The loader and the editor refuse it.
+    """
+    r = float(chain.r)
+    limit = LENGTH_FACTOR * r
+    for i, joint in enumerate(chain.Joints):
+        t = joint.pose_matrix[:3, 3]
+        k = max(range(3), key=lambda axis: abs(float(t[axis])))
+        if not abs(float(t[k])) <= limit:
+            return i, (
+                f"joint {i} ({type(joint).__name__}) would lie at {'xyz'[k]} = "
+                f"{float(t[k]):.6g}, beyond +-1e6 r = {limit:g} (r = {r:g}) from the origin, "
+                "where a design file cannot hold it (kinegami.limits.LENGTH_FACTOR): place the "
+                "joints closer together"
+            )
+    return None
 
 
 def too_many(what: str, cap: int, name: str, count: int | None = None) -> str:

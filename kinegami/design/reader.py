@@ -37,6 +37,7 @@ from kinegami.design.limits import (
     MAX_JOINTS,
     MAX_STATES,
     check_lengths,
+    position_problem,
     too_deep,
     too_many,
 )
@@ -1119,6 +1120,12 @@ def build_plan(plan: _Plan, file=None) -> tuple[KinematicChain | KinematicTree, 
     _apply_edits(chain, plan, file, sources)
     if plan.states is not None:
         _apply_states(chain, plan, file)
+    far = position_problem(chain)
+    if far is not None:  # steps within the bounds that add up beyond them (docs/limits.md)
+        i, reason = far
+        source = sources[i] if i < len(sources) else None
+        where = "dh" if plan.dh is not None else ("$" if source is None else f"joints[{source}]")
+        raise DesignError(f"out of range: {reason}", field=where, file=file)
     origin = DesignOrigin(
         kind="dh" if plan.dh is not None else "joints",
         sources=tuple(sources),

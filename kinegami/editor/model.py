@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from kinegami.chain import KinematicChain
+from kinegami.design.limits import position_problem
 from kinegami.editor import commands as cmd
 from kinegami.editor.commands import Command, CommandError, Outcome
 from kinegami.editor.document import Document, JointRow, joint_parameters
@@ -449,6 +450,11 @@ class EditorModel:
             return self._refused(CommandResult(False, command.label, "the command returned no "
                                                "document"))  # fmt: skip
         after = outcome.document
+        far = position_problem(after.chain)
+        if far is not None and position_problem(before.chain) is None:
+            # a design file could not hold the result (docs/limits.md): refused, not saved later
+            return self._refused(CommandResult(False, command.label,
+                                               f"{command.label}: {far[1]}"))  # fmt: skip
         selected = self._selection_after(before, after, outcome)
         self._undo.append(_Step(command, before, after, self._selected, selected))
         self._redo.clear()
