@@ -324,10 +324,11 @@ def _segment_distances_xyz(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.n
     tc = np.stack([u[0], u[1], zero, zero + 1.0])
     # the first smallest of the critical point and the four, in that order
     every = np.concatenate([gap(s, t)[None], gap(sc, tc)])
-    pick = np.argmin(every, axis=0)[None]
-    s = np.take_along_axis(np.concatenate([s[None], sc]), pick, axis=0)[0]
-    t = np.take_along_axis(np.concatenate([t[None], tc]), pick, axis=0)[0]
-    return np.take_along_axis(every, pick, axis=0)[0], s, t
+    pick = np.argmin(every, axis=0)
+    at = np.arange(pick.size)
+    s = np.concatenate([s[None], sc])[pick, at]
+    t = np.concatenate([t[None], tc])[pick, at]
+    return every[pick, at], s, t
 
 
 #: Most capsules in one group (a part's run of capsules is split into groups this long).
@@ -849,7 +850,18 @@ class ClearanceEngine:
     # --- labels ----------------------------------------------------------------------------
     def _texts(self, rows: np.ndarray, s: np.ndarray) -> list[str]:
         """The part at parameter s of capsule row, in words, for every (row, s)."""
-        out: list[str] = [""] * rows.size
+        if rows.size <= 8:  # a few: one by one
+            out = []
+            for row, at in zip(rows.tolist(), (s * self._lengths[rows]).tolist(), strict=True):
+                breaks, labels = self._pieces[row]
+                text = labels[-1]
+                for n, b in enumerate(breaks.tolist()):
+                    if at < b:
+                        text = labels[n]
+                        break
+                out.append(self._named(row, text))
+            return out
+        out = [""] * rows.size
         for row in np.unique(rows).tolist():
             n = np.flatnonzero(rows == row)
             breaks, labels = self._pieces[row]
