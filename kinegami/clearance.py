@@ -42,7 +42,6 @@ from kinegami.bodies import (
     capsule_model,
     check_margin,
     clear_limit,
-    part_label,
     tree_capsules,
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError
@@ -458,7 +457,6 @@ class ClearanceEngine:
         self._chain_bodies = bool(np.all(self._body_parent[1:] == np.arange(NB - 1)))
         bj = self.movable
         self._revolute_b = kinds[bj] == JOINT_REVOLUTE
-        self._revolute_m = self._revolute_b  # (the name the tests knew)
         self._any_revolute = bool(self._revolute_b.any())
         ax = axes[bj]
         K1 = np.zeros((bj.size, 3, 3))
@@ -522,7 +520,7 @@ class ClearanceEngine:
         else:
             centre, radius, tau_lo, tau_hi = np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0)
             owner = np.zeros(0, dtype=np.int64)
-        self._gstart, self._gsize, self._group_of = gstart, gsize, owner
+        self._gstart, self._gsize = gstart, gsize
         self._spanning = bool(spanning.any())
         self._gcentre, self._gradius = centre, radius
         self._gbody = ba[gstart]
@@ -532,7 +530,6 @@ class ClearanceEngine:
         self._gtau_lo, self._gtau_hi = tau_lo, tau_hi
         self._gkink = kink_max[self._gbody]
         self._ancestor = None if caps is None else caps.ancestor
-        self._max_radius = float(radius.max()) if G else 0.0
         # the k-d tree broad phase searches within twice the radius of most groups; the
         # largest tenth is tested against every group
         self._radius_cut = float(np.quantile(radius, 0.9)) if G else 0.0
@@ -1509,29 +1506,6 @@ class TreeMotion:
             ends = (float(good[n]), float(good[n + 1]))
             out[j] = (min(ends), max(ends))
         return tuple(out)
-
-
-def _clipped(values, ranges: np.ndarray) -> tuple[float, ...]:
-    """Checked states clamped into ``ranges`` (one within 1e-12 of its range moves onto it), as
-    the tuple ``KinematicTree._configured`` takes."""
-    clipped = np.clip(np.asarray(values, dtype=float), ranges[:, 0], ranges[:, 1])
-    return tuple(float(v) for v in clipped)
-
-
-def _pair_at(found: tuple, q: int, clearance: float, joints, names) -> CollidingPair:
-    """Pair ``q`` of :func:`~kinegami.bodies.tree_pair_distances`'s result ``found`` as a
-    CollidingPair: its parts in words, ``clearance``, its closest points and elements."""
-    i, j, _, s, t, rows, a, b = found
-    ii, jj = int(i[q]), int(j[q])
-    p = a[ii] + s[q] * (b[ii] - a[ii])
-    o = a[jj] + t[q] * (b[jj] - a[jj])
-    return CollidingPair(
-        part_label(rows[ii], float(s[q]), joints, names),
-        part_label(rows[jj], float(t[q]), joints, names),
-        clearance,
-        (tuple(map(float, p)), tuple(map(float, o))),
-        (int(rows[ii][5]), int(rows[jj][5])),
-    )
 
 
 def _checked_states(states, ranges: np.ndarray, name: str) -> np.ndarray:
