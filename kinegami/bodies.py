@@ -934,8 +934,9 @@ def _polyline_samples(points: np.ndarray, step: float) -> tuple[np.ndarray, np.n
     return points[k] + t[:, None] * d[k], s
 
 
-#: Most sample points junction_extent evaluates at once (bounds its temporary arrays).
-_JUNCTION_CHUNK = 65_536
+#: Most (sample point, sibling segment) pairs junction_extent evaluates at once: its temporary
+#: arrays then hold at most 3 x 2**20 floats (24 MiB) each, however many siblings there are.
+_JUNCTION_CHUNK = 1 << 20
 #: Most (own segment, sibling segment) pairs whose intervals are computed at once.
 _JUNCTION_PAIRS = 262_144
 
@@ -964,7 +965,7 @@ def junction_extent(
     first = np.cumsum(counts) - counts  # global index of each segment's first sample
     low, high = _candidate_samples(starts, ends, counts, first, a, b, reach)
     found = -math.inf
-    for index in _descending_chunks(low, high):
+    for index in _descending_chunks(low, high, max(1, _JUNCTION_CHUNK // a.shape[0])):
         i = np.searchsorted(first, index, side="right") - 1
         u = (index - first[i]) / (counts[i] - 1)
         points = starts[i] + u[:, None] * (ends - starts)[i]
@@ -981,19 +982,19 @@ def junction_extent(
     return found + 0.02 * r
 
 
-def _descending_chunks(low: np.ndarray, high: np.ndarray):
+def _descending_chunks(low: np.ndarray, high: np.ndarray, chunk: int):
     """The integers of the disjoint intervals [low, high) (sorted), highest first, in arrays
-    of at most :data:`_JUNCTION_CHUNK` (few of them: the scan may end early)."""
+    of at most ``chunk`` (few of them: the scan may end early)."""
     pieces: list[np.ndarray] = []
     size = 0
     for k in range(low.size - 1, -1, -1):
         lo, hi = int(low[k]), int(high[k])
         while hi > lo:
-            take = min(hi - lo, _JUNCTION_CHUNK - size)
+            take = min(hi - lo, chunk - size)
             pieces.append(np.arange(hi - take, hi, dtype=np.int64))
             size += take
             hi -= take
-            if size == _JUNCTION_CHUNK:
+            if size == chunk:
                 yield np.concatenate(pieces)
                 pieces, size = [], 0
     if pieces:
