@@ -353,7 +353,7 @@ class _Layout:
         sorted_body = body[order]
         cuts = np.flatnonzero(np.r_[True, sorted_body[1:] != sorted_body[:-1]]) \
             if order.size else np.zeros(0, dtype=np.int64)  # fmt: skip
-        ends = np.r_[cuts[1:], order.size]
+        ends = np.r_[cuts[1:], order.size] if order.size else cuts  # no points: no slices
         self.slices = [(int(sorted_body[a]), int(a), int(b), points[order[a:b]])
                        for a, b in zip(cuts, ends, strict=True)]  # fmt: skip
         self.size = order.size

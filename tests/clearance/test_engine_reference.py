@@ -160,3 +160,14 @@ def test_sweep_of_a_tree_counts_as_one_configuration_reports():
     deepest = min(rep.min_clearance for rep in reports)
     assert result.worst_pairs[0][0].clearance == pytest.approx(deepest, abs=TOLERANCE)
     assert sum(count for _, count in result.worst_pairs) <= result.colliding
+
+
+def test_designs_with_no_capsules_are_clear():
+    """A tree or a chain of one joint has no parts to test: clear, also over its motion (the
+    engine's point layout is empty; it raised a ValueError)."""
+    from kinegami import SE3, KinematicChain, KinematicTree, StartTip, Waypoint
+    from kinegami.clearance import sweep
+
+    for design in (KinematicTree(Waypoint(4, 1, SE3())), KinematicChain(StartTip(4, 1, SE3(), 1))):
+        assert design.clearance().ok
+        assert sweep(design, samples=5).colliding == 0
