@@ -45,7 +45,7 @@ from kinegami.bodies import (
     tree_capsules,
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.geometry.segments import segment_distances
+from kinegami.geometry.segments import segment_distances, segment_distances_xyz
 from kinegami.joints import PrismaticJoint, RevoluteJoint
 from kinegami.validation import check_int, check_real, shorten, shown
 
@@ -274,60 +274,6 @@ def _rotations(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
     s = np.sin(angles)[:, None, None]
     c = (1.0 - np.cos(angles))[:, None, None]
     return np.eye(3) + s * K + c * (K @ K)
-
-
-#: Squared lengths below this are points (the value of :mod:`kinegami.geometry.segments`).
-_DEGENERATE = 1e-30
-
-
-def _dot(x1, y1, z1, x2, y2, z2):
-    return (x1 * x2 + z1 * z2) + y1 * y2  # the order numpy.einsum sums (..., 3) in
-
-
-def _segment_distances_xyz(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`~kinegami.geometry.segments.segment_distances` on end points given as three
-    coordinate arrays each (``a1 = (x, y, z)``, arrays of one shape): the same arithmetic in
-    the same order (the same bits), without the (..., 3) layout's overhead."""
-    d1 = [q - p for p, q in zip(a1, b1, strict=True)]
-    d2 = [q - p for p, q in zip(a2, b2, strict=True)]
-    w = [p - q for p, q in zip(a1, a2, strict=True)]
-    A, E, B = _dot(*d1, *d1), _dot(*d2, *d2), _dot(*d1, *d2)
-    C, F = _dot(*d1, *w), _dot(*d2, *w)
-    ok1 = A > _DEGENERATE
-    ok2 = E > _DEGENERATE
-    A_safe = np.where(ok1, A, 1.0)
-    E_safe = np.where(ok2, E, 1.0)
-    denom = A * E - B * B
-    proper = ok1 & ok2 & (denom > 1e-14 * A_safe * E_safe)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        s = np.where(proper, (B * F - C * E) / np.where(proper, denom, 1.0), 0.0)
-    s = np.clip(s, 0.0, 1.0)
-    t = np.where(ok2, np.clip((B * s + F) / E_safe, 0.0, 1.0), 0.0)
-    s = np.where(ok1, np.clip((B * t - C) / A_safe, 0.0, 1.0), 0.0)
-    t = np.where(ok2, np.clip((B * s + F) / E_safe, 0.0, 1.0), 0.0)
-
-    def gap(s, t):
-        e = [(p + s * u) - (q + t * v) for p, u, q, v in zip(a1, d1, a2, d2, strict=True)]
-        return np.sqrt((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2])  # numpy.linalg.norm's order
-
-    # the four end-point-to-segment candidates at once: a1 and b1 against the second
-    # segment, a2 and b2 against the first (point_segment_parameters' arithmetic)
-    point = [np.stack(c) for c in zip(a1, b1, a2, b2, strict=True)]
-    base = [np.stack(c) for c in zip(a2, a2, a1, a1, strict=True)]
-    along = [np.stack(c) for c in zip(d2, d2, d1, d1, strict=True)]
-    dd, ok = np.stack([E, E, A, A]), np.stack([ok2, ok2, ok1, ok1])
-    num = _dot(*(p - q for p, q in zip(point, base, strict=True)), *along)
-    u = np.where(ok, np.clip(num / np.where(ok, dd, 1.0), 0.0, 1.0), 0.0)
-    zero = np.zeros_like(A)
-    sc = np.stack([zero, zero + 1.0, u[2], u[3]])
-    tc = np.stack([u[0], u[1], zero, zero + 1.0])
-    # the first smallest of the critical point and the four, in that order
-    every = np.concatenate([gap(s, t)[None], gap(sc, tc)])
-    pick = np.argmin(every, axis=0)
-    at = np.arange(pick.size)
-    s = np.concatenate([s[None], sc])[pick, at]
-    t = np.concatenate([t[None], tc])[pick, at]
-    return every[pick, at], s, t
 
 
 #: Most capsules in one group (a part's run of capsules is split into groups this long).
@@ -835,7 +781,7 @@ class ClearanceEngine:
         x, y, z = _moved(B.reshape(-1, 16), np.tile(k, 4) * NB + bodies, points)
         ends = [(x[n * m : (n + 1) * m], y[n * m : (n + 1) * m], z[n * m : (n + 1) * m])
                 for n in range(4)]  # fmt: skip
-        dist, s, t = _segment_distances_xyz(*ends)
+        dist, s, t = segment_distances_xyz(*ends)
         return k, i, j, dist - 2.0 * self.r, s, t
 
     def _chunk(self) -> int:

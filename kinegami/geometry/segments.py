@@ -16,7 +16,12 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["point_segment_parameters", "segment_distances", "capsule_distances"]
+__all__ = [
+    "point_segment_parameters",
+    "segment_distances",
+    "segment_distances_xyz",
+    "capsule_distances",
+]
 
 #: Segments shorter than this (squared, relative to the squared scale of the pair) are points.
 _DEGENERATE = 1e-30
@@ -34,10 +39,6 @@ def point_segment_parameters(points, a, b) -> np.ndarray:
     num = np.einsum("...i,...i->...", points - a, d)
     safe = np.where(dd > _DEGENERATE, dd, 1.0)
     return np.where(dd > _DEGENERATE, np.clip(num / safe, 0.0, 1.0), 0.0)
-
-
-def _lerp(a: np.ndarray, d: np.ndarray, s: np.ndarray) -> np.ndarray:
-    return a + s[..., None] * d
 
 
 def segment_distances(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -65,14 +66,26 @@ def segment_distances(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.ndarra
     a1, b1, a2, b2 = np.broadcast_arrays(
         *(np.asarray(x, dtype=float) for x in (a1, b1, a2, b2))
     )
-    d1 = b1 - a1
-    d2 = b2 - a2
-    w = a1 - a2
-    A = np.einsum("...i,...i->...", d1, d1)
-    E = np.einsum("...i,...i->...", d2, d2)
-    B = np.einsum("...i,...i->...", d1, d2)
-    C = np.einsum("...i,...i->...", d1, w)
-    F = np.einsum("...i,...i->...", d2, w)
+    shape = a1.shape[:-1]
+    found = segment_distances_xyz(
+        *(tuple(x.reshape(-1, 3)[:, c] for c in range(3)) for x in (a1, b1, a2, b2))
+    )
+    return tuple(x.reshape(shape) for x in found)
+
+
+def _dot(x1, y1, z1, x2, y2, z2):
+    return (x1 * x2 + z1 * z2) + y1 * y2  # the order numpy.einsum sums (..., 3) in
+
+
+def segment_distances_xyz(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The segment distances of :func:`segment_distances` on end points given as three
+    coordinate arrays each (``a1 = (x, y, z)``, 1-D arrays of one length): the kernel both
+    layouts use, without the (..., 3) layout's copies. Returns ``(distance, s, t)``."""
+    d1 = [q - p for p, q in zip(a1, b1, strict=True)]
+    d2 = [q - p for p, q in zip(a2, b2, strict=True)]
+    w = [p - q for p, q in zip(a1, a2, strict=True)]
+    A, E, B = _dot(*d1, *d1), _dot(*d2, *d2), _dot(*d1, *d2)
+    C, F = _dot(*d1, *w), _dot(*d2, *w)
     ok1 = A > _DEGENERATE
     ok2 = E > _DEGENERATE
     A_safe = np.where(ok1, A, 1.0)
@@ -85,23 +98,30 @@ def segment_distances(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.ndarra
     t = np.where(ok2, np.clip((B * s + F) / E_safe, 0.0, 1.0), 0.0)
     s = np.where(ok1, np.clip((B * t - C) / A_safe, 0.0, 1.0), 0.0)
     t = np.where(ok2, np.clip((B * s + F) / E_safe, 0.0, 1.0), 0.0)
-    best = np.linalg.norm(_lerp(a1, d1, s) - _lerp(a2, d2, t), axis=-1)
-    # the four end-point-to-segment candidates (the edges of the parameter square)
-    for point_on_first, fixed in ((True, 0.0), (True, 1.0), (False, 0.0), (False, 1.0)):
-        if point_on_first:
-            p = a1 if fixed == 0.0 else b1
-            tc = point_segment_parameters(p, a2, b2)
-            sc = np.full_like(tc, fixed)
-        else:
-            p = a2 if fixed == 0.0 else b2
-            sc = point_segment_parameters(p, a1, b1)
-            tc = np.full_like(sc, fixed)
-        dist = np.linalg.norm(_lerp(a1, d1, sc) - _lerp(a2, d2, tc), axis=-1)
-        better = dist < best
-        best = np.where(better, dist, best)
-        s = np.where(better, sc, s)
-        t = np.where(better, tc, t)
-    return best, s, t
+
+    def gap(s, t):
+        e = [(p + s * u) - (q + t * v) for p, u, q, v in zip(a1, d1, a2, d2, strict=True)]
+        return np.sqrt((e[0] * e[0] + e[1] * e[1]) + e[2] * e[2])  # numpy.linalg.norm's order
+
+    # the four end-point-to-segment candidates at once: a1 and b1 against the second
+    # segment, a2 and b2 against the first (point_segment_parameters' arithmetic)
+    point = [np.stack(c) for c in zip(a1, b1, a2, b2, strict=True)]
+    base = [np.stack(c) for c in zip(a2, a2, a1, a1, strict=True)]
+    along = [np.stack(c) for c in zip(d2, d2, d1, d1, strict=True)]
+    dd, ok = np.stack([E, E, A, A]), np.stack([ok2, ok2, ok1, ok1])
+    num = _dot(*(p - q for p, q in zip(point, base, strict=True)), *along)
+    u = np.where(ok, np.clip(num / np.where(ok, dd, 1.0), 0.0, 1.0), 0.0)
+    zero = np.zeros_like(A)
+    sc = np.stack([zero, zero + 1.0, u[2], u[3]])
+    tc = np.stack([u[0], u[1], zero, zero + 1.0])
+    # the first smallest of the critical point and the four, in that order
+    every = np.concatenate([gap(s, t)[None], gap(sc, tc)])
+    pick = np.argmin(every, axis=0)
+    at = np.arange(pick.size)
+    s = np.concatenate([s[None], sc])[pick, at]
+    t = np.concatenate([t[None], tc])[pick, at]
+    return every[pick, at], s, t
+
 
 
 def capsule_distances(a1, b1, r1, a2, b2, r2) -> np.ndarray:

@@ -26,7 +26,7 @@ from kinegami.bodies import (
 from kinegami.clearance import ClearanceEngine, TreeMotion, sweep
 from kinegami.design import load_design
 from kinegami.errors import ClearanceWarning
-from kinegami.geometry.segments import segment_distances
+from kinegami.geometry.segments import segment_distances, segment_distances_xyz
 
 DESIGNS = sorted((Path(__file__).parents[2] / "examples" / "designs").glob("*.json"))
 TOLERANCE = 1e-9  # in r
@@ -143,7 +143,7 @@ def test_segment_distance_kernel_is_the_shared_one_bit_for_bit():
     p[3][1000:1500] = p[0][1000:1500] + 2.0 * (p[1][1000:1500] - p[0][1000:1500])
     p[2][1500:2000] = p[0][1500:2000]  # touching ends
     expected = segment_distances(*p)
-    found = clearance_module._segment_distances_xyz(*[tuple(x[:, c] for c in range(3))
+    found = segment_distances_xyz(*[tuple(x[:, c] for c in range(3))
                                                       for x in p])
     for e, f in zip(expected, found, strict=True):
         assert np.array_equal(e, f)
