@@ -446,20 +446,19 @@ def _fold_unsnapped(pattern: TubularPattern, G0: np.ndarray) -> UnsnappedForm:
     marker = np.array(pattern.proximalMarker, dtype=float)
     for placement in placements:
         record, mapping, is_new = placement.record, placement.mapping, placement.is_new
-        fold = _module_fold(n, r, record.kind, _freeze(record.params))
-        exact = fold.exact
+        _, exact, X_exact, T, corr = _exact_fold(n, r, record.kind, _freeze(record.params))
         offset = marker - exact.proximalMarker
         xy = exact.vertices_coords + offset
         xy[:, 0] = mod_w(xy[:, 0], W)
-        world = (G[:3, :3] @ fold.X_exact.T).T + G[:3, 3]
+        world = (G[:3, :3] @ X_exact.T).T + G[:3, 3]
         emap = np.full(exact.numVertices, -1, dtype=np.intp)
-        emap[fold.corr] = mapping
+        emap[corr] = mapping
         extra = emap < 0
         count = int(np.count_nonzero(extra))
         emap[extra] = np.arange(next_extra, next_extra + count)
         next_extra += count
         new = extra.copy()
-        new[fold.corr[is_new]] = True
+        new[corr[is_new]] = True
         shared = emap[~new]
         if shared.size:  # the proximal base: must meet the previous distal base exactly
             flat = coords[0][shared] - xy[~new]
@@ -475,7 +474,7 @@ def _fold_unsnapped(pattern: TubularPattern, G0: np.ndarray) -> UnsnappedForm:
         edges.append(emap[exact.edges_vertices])
         labels.append(exact.edges_assignment)
         proximal = G @ UVA_TO_DUBINS.T
-        G = G @ fold.T
+        G = G @ T
         modules.append(FoldedModule(record, _readonly(emap), proximal, G @ UVA_TO_DUBINS.T))
         marker = exact.distalMarker + offset
         marker[0] = mod_w(marker[0:1], W)[0]
@@ -679,20 +678,30 @@ class _ModuleFold:
 
 
 @functools.lru_cache(maxsize=512)
-def _module_fold(n: int, r: float, kind: str, params: tuple) -> _ModuleFold:
-    """The folded module of a record (cached): see :class:`_ModuleFold`."""
+def _exact_fold(n: int, r: float, kind: str, params: tuple) -> tuple:
+    """(catalog, exact, X_exact, T, corr) of a record (cached): the fields of
+    :class:`_ModuleFold` that need no isometry repair (all the unsnapped form uses)."""
     prism = make_prism(n, r)
     catalog = _rebuild_cached(n, r, kind, params)
     entry = module_kind(kind)
     p = dict(params)
     exact, corr = entry.unsnapped(prism, catalog, p)
     X, T = entry.fold(prism, exact, p)
+    for a in (X, T, corr):
+        a.flags.writeable = False
+    return catalog, exact, X, T, corr
+
+
+@functools.lru_cache(maxsize=512)
+def _module_fold(n: int, r: float, kind: str, params: tuple) -> _ModuleFold:
+    """The folded module of a record (cached): see :class:`_ModuleFold`."""
+    catalog, exact, X, T, corr = _exact_fold(n, r, kind, params)
     pinned = np.zeros(catalog.numVertices, dtype=bool)
     for base in (catalog.proximalBase, catalog.distalBase):
         if base is not None:
             pinned[base] = True
     X_catalog, repaired = _repair_isometry(catalog, X[corr], pinned, release=False)
-    for a in (X, T, corr, X_catalog, repaired):
+    for a in (X_catalog, repaired):
         a.flags.writeable = False
     return _ModuleFold(catalog, exact, X, T, corr, X_catalog, repaired)
 

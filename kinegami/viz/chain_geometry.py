@@ -81,21 +81,46 @@ def arc_points(centre, axis, start, angles) -> np.ndarray:
     return centre + v * np.cos(t) + kxv * np.sin(t) + k * float(k @ v) * (1.0 - np.cos(t))
 
 
-def convex_hull_faces(points) -> list[np.ndarray]:
+def convex_hull_faces(points, frame=None) -> list[np.ndarray]:
     """Faces of the convex hull of ``points`` (k, 3): one ordered polygon per planar facet.
 
     Coplanar hull triangles are merged, so a box gives 6 quadrilaterals. A flat or degenerate
     point set gives an empty list. The output does not depend on the order in which qhull lists
     its triangles (which changes with the last bits of the points): faces come in the order of
     their point indices, each counter-clockwise about its outward normal from its lowest index.
+
+    ``frame`` (4x4, optional) is a frame the points are rigidly attached to (a joint's pose):
+    point sets with the same coordinates in their frames (equal joints anywhere in a chain)
+    then share one hull computation (the faces are the same, moved).
     """
+    pts = np.asarray(points, dtype=float)
+    if frame is None:
+        return [pts[idx] for idx in _hull_face_indices(pts)]
+    F = np.asarray(frame, dtype=float)
+    local = (pts - F[:3, 3]) @ F[:3, :3]
+    scale = max(float(np.abs(local).max(initial=0.0)), 1e-300)
+    key = (pts.shape, np.round(local / scale, 9).tobytes(), float(f"{scale:.9g}"))
+    faces = _HULLS.get(key)
+    if faces is None:
+        faces = _hull_face_indices(local)
+        if len(_HULLS) >= 1024:
+            _HULLS.clear()
+        _HULLS[key] = faces
+    return [pts[idx] for idx in faces]
+
+
+#: Hulls already computed (convex_hull_faces with a frame): their faces' index arrays.
+_HULLS: dict[tuple, tuple[np.ndarray, ...]] = {}
+
+
+def _hull_face_indices(pts: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The faces of :func:`convex_hull_faces` as ordered index arrays into ``pts``."""
     from scipy.spatial import ConvexHull, QhullError
 
-    pts = np.asarray(points, dtype=float)
     try:
         hull = ConvexHull(pts)
     except (QhullError, ValueError):
-        return []
+        return ()
     scale = max(float(np.ptp(pts, axis=0).max()), 1e-300)
     groups: dict[tuple, set[int]] = {}
     normals: dict[tuple, np.ndarray] = {}
@@ -115,8 +140,8 @@ def convex_hull_faces(points) -> list[np.ndarray]:
         d = face - centre
         order = np.argsort(np.arctan2(d @ e2, d @ e1))
         order = np.roll(order, -int(np.argmin(order)))  # start at the lowest index
-        faces.append(face[order])
-    return faces
+        faces.append(idx[order])
+    return tuple(faces)
 
 
 def face_normals(polygons) -> np.ndarray:
@@ -156,7 +181,8 @@ def joint_body_faces(joint: Joint) -> list[np.ndarray]:
         return prism_faces(bottom, top)
     if isinstance(joint, RevoluteJoint):
         first, second = revolute_hull_points(joint)
-        faces = convex_hull_faces(first) + convex_hull_faces(second)
+        T = joint.pose_matrix
+        faces = convex_hull_faces(first, T) + convex_hull_faces(second, T)
         if isinstance(joint, ExtendedRevoluteJoint):
             n, r, h = joint.numSides, joint.r, joint.tubeLength
             for frame, sign in (
@@ -168,7 +194,7 @@ def joint_body_faces(joint: Joint) -> list[np.ndarray]:
                 faces += prism_faces(outer, inner)
         return faces
     if isinstance(joint, StartTip | EndTip):
-        return convex_hull_faces(tip_hull_points(joint))
+        return convex_hull_faces(tip_hull_points(joint), joint.pose_matrix)
     # Any other joint: the hull of its proximal and distal cross sections.
     n, r = joint.numSides, joint.r
     return convex_hull_faces(
