@@ -399,7 +399,8 @@ def random_dh_table(n: int, seed: int = 1, r: float = 1.0) -> list[tuple[float, 
 
 def scale_rows() -> list[tuple[str, str, str]]:
     """How builds grow with the design: safe random chains of 100, 200 and 400 joints, the
-    CPU time of one append early and late in a 400-joint chain, and a 1,000-row DH table."""
+    CPU time of one append early and late in a 400-joint chain, and a 1,000-row DH table
+    (from_dh, and kinegami build of a design file holding it)."""
     times = {}
     for n in (100, 200, 400):
         t0 = time.perf_counter()
@@ -421,6 +422,7 @@ def scale_rows() -> list[tuple[str, str, str]]:
         warnings.simplefilter("ignore")
         KinematicChain.from_dh(random_dh_table(1000), 4, 1.0)
     dh = time.perf_counter() - t0
+    build = _dh_build_seconds(random_dh_table(1000))
     return [
         ("safe random chain, 100 / 200 / 400 joints",
          f"{times[100]:.1f} / {times[200]:.1f} / {times[400]:.1f} s", "400 joints <= 10 s"),
@@ -428,7 +430,24 @@ def scale_rows() -> list[tuple[str, str, str]]:
         ("  CPU per append: joints 1-50 / 351-400", f"{early * 1e3:.1f} / {late * 1e3:.1f} ms",
          "late ~ early (no growth with length)"),
         ("KinematicChain.from_dh, 1,000 random rows", f"{dh:.1f} s", "<= 30 s"),
+        ("kinegami build of that table's design file", f"{build:.1f} s", "<= 30 s"),
     ]  # fmt: skip
+
+
+def _dh_build_seconds(rows: list[tuple[float, ...]]) -> float:
+    """Wall seconds of ``kinegami build`` (a fresh process, its default outputs: DXF, SVG,
+    pictures) of a design file holding the DH table ``rows`` (numSides 4, r 1)."""
+    import json
+    import subprocess
+
+    with tempfile.TemporaryDirectory() as folder:
+        design = Path(folder) / "dh.json"
+        design.write_text(json.dumps({"format": "kinegami-design", "version": 1, "numSides": 4,
+                                      "r": 1, "dh": {"rows": [list(row) for row in rows]}}))
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "kinegami", "build", str(design), "-o",
+                        str(Path(folder) / "out")], check=True, capture_output=True)
+        return time.perf_counter() - t0
 
 
 def _cpu_median(fn, repeat: int) -> float:
