@@ -19,24 +19,27 @@ the tube radius r) is written as 1 mm unless ``units`` or ``scale`` say otherwis
 ignore DXF line types).
 
 The document skeleton (header, tables, layers, objects) is a template made once with ezdxf and
-stored in :mod:`kinegami.export._dxf_template`: :func:`dxf_data` fills in the sheet's extents,
+shipped as package data (``dxf_skeleton.json``, :func:`dxf_skeleton`): :func:`dxf_data` fills
+in the sheet's extents,
 the handle seed, new GUIDs and the time (with ``SOURCE_DATE_EPOCH`` set: that time, and GUIDs
 made from the drawing, so equal sheets give equal files; :mod:`kinegami.export._reproducible`),
 and writes the LINE entities as text straight into the ENTITIES section, with the handles the
 template leaves free. So a DXF file is written
 without importing ezdxf (the first save in a process: ~10 ms instead of ~350 ms), and the file
 is the one ezdxf writes for the same drawing. :func:`dxf_document` builds the same drawing
-with ezdxf entities, for users who want to edit it; :func:`make_template` makes the template
+with ezdxf entities, for users who want to edit it; :func:`make_skeleton` makes the skeleton
 again (after an ezdxf upgrade: ``python -m kinegami.export.dxf``).
 """
 
 from __future__ import annotations
 
 import datetime
+import functools
 import io
+import json
 import os
 import time
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import TYPE_CHECKING, Any, NamedTuple, TextIO
 
 import numpy as np
 
@@ -56,7 +59,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from kinegami.pattern.tubular import TubularPattern
 
-__all__ = ["LAYERS", "DXF_VERSION", "dxf_data", "write_dxf", "dxf_document", "make_template"]
+__all__ = ["LAYERS", "DXF_VERSION", "dxf_data", "write_dxf", "dxf_document", "dxf_skeleton",
+           "make_skeleton", "DxfSkeleton"]
 
 #: Layer name and ACI colour for each kind of line.
 LAYERS = {"M": ("Mountain", 5), "V": ("Valley", 1), "B": ("Boundary", 2), "C": ("Cut", 3)}
@@ -164,16 +168,15 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
     >>> dxf_data(TubeFittingPattern(4, 10.0, 30.0)).split()[:2]
     ['0', 'SECTION']
     """
-    from kinegami.export import _dxf_template as template
-
+    template = dxf_skeleton()
     opts = resolve_sheet_options(options, {"label": None}, "DXF")
     label = check_label(opts.extra["label"])
     segments, kinds, bounds = sheet_lines(pattern, opts)
     count = segments.shape[0]
-    entities = _line_entities(segments, kinds, template.FIRST_HANDLE, template.OWNER, bounds)
+    entities = _line_entities(segments, kinds, template.first_handle, template.owner, bounds)
     if label:  # one TEXT entity, after the lines, as ezdxf writes it
         x, y = (repr(float(v)) for v in _label_point(bounds))
-        entities += (f"  0\nTEXT\n  5\n{template.FIRST_HANDLE + count:X}\n330\n{template.OWNER}\n"
+        entities += (f"  0\nTEXT\n  5\n{template.first_handle + count:X}\n330\n{template.owner}\n"
                      f"100\nAcDbEntity\n  8\n0\n100\nAcDbText\n 10\n{x}\n 20\n{y}\n 30\n0.0\n"
                      f" 40\n{LABEL_HEIGHT!r}\n  1\n{label}\n100\nAcDbText\n")  # fmt: skip
         count += 1
@@ -199,18 +202,18 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
         "YMIN": ymin,
         "XMAX": xmax,
         "YMAX": ymax,
-        "HANDSEED": f"{template.FIRST_HANDLE + count:X}",
+        "HANDSEED": f"{template.first_handle + count:X}",
         "FINGERPRINTGUID": fingerprint,
         "VERSIONGUID": version,
         "TDCREATE": repr(julian),
         "TDUCREATE": repr(julian),
         "TDUPDATE": repr(julian),
         "TDUUPDATE": repr(julian),
-        "CREATED": f"{template.EZDXF_VERSION} @ {now.isoformat()}",
-        "WRITTEN": f"{template.EZDXF_VERSION} @ {now.isoformat()}",
+        "CREATED": f"{template.ezdxf_version} @ {now.isoformat()}",
+        "WRITTEN": f"{template.ezdxf_version} @ {now.isoformat()}",
         "ENTITIES": entities,
     }
-    parts = list(template.PARTS)
+    parts = list(template.parts)
     for i in range(1, len(parts), 2):
         parts[i] = fields[parts[i]]
     return "".join(parts)
@@ -306,12 +309,39 @@ def _source_lines(text: str) -> str:
     return "    (\n" + "\n".join(f"        {s}" for s in literals) + "\n    )"
 
 
-def make_template() -> str:
-    """The source of :mod:`kinegami.export._dxf_template`, made with the installed ezdxf.
+#: The package data file holding the skeleton (kinegami/export/dxf_skeleton.json).
+SKELETON_FILE = "dxf_skeleton.json"
 
-    Run ``python -m kinegami.export.dxf`` to write it after an ezdxf upgrade (a test checks
-    that the stored template is what this version of ezdxf writes).
-    """
+
+class DxfSkeleton(NamedTuple):
+    """The DXF R2013 document ezdxf writes for an empty drawing, as :func:`dxf_data` fills it
+    in: ``parts`` alternates text and the names of the fields it fills (extents, handle seed,
+    GUIDs, times, the ENTITIES section's content); ``first_handle`` is the first free handle
+    (the LINEs'), ``owner`` the modelspace block record's handle, ``ezdxf_version`` the ezdxf
+    that wrote it."""
+
+    ezdxf_version: str
+    first_handle: int
+    owner: str
+    parts: tuple[str, ...]
+
+
+@functools.cache
+def dxf_skeleton() -> DxfSkeleton:
+    """The skeleton shipped with the package (read once; see :func:`make_skeleton`)."""
+    # read through this module's loader, as pkgutil.get_data does (also from a zip), without
+    # the imports importlib.resources pays (15 ms, more than the rest of a first save)
+    path = os.path.join(os.path.dirname(__spec__.origin), SKELETON_FILE)
+    data = json.loads(__spec__.loader.get_data(path).decode("utf-8"))
+    text = "\n".join(data["lines"])
+    return DxfSkeleton(data["ezdxf"], int(data["first_handle"], 16), data["owner"],
+                       tuple(text.split("@@")))  # fmt: skip
+
+
+def make_skeleton() -> str:
+    """The text of the skeleton file (JSON, one line of DXF text per line), made with the
+    installed ezdxf: ``python -m kinegami.export.dxf`` writes it after an ezdxf upgrade, and a
+    test fails when the shipped file differs from what the installed ezdxf writes."""
     import ezdxf
 
     text, first, owner = _ezdxf_skeleton(_SENTINEL_BOUNDS, 0)
@@ -328,23 +358,24 @@ def make_template() -> str:
         text = text[:at] + f"@@{field}@@" + text[text.index("\n", at):]
     cut = text.index(_ENTITIES) + len(_ENTITIES)
     text = text[:cut] + "@@ENTITIES@@" + text[cut:]
-    parts = text.split("@@")
-    lines = ",\n".join(_source_lines(part) if i % 2 == 0 else f"    {part!r}"
-                        for i, part in enumerate(parts))  # fmt: skip
-    return (
-        '"""The DXF R2013 document skeleton of kinegami.export.dxf, as ezdxf writes it.\n\n'
-        "Made by kinegami.export.dxf.make_template() (``python -m kinegami.export.dxf``); do not "
-        'edit.\nPARTS alternates text and the names of the fields dxf_data fills in.\n"""\n\n'
-        f"EZDXF_VERSION = {ezdxf.__version__!r}\n"
-        f"FIRST_HANDLE = 0x{first:X}\n"
-        f"OWNER = {owner!r}\n"
-        f"PARTS = (\n{lines},\n)\n"
-    )
+    data = {
+        "format": "kinegami-dxf-skeleton",
+        "about": "The DXF R2013 document ezdxf writes for an empty drawing; @@NAME@@ marks "
+                 "what kinegami.export.dxf.dxf_data fills in. Made by python -m "
+                 "kinegami.export.dxf; do not edit.",
+        "ezdxf": ezdxf.__version__,
+        "first_handle": f"{first:X}",
+        "owner": owner,
+        "lines": text.split("\n"),
+    }
+    return json.dumps(data, indent=0, ensure_ascii=False) + "\n"
 
 
 if __name__ == "__main__":  # pragma: no cover - python -m kinegami.export.dxf
     from pathlib import Path
 
-    target = Path(__file__).with_name("_dxf_template.py")
-    target.write_text(make_template(), encoding="utf-8")
+    from kinegami._atomic import write_atomic
+
+    target = Path(__file__).with_name(SKELETON_FILE)
+    write_atomic(target, make_skeleton())
     print(f"wrote {target}")
