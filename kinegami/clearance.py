@@ -45,7 +45,12 @@ from kinegami.bodies import (
     tree_capsules,
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.geometry.segments import segment_distances, segment_distances_xyz
+from kinegami.geometry.segments import (
+    segment_distance,
+    segment_distances,
+    segment_distances_stacked,
+    segment_distances_xyz,
+)
 from kinegami.joints import PrismaticJoint, RevoluteJoint
 from kinegami.validation import check_int, check_real, shorten, shown
 
@@ -276,6 +281,10 @@ def _rotations(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * K + c * (K @ K)
 
 
+_EYE3 = np.eye(3)
+_EYE4 = np.eye(4)
+_LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
+
 #: Most capsules in one group (a part's run of capsules is split into groups this long).
 _GROUP_SIZE = 3
 
@@ -286,6 +295,9 @@ _GROUP_PAIRS_LISTED = 300_000
 
 #: Pair-configuration entries (group pairs, then capsule pairs) one batch holds at most.
 _BATCH_ENTRIES = 2_000_000
+
+#: Pairs a one-configuration report measures in plain floats before it turns to numpy.
+_ONE_BY_ONE = 6
 
 
 class _Layout:
@@ -336,6 +348,58 @@ def _moved(M: np.ndarray, row: np.ndarray, points: np.ndarray) -> tuple:
                  + T[:, 4 * c + 2] * points[:, 2] + T[:, 4 * c + 3] for c in range(3))  # fmt: skip
 
 
+class _OneConfiguration:
+    """The arrays of :meth:`ClearanceEngine._report_one`, built once per engine: the listed
+    capsule pairs (indices, flat indices of their capsule centres' coordinates and of their
+    end points' coordinates, twice their half lengths added up, tie order), the pairs whose
+    test by the turning rule depends on the configuration, the static pairs in a report's
+    order, and the end points (homogeneous) with their bodies."""
+
+    def __init__(self, engine: ClearanceEngine):
+        e = engine
+        S = e._S
+        entry = np.repeat(np.arange(e._gp1.size), e._cp_count)
+        i, j = e._cp_i, e._cp_j
+        self.pairs = int(i.size)
+        self.pi, self.pj = i.tolist(), j.tolist()
+        xyz = np.arange(3)[:, None]
+        self.centre_i, self.centre_j = 3 * i[None, :] + xyz, 3 * j[None, :] + xyz
+        self.ends = np.stack([3 * i + xyz, 3 * (S + i) + xyz, 3 * j + xyz, 3 * (S + j) + xyz])
+        self.twice_half = 2.0 * (e._half[i] + e._half[j])
+        self.rank = e._rank(i, j).tolist()
+        # a pair on one path whose turning apart at the current states is below pi (with room
+        # for rounding) is tested at some configurations only; the others always: the hinge
+        # turning up to the farther part is never less than up to the nearer
+        same = e._gp_same[entry]
+        turn = e._turning[j] - e._turning[i]
+        maybe = np.flatnonzero(same & (np.abs(turn) < math.pi - TURN_TOLERANCE + 1e-9))
+        self.maybe = maybe
+        self.maybe_turn = turn[maybe]
+        self.maybe_bi, self.maybe_bj = e.body_a[i[maybe]], e.body_a[j[maybe]]
+        order = np.lexsort((e._static_rank, e._static_clearance))
+        si, sj = e._static_pairs
+        self.static_count = int(order.size)
+        self.static_sorted = e._static_clearance[order]
+        self.static_first = (float(self.static_sorted[0]) if order.size else math.inf,
+                             list(zip(si[order].tolist(), sj[order].tolist(), strict=True)))
+        chain = e._caps is None
+        clear = self.static_sorted.tolist()
+        s, t = e._static_st[0][order].tolist(), e._static_st[1][order].tolist()
+        ranks = e._static_rank[order].tolist()
+        self._static_keys = [(c, 1, ranks[n], -n - 1, s[n], t[n]) if chain
+                             else (c, ranks[n], 1, -n - 1, s[n], t[n])
+                             for n, c in enumerate(clear)]  # fmt: skip
+        points = np.concatenate([e._starts, e._ends])
+        self.points = np.concatenate([points, np.ones((2 * S, 1))], axis=1)
+        self.rows = np.concatenate([e.body_a, e.body_b])
+        self.slack = 1e-9 * (e._extent() + e.r)
+        self.none = np.zeros(0, dtype=np.int64)
+
+    def static_key(self, n: int) -> tuple:
+        """The report's sort key of the n-th static pair (in their order)."""
+        return self._static_keys[n]
+
+
 class ClearanceEngine:
     """Fast clearance queries on one chain (its joints and links as they were when built).
 
@@ -379,6 +443,8 @@ class ClearanceEngine:
         self._starts, self._ends = starts, ends
         self._turning = turning
         self._pieces, self._lengths = pieces, np.asarray(lengths, dtype=float)
+        self._pieces_listed = [(b.tolist(), labels) for b, labels in pieces]
+        self._lengths_listed = self._lengths.tolist()
         self._element = element
         self._states = np.asarray(states, dtype=float)
         S = starts.shape[0]
@@ -404,6 +470,8 @@ class ClearanceEngine:
         bj = self.movable
         self._revolute_b = kinds[bj] == JOINT_REVOLUTE
         self._any_revolute = bool(self._revolute_b.any())
+        self._all_revolute = bool(self._revolute_b.all())
+        self._movable_states = self._states[bj]
         ax = axes[bj]
         K1 = np.zeros((bj.size, 3, 3))
         K1[:, 0, 1], K1[:, 0, 2], K1[:, 1, 2] = -ax[:, 2], ax[:, 1], -ax[:, 0]
@@ -587,6 +655,7 @@ class ClearanceEngine:
         self._static_st = (s, t)
         self._static_rank = self._rank(i, j, static=True)
         self._static_best = None
+        self._one = None  # the one-configuration path's arrays (_one_arrays)
         if i.size:
             self._static_best = int(np.lexsort((self._static_rank, self._static_clearance))[0])
 
@@ -620,25 +689,31 @@ class ClearanceEngine:
         Q = np.asarray(Q, dtype=float)
         K, NB = Q.shape[0], self.bodies
         B = np.empty((K, NB, 4, 4))
-        B[:, 0] = np.eye(4)
+        B[:, 0] = _EYE4
         if NB == 1:
             return B
-        bj = self.movable
-        delta = Q[:, bj] - self._states[bj]
+        delta = Q[:, self.movable] - self._movable_states
         rev = self._revolute_b
         # revolute: Rodrigues' rotation about the hinge line; prismatic: a slide along z
-        s = np.where(rev, np.sin(delta), 0.0)[..., None, None]
-        c = np.where(rev, 1.0 - np.cos(delta), 0.0)[..., None, None]
-        R = np.eye(3) + s * self._K1 + c * self._K2
+        if self._all_revolute:
+            s = np.sin(delta)[..., None, None]
+            c = (1.0 - np.cos(delta))[..., None, None]
+        else:
+            s = np.where(rev, np.sin(delta), 0.0)[..., None, None]
+            c = np.where(rev, 1.0 - np.cos(delta), 0.0)[..., None, None]
+        R = _EYE3 + s * self._K1 + c * self._K2
         p = self._hinge_point
-        M = np.zeros((K, NB - 1, 4, 4))
-        M[..., 3, 3] = 1.0
+        M = np.empty((K, NB - 1, 4, 4))
+        M[..., 3, :] = _LAST_ROW
         M[..., :3, :3] = R
-        M[..., :3, 3] = np.where(rev[:, None], p - (R @ p[:, :, None])[..., 0],
-                                 delta[..., None] * self._axis)  # fmt: skip
+        if self._all_revolute:
+            M[..., :3, 3] = p - (R @ p[:, :, None])[..., 0]
+        else:
+            M[..., :3, 3] = np.where(rev[:, None], p - (R @ p[:, :, None])[..., 0],
+                                     delta[..., None] * self._axis)  # fmt: skip
         parent = self._body_parent
         for b in range(1, NB):
-            B[:, b] = B[:, parent[b]] @ M[:, b - 1]
+            np.matmul(B[:, parent[b]], M[:, b - 1], out=B[:, b])
         return B
 
     def _segments_at(self, B: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -826,13 +901,27 @@ class ClearanceEngine:
         """The part at parameter ``s`` in [0, 1] of capsule ``row``, in words."""
         return self._texts(np.array([row]), np.array([float(s)]))[0]
 
-    def _pair(self, i: int, j: int, s: float, t: float, a, b, clearance: float):
-        p = a[i] + s * (b[i] - a[i])
-        q = a[j] + t * (b[j] - a[j])
-        first, second = self._texts(np.array([i, j]), np.array([s, t], dtype=float))
-        return CollidingPair(first, second, float(clearance),
-                             (tuple(map(float, p)), tuple(map(float, q))),
+    def _pair(self, i: int, j: int, s: float, t: float, a, b, clearance: float,
+              row_i: int | None = None, row_j: int | None = None) -> CollidingPair:  # fmt: skip
+        """The CollidingPair of capsules ``row_i`` and ``row_j`` (default: i and j) at
+        parameters s and t, whose starts and ends are ``a[i]``, ``b[i]``, ``a[j]`` and
+        ``b[j]`` (arrays or lists of three floats each)."""
+        p = tuple(float(x + s * (y - x)) for x, y in zip(a[i], b[i], strict=True))
+        q = tuple(float(x + t * (y - x)) for x, y in zip(a[j], b[j], strict=True))
+        i = i if row_i is None else row_i
+        j = j if row_j is None else row_j
+        first, second = self._label(i, float(s)), self._label(j, float(t))
+        return CollidingPair(first, second, float(clearance), (p, q),
                              (int(self._element[i]), int(self._element[j])))  # fmt: skip
+
+    def _label(self, row: int, s: float) -> str:
+        """The part at parameter s of capsule row, in words (as :meth:`_texts`)."""
+        breaks, labels = self._pieces_listed[row]
+        at = s * self._lengths_listed[row]
+        for n, b in enumerate(breaks):
+            if at < b:
+                return self._named(row, labels[n])
+        return self._named(row, labels[-1])
 
     # --- queries ---------------------------------------------------------------------------
     def worst_arrays(self, Q: np.ndarray, margin: float) -> tuple:
@@ -934,6 +1023,8 @@ class ClearanceEngine:
         values = tuple(float(x) for x in Q[0]) if self._caps is not None \
             else tuple(float(x) for x in q)  # fmt: skip
         limit = clear_limit(self.r, margin)
+        if self._listed:
+            return self._report_one(Q, values, limit, margin)
         threshold = (4.0 if self._listed else 0.5) * self.r + margin
         static = self._static_clearance
         static_min = float(static.min()) if static.size else math.inf
@@ -970,6 +1061,93 @@ class ClearanceEngine:
             pair = make(n)
             pairs.setdefault((pair.first, pair.second), pair)
         min_clearance = float(cc[order[0]])
+        return ClearanceReport(min_clearance >= limit, min_clearance, tuple(pairs.values()),
+                               closest, values, margin, self.r)  # fmt: skip
+
+    def _one_arrays(self) -> _OneConfiguration:
+        """What :meth:`_report_one` needs, built on first use."""
+        if self._one is None:
+            self._one = _OneConfiguration(self)
+        return self._one
+
+    def _report_one(self, Q: np.ndarray, values: tuple, limit: float,
+                    margin: float) -> ClearanceReport:  # fmt: skip
+        """:meth:`report` at one configuration ``Q`` (1, J) of a listed engine, in the fewest
+        numpy calls: every listed capsule pair's clearance is bounded below by its capsule
+        centres' distance minus both half lengths and above by that distance; the pairs whose
+        lower bound is within the larger of the limit and the smallest upper bound (and of the
+        static pairs' smallest clearance) are measured exactly, the same arithmetic as the
+        batch (bit for bit), a few of them in plain floats
+        (:func:`~kinegami.geometry.segments.segment_distance`)."""
+        one = self._one_arrays()
+        r2 = 2.0 * self.r
+        # every end point moved (the arithmetic of _Layout.move), point-major (2S, 3)
+        B = self.body_transforms(Q)[0, :, :3, :].reshape(-1, 12)
+        P = one.points
+        M = B.take(one.rows, axis=0).reshape(-1, 3, 4) * P[:, None, :]
+        W = ((M[..., 0] + M[..., 1]) + M[..., 2]) + M[..., 3]
+        flat = W.reshape(-1)
+        S = self._S
+        static_min = one.static_first[0]
+        bound = limit
+        near = one.none
+        if one.pairs:
+            twice = (W[:S] + W[S:]).reshape(-1)  # twice the capsule centres
+            d = twice.take(one.centre_i) - twice.take(one.centre_j)
+            d *= d
+            twice_gap = np.sqrt((d[0] + d[1]) + d[2])  # twice the centres' distance
+            if one.maybe.size:  # the pairs the turning rule tests at some configurations only
+                kink = self._kinks(Q)[0]
+                turn = one.maybe_turn + kink.take(one.maybe_bj) - kink.take(one.maybe_bi)
+                untested = one.maybe[np.abs(turn) < math.pi - TURN_TOLERANCE]
+                twice_gap[untested] = math.inf
+            low = twice_gap - one.twice_half  # twice (the lower bound + 2r)
+            top = 0.5 * float(twice_gap.min()) - r2
+            bound = max(limit, min(top, static_min))
+            if math.isfinite(bound):
+                near = np.flatnonzero(low <= 2.0 * (bound + one.slack + r2))
+        # measured exactly: a few in plain floats, more at once
+        found: list[tuple] = []
+        if 0 < near.size <= _ONE_BY_ONE:
+            pi, pj = one.pi, one.pj
+            for n in near.tolist():
+                i, j = pi[n], pj[n]
+                a1, b1, a2, b2 = W[[i, S + i, j, S + j]].tolist()
+                dist, s, t = segment_distance(a1, b1, a2, b2)
+                found.append((dist - r2, n, s, t))
+        elif near.size:
+            dist, s, t = segment_distances_stacked(*flat.take(one.ends[:, :, near]))
+            found = list(zip((dist - r2).tolist(), near.tolist(), s.tolist(), t.tolist(),
+                             strict=True))  # fmt: skip
+        # in the report's order: clearance, then (chains) moving pairs before static ones,
+        # then the tie order of :meth:`_rank`
+        rank = one.rank
+        chain = self._caps is None
+        moving = sorted((c, 0, rank[n], n, s, t) if chain else (c, rank[n], 0, n, s, t)
+                        for c, n, s, t in found)  # fmt: skip
+        statics = one.static_first
+        if not moving and not one.static_count:
+            return ClearanceReport(True, math.inf, (), None, values, margin, self.r)
+        take = max(1, int(np.searchsorted(one.static_sorted, limit))) \
+            if one.static_count else 0  # fmt: skip
+        ordered = moving + [one.static_key(n) for n in range(take)]
+        if take and moving:
+            ordered.sort()
+
+        def make(entry: tuple) -> CollidingPair:
+            c, _, _, n, s, t = entry
+            i, j = (one.pi[n], one.pj[n]) if n >= 0 else statics[1][-n - 1]
+            a1, b1, a2, b2 = W[[i, S + i, j, S + j]].tolist()
+            return self._pair(0, 1, s, t, (a1, a2), (b1, b2), c, i, j)
+
+        closest = make(ordered[0])
+        min_clearance = ordered[0][0]
+        pairs: dict[tuple[str, str], CollidingPair] = {}
+        for entry in ordered:
+            if entry[0] >= limit:
+                break
+            pair = closest if entry is ordered[0] else make(entry)
+            pairs.setdefault((pair.first, pair.second), pair)
         return ClearanceReport(min_clearance >= limit, min_clearance, tuple(pairs.values()),
                                closest, values, margin, self.r)  # fmt: skip
 
@@ -1454,9 +1632,28 @@ class TreeMotion:
         return tuple(out)
 
 
+#: The plain types of a state that need no conversion check (bool is not among them).
+_PLAIN_STATES = frozenset({float, int, np.float64})
+
+
 def _checked_states(states, ranges: np.ndarray, name: str) -> np.ndarray:
     """``states`` as a float array (one per joint, each within ``ranges``), or raise."""
     J = ranges.shape[0]
+    # the common case in a few steps: a list or array of plain finite numbers within range
+    # (anything else, or any failure, takes the checks below, which word the error)
+    plain = None
+    if type(states) in (list, tuple) and len(states) == J \
+            and all(type(v) in _PLAIN_STATES for v in states):  # fmt: skip
+        try:
+            plain = np.array(states, dtype=float)
+        except OverflowError:  # an int beyond the float range
+            plain = None
+    elif type(states) is np.ndarray and states.shape == (J,) and states.dtype == np.float64:
+        plain = states.copy()
+    if plain is not None and bool(np.all((ranges[:, 0] - 1e-12 <= plain)
+                                         & (plain <= ranges[:, 1] + 1e-12)
+                                         & np.isfinite(plain))):  # fmt: skip
+        return plain
     if isinstance(states, str | bytes) or not isinstance(states, Sequence | np.ndarray):
         raise InvalidTypeError(
             f"{name} must be a list of {J} joint states, got {type(states).__name__}"

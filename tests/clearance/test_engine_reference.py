@@ -26,7 +26,11 @@ from kinegami.bodies import (
 from kinegami.clearance import ClearanceEngine, TreeMotion, sweep
 from kinegami.design import load_design
 from kinegami.errors import ClearanceWarning
-from kinegami.geometry.segments import segment_distances, segment_distances_xyz
+from kinegami.geometry.segments import (
+    segment_distance,
+    segment_distances,
+    segment_distances_xyz,
+)
 
 DESIGNS = sorted((Path(__file__).parents[2] / "examples" / "designs").glob("*.json"))
 TOLERANCE = 1e-9  # in r
@@ -147,6 +151,47 @@ def test_segment_distance_kernel_is_the_shared_one_bit_for_bit():
                                                       for x in p])
     for e, f in zip(expected, found, strict=True):
         assert np.array_equal(e, f)
+    # a batch without points takes the kernel's unguarded branch: the same bits as in a batch
+    # with points (the guarded branch), pair by pair
+    proper = slice(500, n)
+    alone = segment_distances(*(x[proper] for x in p))
+    for e, f in zip(expected, alone, strict=True):
+        assert np.array_equal(e[proper], f)
+    # the plain-float kernel of one pair (the one-configuration report's few pairs)
+    for k in range(0, n, 3):
+        d, s, t = segment_distance(*(x[k].tolist() for x in p))
+        assert (d, s, t) == (expected[0][k], expected[1][k], expected[2][k]), k
+        assert np.signbit([s, t]).tolist() == np.signbit([expected[1][k],
+                                                            expected[2][k]]).tolist()
+
+
+@pytest.mark.parametrize("name", ["puma", "spherical_series", "hand", "quadruped"])
+def test_one_configuration_report_is_the_batch_bit_for_bit(name):
+    """The one-configuration report (bounds, then a few exact pairs) gives the bits of the
+    batch: with a margin larger than the design every tested pair is closer than it, so the
+    batch's deepest pair is the closest of all pairs, which the report names too; with margin
+    0 the deepest overlap is the same number."""
+    design = load_design(DESIGNS[0].parent / f"{name}.json")
+    chain = isinstance(design, KinematicChain)
+    Q = random_configurations(design, 30, seed=8)
+    engine = ClearanceEngine(design) if chain else TreeMotion(design).engine
+    huge = 1e3 * engine._extent()
+    for margin in (0.0, huge):
+        worst, pairs = engine.worst(Q, margin)
+        for q, w, pair in zip(Q, worst, pairs, strict=True):
+            report = engine.report(list(q), margin)
+            if margin:
+                assert report.min_clearance == w == report.closest.clearance
+                assert (report.closest.first, report.closest.second) == (pair.first,
+                                                                         pair.second)
+                assert report.closest.points == pair.points
+                assert report.pairs and len(report.pairs) == len(
+                    {(p.first, p.second) for p in report.pairs})
+            if np.isfinite(w):
+                assert report.pairs[0].clearance == w
+                assert report.min_clearance == w
+            else:
+                assert report.ok and not report.pairs
 
 
 def test_sweep_of_a_tree_counts_as_one_configuration_reports():
