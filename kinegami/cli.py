@@ -687,9 +687,13 @@ def cmd_edit(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from kinegami.design import DesignInfo, read_design, validate_design
+    from kinegami.design import DesignInfo, audit_design, read_design
 
-    validate_design(args.design)
+    report = audit_design(args.design)
+    if not report.ok:  # every problem, one line each (the first is validate_design's)
+        for problem in report.problems[:-1]:
+            _fail(args.command, str(problem))
+        raise CommandError(str(report.problems[-1]))
     data = read_design(args.design)
     tree = DesignInfo.of(data).structure == "tree"
     if args.build:
@@ -1105,8 +1109,8 @@ def make_parser() -> argparse.ArgumentParser:
         "validate",
         help="check a design file without building it",
         description="Check a design file against the format (schema, types, ranges, rigid "
-        "poses) without building the chain. With --build, also place every joint and apply "
-        "the edits.",
+        "poses) without building the chain, and print every problem found, one line each. "
+        "With --build, also place every joint and apply the edits.",
     )
     validate.add_argument("design", metavar="DESIGN", help="design file (.json)")
     validate.add_argument(

@@ -23,6 +23,7 @@ one-line message names the file, the JSON path of the problem (e.g.
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 
 from kinegami.chain import KinematicChain
 from kinegami.design import limits
@@ -35,6 +36,8 @@ from kinegami.design.reader import (
     VERSIONS,
     DesignInfo,
     DesignOrigin,
+    DesignProblem,
+    audit_document,
     build_plan,
     check_document,
     origin_of,
@@ -57,6 +60,9 @@ __all__ = [
     "chain_from_dict",
     "read_design",
     "validate_design",
+    "audit_design",
+    "DesignReport",
+    "DesignProblem",
     "save_design",
     "design_to_dict",
     "dumps_design",
@@ -140,3 +146,47 @@ def validate_design(path: str | os.PathLike) -> None:
     chain: use :func:`load_design` for the full check. Raises DesignError; returns None.
     """
     read_design(path)
+
+
+@dataclass(frozen=True)
+class DesignReport:
+    """Every problem found in a design file (:func:`audit_design`).
+
+    Attributes
+    ----------
+    file : the design file as given.
+    problems : the problems, each a :class:`~kinegami.design.reader.DesignProblem` (``code``,
+        ``field``: its JSON path, ``error``: its DesignError); the first is the one
+        :func:`validate_design` raises.
+    """
+
+    file: str
+    problems: tuple[DesignProblem, ...]
+
+    @property
+    def ok(self) -> bool:
+        """Whether the design has no problem (validate_design passes)."""
+        return not self.problems
+
+    def __str__(self) -> str:
+        if self.ok:
+            return f"{self.file}: valid"
+        count = len(self.problems)
+        lines = [f"{self.file}: {count} problem{'s' if count > 1 else ''}"]
+        return "\n".join(lines + [f"  {problem}" for problem in self.problems])
+
+
+def audit_design(path: str | os.PathLike) -> DesignReport:
+    """Check the design file ``path`` as :func:`validate_design` does, and return every
+    problem found instead of raising on the first (as ezdxf's ``audit()`` lists a drawing's
+    errors). A file that cannot be read or parsed is one problem (code ``file``); see
+    :func:`~kinegami.design.reader.audit_document` for the stages of the other checks.
+    Like validate_design it does not build the chain (placements, edits and states are only
+    checked by :func:`load_design`).
+    """
+    try:
+        document, file = read_design_file(path)
+    except DesignError as error:
+        return DesignReport(os.fspath(path) if isinstance(path, str | os.PathLike) else
+                            repr(path), (DesignProblem("file", error),))  # fmt: skip
+    return DesignReport(file, tuple(audit_document(document, file)))

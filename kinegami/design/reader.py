@@ -47,6 +47,7 @@ from kinegami.design.schema import (
     VERSIONS,
     check_schema,
     check_top_level,
+    schema_errors,
     version_problem,
 )
 from kinegami.design.trees import (
@@ -76,6 +77,8 @@ __all__ = [
     "parse_design_text",
     "read_design_file",
     "check_document",
+    "audit_document",
+    "DesignProblem",
     "build_chain",
     "origin_of",
     "carry_origin",
@@ -771,6 +774,87 @@ def _check_document(document, file) -> _Plan:
         margin=float(document.get("margin", 0.0)),
         tree=fields.tree, parents=fields.parents, specification=specification,
     )  # fmt: skip
+
+
+# --- every problem at once ------------------------------------------------------------------
+@dataclass(frozen=True)
+class DesignProblem:
+    """One problem of a design file: ``code`` says which check found it (``file``,
+    ``header``, ``value``, ``top-level``, ``version``, ``schema``, ``lengths``, ``names``,
+    ``tree``, ``joint-order``, ``joint``, ``dh``, ``edits``, ``design``; ``build`` for what
+    only building finds), ``error`` is the DesignError that check raises (its ``field`` is the
+    JSON path, ``str(error)`` the one-line message)."""
+
+    code: str
+    error: DesignError
+
+    @property
+    def field(self) -> str:
+        return self.error.field
+
+    def __str__(self) -> str:
+        return str(self.error)
+
+
+def audit_document(document, file=None) -> list[DesignProblem]:
+    """Every problem :func:`check_document` can find in a parsed design, not only the first
+    (empty: the design passes :func:`check_document`).
+
+    The checks run in stages, as check_document runs them: the header; the values (numbers
+    too large, nesting too deep), the top-level fields and the version; the schema (one
+    problem per JSON location); then the checks the schema cannot express (lengths, names,
+    tree fields, the joints one by one, the joint order, a DH table, the edits). A stage runs
+    only when the stages before it found nothing, since its checks assume what they check.
+    The first problem is always the one check_document raises.
+    """
+    problems: list[DesignProblem] = []
+
+    def attempt(code: str, check, *args):
+        try:
+            return True, check(*args)
+        except DesignError as error:
+            if error.file is None and file is not None:
+                error = error.with_file(file)
+            if all(str(error) != str(known) for known in problems):
+                problems.append(DesignProblem(code, error))
+            return False, None
+
+    def first() -> None:  # the problem check_document reports comes first
+        try:
+            check_document(document, file)
+        except DesignError as error:
+            text = str(error)
+            at = next((k for k, p in enumerate(problems) if str(p) == text), None)
+            problems.insert(0, DesignProblem("design", error) if at is None else problems.pop(at))
+
+    if not attempt("header", _check_header, document, file)[0]:
+        return problems
+    for key, value in document.items():
+        attempt("value", _check_values, value, file, (key,))
+    attempt("top-level", check_top_level, document, file)
+    attempt("version", check_version_features, document, file)
+    if not problems:
+        for error in schema_errors(document, file):
+            problems.append(DesignProblem("schema", error))
+    if problems:
+        first()
+        return problems
+    units = document.get("angleUnits", "rad")
+    numSides, r = int(document["numSides"]), float(document["r"])
+    attempt("lengths", check_lengths, document, file)
+    attempt("names", _check_names, document, file)
+    ok, fields = attempt("tree", check_tree_fields, document, file)
+    if "joints" in document:
+        specs = document["joints"]
+        if ok:
+            attempt("joint-order", _check_joint_order, specs, file, not fields.tree)
+        for i, spec in enumerate(specs):
+            attempt("joint", _make_joint, spec, i, numSides, r, units, file)
+    else:
+        attempt("dh", _plan_dh, document["dh"], units)
+    attempt("edits", _plan_edits, document.get("edits", []), units)
+    first()  # also what the stages above do not cover (a tree specification's checks)
+    return problems
 
 
 # --- where the joints of a built chain come from ---------------------------------------------

@@ -247,15 +247,26 @@ def _first_error(validator, document, file) -> None:
     errors = list(validator.iter_errors(document))
     if not errors:
         return
-    error = min(
-        errors,
-        key=lambda e: (
-            _position(document, e.absolute_path),
-            _PRIORITY.get(e.validator, 9),
-            len(e.absolute_schema_path),
-        ),
-    )
-    raise translate(error, document, file)
+    raise translate(min(errors, key=lambda e: _rank(document, e)), document, file)
+
+
+def _rank(document, error) -> tuple:
+    """Which of several schema errors to report first: the earliest in the document, then
+    the most telling keyword, then the most specific schema rule."""
+    return (_position(document, error.absolute_path), _PRIORITY.get(error.validator, 9),
+            len(error.absolute_schema_path))  # fmt: skip
+
+
+def schema_errors(document, file=None) -> list[DesignError]:
+    """Every schema violation of ``document``, one per JSON location (the one
+    :func:`check_schema` would report there), in document order."""
+    best: dict[tuple, object] = {}
+    for error in _validator().iter_errors(document):
+        where = tuple(error.absolute_path)
+        if where not in best or _rank(document, error) < _rank(document, best[where]):
+            best[where] = error
+    ordered = sorted(best.values(), key=lambda e: _rank(document, e))
+    return [translate(error, document, file) for error in ordered]
 
 
 def _angle_units(document) -> str:
