@@ -49,7 +49,6 @@ from kinegami.geometry.segments import (
     segment_distance,
     segment_distances,
     segment_distances_stacked,
-    segment_distances_xyz,
 )
 from kinegami.joints import PrismaticJoint, RevoluteJoint
 from kinegami.validation import check_int, check_real, shorten, shown
@@ -318,16 +317,18 @@ class _Layout:
         self.body = sorted_body
         self.points = points[order]
 
-    def move(self, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """x, y and z of every point (K, size), moved by the body motions ``B`` (K, NB, 4, 4)."""
+    def move(self, B: np.ndarray) -> np.ndarray:
+        """x, y and z of every point (3, K, size), moved by the body motions ``B``
+        (K, NB, 4, 4)."""
         K = B.shape[0]
+        out = np.empty((3, K, self.size))
         if K * len(self.slices) <= 64:  # few configurations: every point's motion gathered
             M = B.reshape(K, -1, 16)[:, self.body]
             P = self.points
-            return tuple(M[..., 4 * c] * P[:, 0] + M[..., 4 * c + 1] * P[:, 1]
-                         + M[..., 4 * c + 2] * P[:, 2] + M[..., 4 * c + 3]
-                         for c in range(3))  # fmt: skip
-        out = (np.empty((K, self.size)), np.empty((K, self.size)), np.empty((K, self.size)))
+            for c in range(3):
+                out[c] = M[..., 4 * c] * P[:, 0] + M[..., 4 * c + 1] * P[:, 1] \
+                    + M[..., 4 * c + 2] * P[:, 2] + M[..., 4 * c + 3]  # fmt: skip
+            return out
         for b, lo, hi, P in self.slices:
             if b == 0:  # the base does not move
                 for c in range(3):
@@ -849,14 +850,23 @@ class ClearanceEngine:
         keep &= ~same | (np.abs(gap_turn) >= math.pi - TURN_TOLERANCE)
         n = np.flatnonzero(keep)
         k, i, j = k[n], i[n], j[n]
-        # the segments of the pairs left, moved one by one
         m = k.size
-        points = np.concatenate([self._starts[i], self._ends[i], self._starts[j], self._ends[j]])
-        bodies = np.concatenate([self.body_a[i], self.body_b[i], self.body_a[j], self.body_b[j]])
-        x, y, z = _moved(B.reshape(-1, 16), np.tile(k, 4) * NB + bodies, points)
-        ends = [(x[n * m : (n + 1) * m], y[n * m : (n + 1) * m], z[n * m : (n + 1) * m])
-                for n in range(4)]  # fmt: skip
-        dist, s, t = segment_distances_xyz(*ends)
+        S = self._S
+        layout = self._end_points
+        if 4 * m >= layout.size * B.shape[0]:  # every end point moved, then the pairs' taken
+            col = layout.column
+            base = k * layout.size
+            at = np.concatenate([base + col[i], base + col[S + i], base + col[j],
+                                 base + col[S + j]])  # fmt: skip
+            ends = layout.move(B).reshape(3, -1).take(at, axis=1)
+        else:  # the segments of the pairs left, moved one by one
+            points = np.concatenate([self._starts[i], self._ends[i], self._starts[j],
+                                     self._ends[j]])  # fmt: skip
+            bodies = np.concatenate([self.body_a[i], self.body_b[i], self.body_a[j],
+                                     self.body_b[j]])  # fmt: skip
+            ends = np.array(_moved(B.reshape(-1, 16), np.tile(k, 4) * NB + bodies, points))
+        ends = ends.reshape(3, 4, m)
+        dist, s, t = segment_distances_stacked(ends[:, 0], ends[:, 1], ends[:, 2], ends[:, 3])
         return k, i, j, dist - 2.0 * self.r, s, t
 
     def _chunk(self) -> int:

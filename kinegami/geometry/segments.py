@@ -89,10 +89,27 @@ def segment_distances_xyz(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.nd
     return segment_distances_stacked(*(np.array(p, dtype=float) for p in (a1, b1, a2, b2)))
 
 
+#: Pairs the kernel measures at once: its temporaries (up to 21 values a pair) stay in cache
+#: (twice as fast as one pass over 37,000 pairs).
+_KERNEL_PAIRS = 8192
+
+
 def segment_distances_stacked(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The kernel of :func:`segment_distances` on end points given as (3, n) arrays (rows x,
-    y and z; views are fine), in few numpy calls whatever n. Returns ``(distance, s, t)``,
-    each (n,)."""
+    y and z; views are fine), in few numpy calls whatever n (in slices of _KERNEL_PAIRS).
+    Returns ``(distance, s, t)``, each (n,)."""
+    n = np.shape(a1)[-1]
+    if n <= _KERNEL_PAIRS:
+        return _segment_kernel(a1, b1, a2, b2)
+    out = np.empty((3, n))
+    for lo in range(0, n, _KERNEL_PAIRS):
+        part = slice(lo, lo + _KERNEL_PAIRS)
+        out[:, part] = _segment_kernel(a1[:, part], b1[:, part], a2[:, part], b2[:, part])
+    return out[0], out[1], out[2]
+
+
+def _segment_kernel(a1, b1, a2, b2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`segment_distances_stacked` on one slice."""
     # b1 - a1, b2 - a2, a1 - a2, b1 - a2 and b2 - a1 at once
     v = np.array([b1, b2, a1, b1, b2]) - np.array([a1, a2, a2, a2, a1])
     # seven dot products at once, each summed (x + z) + y as numpy.einsum sums (..., 3):
