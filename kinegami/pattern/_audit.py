@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from scipy.spatial import cKDTree
 
 from kinegami.pattern._prism import make_prism, periodic_dx
 from kinegami.pattern.catalog import expected_counts
-from kinegami.pattern.tubular import TubularPattern
+
+if TYPE_CHECKING:  # pragma: no cover
+    from kinegami.pattern.tubular import TubularPattern
 
 _SHOWN = 8  # how many offending indices a message lists
 _TIGHT = 1.0 - 1e-6  # points exactly eps apart (up to rounding) are distinct, as in composition

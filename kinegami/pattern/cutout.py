@@ -18,7 +18,7 @@ modules, the folded form) together with those cut-outs:
 the sheet: the pattern's sheet with every line cut back to the paper that is left (no crease
 inside a hole, none below the fish-mouth), the hole edges and the tabs' free edges as cuts, and
 the fish-mouth as the nominal tube's lower boundary. The FOLD exporter builds the same sheet as
-a planar graph (:func:`kinegami.export.fold.sheet_graph`).
+a planar graph (:func:`kinegami.pattern.sheet_graph.sheet_graph`).
 
 Lengths are in the pattern's unit (that of r).
 """
@@ -35,6 +35,7 @@ from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.pattern._prism import make_prism
 from kinegami.pattern.catalog import module_kind
 from kinegami.pattern.sheet import (
+    SHEET_DRAWERS,
     TOLERANCE_FACTOR,
     Sheet,
     clip_segments,
@@ -520,6 +521,8 @@ def flatten_cut(cut: CutPattern, *, skip_creases_on_cut: bool = False) -> Sheet:
     kinds.flags.writeable = False
     return Sheet(pieces, kinds, W, b, y0, height, base.tolerance, base.snapTolerance)
 
+
+SHEET_DRAWERS[CutPattern] = flatten_cut  # what flatten() does with a CutPattern
 
 # --------------------------------------------------------------------------------------------
 # Plane geometry (numpy)

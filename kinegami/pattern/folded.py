@@ -59,6 +59,7 @@ __all__ = [
     "rebo_folded_length",
     "rebo_tilt",
     "unsnapped_form",
+    "pattern_and_frame",
     "UVA_TO_DUBINS",
 ]
 
@@ -236,7 +237,7 @@ def folded_form(pattern_or_chain, frame=None, twistPortion: float = 0.2) -> Fold
         If the pattern has no module records (built by hand) or its records do not rebuild its
         vertices (e.g. a reversed composite).
     """
-    pattern, base = _resolve_input(pattern_or_chain, twistPortion)
+    pattern, base = pattern_and_frame(pattern_or_chain, twistPortion)
     if frame is not None:
         base = _frame_array(frame)
     G0 = base @ UVA_TO_DUBINS
@@ -264,7 +265,7 @@ def unsnapped_form(pattern_or_chain, frame=None, twistPortion: float = 0.2) -> U
     >>> u.extraVertices, bool(u.maxLengthError < 1e-12)
     (0, True)
     """
-    pattern, base = _resolve_input(pattern_or_chain, twistPortion)
+    pattern, base = pattern_and_frame(pattern_or_chain, twistPortion)
     if frame is not None:
         base = _frame_array(frame)
     return _fold_unsnapped(pattern, base @ UVA_TO_DUBINS)
@@ -312,7 +313,7 @@ def _frame_array(frame) -> np.ndarray:
     return T
 
 
-def _resolve_input(obj, twistPortion) -> tuple[TubularPattern, np.ndarray]:
+def pattern_and_frame(obj, twistPortion) -> tuple[TubularPattern, np.ndarray]:
     """(pattern, world Dubins frame of its proximal end) for a pattern or a chain."""
     if isinstance(obj, TubularPattern):
         return obj, UVA_TO_DUBINS.T.copy()

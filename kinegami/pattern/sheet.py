@@ -33,6 +33,7 @@ Everything is in pattern units (the unit of the tube radius r); exporters scale 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -166,6 +167,12 @@ def _rectangle(xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray
     return np.stack([corners, np.roll(corners, -1, axis=0)], axis=1)
 
 
+#: How :func:`flatten` draws the sheets that are no TubularPattern: their class and the
+#: function drawing one (``draw(pattern, skip_creases_on_cut=...)``), registered by the module
+#: that defines the class (kinegami.pattern.cutout registers CutPattern).
+SHEET_DRAWERS: dict[type, Callable[..., Sheet]] = {}
+
+
 def flatten(pattern: TubularPattern, *, skip_creases_on_cut: bool = False) -> Sheet:
     """The lines drawn on the flat sheet of ``pattern`` (docs/fabrication.md, clipped as in B8).
 
@@ -195,10 +202,9 @@ def flatten(pattern: TubularPattern, *, skip_creases_on_cut: bool = False) -> Sh
     from kinegami.pattern.tubular import TubularPattern
 
     if not isinstance(pattern, TubularPattern):
-        from kinegami.pattern.cutout import CutPattern, flatten_cut
-
-        if isinstance(pattern, CutPattern):  # a sheet with take-off holes or a skirt
-            return flatten_cut(pattern, skip_creases_on_cut=skip_creases_on_cut)
+        for kind, draw in SHEET_DRAWERS.items():  # a sheet with take-off holes or a skirt
+            if isinstance(pattern, kind):
+                return draw(pattern, skip_creases_on_cut=skip_creases_on_cut)
         raise InvalidTypeError(f"pattern must be a TubularPattern, got {type(pattern).__name__}")
     skip_creases_on_cut = check_bool("skip_creases_on_cut", skip_creases_on_cut)
     W, b = pattern.width, pattern.sideLength

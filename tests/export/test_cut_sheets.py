@@ -102,7 +102,7 @@ def samples(a, b, fractions=(0.0, 0.25, 0.5, 0.75, 1.0)) -> np.ndarray:
 
 def tab_faces(graph, cut) -> list[np.ndarray]:
     regions = cut.regions()
-    from kinegami.export._cut_graph import interior_point
+    from kinegami.pattern.cut_graph import interior_point
 
     out = []
     for f in graph.faces:
