@@ -51,7 +51,7 @@ from kinegami.geometry.segments import (
     segment_distances_stacked,
 )
 from kinegami.joints import PrismaticJoint, RevoluteJoint
-from kinegami.validation import check_int, check_real, shorten, shown
+from kinegami.validation import UNITS_IN_MM, check_int, check_real, shorten, shown
 
 __all__ = [
     "CONTACT_TOLERANCE",
@@ -74,8 +74,6 @@ __all__ = [
 #: Pairs x configurations evaluated at once (memory bound of the batched broad phase).
 _BATCH_PAIRS = 1_500_000
 
-#: Millimetres per design length unit (the units a verdict can print lengths in).
-UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
 
 
 class Lengths:

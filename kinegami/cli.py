@@ -33,10 +33,7 @@ from kinegami._record import Record
 from kinegami._startup import INTERRUPTED
 from kinegami.errors import KinegamiError
 from kinegami.limits import MAX_INTEGER_DIGITS, MAX_SAMPLES
-from kinegami.validation import shown, shown_path
-
-#: Millimetres per design length unit.
-UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
+from kinegami.validation import UNITS_IN_MM, shown, shown_path
 
 
 class CommandError(Exception):

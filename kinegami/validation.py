@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Iterable, Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -50,6 +51,14 @@ from kinegami.limits import (  # noqa: F401
     R_MAX,
     R_MIN,
 )
+
+#: Millimetres per length unit of a design (its ``units``): the one table every layer uses
+#: (files, exports, reports, the editor, pictures).
+UNITS_IN_MM: Mapping[str, float] = MappingProxyType(
+    {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
+)
+#: The length units a design may be written in.
+LENGTH_UNITS: tuple[str, ...] = tuple(UNITS_IN_MM)
 
 
 def check_bool(name: str, value, none: bool = False) -> bool | None:

@@ -67,7 +67,7 @@ from kinegami.joints import (
     Waypoint,
 )
 from kinegami.tree import KinematicTree
-from kinegami.validation import shorten, shown
+from kinegami.validation import LENGTH_UNITS, shorten, shown
 
 __all__ = [
     "DesignInfo",
@@ -86,7 +86,7 @@ __all__ = [
 ]
 
 FORMAT = "kinegami-design"
-UNITS = ("mm", "cm", "m", "in")
+UNITS = LENGTH_UNITS
 DEFAULT_TWIST_PORTION = 0.2
 
 

@@ -89,8 +89,8 @@ def sheet_lines(pattern, units: str = "mm") -> SheetLines:
     Drawing coordinates: u = y - y0 along the tube, v = xmax - x around it (so the drawing's
     top edge is the sheet's x = W + b/2 edge), pattern units.
     """
-    from kinegami.export._options import UNITS_IN_MM
     from kinegami.pattern.sheet import flatten
+    from kinegami.validation import UNITS_IN_MM
 
     sheet = flatten(pattern)
     xmin, y0, xmax, y1 = sheet.bounds

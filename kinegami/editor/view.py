@@ -1779,7 +1779,7 @@ class EditorView:
                 "runs through it")  # fmt: skip
 
     def _slide_note(self, document: Document, joint: int, slide: float) -> str:
-        from kinegami.export._options import UNITS_IN_MM
+        from kinegami.validation import UNITS_IN_MM
 
         name = document.names[joint]
         what = f"joint {joint}" + (f" '{name}'" if name else "")

@@ -11,7 +11,7 @@ import numpy as np
 from kinegami._format import shown
 from kinegami._record import Record
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.validation import check_bool, check_options, check_positive
+from kinegami.validation import UNITS_IN_MM, check_bool, check_options, check_positive
 
 __all__ = [
     "LABEL_HEIGHT",
@@ -25,9 +25,6 @@ __all__ = [
     "dash_segments",
     "format_numbers",
 ]
-
-#: Length of one pattern unit in millimetres for each accepted ``units`` value.
-UNITS_IN_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
 
 #: Default perforation: cut length and bridge length along fold lines, millimetres.
 DEFAULT_DASH = 1.0

@@ -20,8 +20,8 @@ from pathlib import Path
 
 from kinegami._atomic import write_atomic
 from kinegami.errors import InvalidParameterError
-from kinegami.export._options import UNITS_IN_MM
 from kinegami.export._reproducible import reproducible_3mf
+from kinegami.validation import UNITS_IN_MM
 
 __all__ = [
     "TREE_FORMATS",
