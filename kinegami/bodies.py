@@ -721,12 +721,19 @@ class Overlap:
                 f"the margin {self.margin:.4g}")  # fmt: skip
 
 
+#: A pair of parts with more capsule pairs than this is searched by groups of _BALL_GROUP
+#: consecutive capsules before its capsules are compared (a link of many elbows, or a long one,
+#: has a ball that prunes little).
+_NEAR_SPLIT = 4096
+
+
 def _near_pairs(element, tau, first, centre, half, reach: float) -> tuple[np.ndarray, np.ndarray]:
     """Tested capsule pairs (i < j, j >= first[i]) whose segment balls come within ``reach``.
 
     ``element`` (S,) is each capsule's part (the rows of one part are contiguous). Two
     levels: a ball around each part prunes whole blocks of pairs before the segments' own
-    balls are compared.
+    balls are compared; a pair of large parts is pruned by groups of consecutive capsules in
+    between. The pairs come by pairs of parts (in order), then rows i, then j.
     """
     S = element.size
     starts = np.flatnonzero(np.r_[True, element[1:] != element[:-1]])
@@ -748,18 +755,69 @@ def _near_pairs(element, tau, first, centre, half, reach: float) -> tuple[np.nda
     if e.size == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
     ne, nf = sizes[e], sizes[f]
-    block = ne * nf
+    # blocks of rows [r1, r1 + n1) against [r2, r2 + n2), each within the part pair `pair`
+    r1, n1, r2, n2, pair = starts[e], ne, starts[f], nf, np.arange(e.size)
+    split = ne * nf > _NEAR_SPLIT
+    if split.any():
+        big = np.flatnonzero(split)
+        g1, m1, g2, m2, of = _group_blocks(e[big], f[big], starts, ends, first, centre, half,
+                                           reach)  # fmt: skip
+        small = np.flatnonzero(~split)
+        r1, n1 = np.r_[r1[small], g1], np.r_[n1[small], m1]
+        r2, n2 = np.r_[r2[small], g2], np.r_[n2[small], m2]
+        pair = np.r_[small, big[of]]
+    block = n1 * n2
     total = int(block.sum())
     offset = np.repeat(np.cumsum(block) - block, block)
     q = np.arange(total) - offset
-    nf_rep = np.repeat(nf, block)
-    i = np.repeat(starts[e], block) + q // nf_rep
-    j = np.repeat(starts[f], block) + q % nf_rep
+    nf_rep = np.repeat(n2, block)
+    i = np.repeat(r1, block) + q // nf_rep
+    j = np.repeat(r2, block) + q % nf_rep
     ok = j >= first[i]
     i, j = i[ok], j[ok]
     d = centre[i] - centre[j]
-    ok = np.sqrt(np.einsum("ij,ij->i", d, d)) - half[i] - half[j] < reach
-    return i[ok], j[ok]
+    ok2 = np.sqrt(np.einsum("ij,ij->i", d, d)) - half[i] - half[j] < reach
+    i, j = i[ok2], j[ok2]
+    if split.any():  # the order of whole blocks: each pair's place among all of its blocks'
+        which = np.repeat(pair, block)[ok][ok2]
+        place = (np.cumsum(ne * nf) - ne * nf)[which] + (i - starts[e[which]]) * nf[which] \
+            + (j - starts[f[which]])  # fmt: skip
+        order = np.argsort(place, kind="stable")
+        i, j = i[order], j[order]
+    return i, j
+
+
+def _group_blocks(e, f, starts, ends, first, centre, half, reach: float):
+    """The blocks of groups of at most ``_BALL_GROUP`` consecutive rows of parts e and f (for
+    each pair of parts e[k], f[k]) that contain a tested pair and whose groups' balls come
+    within ``reach``: (first row, rows) of each side and k."""
+    G = _BALL_GROUP
+    parts = np.unique(np.r_[e, f])
+    count = -(-(ends[parts] - starts[parts]) // G)  # groups per part
+    begin = np.zeros(starts.size, dtype=np.int64)
+    begin[parts] = np.cumsum(count) - count  # index of each part's first group
+    number = np.zeros(starts.size, dtype=np.int64)
+    number[parts] = count
+    owner = np.repeat(parts, count)
+    g0 = starts[owner] + G * (np.arange(owner.size) - begin[owner])
+    g1 = np.minimum(g0 + G, ends[owner])
+    size = g1 - g0
+    at = np.cumsum(size) - size
+    rows = np.repeat(g0 - at, size) + np.arange(int(size.sum()))  # every group's rows
+    gc = np.add.reduceat(centre[rows], at, axis=0) / size[:, None]
+    spread = np.sqrt(((centre[rows] - np.repeat(gc, size, axis=0)) ** 2).sum(axis=1)) + half[rows]
+    gr = np.maximum.reduceat(spread, at)
+    gfirst = np.minimum.reduceat(first[rows], at)
+    slack = reach + 1e-9 * (1.0 + float(np.abs(gc).max()) + 2.0 * float(gr.max()))
+    pairs = number[e] * number[f]
+    k = np.repeat(np.arange(e.size), pairs)
+    q = np.arange(int(pairs.sum())) - np.repeat(np.cumsum(pairs) - pairs, pairs)
+    ge = begin[e][k] + q // number[f][k]
+    gf = begin[f][k] + q % number[f][k]
+    d = gc[ge] - gc[gf]
+    keep = (gfirst[ge] < g1[gf]) & (np.sqrt((d**2).sum(axis=1)) - gr[ge] - gr[gf] < slack)
+    ge, gf, k = ge[keep], gf[keep], k[keep]
+    return g0[ge], size[ge], g0[gf], size[gf], k
 
 
 def worst_overlap(
@@ -964,15 +1022,23 @@ def junction_extent(
     reach = (2.0 * r + margin) * (1.0 - CONTACT_TOLERANCE)
     first = np.cumsum(counts) - counts  # global index of each segment's first sample
     low, high = _candidate_samples(starts, ends, counts, first, a, b, reach)
+    # a sample is measured against the sibling segments whose balls it comes near (with a
+    # rounding allowance: the nearer ones decide whether it is within reach)
+    centre, half = 0.5 * (a + b), 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
+    scale = max(float(np.abs(starts).max()), float(np.abs(ends).max()),
+                float(np.abs(a).max()), float(np.abs(b).max()), 1.0)  # fmt: skip
+    near = reach * (1.0 + 1e-6) + 1e-9 * scale
     found = -math.inf
     for index in _descending_chunks(low, high, max(1, _JUNCTION_CHUNK // a.shape[0])):
         i = np.searchsorted(first, index, side="right") - 1
         u = (index - first[i]) / (counts[i] - 1)
         points = starts[i] + u[:, None] * (ends - starts)[i]
-        t = _point_params(points[:, None, :], a[None], b[None])
-        nearest = a[None] + t[..., None] * (b - a)[None]
-        distance = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).min(axis=1)
-        close = distance < reach
+        p, q = _ball_pairs(points, np.zeros(points.shape[0]), centre, half, near)
+        t = _point_params(points[p], a[q], b[q])
+        nearest = a[q] + t[:, None] * (b - a)[q]
+        distance = np.sqrt(((points[p] - nearest) ** 2).sum(axis=1))
+        close = np.zeros(points.shape[0], dtype=bool)
+        close[p[distance < reach]] = True
         if close.any():
             found = max(found, float(_polyline_distance(points[close], polyline).max()))
             if found + 0.02 * r >= limit:
@@ -1006,45 +1072,51 @@ def _candidate_samples(starts, ends, counts, first, a, b, reach: float):
     i is ``first[i] + k``, at parameter k / (counts[i] - 1)) that may lie within ``reach`` of
     a sibling segment (a, b): those inside the cylinder of radius ``reach`` around the
     sibling's line, between the planes ``reach`` beyond its ends (a superset of the capsule),
-    padded by two samples on each side against rounding."""
+    padded by two samples on each side against rounding. Only the (own, sibling) pairs whose
+    balls come that close are measured (:func:`_ball_pairs`)."""
     e = b - a
     length = np.sqrt((e**2).sum(axis=1))
     e = np.where(length[:, None] > 0.0, e / np.where(length > 0.0, length, 1.0)[:, None], 0.0)
     slack = reach * (1.0 + 1e-6) + 1e-9 * max(
         float(np.abs(starts).max()), float(np.abs(ends).max()), float(np.abs(a).max()), 1.0)
-    found_low, found_high = [], []
-    block = max(1, _JUNCTION_PAIRS // a.shape[0])
-    for s0 in range(0, starts.shape[0], block):
-        s, d = starts[s0 : s0 + block], (ends - starts)[s0 : s0 + block]
-        rel = s[:, None, :] - a[None]  # (n, m, 3)
-        t0 = (rel * e[None]).sum(axis=2)  # axial coordinate at u = 0 and its rate
-        t1 = (d[:, None, :] * e[None]).sum(axis=2)
-        w0 = rel - t0[..., None] * e[None]  # the part across the sibling's line
-        w1 = d[:, None, :] - t1[..., None] * e[None]
-        ww = (w1**2).sum(axis=2)
+    # the region of a sibling lies within length / 2 + 2 slack of its midpoint: pairs whose
+    # balls are 3 slack apart have no sample in it
+    own_half = 0.5 * np.sqrt(((ends - starts) ** 2).sum(axis=1))
+    pairs_i, pairs_j = _ball_pairs(0.5 * (starts + ends), own_half, 0.5 * (a + b), 0.5 * length,
+                                   3.0 * slack)  # fmt: skip
+    found_low, found_high = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
+    for p0 in range(0, pairs_i.size, _JUNCTION_PAIRS):
+        i, j = pairs_i[p0 : p0 + _JUNCTION_PAIRS], pairs_j[p0 : p0 + _JUNCTION_PAIRS]
+        d, ej = (ends - starts)[i], e[j]
+        rel = starts[i] - a[j]  # (pairs, 3)
+        t0 = (rel * ej).sum(axis=1)  # axial coordinate at u = 0 and its rate
+        t1 = (d * ej).sum(axis=1)
+        w0 = rel - t0[:, None] * ej  # the part across the sibling's line
+        w1 = d - t1[:, None] * ej
+        ww = (w1**2).sum(axis=1)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             # across: |w0 + u w1| < slack, an interval around the nearest u
-            centre = np.where(ww > 0.0, -(w0 * w1).sum(axis=2) / np.where(ww > 0.0, ww, 1.0),
+            centre = np.where(ww > 0.0, -(w0 * w1).sum(axis=1) / np.where(ww > 0.0, ww, 1.0),
                               0.0)  # fmt: skip
-            gap = np.sqrt(((w0 + centre[..., None] * w1) ** 2).sum(axis=2))
+            gap = np.sqrt(((w0 + centre[:, None] * w1) ** 2).sum(axis=1))
             half = np.where(ww > 0.0, np.sqrt(np.maximum(slack**2 - gap**2, 0.0) / ww), np.inf)
             inside = gap < slack
             lo, hi = centre - half, centre + half
             # along: -slack < t0 + u t1 < length + slack
             ua = (-slack - t0) / t1
-            ub = (length[None] + slack - t0) / t1
+            ub = (length[j] + slack - t0) / t1
             moving = t1 != 0.0
             lo = np.where(moving, np.maximum(lo, np.minimum(ua, ub)), lo)
             hi = np.where(moving, np.minimum(hi, np.maximum(ua, ub)), hi)
-            inside &= moving | ((t0 > -slack) & (t0 < length[None] + slack))
+            inside &= moving | ((t0 > -slack) & (t0 < length[j] + slack))
         lo, hi = np.maximum(lo, 0.0), np.minimum(hi, 1.0)
         inside &= lo <= hi
-        ii, jj = np.nonzero(inside)
-        steps = (counts[s0 : s0 + block] - 1)[ii].astype(float)
-        k0 = np.maximum(np.floor(lo[ii, jj] * steps) - 2.0, 0.0).astype(np.int64)
-        k1 = np.minimum(np.ceil(hi[ii, jj] * steps) + 3.0, steps + 1.0).astype(np.int64)
-        found_low.append(first[s0 : s0 + block][ii] + k0)
-        found_high.append(first[s0 : s0 + block][ii] + k1)
+        q = np.flatnonzero(inside)
+        steps = (counts[i[q]] - 1).astype(float)
+        k0 = np.maximum(np.floor(lo[q] * steps) - 2.0, 0.0).astype(np.int64)
+        k1 = np.minimum(np.ceil(hi[q] * steps) + 3.0, steps + 1.0).astype(np.int64)
+        found_low.append(first[i[q]] + k0)
+        found_high.append(first[i[q]] + k1)
     low, high = np.concatenate(found_low), np.concatenate(found_high)
     if low.size == 0:
         return low, high
@@ -1057,20 +1129,126 @@ def _candidate_samples(starts, ends, counts, first, a, b, reach: float):
     return low[starts_at], np.maximum.reduceat(high, starts_at)
 
 
+#: Consecutive balls per group in :func:`_ball_pairs`, and about the most pairs (of groups, or
+#: of balls) it holds at once.
+_BALL_GROUP = 32
+_BALL_PAIRS = 1 << 18
+
+
+def _group_balls(centre: np.ndarray, half: np.ndarray, size: int):
+    """Balls around groups of ``size`` consecutive balls: (first index of each group, centre,
+    radius)."""
+    begin = np.arange(0, half.size, size)
+    count = np.diff(np.r_[begin, half.size])
+    c = np.add.reduceat(centre, begin, axis=0) / count[:, None]
+    owner = np.repeat(np.arange(begin.size), count)
+    spread = np.sqrt(((centre - c[owner]) ** 2).sum(axis=1)) + half
+    return begin, c, np.maximum.reduceat(spread, begin)
+
+
+def _ball_pairs(c1, h1, c2, h2, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """Index pairs (i, j) of balls (centres ``c1``, radii ``h1``) and (``c2``, ``h2``) whose
+    surfaces come within ``reach`` (|c1_i - c2_j| - h1_i - h2_j < reach), in no particular
+    order. Groups of consecutive balls (a tube's capsules) are compared first, so far-apart
+    stretches of two tubes cost one test per pair of groups; about 2**18 pairs (of groups or
+    of balls) are held at once while searching."""
+    empty = np.zeros(0, dtype=np.int64)
+    if h1.size == 0 or h2.size == 0:
+        return empty, empty
+    g = _BALL_GROUP
+    begin1, gc1, gr1 = _group_balls(c1, h1, g)
+    begin2, gc2, gr2 = _group_balls(c2, h2, g)
+    # a rounding allowance: the groups' balls may only keep more pairs than the exact test
+    slack = reach + 1e-9 * (1.0 + float(np.abs(gc1).max()) + float(np.abs(gc2).max())
+                            + float(gr1.max()) + float(gr2.max()))  # fmt: skip
+    sizes1, sizes2 = np.diff(np.r_[begin1, h1.size]), np.diff(np.r_[begin2, h2.size])
+    found_i, found_j = [empty], [empty]
+    rows = max(1, _BALL_PAIRS // begin2.size)
+    for r0 in range(0, begin1.size, rows):
+        d = gc1[r0 : r0 + rows, None, :] - gc2[None]
+        near = np.sqrt((d**2).sum(axis=2)) - gr1[r0 : r0 + rows, None] - gr2[None] < slack
+        ge, gf = np.nonzero(near)
+        ge += r0
+        block = sizes1[ge] * sizes2[gf]
+        # the near group pairs, a few at a time: at most _BALL_PAIRS ball pairs each
+        cut = np.searchsorted(np.cumsum(block), np.arange(1, 1 + int(block.sum()) //
+                                                          _BALL_PAIRS) * _BALL_PAIRS)
+        for part in np.split(np.arange(ge.size), np.unique(cut)):
+            if part.size == 0:
+                continue
+            n2, size = sizes2[gf[part]], block[part]
+            q = np.arange(int(size.sum())) - np.repeat(np.cumsum(size) - size, size)
+            n2_rep = np.repeat(n2, size)
+            i = np.repeat(begin1[ge[part]], size) + q // n2_rep
+            j = np.repeat(begin2[gf[part]], size) + q % n2_rep
+            d = c1[i] - c2[j]
+            keep = np.sqrt((d**2).sum(axis=1)) - h1[i] - h2[j] < reach
+            found_i.append(i[keep])
+            found_j.append(j[keep])
+    return np.concatenate(found_i), np.concatenate(found_j)
+
+
 def _point_params(points, a, b) -> np.ndarray:
     return point_segment_parameters(points, a, b)
 
 
+#: Most (point, segment) pairs :func:`_polyline_distance` measures all at once; beyond, it
+#: measures each point against the segments that can be nearest, about _BALL_PAIRS at a time.
+_POLYLINE_DENSE = 1 << 16
+#: Consecutive segments per group in :func:`_polyline_distance` (fastest of 4, 8, 16, 32 on
+#: the rows of fuzzed trees' tubes).
+_POLYLINE_GROUP = 8
+
+
 def _polyline_distance(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
-    """Distance along ``polyline`` (from its start) of the point of it nearest each point."""
+    """Distance along ``polyline`` (from its start) of the point of it nearest each point
+    (of equally near segments, the first)."""
     a, b = polyline[:-1], polyline[1:]
     lengths = np.sqrt(((b - a) ** 2).sum(axis=1))
     cumulative = np.concatenate([[0.0], np.cumsum(lengths)])
-    t = _point_params(points[:, None, :], a[None], b[None])
-    nearest = a[None] + t[..., None] * (b - a)[None]
-    k = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).argmin(axis=1)
-    rows = np.arange(points.shape[0])
-    return cumulative[k] + t[rows, k] * lengths[k]
+    if points.shape[0] * a.shape[0] <= _POLYLINE_DENSE:
+        t = _point_params(points[:, None, :], a[None], b[None])
+        nearest = a[None] + t[..., None] * (b - a)[None]
+        k = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).argmin(axis=1)
+        rows = np.arange(points.shape[0])
+        return cumulative[k] + t[rows, k] * lengths[k]
+    # groups of consecutive segments: the nearest segment lies in a group whose ball comes
+    # within the smallest distance to any group's far side (with a rounding allowance)
+    begin, gc, gr = _group_balls(0.5 * (a + b), 0.5 * lengths, _POLYLINE_GROUP)
+    sizes = np.diff(np.r_[begin, a.shape[0]])
+    allowance = 1e-9 * (1.0 + float(np.abs(points).max()) + float(np.abs(polyline).max())
+                        + 2.0 * float(gr.max()))  # fmt: skip
+    best = np.full(points.shape[0], np.inf)
+    best_k = np.zeros(points.shape[0], dtype=np.int64)
+    best_t = np.zeros(points.shape[0])
+    step = max(1, _BALL_PAIRS // begin.size)
+    for p0 in range(0, points.shape[0], step):
+        d = np.sqrt(((points[p0 : p0 + step, None, :] - gc[None]) ** 2).sum(axis=2))
+        upper = (d + gr[None]).min(axis=1)
+        pp, gg = np.nonzero(d - gr[None] <= upper[:, None] + allowance)  # by point, then group
+        pp += p0
+        size = sizes[gg]
+        cut = np.searchsorted(np.cumsum(size), np.arange(1, 1 + int(size.sum()) //
+                                                         _BALL_PAIRS) * _BALL_PAIRS)
+        for part in np.split(np.arange(pp.size), np.unique(cut)):
+            if part.size == 0:
+                continue
+            n = size[part]
+            q = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+            i = np.repeat(pp[part], n)
+            k = np.repeat(begin[gg[part]], n) + q  # by point, then segment
+            t = _point_params(points[i], a[k], b[k])
+            nearest = a[k] + t[:, None] * (b - a)[k]
+            dist = np.sqrt(((points[i] - nearest) ** 2).sum(axis=1))
+            run = np.flatnonzero(np.r_[True, i[1:] != i[:-1]])
+            low = np.minimum.reduceat(dist, run)
+            hit = np.flatnonzero(dist == np.repeat(low, np.diff(np.r_[run, i.size])))
+            _, first_hit = np.unique(i[hit], return_index=True)  # each point's first nearest
+            at = hit[first_hit]
+            better = dist[at] < best[i[at]]  # earlier segments win ties
+            who = i[at][better]
+            best[who], best_k[who], best_t[who] = dist[at][better], k[at][better], t[at][better]
+    return cumulative[best_k] + best_t * lengths[best_k]
 
 
 @dataclass(frozen=True, eq=False)
