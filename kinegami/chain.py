@@ -45,6 +45,7 @@ from kinegami.validation import (
     check_real,
     check_translation,
     check_twist_portion,
+    joint_count_refusal,
     shown,
 )
 
@@ -399,6 +400,9 @@ class _JointAssembly:
     ) -> int | None:
         """Add ``newJoint`` as a child of joint ``p`` (append / addJoint; docs/placement.md):
         the new joint's index, or None with a PlacementWarning (nothing changed)."""
+        if (full := joint_count_refusal(len(self._joints), self._noun)) is not None:
+            self._reject(f"{what} failed: {full}")
+            return None
         relative = check_bool("relative", relative)
         safe = check_bool("safe", safe)
         fixedPosition = check_bool("fixedPosition", fixedPosition)

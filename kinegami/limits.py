@@ -34,6 +34,7 @@ __all__ = [
     "MAX_STARTS",
     "MAX_PDF_PAGES",
     "MAX_INTEGER_DIGITS",
+    "MAX_API_JOINTS",
 ]
 
 # --- sizes and lengths (the API and design files) -----------------------------------------
@@ -91,3 +92,7 @@ MAX_STARTS = 64
 MAX_PDF_PAGES = 200
 #: Most digits of an integer option on the command line (``--seed``, ``--motion``, ``--port``).
 MAX_INTEGER_DIGITS = 30
+
+#: Most joints of a chain or tree built through the Python API (append, addJoint, from_dh...):
+#: as MAX_JOINTS for design files plus what safe placement adds (up to four waypoints a joint).
+MAX_API_JOINTS = 5 * MAX_JOINTS

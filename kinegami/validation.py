@@ -41,6 +41,7 @@ from kinegami.errors import InvalidParameterError, InvalidTypeError, ReadOnlyErr
 from kinegami.limits import (  # noqa: F401
     FILE_NUM_SIDES_MAX,
     LENGTH_FACTOR,
+    MAX_API_JOINTS,
     MAX_SAMPLED_STATES,
     MAX_SAMPLES,
     MAX_STARTS,
@@ -282,6 +283,17 @@ def check_samples(name: str, value, joints: int) -> int:
 def check_starts(value) -> int:
     """The number of starts of a compaction: an integer in [1, MAX_STARTS]."""
     return _check_count("starts", value, MAX_STARTS, "MAX_STARTS", "each is a whole search")
+
+
+def joint_count_refusal(count: int, noun: str = "chain") -> str | None:
+    """Why a chain or tree of ``count`` joints takes no more (it has ``MAX_API_JOINTS``), in one
+    line; None while it may grow. Append and addJoint report it as any failed placement does
+    (None with a PlacementWarning, nothing changed)."""
+    if count < MAX_API_JOINTS:
+        return None
+    return (f"the {noun} has {count} joints, the most it may have (kinegami.limits."
+            f"MAX_API_JOINTS = {MAX_API_JOINTS}: each placement tests the whole {noun}, "
+            "so its cost grows with every joint)")  # fmt: skip
 
 
 def _check_count(name: str, value, maximum: int, constant: str, why: str) -> int:
