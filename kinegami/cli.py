@@ -73,22 +73,93 @@ class BuildJob:
         return self._clearance
 
 
-def _write_pngs(job: BuildJob, paths: list[Path]) -> None:
+def _png_data(job: BuildJob) -> tuple[bytes, bytes]:
+    """The PNG files of the 3D chain and of its pattern (150 dpi)."""
+    import io
+
     import matplotlib
 
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 
-    fig, _ = job.chain.show(block=False, units=job.info.units)
+    pictures = []
+    for draw in (lambda: job.chain.show(block=False, units=job.info.units),
+                 lambda: job.pattern.show(units=job.info.units)):  # fmt: skip
+        fig, _ = draw()
+        try:
+            data = io.BytesIO()
+            fig.savefig(data, format="png", dpi=150, bbox_inches="tight")
+            pictures.append(data.getvalue())
+        finally:
+            plt.close(fig)
+    return pictures[0], pictures[1]
+
+
+def _write_pngs(job: BuildJob, paths: list[Path]) -> None:
+    for path, data in zip(paths, _png_data(job), strict=True):
+        path.write_bytes(data)
+
+
+#: A chain with at least this many joints has its pictures drawn in a second process while
+#: this one checks it and writes the other files (when the machine has two cores or more).
+BACKGROUND_PICTURES_JOINTS = 200
+
+
+class BackgroundPictures:
+    """:func:`_png_data` of a job computed in a forked child process (the job is inherited,
+    not copied through a pipe); :meth:`result` waits for the two files' bytes, :meth:`stop`
+    ends the child if it still runs. Only where the ``fork`` start method exists."""
+
+    def __init__(self, job: BuildJob):
+        import multiprocessing
+
+        context = multiprocessing.get_context("fork")
+        self._receive, send = context.Pipe(duplex=False)
+        self._process = context.Process(target=_send_png_data, args=(job, send), daemon=True)
+        self._process.start()
+        send.close()
+
+    @staticmethod
+    def wanted(job: BuildJob, formats) -> bool:
+        """Whether drawing the pictures in the background pays for this build."""
+        import multiprocessing
+
+        return (any(fmt.name == "png" for fmt in formats) and len(formats) > 1
+                and len(job.chain.Joints) >= BACKGROUND_PICTURES_JOINTS
+                and (os.cpu_count() or 1) > 1
+                and "fork" in multiprocessing.get_all_start_methods())  # fmt: skip
+
+    def result(self) -> tuple[bytes, bytes]:
+        """The two PNG files; the child's KinegamiError is raised here as a KinegamiError."""
+        try:
+            kind, payload = self._receive.recv()
+        except EOFError:
+            status = self._process.exitcode
+            raise CommandError("png export: the process drawing the pictures ended without "
+                               f"them (exit status {status})") from None  # fmt: skip
+        finally:
+            self._process.join()
+        if kind != "ok":
+            raise KinegamiError(payload) if kind == "error" else CommandError(payload)
+        return payload
+
+    def stop(self) -> None:
+        if self._process.is_alive():
+            self._process.terminate()
+        self._process.join()
+        self._receive.close()
+
+
+def _send_png_data(job: BuildJob, send) -> None:
+    """The child of :class:`BackgroundPictures`: draw, send the bytes or the error's line."""
     try:
-        fig.savefig(paths[0], dpi=150, bbox_inches="tight")
+        send.send(("ok", _png_data(job)))
+    except KinegamiError as error:
+        send.send(("error", str(error)))
+    except Exception as error:  # a bug: its one line, as main() words one
+        send.send(("bug", f"png export: internal error: {type(error).__name__}: {error}"))
     finally:
-        plt.close(fig)
-    fig, _ = job.pattern.show(units=job.info.units)
-    try:
-        fig.savefig(paths[1], dpi=150, bbox_inches="tight")
-    finally:
-        plt.close(fig)
+        send.close()
 
 
 def _registry_writer(suffix: str) -> Callable[..., None]:
@@ -574,27 +645,39 @@ def cmd_build(args: argparse.Namespace) -> int:
                             "(junctions join the sheets of a tree)")  # fmt: skip
     formats = _parse_formats(",".join(DEFAULT_FORMATS) if args.formats is None else args.formats)
     job = BuildJob(chain, info)
-    _check_pattern(job)
-    lines = _summary(job, args.design)
-    if not job.clearance.ok:
-        _warn(args.command, _overlap_warning(job.clearance, info, args.design))
-    # write everything into a hidden staging folder in the target, then publish it as one
-    # transaction (kinegami.export.publish): a failure or an interrupt leaves the folder as
-    # it was, and a build killed earlier is recovered first
-    staging = _open_staging(args.command, out)
+    # a large chain's pictures are drawn by a second process meanwhile (the longest output)
+    pictures = BackgroundPictures(job) if BackgroundPictures.wanted(job, formats) else None
     try:
-        for fmt in formats:
-            try:
-                fmt.write(job, [staging.new / f"{stem}{suffix}" for suffix in fmt.suffixes])
-            except KinegamiError as error:
-                raise CommandError(f"{args.design}: {fmt.name} export: {error}") from None
-            except OSError as error:
-                raise CommandError(
-                    f"{fmt.name} export: cannot write {str(out)!r}: {error.strerror or error}"
-                ) from None
-        written = staging.publish()  # all or nothing, whatever interrupts it
+        _check_pattern(job)
+        lines = _summary(job, args.design)
+        if not job.clearance.ok:
+            _warn(args.command, _overlap_warning(job.clearance, info, args.design))
+        # write everything into a hidden staging folder in the target, then publish it as one
+        # transaction (kinegami.export.publish): a failure or an interrupt leaves the folder as
+        # it was, and a build killed earlier is recovered first
+        staging = _open_staging(args.command, out)
+        try:
+            for fmt in formats:
+                paths = [staging.new / f"{stem}{suffix}" for suffix in fmt.suffixes]
+                try:
+                    if pictures is not None and fmt.name == "png":
+                        for path, data in zip(paths, pictures.result(), strict=True):
+                            path.write_bytes(data)
+                    else:
+                        fmt.write(job, paths)
+                except KinegamiError as error:
+                    raise CommandError(f"{args.design}: {fmt.name} export: {error}") from None
+                except OSError as error:
+                    raise CommandError(
+                        f"{fmt.name} export: cannot write {str(out)!r}: "
+                        f"{error.strerror or error}"
+                    ) from None
+            written = staging.publish()  # all or nothing, whatever interrupts it
+        finally:
+            staging.close()
     finally:
-        staging.close()
+        if pictures is not None:
+            pictures.stop()
     lines.append("  files written:")
     lines.extend(f"    {path}{os.sep if path.is_dir() else ''}" for path in written)
     print("\n".join(lines))
