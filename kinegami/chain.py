@@ -897,11 +897,13 @@ class KinematicChain(_JointAssembly):
     def creasePattern(self, twistPortion: float = 0.2):
         """The chain's tubular crease pattern (docs/fabrication.md) as a TubularPattern."""
         from kinegami.pattern import TubularPattern
-        from kinegami.pattern.catalog import build_pieces
+        from kinegami.pattern.catalog import build_pieces, check_pattern_size
 
         twistPortion = check_twist_portion(twistPortion)
         # every link's modules built together (the elbows of the whole chain in one batch)
         pieces = [link.pattern_pieces(self.numSides, twistPortion) for link in self._links[1:]]
+        check_pattern_size([p for link in pieces for p in link]
+                           + [p for joint in self._joints for p in joint.pattern_pieces()])
         built = iter(build_pieces([piece for link in pieces for piece in link]))
         modules = [self._joints[0].pattern]
         for link, joint in zip(pieces, self._joints[1:], strict=True):

@@ -375,6 +375,11 @@ class Joint(ReadOnlyAttributes):
         """
         return _catalog_pattern(*self._pattern_recipe())
 
+    def pattern_pieces(self) -> list[tuple[str, tuple]]:
+        """What :attr:`pattern` is built from, as ``LinkCSC.pattern_pieces``: a (catalog kind,
+        build arguments) pair per module, in order (nothing is built)."""
+        return list(self._pattern_recipe())
+
     def _pattern_recipe(self) -> tuple:
         """The pieces of this joint's pattern: (catalog module kind, its build arguments) each,
         composed in order (see kinegami.pattern.catalog)."""

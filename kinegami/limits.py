@@ -34,6 +34,8 @@ __all__ = [
     "MAX_STARTS",
     "MAX_PDF_PAGES",
     "MAX_INTEGER_DIGITS",
+    "TAKEOFF_WORK",
+    "MAX_PATTERN_VERTICES",
     "MAX_API_JOINTS",
 ]
 
@@ -93,6 +95,20 @@ MAX_PDF_PAGES = 200
 #: Most digits of an integer option on the command line (``--seed``, ``--motion``, ``--port``).
 MAX_INTEGER_DIGITS = 30
 
+# --- work inside one operation -------------------------------------------------------------
+#: Most capsule tests of one joint's take-off search (kinegami.tree.takeoffs): each candidate
+#: placement is a clearance test of the whole folded body, so a body of S capsules (about two
+#: per elbow and two per joint) measures at most TAKEOFF_WORK / S candidates. Ordinary trees
+#: (a few hundred capsules: every face at 5 heights and 48 sets) stay within it; an 11-joint tree
+#: of one-degree elbows (2,700 capsules) measured 174 candidates at about 0.14 s each.
+TAKEOFF_WORK = 100_000
+#: Most crease-pattern vertices of one chain's pattern or one tree's sheets, estimated from
+#: the counts before anything is built (kinegami.pattern.catalog.check_pattern_size): each count
+#: is within its own limit, but their product is not (1,000 joints, up to 720 elbows a link,
+#: numSides up to 1024, 200 layers). A vertex costs about 250 bytes with its edges; 2,000,000
+#: vertices is over three 1024-sided prismatic joints of 200 layers (0.6 M vertices each,
+#: 160 MB).
+MAX_PATTERN_VERTICES = 2_000_000
 #: Most joints of a chain or tree built through the Python API (append, addJoint, from_dh...):
 #: as MAX_JOINTS for design files plus what safe placement adds (up to four waypoints a joint).
 MAX_API_JOINTS = 5 * MAX_JOINTS

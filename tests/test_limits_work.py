@@ -1,23 +1,33 @@
 """Limits on work that the counts of a design multiply (issue 29, docs/limits.md): joints added
-through the API (MAX_API_JOINTS). Each refusal is one line naming the value, the limit and why,
-given before the work starts, and leaves the design bit-identical."""
+through the API (MAX_API_JOINTS), the vertices of a crease pattern (MAX_PATTERN_VERTICES) and
+the candidates of a tree's take-off search (TAKEOFF_WORK). Each refusal is one line naming the
+value, the limit and why, given before the work starts, and leaves the design bit-identical."""
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import pytest
+from gallery_designs import TREE_DESIGNS
 from spatialmath import SE3
 
 from kinegami import (
     EndTip,
+    InvalidParameterError,
     KinematicChain,
     KinematicTree,
     PlacementWarning,
+    PrismaticJoint,
+    RevoluteJoint,
     StartTip,
     Waypoint,
     limits,
 )
+from kinegami.design import load_design
+from kinegami.pattern import catalog
+from kinegami.pattern.catalog import check_pattern_size, module_kind, module_vertices
+from kinegami.tree import takeoffs
 
 
 # --- joints through the API -------------------------------------------------------------------
@@ -57,3 +67,86 @@ def test_add_joint_to_a_full_tree_returns_none_and_warns(monkeypatch, snapshot):
 def test_max_api_joints_leaves_room_for_every_design_file():
     # a file's MAX_JOINTS entries with the waypoints safe placement adds (up to four each)
     assert limits.MAX_API_JOINTS >= limits.MAX_STATES == 5 * limits.MAX_JOINTS
+
+
+# --- crease-pattern vertices ------------------------------------------------------------------
+@pytest.mark.parametrize("piece", [
+    ("revolute", (4, 1.0, math.pi, 1)), ("revolute", (8, 1.0, math.pi, 4)),
+    ("revolute", (64, 1.0, 6.0, 32)), ("revolute", (256, 1.0, math.pi, 1)),
+    ("prismatic", (4, 1.0, 2.0, 1, math.pi / 4)), ("prismatic", (64, 1.0, 2.0, 10, math.pi / 4)),
+    ("prismatic", (256, 1.0, 2.0, 200, math.pi / 4)), ("elbow", (4, 1.0, 0.5, 0.3)),
+    ("elbow", (64, 1.0, 0.5, 0.0)), ("twist", (64, 1.0, 0.5, 1.0)), ("tube", (256, 1.0, 1.0)),
+    ("end_tip", (64, 1.0, 1.0)), ("start_tip", (8, 1.0, 1.0)),
+])  # fmt: skip
+def test_the_estimate_bounds_every_module_and_is_close(piece):
+    kind, args = piece
+    built = len(module_kind(kind).build(*args).vertices_coords)
+    assert built <= module_vertices(kind, args) <= 4 * built + 8
+
+
+def test_the_estimate_bounds_a_whole_chain(example_1a):
+    pattern = example_1a.creasePattern()
+    pieces = [link.pattern_pieces(4, 0.2) for link in example_1a.Links[1:]]
+    recipe = [piece for joint in example_1a.Joints for piece in joint.pattern_pieces()]
+    estimate = check_pattern_size([p for link in pieces for p in link] + recipe)
+    assert len(pattern.vertices_coords) <= estimate <= 4 * len(pattern.vertices_coords)
+
+
+def test_a_chain_whose_pattern_would_be_too_large_is_refused_before_building(
+        monkeypatch, snapshot):  # fmt: skip
+    chain = KinematicChain(StartTip(64, 1, SE3(), 1), maxAnglePerElbow=math.pi / 180)
+    for _k in range(3):
+        chain.append(PrismaticJoint(64, 1, 4, 200, math.pi / 4, SE3.Trans(0, 0, 30)), safe=False)
+        chain.append(RevoluteJoint(64, 1, math.pi, SE3.Rx(3.0) * SE3.Trans(0, 0, 30)))
+    before = snapshot(chain)
+    built = []
+    monkeypatch.setattr(catalog, "build_pieces", lambda pieces: built.append(1))
+    monkeypatch.setattr("kinegami.pattern.catalog.MAX_PATTERN_VERTICES", 20_000)
+    with pytest.raises(InvalidParameterError) as excinfo:
+        chain.creasePattern()
+    text = str(excinfo.value)
+    assert "\n" not in text
+    for word in ("crease-pattern vertices", "more than the limit 20,000", "MAX_PATTERN_VERTICES",
+                 "250 bytes"):  # fmt: skip
+        assert word in text, (word, text)
+    assert not built  # refused before any module was built
+    assert snapshot(chain) == before
+
+
+def test_the_default_limit_builds_ordinary_and_large_patterns():
+    chain = KinematicChain(StartTip(256, 1, SE3(), 1))
+    chain.append(PrismaticJoint(256, 1, 4, 200, math.pi / 4, SE3.Trans(0, 0, 30)), safe=False)
+    assert 150_000 < len(chain.creasePattern().vertices_coords) < limits.MAX_PATTERN_VERTICES
+
+
+def test_a_tree_whose_sheets_would_be_too_large_is_refused(monkeypatch):
+    from kinegami.tree.sheets import fabricate
+
+    tree = KinematicTree(Waypoint(8, 1, SE3()))
+    tree.addJoint(0, PrismaticJoint(8, 1, 4, 200, math.pi / 4, SE3.Trans(0, 0, 30)), safe=False)
+    tree.addJoint(0, EndTip(8, 1, SE3.Trans(20, 0, 5) * SE3.Ry(math.pi / 2), 1), safe=False)
+    monkeypatch.setattr("kinegami.pattern.catalog.MAX_PATTERN_VERTICES", 2_000)
+    with pytest.raises(InvalidParameterError, match="MAX_PATTERN_VERTICES"):
+        fabricate(tree, junction="connector")
+
+
+# --- the take-off search ----------------------------------------------------------------------
+@pytest.mark.parametrize("path", TREE_DESIGNS, ids=lambda p: p.stem)
+def test_the_takeoff_search_measures_everything_for_ordinary_trees(path):
+    tree = load_design(path)
+    for branches in (1, 2, 3):
+        per_branch, sets = takeoffs.search_budget(tree, branches)
+        assert per_branch >= tree.numSides * takeoffs.TakeoffOptions().heights
+        assert sets == takeoffs.EVALUATED_SETS
+
+
+def test_the_takeoff_search_of_a_tree_of_many_capsules_is_bounded():
+    tree = KinematicTree(Waypoint(8, 1, SE3()), maxAnglePerElbow=math.pi / 180)
+    for k in range(6):
+        tree.addJoint(0 if k < 3 else k, RevoluteJoint(8, 1, math.pi, SE3.Trans(3 * k - 6, 4, 9)
+                                                       * SE3.Rx(2.5)), safe=False)  # fmt: skip
+    per_branch, sets = takeoffs.search_budget(tree, 2)
+    capsules = limits.TAKEOFF_WORK // (2 * per_branch + sets)
+    assert capsules > 500  # many capsules: fewer candidates than every face at 5 heights
+    assert per_branch < 8 * 5 and 1 <= sets < takeoffs.EVALUATED_SETS
+    assert (2 * per_branch + sets) * capsules <= limits.TAKEOFF_WORK

@@ -18,7 +18,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from kinegami._record import Record
-from kinegami.errors import UnknownModuleKindError
+from kinegami.errors import InvalidParameterError, UnknownModuleKindError
+from kinegami.limits import MAX_PATTERN_VERTICES
 
 if TYPE_CHECKING:
     from kinegami.pattern._prism import Prism
@@ -30,10 +31,12 @@ __all__ = [
     "UnknownModuleKindError",
     "build_pieces",
     "cached_build",
+    "check_pattern_size",
     "expected_counts",
     "find_kind",
     "kinds",
     "module_kind",
+    "module_vertices",
     "register",
     "unregister",
 ]
@@ -210,6 +213,46 @@ def build_pieces(pieces: Iterable[tuple[str, tuple]]) -> list[TubularPattern]:
         patterns = many(arguments) if many is not None else [build(*a) for a in arguments]
         built[kind] = dict(zip(arguments, patterns, strict=True))
     return [built[kind][args] for kind, args in pieces]
+
+
+def module_vertices(kind: str, args: tuple) -> int:
+    """At most how many vertices the module ``kind`` built from ``args`` has (its first argument
+    is numSides n), from its counts alone: a revolute joint of L sink layers n (10 L + 6), a
+    prismatic joint of M layers n (3 M + 4), an elbow 6 n + 4, a twist or tube 2 n, anything
+    else 4 n (measured for n from 4 to 1024: docs/limits.md)."""
+    try:
+        n = int(args[0])
+        if kind == "revolute":
+            return n * (10 * int(args[3]) + 6)
+        if kind == "prismatic":
+            return n * (3 * int(args[3]) + 4)
+    except (TypeError, ValueError, IndexError):
+        return 0  # not a count: the module's own checks refuse it
+    if kind == "elbow":
+        return 6 * n + 4
+    if kind in ("twist", "tube"):
+        return 2 * n
+    return 4 * n
+
+
+def check_pattern_size(pieces: Iterable[tuple[str, tuple]], what: str = "the pattern") -> int:
+    """Raise InvalidParameterError, before anything is built, when the modules ``pieces``
+    ((kind, build arguments) each) would have more than ``MAX_PATTERN_VERTICES`` vertices
+    together (:func:`module_vertices`); return the estimate otherwise."""
+    total = 0
+    modules = 0
+    for kind, args in pieces:
+        total += module_vertices(kind, args)
+        modules += 1
+    if total > MAX_PATTERN_VERTICES:
+        raise InvalidParameterError(
+            f"{what} would have about {total:,} crease-pattern vertices in {modules:,} modules, "
+            f"more than the limit {MAX_PATTERN_VERTICES:,} (kinegami.limits."
+            "MAX_PATTERN_VERTICES: each vertex costs about 250 bytes and every export and view "
+            "works per vertex); use fewer joints, elbows (a larger maxAnglePerElbow), sides "
+            "or layers"
+        )
+    return total
 
 
 _REGISTRY: dict[str, ModuleKind] = {}

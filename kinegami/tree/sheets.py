@@ -39,6 +39,7 @@ import numpy as np
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.links import LinkCSC
 from kinegami.pattern import TubularPattern
+from kinegami.pattern.catalog import check_pattern_size
 from kinegami.pattern.cutout import CutPattern, SheetHole
 from kinegami.tree.connector import ConnectorOptions, JunctionSocket, junction_sockets
 from kinegami.tree.model import KinematicTree
@@ -401,6 +402,9 @@ def fabricate(
         raise InvalidTypeError(f"takeoff must be TakeoffOptions, got {takeoff!r}")
     takeoff = takeoff.resolved(tree.r)
     requested = _junction_kinds(tree, junction)
+    check_pattern_size(  # the sheets hold every link and joint (take-offs add a skirt each)
+        [p for link in tree.Links[1:] for p in link.pattern_pieces(tree.numSides, twistPortion)]
+        + [p for joint in tree.Joints for p in joint.pattern_pieces()], "the tree's sheets")
     kinds = {k: ("connector" if kind == "connector" else "takeoff")
              for k, kind in requested.items()}  # fmt: skip
     notes: list[str] = []

@@ -12,7 +12,10 @@ For each branch the face p and the hole's height y0 are chosen among every face 
 ``TakeoffOptions.heights`` heights spread over the part of the tube that holds the hole and its
 margin: those from which a CSC path to c exists, preferring the placement whose body passes
 least through itself (:func:`takeoff_overlap`), then the shortest new link; the branches of one
-joint are placed together, their holes (with margins) apart.
+joint are placed together, their holes (with margins) apart. Each candidate is a clearance test
+of the whole body, so one joint's search measures at most
+``kinegami.limits.TAKEOFF_WORK / capsules`` candidates (docs/limits.md): a body of many
+capsules tries fewer heights, then fewer faces (evenly spread); ordinary trees try them all.
 
 The folded body is measured as a tree of its own (:func:`takeoff_body`): the trunk's link is
 cut at every take-off point O (the trunk's axis point at the hole's centre) by a zero-length
@@ -32,10 +35,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from kinegami.bodies import Overlap, tree_worst_overlap
+from kinegami.bodies import Overlap, link_polyline, tree_worst_overlap
 from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
 from kinegami.geometry.csc_centreline import csc_transported_frame
 from kinegami.joints import Waypoint
+from kinegami.limits import TAKEOFF_WORK
 from kinegami.links import LinkCSC
 from kinegami.pattern.takeoff import TakeoffJunction, takeoff_junction
 from kinegami.validation import check_in_range, check_int, check_radius
@@ -348,13 +352,16 @@ def place_takeoffs(
         )
     span = max(0.0, tube_height - 2.0 * e)
     count = 1 if span <= 1e-9 * r else options.heights
+    tests, sets = search_budget(tree, len(branches))
+    count = min(count, max(1, tests // n))
+    faces = range(n) if n <= tests else sorted({round(k * n / tests) for k in range(tests)})
     heights = [e + span * (0.5 if count == 1 else k / (count - 1)) for k in range(count)]
     W = probe.prism.W
     candidates: dict[int, list[TakeoffPlacement]] = {}
     for c in branches:
         end = tree.Joints[c].proximal_dubins_frame()
         found = []
-        for p in range(n):
+        for p in faces:
             for y0 in heights:
                 J = takeoff_junction(n, r, p, y0, stub_length=options.stub_length,
                                      tab_width=options.tab_width)  # fmt: skip
@@ -374,16 +381,30 @@ def place_takeoffs(
         found.sort(key=lambda q: (round(q.depth / (DEPTH_TOLERANCE * r)), q.link.length,
                                   q.junction.face, q.junction.y0))  # fmt: skip
         candidates[c] = found
-    return _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache)
+    return _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache, sets)
 
 
-def _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache):
+def search_budget(tree, branches: int) -> tuple[int, int]:
+    """How many placements of one branch (faces times heights) and how many sets of
+    placements the take-off search at a joint with ``branches`` branches measures: within
+    ``TAKEOFF_WORK`` capsule tests in all (docs/limits.md), each test measuring the whole body
+    (about two capsules per elbow and two per joint), at least one of each."""
+    capsules = 2 * len(tree.Joints) + sum(2 * (len(link_polyline(link)) - 1)
+                                          for link in tree.Links[1:])  # fmt: skip
+    total = max(2, TAKEOFF_WORK // max(1, capsules))
+    sets = max(1, min(EVALUATED_SETS, total // 4))
+    return max(1, (total - sets) // max(1, branches)), sets
+
+
+def _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache,
+             evaluated: int = EVALUATED_SETS):  # fmt: skip
     """The best set of placements, one per branch, whose holes are apart.
 
     Each branch contributes its best candidates and its best one at every height; the sets
     whose holes are apart are ranked by their worst single depth and total length, and the
-    first :data:`EVALUATED_SETS` are measured together (the depth of the tree with all their
-    links). Without such a set (or with too many), branches are placed one by one.
+    first ``evaluated`` (at most :data:`EVALUATED_SETS`) are measured together (the depth of
+    the tree with all their links). Without such a set (or with too many), branches are placed
+    one by one.
     """
     pools = []
     for c in branches:
@@ -400,7 +421,7 @@ def _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache):
         sets.sort(key=lambda combo: (round(max(q.depth for q in combo) / scale),
                                      sum(q.link.length for q in combo)))  # fmt: skip
         best, best_key = None, None
-        for combo in sets[:EVALUATED_SETS]:
+        for combo in sets[:evaluated]:
             trial = placed + [(trunk, tube_arc + q.junction.y0, q.child, q.link) for q in combo]
             depth = _depth(takeoff_overlap(tree, trial, cache=cache))
             key = (round(depth / scale), sum(q.link.length for q in combo))
