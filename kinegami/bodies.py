@@ -727,8 +727,11 @@ class Overlap:
 _NEAR_SPLIT = 4096
 
 
-def _near_pairs(element, tau, first, centre, half, reach: float) -> tuple[np.ndarray, np.ndarray]:
-    """Tested capsule pairs (i < j, j >= first[i]) whose segment balls come within ``reach``.
+def _near_pairs(element, tau, first, centre, half, reach: float,
+                wanted=None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Tested capsule pairs (i < j, j >= first[i]) whose segment balls come within ``reach``
+    (with ``wanted``, a bool per capsule constant over each part: only pairs with a wanted
+    capsule).
 
     ``element`` (S,) is each capsule's part (the rows of one part are contiguous). Two
     levels: a ball around each part prunes whole blocks of pairs before the segments' own
@@ -751,6 +754,8 @@ def _near_pairs(element, tau, first, centre, half, reach: float) -> tuple[np.nda
     d = c[e] - c[f]
     near = np.sqrt(np.einsum("ij,ij->i", d, d)) - rho[e] - rho[f] < reach
     keep = tested & near
+    if wanted is not None:
+        keep &= wanted[starts[e]] | wanted[starts[f]]
     e, f = e[keep], f[keep]
     if e.size == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
@@ -1553,7 +1558,8 @@ def tree_pair_distances(
     tau = caps.turning + np.where(caps.start_joint >= 0, kinks[caps.start_joint], 0.0)
     centre = 0.5 * (a + b)
     half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
-    i, j = _near_pairs(caps.element, tau, np.arange(S) + 1, centre, half, reach)
+    wanted = node >= since if since > 0 else None  # a part's rows share their node
+    i, j = _near_pairs(caps.element, tau, np.arange(S) + 1, centre, half, reach, wanted)
     if since > 0 and i.size:
         keep = (node[i] >= since) | (node[j] >= since)
         i, j = i[keep], j[keep]
