@@ -116,12 +116,13 @@ def regular_polygon(frame: np.ndarray, r: float, n: int) -> np.ndarray:
     return circle_points(frame[:3, 3], frame[:3, 1], frame[:3, 2], r, psi)
 
 
-def _hinge(centre, direction, length: float) -> np.ndarray:
+def hinge_segment(centre, direction, length: float) -> np.ndarray:
+    """(2, 3): the segment of ``length`` centred at ``centre`` along unit ``direction``."""
     d = 0.5 * length * np.asarray(direction, dtype=float)
     return np.stack([centre - d, centre + d])
 
 
-def _shifted(frame: np.ndarray, distance: float) -> np.ndarray:
+def shifted_frame(frame: np.ndarray, distance: float) -> np.ndarray:
     """``frame`` translated along its own first axis."""
     out = np.array(frame)
     out[:3, 3] += distance * frame[:3, 0]
@@ -148,10 +149,10 @@ def revolute_hull_points(joint: RevoluteJoint) -> tuple[np.ndarray, np.ndarray]:
     """
     n, r = joint.numSides, joint.r
     T = joint.pose_matrix
-    hinge = _hinge(T[:3, 3], T[:3, 2], polygon_side(r, n))
+    hinge = hinge_segment(T[:3, 3], T[:3, 2], polygon_side(r, n))
     h = joint.tubeLength if isinstance(joint, ExtendedRevoluteJoint) else 0.0
-    proximal = _shifted(joint.proximal_dubins_frame(), h)
-    distal = _shifted(joint.distal_dubins_frame(), -h)
+    proximal = shifted_frame(joint.proximal_dubins_frame(), h)
+    distal = shifted_frame(joint.distal_dubins_frame(), -h)
     return (
         np.vstack([regular_polygon(proximal, r, n), hinge]),
         np.vstack([regular_polygon(distal, r, n), hinge]),
@@ -166,7 +167,7 @@ def tip_hull_points(joint: StartTip | EndTip) -> np.ndarray:
         open_end, closed_end = joint.distal_dubins_frame(), joint.proximal_dubins_frame()
     else:
         open_end, closed_end = joint.proximal_dubins_frame(), joint.distal_dubins_frame()
-    segment = _hinge(closed_end[:3, 3], closed_end[:3, 2], polygon_side(r, n))
+    segment = hinge_segment(closed_end[:3, 3], closed_end[:3, 2], polygon_side(r, n))
     return np.vstack([regular_polygon(open_end, r, n), segment])
 
 
@@ -204,15 +205,15 @@ TURN_TOLERANCE = 1e-9
 #: Joint motion codes of :class:`CapsuleModel`.
 JOINT_FIXED, JOINT_REVOLUTE, JOINT_PRISMATIC = 0, 1, 2
 
-_ORDINALS = (
+ORDINALS = (
     "first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth", "tenth",
 )  # fmt: skip
 
 
 def _ordinal(k: int) -> str:
     """'first', 'second', ... for k = 1..10, then '11th', '12th', ..."""
-    if 1 <= k <= len(_ORDINALS):
-        return _ORDINALS[k - 1]
+    if 1 <= k <= len(ORDINALS):
+        return ORDINALS[k - 1]
     suffix = "th" if 10 <= k % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(k % 10, "th")
     return f"{k}{suffix}"
 

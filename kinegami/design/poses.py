@@ -126,7 +126,7 @@ def _steps_pose(steps, angle_units: str) -> np.ndarray:
     return pose
 
 
-def _scaled(vector) -> np.ndarray | None:
+def rescaled_exactly(vector) -> np.ndarray | None:
     """``vector`` times a power of two bringing its largest entry into [0.5, 1) (exact, so
     normalising it gives the same bits as normalising ``vector``); None for a zero vector."""
     v = np.array(vector, dtype=float)
@@ -138,7 +138,7 @@ def _scaled(vector) -> np.ndarray | None:
 
 def _axis_pose(spec, path) -> np.ndarray:
     point = np.array(spec.get("point", (0.0, 0.0, 0.0)), dtype=float)
-    axis = _scaled(spec["axis"])
+    axis = rescaled_exactly(spec["axis"])
     if axis is None:
         raise DesignError(
             "the axis must be a non-zero vector", field=json_path([*path, "axis"]),
@@ -146,7 +146,7 @@ def _axis_pose(spec, path) -> np.ndarray:
         )  # fmt: skip
     z = axis / math.sqrt(float(axis @ axis))
     if "xhat" in spec:
-        xhat = _scaled(spec["xhat"])
+        xhat = rescaled_exactly(spec["xhat"])
         if xhat is None:
             xhat = np.zeros(3)
     else:

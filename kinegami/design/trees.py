@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from kinegami.design.errors import DesignError, json_path
-from kinegami.design.poses import _scaled
+from kinegami.design.poses import rescaled_exactly
 from kinegami.joints import Joint
 from kinegami.validation import shorten
 
@@ -270,7 +270,7 @@ def _check_tree_order(specs, parents, file) -> None:
 
 
 def _check_growth_direction(placement: dict, file) -> None:
-    if "growthDirection" in placement and _scaled(placement["growthDirection"]) is None:
+    if "growthDirection" in placement and rescaled_exactly(placement["growthDirection"]) is None:
         raise DesignError(
             "the growth direction must be a non-zero vector",
             field="placement.growthDirection", value=placement["growthDirection"], file=file,

@@ -385,7 +385,7 @@ def link_parts(
 # --- whole chain ---------------------------------------------------------------------------
 
 
-def _check_chain(chain: Any, fmt: str) -> KinematicChain | KinematicTree:
+def check_assembly(chain: Any, fmt: str) -> KinematicChain | KinematicTree:
     """``chain`` if it is a KinematicChain or a KinematicTree, else an InvalidTypeError."""
     from kinegami.chain import KinematicChain
     from kinegami.tree.model import KinematicTree
@@ -398,7 +398,7 @@ def _check_chain(chain: Any, fmt: str) -> KinematicChain | KinematicTree:
     return chain
 
 
-def _is_tree(obj: Any) -> bool:
+def is_tree(obj: Any) -> bool:
     """True for a tree that branches somewhere (a tree whose parents are i - 1 is a chain and
     gives the chain's files)."""
     parents = tuple(obj.Parents)
@@ -429,7 +429,7 @@ def chain_parts(
         World coordinates, chain units: joint 0, link 1, joint 1, link 2, ... (link i runs
         from joint ``Parents[i]`` to joint i).
     """
-    chain = _check_chain(chain, "mesh")
+    chain = check_assembly(chain, "mesh")
     twistPortion = check_twist_portion(twistPortion)
     parts = joint_parts(chain.Joints[0], 0, split_joints)
     for i in range(1, len(chain.Joints)):
@@ -447,7 +447,7 @@ _MESH_DEFAULTS = {"units": "mm", "scale": 1.0, "twistPortion": 0.2}
 
 
 def _scaled_parts(chain: Any, options: dict[str, Any], fmt: str) -> list[MeshPart]:
-    chain = _check_chain(chain, fmt)
+    chain = check_assembly(chain, fmt)
     opts = resolve_options(options, _MESH_DEFAULTS, f"{fmt} export")
     factor = mesh_factor(opts["units"], opts["scale"])
     parts = chain_parts(chain, twistPortion=opts["twistPortion"])
@@ -510,7 +510,7 @@ def stl_data(chain: KinematicChain | KinematicTree, **options: Any) -> bytes:
         For a bad option value.
     """
     parts = _scaled_parts(chain, options, "STL")
-    return stl_bytes(*_concatenate(parts), _TREE_STL_HEADER if _is_tree(chain) else _STL_HEADER)
+    return stl_bytes(*_concatenate(parts), _TREE_STL_HEADER if is_tree(chain) else _STL_HEADER)
 
 
 def write_stl(chain: KinematicChain | KinematicTree, stream: BinaryIO, **options: Any) -> None:
@@ -525,7 +525,7 @@ def obj_data(chain: KinematicChain | KinematicTree, **options: Any) -> str:
     """
     parts = _scaled_parts(chain, options, "OBJ")
     out = [
-        f"# kinegami {'tree' if _is_tree(chain) else 'chain'} mesh: one object per part, "
+        f"# kinegami {'tree' if is_tree(chain) else 'chain'} mesh: one object per part, "
         "millimetres, current configuration\n",
         f"# {len(parts)} parts\n",
     ]

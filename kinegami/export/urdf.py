@@ -65,9 +65,9 @@ import numpy as np
 
 from kinegami.errors import InvalidParameterError
 from kinegami.export.mesh import (
-    _check_chain,
-    _is_tree,
     chain_parts,
+    check_assembly,
+    is_tree,
     mesh_factor,
     shell_mass_properties,
     stl_bytes,
@@ -174,7 +174,7 @@ def _parents(chain: KinematicChain | KinematicTree) -> tuple[int, ...]:
 def chain_bodies(chain: KinematicChain | KinematicTree) -> ChainBodies:
     """Split ``chain`` (or a tree) into rigid bodies at its revolute and prismatic joints (see
     module doc). A joint's proximal side lies in the body of its parent's distal side."""
-    chain = _check_chain(chain, "URDF")
+    chain = check_assembly(chain, "URDF")
     parents = _parents(chain)
     movable, proximal, distal = [], [], []
     zero = np.empty((len(chain.Joints), 4, 4))
@@ -266,9 +266,9 @@ def urdf_model(chain: KinematicChain | KinematicTree, **options: Any) -> UrdfMod
     InvalidParameterError
         For a bad option value.
     """
-    chain = _check_chain(chain, "URDF")
+    chain = check_assembly(chain, "URDF")
     parents = _parents(chain)
-    tree = _is_tree(chain)
+    tree = is_tree(chain)
     opts = resolve_options(options, URDF_DEFAULTS, "URDF export")
     default_name = "kinegami_tree" if tree else "kinegami_chain"
     name = _check_name(default_name if opts["name"] is None else opts["name"], "name")

@@ -10,7 +10,7 @@ import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.pattern._prism import Prism
-from kinegami.pattern.tubular import ModuleRecord, TubularPattern, _first_occurrence_mask
+from kinegami.pattern.tubular import ModuleRecord, TubularPattern, first_occurrence_mask
 from kinegami.validation import check_nonnegative, check_real
 
 
@@ -60,7 +60,7 @@ def distinct_creases(
     lo = np.minimum(edges[:, 0], edges[:, 1])
     hi = np.maximum(edges[:, 0], edges[:, 1])
     key = lo.astype(np.int64) * num_vertices + hi
-    keep &= _first_occurrence_mask(key)
+    keep &= first_occurrence_mask(key)
     return edges[keep], labels[keep]
 
 

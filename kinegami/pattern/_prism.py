@@ -60,9 +60,9 @@ class Prism:
                             ("eps", eps)):  # fmt: skip
             s(self, name, value)
         k = np.arange(numSides)
-        s(self, "columns", _readonly((k + 0.5) * b))
-        s(self, "vertex_angles", _readonly((k + 0.5) * (2.0 * math.pi / numSides)))
-        s(self, "panel_centres", _readonly(wrap_x((k + 1.0) * b, W, eps)))
+        s(self, "columns", readonly((k + 0.5) * b))
+        s(self, "vertex_angles", readonly((k + 0.5) * (2.0 * math.pi / numSides)))
+        s(self, "panel_centres", readonly(wrap_x((k + 1.0) * b, W, eps)))
         s(self, "_cache", {})
 
     def cached(self, key, make):
@@ -103,7 +103,8 @@ class Prism:
         )
 
 
-def _readonly(array: np.ndarray) -> np.ndarray:
+def readonly(array: np.ndarray) -> np.ndarray:
+    """``array`` made read-only (in place) and returned."""
     array.setflags(write=False)
     return array
 

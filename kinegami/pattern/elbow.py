@@ -22,9 +22,9 @@ from kinegami.pattern._fold import (
     require_all,
     rot_axis,
 )
-from kinegami.pattern._prism import Prism, _readonly, make_prism, periodic_dx, wrap_x
+from kinegami.pattern._prism import Prism, make_prism, periodic_dx, readonly, wrap_x
 from kinegami.pattern.catalog import ModuleCounts
-from kinegami.pattern.tubular import ModuleRecord, TubularPattern, _first_occurrence_mask
+from kinegami.pattern.tubular import ModuleRecord, TubularPattern, first_occurrence_mask
 
 __all__ = ["ELBOW_ANGLE_TOL", "ElbowFittingPattern", "ElbowGeometry", "elbow_geometry"]
 
@@ -245,7 +245,7 @@ def _elbow_patterns(prism: Prism, angles: list[tuple]) -> list[TubularPattern]:
         block.setflags(write=False)
         for i, row in zip(rows, block, strict=True):
             vertices[i] = row
-    proximal_marker = _readonly(np.zeros(2))
+    proximal_marker = readonly(np.zeros(2))
     distal_markers = np.zeros((E, 2))
     distal_markers[:, 1] = H
     distal_markers.setflags(write=False)
@@ -343,17 +343,17 @@ def _new_layouts(prism: Prism, collapsed: np.ndarray, low: np.ndarray) -> list[_
     lo = np.minimum(edges[:, :, 0], edges[:, :, 1]).astype(np.int64)
     hi = np.maximum(edges[:, :, 0], edges[:, :, 1])
     key = (np.arange(U)[:, None] * width + lo) * width + hi
-    first = _first_occurrence_mask(key.reshape(-1)).reshape(U, -1)
+    first = first_occurrence_mask(key.reshape(-1)).reshape(U, -1)
     keep = first & (edges[:, :, 0] != edges[:, :, 1])
-    P, D = _readonly(P), _readonly(D.copy())
+    P, D = readonly(P), readonly(D.copy())
     layouts = []
     for u, total in enumerate(totals):
         layout = _Layout()
         layout.P, layout.D, layout.total = P, D, total
-        layout.edges = _readonly(edges[u][keep[u]])
-        layout.labels = _readonly(labels[keep[u]])
-        layout.x_index = _readonly(x_index[u, :total].copy())
-        layout.y_index = _readonly(y_index[u, :total].copy())
+        layout.edges = readonly(edges[u][keep[u]])
+        layout.labels = readonly(labels[keep[u]])
+        layout.x_index = readonly(x_index[u, :total].copy())
+        layout.y_index = readonly(y_index[u, :total].copy())
         layouts.append(layout)
     return layouts
 

@@ -43,7 +43,7 @@ import numpy as np
 
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.pattern._fold import MERGE_TOLERANCE, FoldedFormError, mod_w
-from kinegami.pattern._prism import make_prism, periodic_dx
+from kinegami.pattern._prism import make_prism, periodic_dx, readonly
 from kinegami.pattern.catalog import module_kind
 from kinegami.pattern.prismatic import rebo_folded_length, rebo_tilt
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
@@ -410,7 +410,7 @@ def _fold(pattern: TubularPattern, G0: np.ndarray) -> FoldedForm:
         proximal = G @ UVA_TO_DUBINS.T
         G = G @ fold.T
         modules.append(
-            FoldedModule(record, _readonly(mapping.copy()), proximal, G @ UVA_TO_DUBINS.T)
+            FoldedModule(record, readonly(mapping.copy()), proximal, G @ UVA_TO_DUBINS.T)
         )
         repaired.append(mapping[fold.repaired])
     if seam_error > 1e-6 * r:  # pragma: no cover - would be a bug in a module's geometry
@@ -476,7 +476,7 @@ def _fold_unsnapped(pattern: TubularPattern, G0: np.ndarray) -> UnsnappedForm:
         labels.append(exact.edges_assignment)
         proximal = G @ UVA_TO_DUBINS.T
         G = G @ T
-        modules.append(FoldedModule(record, _readonly(emap), proximal, G @ UVA_TO_DUBINS.T))
+        modules.append(FoldedModule(record, readonly(emap), proximal, G @ UVA_TO_DUBINS.T))
         marker = exact.distalMarker + offset
         marker[0] = mod_w(marker[0:1], W)[0]
     if gap > 1e-9 * r:  # pragma: no cover - would be a bug in a module's unsnapped geometry
@@ -527,11 +527,6 @@ def _rebuild(n: int, r: float, record: ModuleRecord, m: int) -> TubularPattern:
 @functools.lru_cache(maxsize=512)
 def _rebuild_cached(n: int, r: float, kind: str, params: tuple) -> TubularPattern:
     return module_kind(kind).rebuild(n, r, dict(params))
-
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a.flags.writeable = False
-    return a
 
 
 # ------------------------------------------------------------------------------------------------

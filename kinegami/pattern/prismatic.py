@@ -21,7 +21,7 @@ from kinegami.pattern._fold import (
 )
 from kinegami.pattern._prism import Prism, make_prism, wrap_x
 from kinegami.pattern.catalog import ModuleCounts
-from kinegami.pattern.tube import _tube
+from kinegami.pattern.tube import tube_pattern
 from kinegami.pattern.tubular import ModuleRecord, TubularPattern
 from kinegami.validation import (
     check_in_range,
@@ -205,8 +205,8 @@ def PrismaticJointPattern(
     )
     L = geo.height
     n = prism.numSides
-    sleeve = _tube(prism, L, "M", ModuleRecord("tube", {"height": L}))
-    lining = _tube(prism, L, "V", ModuleRecord("tube", {"height": L}))
+    sleeve = tube_pattern(prism, L, "M", ModuleRecord("tube", {"height": L}))
+    lining = tube_pattern(prism, L, "V", ModuleRecord("tube", {"height": L}))
     k = np.arange(n)
     lining = TubularPattern._build(
         n, prism.r, lining.vertices_coords.copy(),
@@ -216,7 +216,7 @@ def PrismaticJointPattern(
         lining.distalMarker.copy(), L, lining.modules, 0, None, False,
     )  # fmt: skip
     rebo = _build_rebo(prism, geo, N, True, ModuleRecord("rebo", {}))
-    piston = _tube(prism, L, "M", ModuleRecord("tube", {"height": L}))
+    piston = tube_pattern(prism, L, "M", ModuleRecord("tube", {"height": L}))
     whole = TubularPattern.concatenate([sleeve, lining, rebo, piston])
     record = ModuleRecord("prismatic", {"neutralLength": d, "numLayers": N, "coneAngle": beta})
     return TubularPattern._build(  # whole's arrays are its own (read-only, shared with none)

@@ -40,7 +40,7 @@ import numpy as np
 
 from kinegami._record import Record
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.pattern._prism import SHEET_TOLERANCE_FACTOR, periodic_dx
+from kinegami.pattern._prism import SHEET_TOLERANCE_FACTOR, periodic_dx, readonly
 from kinegami.validation import check_bool
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -156,11 +156,6 @@ def _check_kind(kind: str) -> str:
     return kind
 
 
-def _readonly(array: np.ndarray) -> np.ndarray:
-    array.flags.writeable = False
-    return array
-
-
 def _rectangle(xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray:
     """The 4 sides of an axis-aligned rectangle (bottom, right, top, left), shape (4, 2, 2)."""
     corners = np.array([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax]])
@@ -256,7 +251,7 @@ def flatten(pattern: TubularPattern, *, skip_creases_on_cut: bool = False) -> Sh
         outlines, outline_kinds = outlines[[0, 4]], outline_kinds[[0, 4]]
     segments = np.concatenate([creases, outlines])
     kinds = np.concatenate([labels, outline_kinds])
-    return Sheet(_readonly(segments), _readonly(kinds), W, b, y0, H, tol, snap)
+    return Sheet(readonly(segments), readonly(kinds), W, b, y0, H, tol, snap)
 
 
 def clip_segments(

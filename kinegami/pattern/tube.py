@@ -108,7 +108,9 @@ def TubeFittingPattern(numSides: int, r: float, height: float) -> TubularPattern
     return _many_tubes([(numSides, r, height)])[0]
 
 
-def _tube(prism, h: float, label: str, record: ModuleRecord) -> TubularPattern:
+def tube_pattern(prism, h: float, label: str, record: ModuleRecord) -> TubularPattern:
+    """A straight tube of height ``h`` whose ring creases are labelled ``label`` (``"M"`` or
+    ``"V"``), recorded as ``record`` (the sleeves and piston of a prismatic joint use it)."""
     if h < prism.eps:
         return _empty(prism, record)
     n = prism.numSides

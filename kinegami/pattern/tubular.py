@@ -22,7 +22,7 @@ import numpy as np
 
 from kinegami._record import Record
 from kinegami.errors import InvalidParameterError, InvalidTypeError, ReadOnlyError
-from kinegami.pattern._prism import EPS_FACTOR, make_prism, periodic_dx, wrap_x
+from kinegami.pattern._prism import EPS_FACTOR, make_prism, periodic_dx, readonly, wrap_x
 from kinegami.validation import check_nonnegative
 
 _KEY_SHIFT = np.int64(1) << np.int64(32)
@@ -156,11 +156,6 @@ class ValidationReport(Record):
         return f"{len(self.problems)} problem(s):\n" + "\n".join(f"- {p}" for p in self.problems)
 
 
-def _readonly(array: np.ndarray) -> np.ndarray:
-    array.setflags(write=False)  # half the cost of array.flags.writeable = False
-    return array
-
-
 def _edge_keys(edges: np.ndarray) -> np.ndarray:
     """One int64 per crease identifying its unordered vertex pair."""
     lo = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64)
@@ -177,7 +172,7 @@ def _repeats(keys: np.ndarray) -> np.ndarray:
     return repeated
 
 
-def _first_occurrence_mask(keys: np.ndarray) -> np.ndarray:
+def first_occurrence_mask(keys: np.ndarray) -> np.ndarray:
     """Boolean mask keeping the first crease of every group of equal keys."""
     return ~_repeats(keys)
 
@@ -449,7 +444,7 @@ class TubularPattern:
         """
         mv = self._module_vertices
         if mv is None and len(self.modules) == 1:
-            mv = (_readonly(np.arange(self.numVertices)),)
+            mv = (readonly(np.arange(self.numVertices)),)
             object.__setattr__(self, "_module_vertices", mv)
         return mv
 
@@ -621,7 +616,7 @@ class TubularPattern:
                 keys = np.zeros(0, dtype=np.int64)
             else:
                 keys = _keys_within(_edge_keys(self.edges_vertices), self.distalBase)
-            object.__setattr__(self, "_distal_keys", _readonly(keys))
+            object.__setattr__(self, "_distal_keys", readonly(keys))
         return self._distal_keys
 
     def _get_internal_duplicates(self) -> bool:
@@ -636,9 +631,9 @@ class TubularPattern:
 def _placed(pattern: TubularPattern, mapping: np.ndarray) -> tuple[np.ndarray, ...] | None:
     """``pattern.module_vertices`` renumbered by ``mapping`` (its vertex -> composite vertex)."""
     if pattern._module_vertices is None and len(pattern.modules) == 1:
-        return (_readonly(mapping),)
+        return (readonly(mapping),)
     own = pattern.module_vertices
-    return None if own is None else tuple(_readonly(mapping[v]) for v in own)
+    return None if own is None else tuple(readonly(mapping[v]) for v in own)
 
 
 def _join_placements(first, second):
@@ -747,7 +742,7 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
         edge_starts = np.concatenate([[0], np.cumsum(counts)])
         for k in flagged:
             a, b = edge_starts[k], edge_starts[k + 1]
-            keep[a:b] &= _first_occurrence_mask(_edge_keys(edges[a:b]))
+            keep[a:b] &= first_occurrence_mask(_edge_keys(edges[a:b]))
     shared = np.zeros(N0 + num_new, dtype=bool)
     shared[index[N0 + proximal]] = True
     old_edges = first.edges_vertices
@@ -764,7 +759,7 @@ def _compose_all(first: TubularPattern, patterns: list[TubularPattern]) -> Tubul
     if placements is not None:
         placements = list(placements)
         bounds = zip((N0 + starts).tolist(), (N0 + starts + sizes).tolist(), strict=True)
-        _readonly(index)  # its slices are read-only views
+        readonly(index)  # its slices are read-only views
         if all(p._module_vertices is None and len(p.modules) == 1 for p in pats):
             placements += [index[a:b] for a, b in bounds]  # _placed's common case, at once
         else:
@@ -922,7 +917,7 @@ def _compose_step(state: _ComposeState, other: TubularPattern, index: int) -> _S
             repeated = (keys[candidates, None] == state.distal_keys[None, :]).any(axis=1)
             keep[candidates[repeated]] = False
     if other._get_internal_duplicates():
-        keep &= _first_occurrence_mask(keys)
+        keep &= first_occurrence_mask(keys)
     removed = int(keep.shape[0] - np.count_nonzero(keep))
     if removed:
         edges, keys = edges[keep], keys[keep]

@@ -21,13 +21,13 @@ import math
 import numpy as np
 
 from kinegami.bodies import (
-    _hinge,
-    _shifted,
     circle_points,
+    hinge_segment,
     polygon_side,
     prismatic_prism_vertices,
     regular_polygon,
     revolute_hull_points,
+    shifted_frame,
     tip_hull_points,
 )
 from kinegami.geometry.frames import rotation
@@ -190,7 +190,7 @@ def joint_body_faces(joint: Joint) -> list[np.ndarray]:
                 (joint.distal_dubins_frame(), -1.0),
             ):
                 outer = regular_polygon(frame, r, n)
-                inner = regular_polygon(_shifted(frame, sign * h), r, n)
+                inner = regular_polygon(shifted_frame(frame, sign * h), r, n)
                 faces += prism_faces(outer, inner)
         return faces
     if isinstance(joint, StartTip | EndTip):
@@ -212,7 +212,7 @@ def joint_axis_segment(joint: Joint, scale: float) -> np.ndarray | None:
     if not isinstance(joint, RevoluteJoint | PrismaticJoint):
         return None
     T = joint.pose_matrix
-    return _hinge(T[:3, 3], T[:3, 2], 2.0 * scale * joint.r)
+    return hinge_segment(T[:3, 3], T[:3, 2], 2.0 * scale * joint.r)
 
 
 def joint_frames(joint: Joint) -> dict[str, np.ndarray]:

@@ -455,7 +455,7 @@ def _labelled_parts(chain, label: str, parts) -> list:
     arc that holds the elbow, the twist or tube, the joint or its half. Falls back to every
     part of the chain element when the named piece has no mesh part of its own (an arc too
     small to be modelled)."""
-    from kinegami.bodies import _ORDINALS
+    from kinegami.bodies import ORDINALS
 
     link = _LINK_LABEL.match(label)
     if link:
@@ -466,7 +466,7 @@ def _labelled_parts(chain, label: str, parts) -> list:
             if elbow.group(1):
                 k = int(elbow.group(1))
             else:
-                k = _ORDINALS.index(elbow.group(3)) + 1
+                k = ORDINALS.index(elbow.group(3)) + 1
             side = "arc1" if k <= chain.Links[index].elbows1.count else "arc2"
     else:
         joint = _JOINT_LABEL.match(label)
