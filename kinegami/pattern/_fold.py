@@ -68,10 +68,8 @@ def match_vertices(catalog_xy: np.ndarray, exact_xy: np.ndarray, prism: Prism) -
     """For every catalog vertex, the nearest unsnapped vertex (periodic in x): the same point
     (a collapsed column's Q_k is M_k), or less than eps away for a point snapped onto the
     seam."""
-    dx = periodic_dx(catalog_xy[:, None, 0] - exact_xy[None, :, 0], prism.W)
-    dist = np.hypot(dx, catalog_xy[:, None, 1] - exact_xy[None, :, 1])
-    nearest = np.argmin(dist, axis=1)
-    worst = dist[np.arange(catalog_xy.shape[0]), nearest].max(initial=0.0)
+    nearest, dist = nearest_within(catalog_xy, exact_xy, prism.W, 3.0 * prism.eps)
+    worst = np.where(nearest < 0, np.inf, dist).max(initial=0.0)
     if worst > 3.0 * prism.eps or np.unique(nearest).size != nearest.size:
         raise FoldedFormError(  # pragma: no cover - a catalog module changed its vertices
             f"the catalog module's vertices do not match its unsnapped geometry ({worst:.3g})"
@@ -87,14 +85,51 @@ def assign(
     Returns (X, matched): vertices farther than ``tol`` from every named point are unmatched
     (their rows of X are NaN).
     """
-    dx = periodic_dx(xy[:, None, 0] - named_xy[None, :, 0], W)
-    dy = xy[:, None, 1] - named_xy[None, :, 1]
-    dist = np.hypot(dx, dy)
-    nearest = np.argmin(dist, axis=1)
-    matched = dist[np.arange(xy.shape[0]), nearest] <= tol
+    nearest, _ = nearest_within(xy, named_xy, W, tol)
+    matched = nearest >= 0
     X = np.full((xy.shape[0], 3), np.nan)
     X[matched] = named_X[nearest[matched]]
     return X, matched
+
+
+#: Most (point, named point) pairs :func:`nearest_within` measures at once.
+_NEAREST_PAIRS = 1 << 20
+
+
+def nearest_within(xy: np.ndarray, named_xy: np.ndarray, W: float, tol: float):
+    """For each point of ``xy``, the first of the nearest points of ``named_xy`` (periodic in
+    x, distance ``hypot(dx, dy)``) when it is at most ``tol`` away, else -1; and that distance.
+
+    Only named points within ``tol`` in y are measured (sorted by y), a bounded number of pairs
+    at a time: a module of 38,400 vertices asked for an 11 GiB distance matrix (issue 29)."""
+    count = xy.shape[0]
+    nearest = np.full(count, -1, dtype=np.int64)
+    best = np.full(count, np.inf)
+    if count == 0 or named_xy.shape[0] == 0:
+        return nearest, best
+    order = np.argsort(named_xy[:, 1], kind="stable")
+    ys = named_xy[order, 1]
+    slack = tol * (1.0 + 1e-9) + 1e-12 * (float(np.abs(ys).max()) + float(np.abs(xy[:, 1]).max()))
+    low = np.searchsorted(ys, xy[:, 1] - slack, side="left")
+    size = np.searchsorted(ys, xy[:, 1] + slack, side="right") - low
+    size = np.maximum(size, 0)
+    cut = np.searchsorted(np.cumsum(size), np.arange(1, 1 + int(size.sum()) // _NEAREST_PAIRS)
+                          * _NEAREST_PAIRS)  # fmt: skip
+    for part in np.split(np.arange(count), np.unique(cut)):
+        n = size[part]
+        if part.size == 0 or n.sum() == 0:
+            continue
+        i = np.repeat(part, n)
+        q = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)  # place in each window
+        j = order[np.repeat(low[part], n) + q]
+        dx = periodic_dx(xy[i, 0] - named_xy[j, 0], W)
+        dist = np.hypot(dx, xy[i, 1] - named_xy[j, 1])
+        keep = dist <= tol
+        i, j, dist = i[keep], j[keep], dist[keep]
+        first = np.lexsort((j, dist, i))  # by point, then distance, then the named point's index
+        lead = first[np.r_[True, i[first][1:] != i[first][:-1]]] if first.size else first
+        nearest[i[lead]], best[i[lead]] = j[lead], dist[lead]
+    return nearest, best
 
 
 def require_all(matched: np.ndarray, kind: str) -> None:
