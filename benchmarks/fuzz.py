@@ -616,13 +616,14 @@ def _spawn(kind: str, seeds: list[int], memory: int, nice: int) -> subprocess.Po
 
 
 def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEOUT,
-        memory: int = MEMORY, nice: int = 0, report=None) -> dict:
+        memory: int = MEMORY, nice: int = 0, report=None, every: int = 500) -> dict:
     """Run the cases ``seeds`` of ``kind`` in ``workers`` processes; return the counts and
     every problem: ``{"cases", "ok", "problems": [(seed, status, detail)], "slowest"}``.
 
     A case that uses more than ``timeout`` seconds of CPU (or runs for more than five times as
     long, wall clock: the machine may be shared) is a "hang" (its worker is killed and
-    restarted after it); a worker that dies is a "crash" on the case it was running."""
+    restarted after it); a worker that dies is a "crash" on the case it was running. Every
+    ``every`` cases ``report`` gets a progress line with the next seed (to resume from)."""
     pending = list(seeds)
     per_worker = max(1, math.ceil(len(pending) / max(1, workers)))
     queues = [pending[i:i + per_worker] for i in range(0, len(pending), per_worker)]
@@ -650,8 +651,10 @@ def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEO
         state["queue"] = state["queue"][state["queue"].index(seed) + 1:]
         state["current"] = None
         result["cases"] += 1
-        if report and result["cases"] % 500 == 0:
-            report(f"{kind}: {result['cases']} cases done, {len(result['problems'])} problems")
+        if report and every > 0 and result["cases"] % every == 0:
+            report(f"{kind}: {result['cases']} cases done, {result['ok']} passed, "
+                   f"{len(result['problems'])} problems; resume with --seed "
+                   f"{max(seeds[:result['cases']]) + 1 if workers == 1 else '(see problems)'}")
 
     def stop(proc, status: str) -> None:
         state = running.pop(proc)
@@ -724,6 +727,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=float, default=TIMEOUT)
     parser.add_argument("--memory", type=int, default=MEMORY, help="bytes of address space")
     parser.add_argument("--nice", type=int, default=10)
+    parser.add_argument("--progress", type=int, default=500,
+                        help="a progress line every N cases (0: none)")
     args = parser.parse_args(argv)
     found = 0
     kinds = (("design", args.designs), ("operations", args.operations), ("cli", args.cli),
@@ -733,7 +738,7 @@ def main(argv: list[str] | None = None) -> int:
             continue
         started = time.monotonic()
         result = run(kind, _seeds(args.seed, count), workers=args.workers, timeout=args.timeout,
-                     memory=args.memory, nice=args.nice,
+                     memory=args.memory, nice=args.nice, every=args.progress,
                      report=lambda line: print(line, flush=True))  # fmt: skip
         found += len(result["problems"])
         slowest, seed = result["slowest"]
