@@ -51,7 +51,15 @@ from kinegami.geometry.segments import (
     segment_distances_stacked,
 )
 from kinegami.joints import PrismaticJoint, RevoluteJoint
-from kinegami.validation import UNITS_IN_MM, check_int, check_real, shorten, shown
+from kinegami.limits import MAX_SAMPLED_STATES, MAX_SAMPLES
+from kinegami.validation import (
+    UNITS_IN_MM,
+    check_int,
+    check_real,
+    check_samples,
+    shorten,
+    shown,
+)
 
 __all__ = [
     "CONTACT_TOLERANCE",
@@ -69,6 +77,7 @@ __all__ = [
     "TreeEngine",
     "TreeMotion",
     "engine_for",
+    "keep_tree_engine",
 ]
 
 #: Pairs x configurations evaluated at once (memory bound of the batched broad phase).
@@ -537,7 +546,10 @@ class ClearanceEngine:
         self._spanning = bool(spanning.any())
         self._gcentre, self._gradius = centre, radius
         self._gbody = ba[gstart]
+        self._gbody_end = bb[gstart]  # differs from _gbody for a sliding capsule's group
         self._gspan = spanning[gstart]
+        self._body_of = body_of
+        self._affected_by: dict[int, np.ndarray] = {}
         node = (element + 1) // 2
         self._gnode = node[gstart]
         self._gtau_lo, self._gtau_hi = tau_lo, tau_hi
@@ -753,11 +765,48 @@ class ClearanceEngine:
         return Q
 
     # --- the core query --------------------------------------------------------------------
-    def _near_groups(self, xyz: tuple, threshold: float):
+    def _affected(self, joint: int) -> np.ndarray:
+        """The listed group pairs that move relative to each other when joint ``joint`` alone
+        moves: one group beyond it (in its body's subtree) and the other not, or a sliding
+        capsule's group whose ends lie on both sides."""
+        if joint not in self._affected_by:
+            NB = self.bodies
+            inside = np.zeros(NB, dtype=bool)
+            b = int(self._body_of[joint])
+            inside[b] = True
+            for c in range(b + 1, NB):  # parents come before their children
+                inside[c] = inside[self._body_parent[c]]
+            start, end = inside[self._gbody], inside[self._gbody_end]
+            mixed = start != end
+            g1, g2 = self._gp1, self._gp2
+            self._affected_by[joint] = np.flatnonzero(mixed[g1] | mixed[g2]
+                                                      | (start[g1] != start[g2]))  # fmt: skip
+        return self._affected_by[joint]
+
+    def _near_groups(self, xyz: np.ndarray, threshold: float, moving=None):
         """(k, g1, g2, same path, n): the pairs of groups that move relative to each other
         (and may be tested) whose balls come within ``threshold`` at configuration k (n: their
-        index in the list, when listed)."""
+        index in the list, when listed). ``moving`` (listed engines): per configuration, the
+        joint in which it differs from a clear configuration; only the group pairs that joint
+        moves relative to each other are tested there (see :meth:`worst_arrays`)."""
         radius = self._gradius
+        if self._listed and moving is not None:
+            kk, n = [], []
+            for joint in np.unique(moving).tolist():
+                rows = np.flatnonzero(moving == joint)
+                pairs = self._affected(joint)
+                kk.append(np.repeat(rows, pairs.size))
+                n.append(np.tile(pairs, rows.size))
+            kk, n = np.concatenate(kk), np.concatenate(n)
+            g1, g2 = self._gp1[n], self._gp2[n]
+            P = xyz.shape[2]
+            flat = xyz.reshape(3, -1)
+            d = flat.take(kk * P + self._gcol[g1], axis=1) \
+                - flat.take(kk * P + self._gcol[g2], axis=1)  # fmt: skip
+            reach = radius[g1] + radius[g2] + threshold
+            near = np.flatnonzero(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= reach * reach)
+            n = n[near]
+            return kk[near], g1[near], g2[near], self._gp_same[n], n
         if self._listed:
             g1, g2 = self._gp1, self._gp2
             c1, c2 = self._gcol[g1], self._gcol[g2]
@@ -793,12 +842,13 @@ class ClearanceEngine:
         g1, g2 = np.concatenate(out_1), np.concatenate(out_2)
         return np.concatenate(out_k), g1, g2, self._same_path(g1, g2), None
 
-    def _candidates(self, Q: np.ndarray, threshold: float):
+    def _candidates(self, Q: np.ndarray, threshold: float, moving=None):
         """Exact clearances of the tested pairs that move relative to each other and whose
         capsule balls are within ``threshold`` of each other, at configurations ``Q`` (K, J).
 
         Returns (k, i, j, clearance, s, t, xyz): configuration and capsule indices, the
         clearance and closest-point parameters of each such pair, and :meth:`_world`'s points.
+        ``moving``: as in :meth:`worst_arrays`.
         """
         B = self.body_transforms(Q)
         none = np.zeros(0, dtype=np.int64)
@@ -806,7 +856,7 @@ class ClearanceEngine:
         if self._listed and self._gp1.size == 0:
             return empty
         xyz = self._centres.move(B)
-        kk, g1, g2, same, n_gp = self._near_groups(xyz, threshold)
+        kk, g1, g2, same, n_gp = self._near_groups(xyz, threshold, moving)
         if kk.size == 0:
             return empty
         if self._listed:
@@ -932,9 +982,14 @@ class ClearanceEngine:
         return self._named(row, labels[-1])
 
     # --- queries ---------------------------------------------------------------------------
-    def worst_arrays(self, Q: np.ndarray, margin: float) -> tuple:
+    def worst_arrays(self, Q: np.ndarray, margin: float, moving=None) -> tuple:
         """The closest pair closer than ``margin`` at each configuration of ``Q`` (K, J):
-        ``(clearance, i, j, s, t)`` (K,) each; +inf and -1 where clear."""
+        ``(clearance, i, j, s, t)`` (K,) each; +inf and -1 where clear.
+
+        ``moving`` (K,) ints, optional: per configuration, the one joint in which it differs
+        from a configuration that is clear with ``margin``; the pairs of parts that this
+        joint does not move relative to each other are as clear as there and are not tested
+        (the free intervals' scans)."""
         Q = self._configurations(Q)
         K = Q.shape[0]
         out = np.full(K, np.inf)
@@ -947,7 +1002,8 @@ class ClearanceEngine:
         chain = self._caps is None
         for start in range(0, K, self._chunk()):
             Qc = Q[start : start + self._chunk()]
-            k, i, j, c, s, t, _ = self._candidates(Qc, margin)
+            mc = None if moving is None else moving[start : start + self._chunk()]
+            k, i, j, c, s, t, _ = self._candidates(Qc, margin, mc)
             hit = np.flatnonzero(c < limit)
             k, i, j, c, s, t = k[hit], i[hit], j[hit], c[hit], s[hit], t[hit]
             rank = self._rank(i, j)
@@ -995,10 +1051,10 @@ class ClearanceEngine:
             pairs[w] = pair
         return found[0], pairs
 
-    def colliding(self, Q: np.ndarray, margin: float = 0.0) -> np.ndarray:
+    def colliding(self, Q: np.ndarray, margin: float = 0.0, moving=None) -> np.ndarray:
         """(K,) True where the configuration has parts closer than ``margin`` (0: where it
-        self-intersects)."""
-        return np.isfinite(self.worst_arrays(np.asarray(Q, dtype=float), margin)[0])
+        self-intersects); ``moving`` as in :meth:`worst_arrays`."""
+        return np.isfinite(self.worst_arrays(np.asarray(Q, dtype=float), margin, moving)[0])
 
     def tally(self, Q: np.ndarray, found: tuple) -> tuple[np.ndarray, tuple]:
         """What :func:`sweep` reports of ``Q`` from :meth:`worst_arrays`'s ``found``: the
@@ -1194,7 +1250,8 @@ class ClearanceEngine:
             Q = np.repeat(states[None, :], grid.size, axis=0)
             Q[:, j] = grid
             rows.append(Q)
-        hits = self.colliding(np.vstack(rows), margin).reshape(len(jobs), resolution)
+        moving = np.repeat([j for j, _ in jobs], resolution)
+        hits = self.colliding(np.vstack(rows), margin, moving).reshape(len(jobs), resolution)
         good = np.empty(len(jobs))
         bad = np.full(len(jobs), np.nan)
         for n, (j, target) in enumerate(jobs):
@@ -1213,7 +1270,7 @@ class ClearanceEngine:
             Q = np.repeat(states[None, :], open_.size, axis=0)
             for row, n in enumerate(open_):
                 Q[row, jobs[n][0]] = mid[row]
-            hit = self.colliding(Q, margin)
+            hit = self.colliding(Q, margin, np.array([jobs[n][0] for n in open_]))
             bad[open_[hit]] = mid[hit]
             good[open_[~hit]] = mid[~hit]
         for n, (j, _) in enumerate(jobs):
@@ -1264,6 +1321,20 @@ def _tree_engine(tree, names=None, margin: float = 0.0) -> TreeEngine:
     cached.insert(0, (tuple(joints), tuple(links), parents, names, margin, engine))
     del cached[4:]
     return engine
+
+
+def keep_tree_engine(tree, engine: TreeEngine, margin: float) -> None:
+    """Keep ``engine`` (built for ``tree`` at other states, for ``margin`` and no names) as
+    the engine of ``tree`` as it is now. An engine answers absolute states and measures a
+    tree's junctions on the links its links are rigid copies of, so it stays valid when
+    setJointStates moves the design; the tree's next clearance queries then need no new
+    engine and name the parts it names."""
+    joints, links, parents = tree.Joints, tree.Links, tuple(tree.Parents)
+    if not isinstance(engine, TreeEngine) or len(engine.ranges) != len(joints):
+        raise InvalidTypeError("engine must be a TreeEngine of the tree's design")
+    cached = _TREE_ENGINES.setdefault(tree, [])
+    cached.insert(0, (tuple(joints), tuple(links), parents, None, check_margin(margin), engine))
+    del cached[4:]
 
 
 def _same_objects(known: tuple, now) -> bool:
@@ -1383,11 +1454,14 @@ def sweep(
         raise InvalidTypeError(f"resolution must be an integer >= 1, got {shown(resolution)}")
     if resolution < 1:
         raise InvalidParameterError(f"resolution must be an integer >= 1, got {shown(resolution)}")
+    J = len(engine.ranges)
+    _check_scan(int(resolution))
     if configurations is None:
         if isinstance(samples, bool) or not isinstance(samples, int | np.integer):
             raise InvalidTypeError(f"samples must be an integer > 0, got {shown(samples)}")
         if samples <= 0:
             raise InvalidParameterError(f"samples must be an integer > 0, got {shown(samples)}")
+        samples = check_samples("samples", samples, J)
         seed = check_int("seed", seed, minimum=0, floats=False)
         rng = np.random.default_rng(seed)
         lo, hi = engine.ranges[:, 0], engine.ranges[:, 1]
@@ -1402,6 +1476,13 @@ def sweep(
             )
         if len(configurations) == 0:
             raise InvalidParameterError("configurations must not be empty")
+        count = len(configurations)
+        if count > MAX_SAMPLES or count * J > MAX_SAMPLED_STATES:
+            raise InvalidParameterError(
+                f"configurations: {count} configurations of {J} joints, more than "
+                f"{min(MAX_SAMPLES, MAX_SAMPLED_STATES // max(J, 1))} (each is a clearance "
+                "test of the whole chain; kinegami.limits.MAX_SAMPLES and MAX_SAMPLED_STATES)"
+            )
         Q = np.array(
             [engine.check_states(c, f"configurations[{k}]") for k, c in enumerate(configurations)]
         )
@@ -1416,6 +1497,16 @@ def sweep(
         states=tuple(float(x) for x in current),
         margin=margin,
     )
+
+
+def _check_scan(resolution: int) -> None:
+    """The free intervals scan ``resolution`` states of every joint and side: a motion check
+    of that many configurations each, at most MAX_SAMPLES (docs/limits.md)."""
+    if resolution > MAX_SAMPLES:
+        raise InvalidParameterError(
+            f"resolution must be an integer in [1, {MAX_SAMPLES}] (grid steps per joint and "
+            f"side of the free intervals; kinegami.limits.MAX_SAMPLES), got {shown(resolution)}"
+        )
 
 
 def _worst_with_progress(engine, Q: np.ndarray, progress) -> tuple:
@@ -1593,9 +1684,10 @@ class TreeMotion:
         None where clear)."""
         return self.engine.worst(Q, self.margin)
 
-    def colliding(self, Q: np.ndarray) -> np.ndarray:
-        """(K,) True where the configuration has parts closer than the margin."""
-        return self.engine.colliding(Q, self.margin)
+    def colliding(self, Q: np.ndarray, moving=None) -> np.ndarray:
+        """(K,) True where the configuration has parts closer than the margin (``moving``:
+        see :meth:`ClearanceEngine.worst_arrays`)."""
+        return self.engine.colliding(Q, self.margin, moving)
 
     def free_intervals(self, states: np.ndarray, resolution: int = 64) -> tuple:
         """Per joint, the clear interval of its own state around ``states`` (see SweepReport):
@@ -1613,7 +1705,8 @@ class TreeMotion:
         Q = np.repeat(states[None, :], len(jobs) * resolution, axis=0)
         for n, (j, _) in enumerate(jobs):
             Q[n * resolution : (n + 1) * resolution, j] = grids[n][1:]
-        hits = self.colliding(Q).reshape(len(jobs), resolution)
+        hits = self.colliding(Q, np.repeat([j for j, _ in jobs], resolution))
+        hits = hits.reshape(len(jobs), resolution)
         good = np.empty(len(jobs))
         bad = np.full(len(jobs), np.nan)
         for n in range(len(jobs)):
@@ -1629,8 +1722,9 @@ class TreeMotion:
                 break
             mid = 0.5 * (good[open_] + bad[open_])
             Q = np.repeat(states[None, :], open_.size, axis=0)
-            Q[np.arange(open_.size), [jobs[n][0] for n in open_.tolist()]] = mid
-            hit = self.colliding(Q)
+            joints = np.array([jobs[n][0] for n in open_.tolist()])
+            Q[np.arange(open_.size), joints] = mid
+            hit = self.colliding(Q, joints)
             bad[open_[hit]] = mid[hit]
             good[open_[~hit]] = mid[~hit]
         for n in range(0, len(jobs), 2):

@@ -251,12 +251,36 @@ def test_bad_states(states, error, words):
         ({"configurations": []}, InvalidParameterError, "must not be empty"),
         ({"configurations": [[0, 0]]}, InvalidParameterError, "configurations[0] must have"),
         ({"resolution": 0}, InvalidParameterError, "resolution must be an integer >= 1"),
+        ({"samples": 100_001}, InvalidParameterError,
+         "samples must be an integer in [1, 100000] (each is a clearance test of the whole "
+         "chain; kinegami.limits.MAX_SAMPLES), got 100001"),
+        ({"samples": 10**30}, InvalidParameterError, "kinegami.limits.MAX_SAMPLES"),
+        ({"resolution": 100_001}, InvalidParameterError,
+         "resolution must be an integer in [1, 100000] (grid steps per joint and side of the "
+         "free intervals; kinegami.limits.MAX_SAMPLES), got 100001"),
+        ({"configurations": [[0.0, 0.0, 0.0]] * 100_001}, InvalidParameterError,
+         "configurations: 100001 configurations of 3 joints, more than 100000"),
     ],
 )
 def test_bad_sweep_arguments(kwargs, error, words):
     with pytest.raises(error) as info:
         sweep(fold_back_chain(), **kwargs)
     assert words in str(info.value)
+
+
+def test_sweep_sampled_states_are_capped(monkeypatch):
+    """samples x joints is capped by MAX_SAMPLED_STATES (the sampled states are one array),
+    before any configuration is drawn or tested; the largest allowed count runs."""
+    import kinegami.validation as validation
+
+    chain = fold_back_chain()
+    monkeypatch.setattr(validation, "MAX_SAMPLED_STATES", 30)
+    with pytest.raises(InvalidParameterError) as info:
+        sweep(chain, samples=11)
+    assert isinstance(info.value, ValueError)
+    assert "11 configurations of 3 joints are 33 sampled states, more than 30" in str(info.value)
+    assert "use at most 10" in str(info.value)
+    assert sweep(chain, samples=10).samples == 10
 
 
 def test_not_a_chain():

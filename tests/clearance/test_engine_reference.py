@@ -216,3 +216,23 @@ def test_designs_with_no_capsules_are_clear():
     for design in (KinematicTree(Waypoint(4, 1, SE3())), KinematicChain(StartTip(4, 1, SE3(), 1))):
         assert design.clearance().ok
         assert sweep(design, samples=5).colliding == 0
+
+
+@pytest.mark.parametrize("name", ["puma", "spherical_limb", "algorithmic_hand", "quadruped"])
+def test_free_intervals_test_only_the_pairs_a_joint_moves(name, monkeypatch):
+    """The free-interval scans test, for each joint, only the pairs of parts that joint moves
+    relative to each other (the others are as clear as at the current states): the intervals
+    are those of scans that test every pair."""
+    design = load_design(DESIGNS[0].parent / f"{name}.json")
+    chain = isinstance(design, KinematicChain)
+    motion = (clearance_module._ChainMotion(ClearanceEngine(design), 0.0) if chain
+              else TreeMotion(design))  # fmt: skip
+    engine = motion.engine
+    states = np.array([joint.state for joint in design.Joints])
+    fast = motion.free_intervals(states, 16)
+    sizes = [engine._affected(j).size for j in engine.movable.tolist()]
+    assert min(sizes) < engine._gp1.size  # some joint leaves pairs out
+    monkeypatch.setattr(type(engine), "_affected", lambda self, joint: np.arange(self._gp1.size))
+    every = motion.free_intervals(states, 16)
+    assert fast == every
+    assert any(interval is not None and interval[0] < interval[1] for interval in fast)
