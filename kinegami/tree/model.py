@@ -19,7 +19,7 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from kinegami.bodies import link_polyline, tree_worst_overlap
+from kinegami.bodies import Overlap, link_polyline, tree_worst_overlap
 from kinegami.chain import RADIAL_VARIANTS, KinematicChain, _JointAssembly
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
 from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube
@@ -177,6 +177,10 @@ class KinematicTree(_JointAssembly):
     _placement_adds_pairs_only = False
 
     def _overlap(self, joints, links, parents, since: int = 0):
+        known = self.__dict__.get("_states_overlap")  # set by setJointStates for its lists
+        if known is not None and known[0] is joints and known[1] is links and since == 0 \
+                and parents is None:  # fmt: skip
+            return known[2]
         parents = self._parents if parents is None else parents
         return tree_worst_overlap(joints, links, parents, self.r, since=since,
                                   margin=self.margin)  # fmt: skip
@@ -344,7 +348,19 @@ class KinematicTree(_JointAssembly):
         if values is None:
             return False
         joints, links = self._configured(values)
-        return self._accept("setJointStates", joints, links)
+        # the tree's clearance engine answers any states of this design; it stays the
+        # engine of the tree at the new states (docs/clearance.md)
+        from kinegami.clearance import TreeMotion, keep_tree_engine
+
+        engine = TreeMotion(self, margin=self._margin).engine
+        self._states_overlap = (joints, links, _engine_overlap(engine, values, self._margin))
+        try:
+            accepted = self._accept("setJointStates", joints, links)
+        finally:
+            del self._states_overlap
+        if accepted:
+            keep_tree_engine(self, engine, self._margin)
+        return accepted
 
     def _configured(self, values: Sequence[float]) -> tuple[list, list]:
         """Joint and link lists at the (checked) states ``values``, one per joint."""
@@ -380,6 +396,18 @@ class KinematicTree(_JointAssembly):
         from kinegami.viz.chain_plot import show_chain
 
         return show_chain(self, **options)
+
+
+def _engine_overlap(engine, values, margin: float) -> Overlap | None:
+    """The deepest pair closer than ``margin`` at the states ``values`` as the engine's
+    report finds it, as an Overlap (None when clear): what tree_worst_overlap gives for the
+    configured lists (the same verdict; equal depths to rounding; where two parts are equally
+    close, the one the tree's clearance report names)."""
+    report = engine.report(list(values), margin)
+    if report.ok:
+        return None
+    pair = report.pairs[0]
+    return Overlap(pair.clearance, pair.first, pair.second, pair.elements, margin)
 
 
 def _joint_list(joints) -> list[Joint]:
