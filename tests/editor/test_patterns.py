@@ -2,12 +2,33 @@
 
 from __future__ import annotations
 
+import importlib.util
+import sys
+from pathlib import Path
+
 import numpy as np
 
 from kinegami.editor import PatternCache
-from kinegami.editor._benchmark import compact_chain, drag
 from kinegami.editor.model import EditorModel
 from tests.editor.helpers import example_model
+
+
+def _benchmark_module(name: str):
+    """benchmarks/<name>.py as a module (its folder on sys.path while it loads: it imports
+    run.py beside it)."""
+    folder = Path(__file__).resolve().parents[2] / "benchmarks"
+    sys.path.insert(0, str(folder))
+    try:
+        spec = importlib.util.spec_from_file_location(f"benchmarks_{name}", folder / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+    finally:
+        sys.path.remove(str(folder))
+
+
+_drag = _benchmark_module("editor_drag")
+compact_chain, drag = _drag.compact_chain, _drag.drag
 
 
 def same(a, b) -> bool:

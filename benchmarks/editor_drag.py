@@ -1,4 +1,4 @@
-"""The cost of a drag step in the editor: ``python -m kinegami.editor._benchmark``.
+"""The cost of a drag step in the editor: ``python benchmarks/editor_drag.py``.
 
 One step is a slide command on a 32-joint chain (the compact chain of benchmarks/run.py),
 then the clearance report and the crease pattern of the new document, as a view asks for
@@ -9,32 +9,15 @@ without propagation. See docs/editor.md (Measured).
 from __future__ import annotations
 
 import statistics
+import sys
 import time
-import warnings
+from pathlib import Path
 
-import numpy as np
-from scipy.spatial.transform import Rotation
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run.py beside this file
 
-from kinegami.chain import KinematicChain
-from kinegami.editor.model import EditorModel
-from kinegami.joints import PrismaticJoint, RevoluteJoint, StartTip
+from run import compact_chain  # noqa: E402
 
-
-def compact_chain(n: int = 32, seed: int = 0, r: float = 1.0) -> KinematicChain:
-    """The 32-joint compact-placement chain of benchmarks/run.py (random poses, seed 0)."""
-    rng = np.random.default_rng(seed)
-    chain = KinematicChain(StartTip(4, r, np.eye(4), r))
-    while len(chain.Joints) < n:
-        T = np.eye(4)
-        T[:3, :3] = Rotation.random(random_state=int(rng.integers(1 << 31))).as_matrix()
-        T[:3, 3] = rng.uniform(-4 * r, 4 * r, 3)
-        i = len(chain.Joints)
-        joint = (RevoluteJoint(4, r, np.pi, T) if i % 2 == 0
-                 else PrismaticJoint(4, r, 3 * r, 3, np.pi / 4, T))  # fmt: skip
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            chain.append(joint, safe=False)
-    return chain
+from kinegami.editor.model import EditorModel  # noqa: E402
 
 
 def drag(model: EditorModel, joint: int, propagate: bool, steps: int = 11) -> list[tuple]:

@@ -1,4 +1,4 @@
-"""The cost of a drag step in the browser view: ``python -m kinegami.editor._view_benchmark``.
+"""The cost of a drag step in the browser view: ``python benchmarks/editor_view.py``.
 
 The 32-joint compact chain of benchmarks/run.py in an :class:`~kinegami.editor.view.EditorView`
 drawn on a viser server with no tab connected (so sending over the network is not counted).
@@ -21,10 +21,15 @@ from __future__ import annotations
 
 import math
 import statistics
+import sys
 import time
+from pathlib import Path
 
-from kinegami.editor._benchmark import compact_chain
-from kinegami.editor.model import EditorModel
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run.py beside this file
+
+from run import compact_chain  # noqa: E402
+
+from kinegami.editor.model import EditorModel  # noqa: E402
 
 
 def _median_ms(values) -> float:
@@ -97,7 +102,7 @@ def trees(steps: int = 5) -> None:
 
     from kinegami.editor.server import EditorServer
 
-    hand = Path(__file__).resolve().parents[2] / "examples" / "designs" / "hand.json"
+    hand = Path(__file__).resolve().parents[1] / "examples" / "designs" / "hand.json"
     server = EditorServer(hand, port=0, autosave=False)
     try:
         view = server.new_view(server.server)
