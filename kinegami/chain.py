@@ -49,7 +49,7 @@ from kinegami.validation import (
     shown,
 )
 
-__all__ = ["KinematicChain", "PlacementWarning", "ClearanceWarning"]
+__all__ = ["KinematicChain", "JointAssembly", "PlacementWarning", "ClearanceWarning"]
 
 
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
@@ -93,7 +93,7 @@ def _propagate_flag(propogate, propagate) -> bool:
     return propagate
 
 
-class _JointAssembly:
+class JointAssembly:
     """What a chain and a tree share: the root, joints and links in world coordinates, one
     bounding ball, placement of new joints and the all-or-nothing commit of every change.
 
@@ -713,7 +713,7 @@ class _JointAssembly:
         )
 
 
-class KinematicChain(_JointAssembly):
+class KinematicChain(JointAssembly):
     """A serial chain of tubular origami joints joined by CSC links.
 
     Parameters

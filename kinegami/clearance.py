@@ -779,8 +779,29 @@ class ClearanceEngine:
             start, end = inside[self._gbody], inside[self._gbody_end]
             mixed = start != end
             g1, g2 = self._gp1, self._gp2
-            self._affected_by[joint] = np.flatnonzero(mixed[g1] | mixed[g2]
-                                                      | (start[g1] != start[g2]))  # fmt: skip
+            pairs = np.flatnonzero(mixed[g1] | mixed[g2] | (start[g1] != start[g2]))
+            # the closest the two group centres come while the joint alone moves, at any
+            # state: the one inside turns about (slides along) the joint's axis
+            g1, g2 = g1[pairs], g2[pairs]
+            inner = np.where(start[g1], g1, g2)
+            outer = np.where(start[g1], g2, g1)
+            m = int(np.flatnonzero(self.movable == joint)[0])
+            axis = self._axis[m]
+            u = self._gcentre[inner] - self._hinge_point[m]
+            w = self._gcentre[outer] - self._hinge_point[m]
+            along = u @ axis
+            if self._revolute_b[m]:
+                across = u - along[:, None] * axis
+                cos_part = np.einsum("ij,ij->i", across, w)
+                sin_part = np.einsum("ij,ij->i", np.cross(axis, across), w)
+                low = np.einsum("ij,ij->i", u, u) + np.einsum("ij,ij->i", w, w) \
+                    - 2.0 * along * (w @ axis) - 2.0 * np.hypot(cos_part, sin_part)  # fmt: skip
+            else:
+                d = u - w
+                low = np.einsum("ij,ij->i", d, d) - (d @ axis) ** 2
+            closest = np.sqrt(np.maximum(low, 0.0))
+            closest[mixed[g1] | mixed[g2]] = -math.inf  # a sliding capsule's group: always
+            self._affected_by[joint] = (pairs, closest - self._gradius[g1] - self._gradius[g2])
         return self._affected_by[joint]
 
     def _near_groups(self, xyz: np.ndarray, threshold: float, moving=None):
@@ -792,9 +813,11 @@ class ClearanceEngine:
         radius = self._gradius
         if self._listed and moving is not None:
             kk, n = [], []
+            slack = 1e-9 * (float(np.abs(self._gcentre).max()) + float(radius.max()))
             for joint in np.unique(moving).tolist():
                 rows = np.flatnonzero(moving == joint)
-                pairs = self._affected(joint)
+                pairs, gap = self._affected(joint)
+                pairs = pairs[gap <= threshold + slack]  # the others never come near
                 kk.append(np.repeat(rows, pairs.size))
                 n.append(np.tile(pairs, rows.size))
             kk, n = np.concatenate(kk), np.concatenate(n)
@@ -1443,10 +1466,10 @@ def sweep(
         The colliding fraction, the worst pairs, and each joint's free interval around the
         chain's current states.
     """
-    from kinegami.chain import KinematicChain, _JointAssembly
+    from kinegami.chain import JointAssembly, KinematicChain
 
     margin = _margin_of(chain, margin)
-    if isinstance(chain, _JointAssembly) and not isinstance(chain, KinematicChain):
+    if isinstance(chain, JointAssembly) and not isinstance(chain, KinematicChain):
         engine = TreeMotion(chain, names, margin)  # a KinematicTree (a layer above this one)
     else:
         engine = _ChainMotion(engine_for(chain, names), margin)

@@ -9,8 +9,8 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "kinegami"
 
-#: Shared private names still being made public (the layout work), each with where it is used.
-NOT_YET = {("kinegami.chain", "_JointAssembly")}
+#: Shared private names still being made public (the layout work).
+NOT_YET: set[tuple[str, str]] = set()
 
 
 def _private_imports() -> dict[tuple[str, str], list[str]]:

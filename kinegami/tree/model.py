@@ -20,7 +20,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from kinegami.bodies import Overlap, link_polyline, tree_worst_overlap
-from kinegami.chain import RADIAL_VARIANTS, KinematicChain, _JointAssembly
+from kinegami.chain import RADIAL_VARIANTS, JointAssembly, KinematicChain
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
 from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube
 from kinegami.validation import check_int, shown
@@ -28,7 +28,7 @@ from kinegami.validation import check_int, shown
 __all__ = ["KinematicTree"]
 
 
-class KinematicTree(_JointAssembly):
+class KinematicTree(JointAssembly):
     """A tree of tubular origami joints joined by CSC links.
 
     Parameters
