@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -151,18 +152,28 @@ def main(argv: list[str] | None = None) -> int:
                         help="a checkout of SungRoboticsGroup/KinegamiPython (d3dc867)")
     parser.add_argument("--repeat", type=int, default=3, help="runs per figure (median)")
     parser.add_argument("--joints", type=int, default=32, help="joints of the compact chain")
+    parser.add_argument("--rounds", type=int, default=3,
+                        help="fresh processes per side, alternating (median of the rounds)")
     args = parser.parse_args(argv)
     if not (args.reference / "KinematicChain.py").is_file():
         parser.error(f"{args.reference} holds no KinematicChain.py (not a KinegamiPython checkout)")
     print(f"running the workload on kinegami and on {args.reference} ...", file=sys.stderr)
-    ours = run("kinegami", None, args.repeat, args.joints)
-    theirs = run("reference", args.reference.resolve(), args.repeat, args.joints)
+    # the two sides alternate, round by round and in turn first, so that a change in the
+    # machine's load during the run weighs on both alike
+    rounds: dict[str, list[dict]] = {"kinegami": [], "reference": []}
+    for k in range(max(1, args.rounds)):
+        order = ("kinegami", "reference") if k % 2 == 0 else ("reference", "kinegami")
+        for api in order:
+            path = None if api == "kinegami" else args.reference.resolve()
+            rounds[api].append(run(api, path, args.repeat, args.joints))
+    ours, theirs = ({key: statistics.median(r[key] for r in rounds[api]) for key in rounds[api][0]}
+                    for api in ("kinegami", "reference"))  # fmt: skip
     print(f"{'figure':40} {'kinegami':>12} {'reference':>12} {'ratio':>8}  goal")
     for key, what, _, goal in FIGURES:
         ratio = theirs[key] / ours[key] if ours[key] > 0 else float("inf")
         print(f"{what:40} {ours[key] * 1e3:>9.2f} ms {theirs[key] * 1e3:>9.2f} ms "
               f"{ratio:>7.1f}x  {goal}")  # fmt: skip
-    print(f"joints built: kinegami {ours['joints']}, reference {theirs['joints']}")
+    print(f"joints built: kinegami {ours['joints']:.0f}, reference {theirs['joints']:.0f}")
     return 0
 
 
