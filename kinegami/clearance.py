@@ -550,6 +550,10 @@ class ClearanceEngine:
         self._gspan = spanning[gstart]
         self._body_of = body_of
         self._affected_by: dict[int, np.ndarray] = {}
+        self._closest_ever = None  # _closest_over_motion, on first use
+        self._reach_cache: dict[float, tuple] = {}
+        self._reach_slack = 1e-9 * (float(np.abs(centre).max()) + float(radius.max())) \
+            if G else 0.0  # fmt: skip
         node = (element + 1) // 2
         self._gnode = node[gstart]
         self._gtau_lo, self._gtau_hi = tau_lo, tau_hi
@@ -804,6 +808,78 @@ class ClearanceEngine:
             self._affected_by[joint] = (pairs, closest - self._gradius[g1] - self._gradius[g2])
         return self._affected_by[joint]
 
+    def _reachable(self, threshold: float) -> tuple:
+        """The listed group pairs whose balls can come within ``threshold`` at some
+        configuration (with their centres' columns and their reach): the others never come
+        near. Over any motion, a group lies within a ball about the hinge of the first joint
+        between it and the two groups' deepest common body, fixed in that body: its radius
+        is the distance from the group's centre to its own body's hinge plus the distances
+        between the hinges on the way and the strokes of the sliding joints there."""
+        cached = self._reach_cache.get(threshold)
+        if cached is None:
+            if self._closest_ever is None:
+                self._closest_ever = self._closest_over_motion()
+            sub = np.flatnonzero(self._closest_ever <= threshold + self._reach_slack)
+            g1, g2 = self._gp1[sub], self._gp2[sub]
+            reach = self._gradius[g1] + self._gradius[g2] + threshold
+            cached = (sub, self._gcol[g1], self._gcol[g2], reach)
+            if len(self._reach_cache) < 8:
+                self._reach_cache[threshold] = cached
+        return cached
+
+    def _closest_over_motion(self) -> np.ndarray:
+        """For every listed group pair, a lower bound of the gap between their balls over
+        every configuration (see :meth:`_reachable`; -inf for a sliding capsule's group)."""
+        NB, parent = self.bodies, self._body_parent
+        hinge = np.vstack([np.zeros((1, 3)), self._hinge_point])
+        stroke = np.zeros(NB)
+        slides = np.flatnonzero(~self._revolute_b)
+        if slides.size:
+            j = self.movable[slides]
+            stroke[slides + 1] = np.abs(self.ranges[j] - self._states[j][:, None]).max(axis=1)
+        depth = np.zeros(NB, dtype=np.int64)
+        along = np.zeros(NB)  # hinge to hinge from the first movable body on the way
+        strokes = np.zeros(NB)
+        for b in range(1, NB):
+            p = int(parent[b])
+            depth[b] = depth[p] + 1
+            along[b] = along[p] + (float(np.linalg.norm(hinge[b] - hinge[p])) if p else 0.0)
+            strokes[b] = strokes[p] + stroke[b]
+        g1, g2 = self._gp1, self._gp2
+        b1, b2 = self._gbody[g1], self._gbody[g2]
+        x1, x2 = b1.copy(), b2.copy()
+        while True:  # the deepest common body
+            up1, up2 = depth[x1] > depth[x2], depth[x2] > depth[x1]
+            if not (up1.any() or up2.any()):
+                break
+            x1, x2 = np.where(up1, parent[x1], x1), np.where(up2, parent[x2], x2)
+        while True:
+            differ = x1 != x2
+            if not differ.any():
+                break
+            x1, x2 = np.where(differ, parent[x1], x1), np.where(differ, parent[x2], x2)
+        common = x1
+
+        def ball(g: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            first = b.copy()  # the body after the common one on the way to b
+            while True:
+                up = (first != common) & (parent[np.maximum(first, 0)] != common)
+                if not up.any():
+                    break
+                first = np.where(up, parent[first], first)
+            centre = self._gcentre[g]
+            moves = b != common
+            radius = np.where(moves, np.sqrt(((centre - hinge[b]) ** 2).sum(axis=1))
+                              + along[b] - along[first] + strokes[b] - strokes[common], 0.0)
+            return np.where(moves[:, None], hinge[first], centre), radius  # fmt: skip
+
+        c1, r1 = ball(g1, b1)
+        c2, r2 = ball(g2, b2)
+        gap = np.sqrt(((c1 - c2) ** 2).sum(axis=1)) - r1 - r2 - self._gradius[g1] \
+            - self._gradius[g2]  # fmt: skip
+        gap[self._gspan[g1] | self._gspan[g2]] = -math.inf
+        return gap
+
     def _near_groups(self, xyz: np.ndarray, threshold: float, moving=None):
         """(k, g1, g2, same path, n): the pairs of groups that move relative to each other
         (and may be tested) whose balls come within ``threshold`` at configuration k (n: their
@@ -831,12 +907,11 @@ class ClearanceEngine:
             n = n[near]
             return kk[near], g1[near], g2[near], self._gp_same[n], n
         if self._listed:
-            g1, g2 = self._gp1, self._gp2
-            c1, c2 = self._gcol[g1], self._gcol[g2]
+            sub, c1, c2, reach = self._reachable(threshold)
             d = [np.take(c, c1, axis=1) - np.take(c, c2, axis=1) for c in xyz]
-            reach = radius[g1] + radius[g2] + threshold
-            kk, n = np.nonzero(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= reach * reach)
-            return kk, g1[n], g2[n], self._gp_same[n], n
+            kk, m = np.nonzero(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= reach * reach)
+            n = sub[m]
+            return kk, self._gp1[n], self._gp2[n], self._gp_same[n], n
         from scipy.spatial import cKDTree
 
         large = self._large_groups

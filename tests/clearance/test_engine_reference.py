@@ -238,3 +238,23 @@ def test_free_intervals_test_only_the_pairs_a_joint_moves(name, monkeypatch):
     every = motion.free_intervals(states, 16)
     assert fast == every
     assert any(interval is not None and interval[0] < interval[1] for interval in fast)
+
+
+@pytest.mark.parametrize("path", DESIGNS, ids=lambda p: p.stem)
+def test_group_pairs_left_out_never_come_near(path):
+    """The batch leaves out the listed group pairs whose balls cannot come within the margin
+    at any configuration: at random configurations every pair's ball gap is at least the
+    bound it was left out by."""
+    design = load_design(path)
+    chain = isinstance(design, KinematicChain)
+    engine = ClearanceEngine(design) if chain else TreeMotion(design).engine
+    if not engine._listed or engine._gp1.size == 0:
+        return
+    bound = engine._closest_over_motion()
+    Q = engine._configurations(random_configurations(design, 200, seed=13))
+    centres = engine._centres.move(engine.body_transforms(Q))[:, :, engine._gcol]
+    d = centres[:, :, engine._gp1] - centres[:, :, engine._gp2]
+    gap = np.sqrt((d * d).sum(axis=0)) - engine._gradius[engine._gp1] \
+        - engine._gradius[engine._gp2]  # fmt: skip
+    scale = float(np.abs(engine._gcentre).max()) + float(engine._gradius.max())
+    assert np.all(gap >= bound - 1e-9 * scale), path.stem
