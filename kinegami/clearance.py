@@ -1517,8 +1517,9 @@ def sweep(
         A tree is tested configuration by configuration with the pair rule of trees
         (:class:`TreeMotion`, docs/trees.md); a chain with its vectorised engine.
     samples : int
-        Number of configurations drawn uniformly from the joints' state ranges (> 0; ignored
-        when ``configurations`` is given).
+        Number of configurations drawn uniformly from the joints' state ranges (> 0, at most
+        kinegami.limits.MAX_SAMPLES, and samples x joints at most MAX_SAMPLED_STATES, as every
+        count of configurations here; ignored when ``configurations`` is given).
     seed : int
         Seed of the random configurations (numpy ``default_rng``; >= 0; ignored when
         ``configurations`` is given).
@@ -1526,7 +1527,8 @@ def sweep(
         The configurations to test instead (absolute states, one per joint).
     names : joint names for the report, optional.
     resolution : int
-        Grid steps per joint and direction when searching the free intervals (>= 1).
+        Grid steps per joint and direction when searching the free intervals (1 to
+        kinegami.limits.MAX_SAMPLES).
     progress : bool or callable, optional
         ``progress(done, total)`` as configurations are tested (total: their count);
         returning False stops the sweep with :class:`~kinegami.errors.Cancelled`. True or
