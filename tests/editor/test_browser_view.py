@@ -293,7 +293,10 @@ def test_escape_cancels_a_real_handle_drag(browser, servers, tmp_path):
     page, view = open_tab(browser, servers["example1"])
     try:
         view.click_joint(4)
-        time.sleep(1.5)  # the handle is drawn
+        # the selection reaches the page (its modules highlighted on the sheet), then the
+        # handle is drawn: as test_browser.py's drag waits
+        page.locator("rect.kinegami-highlight").first.wait_for()
+        time.sleep(1.5)
         document = view.model.document
         pose = view.model.chain.Joints[4].pose_matrix.copy()
         box = page.locator("canvas").first.bounding_box()
