@@ -398,14 +398,22 @@ def random_dh_table(n: int, seed: int = 1, r: float = 1.0) -> list[tuple[float, 
 
 
 def scale_rows() -> list[tuple[str, str, str]]:
-    """How builds grow with the design: safe random chains of 100, 200 and 400 joints, the
+    """How builds grow with the design: safe random chains of 100, 200 and 400 joints (three
+    seeds), the
     CPU time of one append early and late in a 400-joint chain, and a 1,000-row DH table
     (from_dh, and kinegami build of a design file holding it)."""
-    times = {}
-    for n in (100, 200, 400):
-        t0 = time.perf_counter()
-        safe_chain(0, n)
-        times[n] = time.perf_counter() - t0
+    # three seeds; wall time per size (median) and, per seed, the CPU-time ratio 400 / 200
+    # (one run of one seed swings between 1.9x and 2.9x on a shared machine)
+    wall: dict[int, list[float]] = {100: [], 200: [], 400: []}
+    cpu: dict[int, list[float]] = {100: [], 200: [], 400: []}
+    for seed in range(3):
+        for n in (100, 200, 400):
+            t0, c0 = time.perf_counter(), time.process_time()
+            safe_chain(seed, n)
+            wall[n].append(time.perf_counter() - t0)
+            cpu[n].append(time.process_time() - c0)
+    times = {n: statistics.median(values) for n, values in wall.items()}
+    ratios = sorted(c400 / c200 for c400, c200 in zip(cpu[400], cpu[200], strict=True))
     # CPU time per append over joints 1-50 and 351-400 of one safe chain
     rng = np.random.default_rng(0)
     chain = KinematicChain(StartTip(4, 1.0, np.eye(4), 1.0))
@@ -424,9 +432,11 @@ def scale_rows() -> list[tuple[str, str, str]]:
     dh = time.perf_counter() - t0
     build = _dh_build_seconds(random_dh_table(1000))
     return [
-        ("safe random chain, 100 / 200 / 400 joints",
+        ("safe random chain, 100 / 200 / 400 joints (median of 3 seeds)",
          f"{times[100]:.1f} / {times[200]:.1f} / {times[400]:.1f} s", "400 joints <= 10 s"),
-        ("  400 joints / 200 joints", f"{times[400] / times[200]:.2f}x", "<= 2.5x (near-linear)"),
+        ("  400 joints / 200 joints (CPU, 3 seeds)",
+         f"{statistics.median(ratios):.2f}x ({ratios[0]:.2f}-{ratios[-1]:.2f})",
+         "<= 2.5x (near-linear)"),
         ("  CPU per append: joints 1-50 / 351-400", f"{early * 1e3:.1f} / {late * 1e3:.1f} ms",
          "late ~ early (no growth with length)"),
         ("KinematicChain.from_dh, 1,000 random rows", f"{dh:.1f} s", "<= 30 s"),
