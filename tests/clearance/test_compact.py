@@ -123,7 +123,7 @@ def test_dask_executor_works_unchanged():
 
 
 def test_motion_keeps_the_colliding_fraction():
-    from kinegami.optimize import _colliding_fraction, _motion_configurations
+    from kinegami.optimize.compaction import _colliding_fraction, _motion_configurations
 
     chain = random_safe_chain(4, 4)
     out = compact(chain, executor=serial(), starts=2, motion=True, samples=50)
@@ -145,7 +145,7 @@ def test_a_self_intersecting_chain_comes_out_clear():
 
 
 def test_compaction_error_when_no_start_is_clear(monkeypatch):
-    import kinegami.optimize as optimize
+    import kinegami.optimize.compaction as optimize
     from kinegami.bodies import Overlap
 
     def always(joints, links, r, *args, **kwargs):  # nothing is ever clear
@@ -205,7 +205,7 @@ def test_a_shortest_choice_that_collides_is_banned_away(monkeypatch):
     the search bans culprits until the design is clear, and it is still shorter."""
     from pathlib import Path
 
-    import kinegami.optimize as optimize
+    import kinegami.optimize.compaction as optimize
     from kinegami.bodies import worst_overlap
     from kinegami.design import load_design
 
@@ -231,7 +231,7 @@ def test_a_shortest_choice_that_collides_is_banned_away(monkeypatch):
 def test_a_banned_candidate_is_never_chosen():
     chain = random_safe_chain(4, 4)
     joints = [j for i, j in enumerate(chain.Joints) if i == 0 or not isinstance(j, Waypoint)]
-    import kinegami.optimize as optimize
+    import kinegami.optimize.compaction as optimize
 
     layers = optimize._Layers(chain, joints, optimize._coarse_options(joints, chain.r, None),
                               restarts=False)  # fmt: skip
