@@ -3,6 +3,7 @@ exact document snapshot."""
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 from kinegami.editor import Document, EditorModel
@@ -55,3 +56,15 @@ def snapshot(document: Document) -> tuple:
         (document.name, document.description, document.units, document.twistPortion),
         (chain.requireClearance, chain.maxAnglePerElbow),
     )
+
+
+def wait_for(condition, what: str, timeout: float = 60.0, step: float = 0.1):
+    """``condition()``'s first true value, polled every ``step`` s; an AssertionError naming
+    ``what`` after ``timeout`` s (a liveness bound for the browser tests, not a timing test)."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(step)
+    raise AssertionError(f"timed out after {timeout} s waiting for {what}")

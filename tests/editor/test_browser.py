@@ -14,6 +14,8 @@ from pathlib import Path
 import headless_chromium
 import pytest
 
+from tests.editor.helpers import wait_for as helpers_wait_for
+
 from .helpers import EXAMPLE1, HAND
 
 pytestmark = pytest.mark.browser
@@ -38,13 +40,8 @@ def server(browser):
 
 
 def wait_for(condition, what: str, timeout: float = TIMEOUT):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.1)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+    """tests/editor/helpers.wait_for with this file's timeout."""
+    return helpers_wait_for(condition, what, timeout)
 
 
 @pytest.fixture

@@ -13,6 +13,7 @@ import headless_chromium
 import pytest
 
 from .helpers import EXAMPLE1
+from .helpers import wait_for as helpers_wait_for
 
 pytestmark = pytest.mark.browser
 
@@ -56,13 +57,8 @@ def server(browser, design):
 
 
 def wait_for(condition, what: str, timeout: float = TIMEOUT):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.1)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+    """tests/editor/helpers.wait_for with this file's timeout."""
+    return helpers_wait_for(condition, what, timeout)
 
 
 @pytest.fixture

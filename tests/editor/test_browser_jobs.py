@@ -9,10 +9,11 @@ liveness limits, not timing asserts (benchmarks/editor_jobs.py measures the late
 from __future__ import annotations
 
 import shutil
-import time
 
 import headless_chromium
 import pytest
+
+from tests.editor.helpers import wait_for as helpers_wait_for
 
 from .helpers import EXAMPLE1, HAND, ROOT
 
@@ -30,13 +31,8 @@ def browser():
 
 
 def wait_for(condition, what: str, timeout: float = TIMEOUT):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+    """tests/editor/helpers.wait_for with this file's timeout."""
+    return helpers_wait_for(condition, what, timeout, step=0.05)
 
 
 def open_tab(browser, server):
