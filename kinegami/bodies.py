@@ -1611,7 +1611,12 @@ def part_label(row, param: float, joints, names=None) -> str:
         if at < x:
             text = labels[n]
             break
-    element = int(row[5])
+    return with_joint_name(text, int(row[5]), joints, names)
+
+
+def with_joint_name(text: str, element: int, joints, names=None) -> str:
+    """A part's words ``text`` with its joint's name from ``names`` after "joint j, Type"
+    (``element`` 2 j is joint j; links and unnamed joints are left as they are)."""
     if names is not None and element % 2 == 0:
         jj = element // 2
         if jj < len(names) and names[jj] is not None:

@@ -43,6 +43,7 @@ from kinegami.bodies import (
     check_margin,
     clear_limit,
     tree_capsules,
+    with_joint_name,
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.segments import (
@@ -1740,14 +1741,7 @@ class TreeEngine(ClearanceEngine):
 
     def _named(self, row: int, text: str) -> str:
         """``text`` with the joint's name (as :func:`~kinegami.bodies.part_label` words it)."""
-        element = int(self._element[row])
-        names = self._names
-        if names is not None and element % 2 == 0:
-            jj = element // 2
-            if jj < len(names) and names[jj] is not None:
-                plain = f"joint {jj}, {type(self._joints[jj]).__name__}"
-                text = text.replace(plain, f"{plain} '{names[jj]}'", 1)
-        return text
+        return with_joint_name(text, int(self._element[row]), self._joints, self._names)
 
 
 class TreeMotion:
