@@ -807,38 +807,45 @@ def audit_document(document, file=None) -> list[DesignProblem]:
     only when the stages before it found nothing, since its checks assume what they check.
     The first problem is always the one check_document raises.
     """
+    try:  # a valid design (the usual case) is checked once
+        check_document(document, file)
+        return []
+    except DesignError as error:
+        first = error
     problems: list[DesignProblem] = []
+
+    def add(code: str, error: DesignError) -> None:
+        if error.file is None and file is not None:
+            error = error.with_file(file)
+        if all(str(error) != str(known) for known in problems):
+            problems.append(DesignProblem(code, error))
 
     def attempt(code: str, check, *args):
         try:
             return True, check(*args)
         except DesignError as error:
-            if error.file is None and file is not None:
-                error = error.with_file(file)
-            if all(str(error) != str(known) for known in problems):
-                problems.append(DesignProblem(code, error))
+            add(code, error)
             return False, None
 
-    def first() -> None:  # the problem check_document reports comes first
-        try:
-            check_document(document, file)
-        except DesignError as error:
-            text = str(error)
-            at = next((k for k, p in enumerate(problems) if str(p) == text), None)
-            problems.insert(0, DesignProblem("design", error) if at is None else problems.pop(at))
+    if attempt("header", _check_header, document, file)[0]:
+        for key, value in document.items():
+            attempt("value", _check_values, value, file, (key,))
+        attempt("top-level", check_top_level, document, file)
+        attempt("version", check_version_features, document, file)
+        if not problems:
+            for error in schema_errors(document, file):
+                add("schema", error)
+        if not problems:
+            _audit_semantics(document, file, attempt)
+    # the problem check_document reports comes first
+    at = next((k for k, p in enumerate(problems) if str(p) == str(first)), None)
+    problems.insert(0, DesignProblem("design", first) if at is None else problems.pop(at))
+    return problems
 
-    if not attempt("header", _check_header, document, file)[0]:
-        return problems
-    for key, value in document.items():
-        attempt("value", _check_values, value, file, (key,))
-    attempt("top-level", check_top_level, document, file)
-    attempt("version", check_version_features, document, file)
-    if not problems:
-        for error in schema_errors(document, file):
-            problems.append(DesignProblem("schema", error))
-    if problems:
-        first()
-        return problems
+
+def _audit_semantics(document: dict, file, attempt) -> None:
+    """The checks the schema cannot express, each through ``attempt(code, check, *args)``
+    (:func:`audit_document`); the document is schema-valid."""
     units = document.get("angleUnits", "rad")
     numSides, r = int(document["numSides"]), float(document["r"])
     attempt("lengths", check_lengths, document, file)
@@ -853,8 +860,6 @@ def audit_document(document, file=None) -> list[DesignProblem]:
     else:
         attempt("dh", _plan_dh, document["dh"], units)
     attempt("edits", _plan_edits, document.get("edits", []), units)
-    first()  # also what the stages above do not cover (a tree specification's checks)
-    return problems
 
 
 # --- where the joints of a built chain come from ---------------------------------------------
