@@ -33,8 +33,8 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
+from kinegami.chain.joints import _catalog_pattern
 from kinegami.geometry.csc import solve_csc, solve_csc_all
-from kinegami.joints import _catalog_pattern
 
 DESIGNS = Path(__file__).resolve().parents[1] / "examples" / "designs"
 

@@ -853,8 +853,8 @@ def _movable(chain) -> list[int]:
 
 
 def _check_json(chain, info, design, report, motion, seed) -> dict:
+    from kinegami.chain.joints import RevoluteJoint
     from kinegami.design.reader import origin_of
-    from kinegami.joints import RevoluteJoint
 
     origin = origin_of(chain)
     data = {
@@ -898,7 +898,7 @@ def _check_json(chain, info, design, report, motion, seed) -> dict:
 
 
 def _check_lines(chain, info, design, report, motion, seed) -> list[str]:
-    from kinegami.joints import RevoluteJoint
+    from kinegami.chain.joints import RevoluteJoint
 
     lengths = _lengths(chain.r, info.units)
     title = f"{_printable(info.name)} ({design})" if info.name else design

@@ -24,7 +24,7 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
-from kinegami.dh import dh_transform
+from kinegami.chain.dh import dh_transform
 from kinegami.validation import LENGTH_FACTOR, R_MAX, R_MIN, shorten, shown, shown_path
 
 HUGE = 10**400  # a Python int beyond the float range

@@ -34,9 +34,9 @@ import pytest
 from ezdxf import bbox
 
 from kinegami import *
-from kinegami.bodies import link_polyline
+from kinegami.chain.bodies import link_polyline
+from kinegami.chain.dh import dh_joint_frames, dh_tool_frame
 from kinegami.design import chain_from_dict, load_design, load_design_with_info
-from kinegami.dh import dh_joint_frames, dh_tool_frame
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"

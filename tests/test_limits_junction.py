@@ -2,7 +2,8 @@
 
 A tree whose branches are 1e6 r long used to sample every 0.02 r along them against every
 sibling capsule at once: 5e7 points x 13 siblings, a 14.5 GiB array and a MemoryError (84 s and
-4.3 GB at 1e5 r). :func:`kinegami.bodies.junction_extent` now evaluates only the samples that
+4.3 GB at 1e5 r). :func:`kinegami.clearance.tree_bodies.junction_extent` now evaluates only the
+samples that
 can be close to a sibling, a bounded number at a time, with the same answers.
 """
 
@@ -16,7 +17,8 @@ import textwrap
 import numpy as np
 import pytest
 
-from kinegami.bodies import CONTACT_TOLERANCE, junction_extent
+from kinegami.chain.bodies import CONTACT_TOLERANCE
+from kinegami.clearance.tree_bodies import junction_extent
 from kinegami.geometry.segments import point_segment_parameters
 
 
@@ -214,7 +216,7 @@ MANY_SIBLINGS = """
 import resource
 resource.setrlimit(resource.RLIMIT_AS, (1024 * 2**20, 1024 * 2**20))
 import numpy as np
-from kinegami.bodies import junction_extent
+from kinegami.clearance.tree_bodies import junction_extent
 # one tube 2,000 r long beside 800 sibling capsules 2.5 r long along it, 0.5 r away: 1e5
 # samples against 800 segments (once 65,536 x 800 x 3 floats, 1.2 GiB, at a time)
 polyline = np.array([[0.0, 0, 0], [0, 0, 2000]])

@@ -25,7 +25,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from kinegami.chain import KinematicChain
+from kinegami.chain.model import KinematicChain
 from kinegami.design import limits
 from kinegami.design.checks import check_pattern, joint_table
 from kinegami.design.errors import DesignError

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 
-from kinegami.chain import KinematicChain
+from kinegami.chain.model import KinematicChain
 from kinegami.design.errors import NUMERIC_ERRORS, DesignError, json_path, numeric_errors
 from kinegami.design.reader import (
     DEFAULT_TWIST_PORTION,

@@ -27,7 +27,15 @@ import warnings
 import weakref
 from dataclasses import dataclass
 
-from kinegami.chain import KinematicChain, PlacementWarning
+from kinegami.chain.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+from kinegami.chain.model import KinematicChain
 from kinegami.design.errors import DesignError, json_path, numeric_errors
 from kinegami.design.limits import (
     MAX_DEPTH,
@@ -57,15 +65,7 @@ from kinegami.design.trees import (
     construct_tree,
     structure_of,
 )
-from kinegami.errors import ClearanceWarning, JointIndexError, KinegamiError
-from kinegami.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
-)
+from kinegami.errors import ClearanceWarning, JointIndexError, KinegamiError, PlacementWarning
 from kinegami.tree import KinematicTree
 from kinegami.validation import LENGTH_UNITS, shorten, shown
 
@@ -1038,7 +1038,7 @@ def _build_from_specification(plan: _Plan, file) -> tuple[KinematicTree, list]:
         ) from None
     tree.margin = plan.margin
     if plan.require_clearance:
-        from kinegami.bodies import tree_worst_overlap
+        from kinegami.clearance.tree_bodies import tree_worst_overlap
 
         found = tree_worst_overlap(tree.Joints, tree.Links, tree.Parents, tree.r,
                                    margin=plan.margin)  # fmt: skip
@@ -1079,7 +1079,7 @@ def _build_from_dh(plan: _Plan, file) -> tuple[KinematicChain, list]:
         raise DesignError(message, field=field, file=file) from None
     chain.margin = plan.margin
     if plan.require_clearance:
-        from kinegami.bodies import worst_overlap
+        from kinegami.chain.bodies import worst_overlap
 
         found = worst_overlap(chain.Joints, chain.Links, chain.r, margin=plan.margin)
         if found is not None:  # placement warns only when it adds an overlap

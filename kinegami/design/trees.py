@@ -21,9 +21,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from kinegami.chain.joints import Joint
 from kinegami.design.errors import DesignError, json_path
 from kinegami.design.poses import rescaled_exactly
-from kinegami.joints import Joint
 from kinegami.validation import shorten
 
 __all__ = [

@@ -22,12 +22,8 @@ import os
 from pathlib import Path
 
 from kinegami._atomic import write_atomic
-from kinegami.bodies import tree_worst_overlap, worst_overlap
-from kinegami.chain import KinematicChain
-from kinegami.design.errors import DesignError
-from kinegami.design.reader import FORMAT, UNITS, check_document, origin_of
-from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.joints import (
+from kinegami.chain.bodies import worst_overlap
+from kinegami.chain.joints import (
     EndTip,
     ExtendedRevoluteJoint,
     Joint,
@@ -36,6 +32,11 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
+from kinegami.chain.model import KinematicChain
+from kinegami.clearance.tree_bodies import tree_worst_overlap
+from kinegami.design.errors import DesignError
+from kinegami.design.reader import FORMAT, UNITS, check_document, origin_of
+from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.tree import KinematicTree
 from kinegami.validation import check_twist_portion
 

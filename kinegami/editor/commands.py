@@ -18,7 +18,16 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from kinegami.chain import KinematicChain
+from kinegami.chain.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    Joint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+from kinegami.chain.model import KinematicChain
 from kinegami.design import limits
 from kinegami.design.reader import UNITS
 from kinegami.editor.document import Document, fork_chain, joint_parameters
@@ -29,15 +38,6 @@ from kinegami.errors import (
     EditorCommandError,
     KinegamiError,
     PlacementWarning,
-)
-from kinegami.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
-    Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
 )
 from kinegami.tree import KinematicTree
 from kinegami.validation import shown

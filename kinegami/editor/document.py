@@ -21,7 +21,16 @@ from pathlib import Path
 import numpy as np
 
 from kinegami._atomic import write_atomic
-from kinegami.chain import KinematicChain
+from kinegami.chain.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    Joint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+)
+from kinegami.chain.model import KinematicChain
 from kinegami.design import DesignInfo, design_to_dict, dumps_design
 from kinegami.design.reader import (
     DEFAULT_TWIST_PORTION,
@@ -33,15 +42,6 @@ from kinegami.design.reader import (
     read_design_file,
 )
 from kinegami.errors import ClearanceWarning, InvalidParameterError, InvalidTypeError
-from kinegami.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
-    Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
-)
 from kinegami.tree import KinematicTree
 
 __all__ = ["Document", "JointRow", "joint_parameters", "fork_chain"]

@@ -62,7 +62,7 @@ def _moves(joint) -> bool:
 
 
 def _state(joint, value: float) -> str:
-    from kinegami.joints import RevoluteJoint
+    from kinegami.chain.joints import RevoluteJoint
 
     if isinstance(joint, RevoluteJoint):
         return f"{math.degrees(value):.1f} deg"

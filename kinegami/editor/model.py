@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kinegami.chain import KinematicChain
+from kinegami.chain.model import KinematicChain
 from kinegami.design.limits import position_problem
 from kinegami.editor import commands as cmd
 from kinegami.editor.commands import Command, CommandError, Outcome

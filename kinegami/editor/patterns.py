@@ -24,8 +24,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from kinegami.chain import KinematicChain
-from kinegami.links import LinkCSC
+from kinegami.chain.links import LinkCSC
+from kinegami.chain.model import KinematicChain
 from kinegami.pattern import TubularPattern
 
 __all__ = ["PatternCache", "link_shape_key", "joint_records", "TreeSheets", "tree_sheets",

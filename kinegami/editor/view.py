@@ -560,7 +560,7 @@ class EditorView:
         self._update_panel(structure=True)
 
     def _joint_node(self, joint, i: int) -> _Node:
-        from kinegami.export.mesh import joint_parts
+        from kinegami.clearance.solids import joint_parts
 
         node = _Node(self._new_uid(), joint)
         pose = np.asarray(joint.pose_matrix, dtype=float)
@@ -573,7 +573,7 @@ class EditorView:
         return node
 
     def _link_node(self, link, i: int) -> _Node:
-        from kinegami.export.mesh import link_parts
+        from kinegami.clearance.solids import link_parts
 
         node = _Node(self._new_uid(), link)
         frame = np.asarray(link.start_frame, dtype=float)

@@ -344,7 +344,7 @@ def _subject(obj: Any, fmt: ExportFormat, options: dict[str, Any]) -> Any:
 
     if fmt.accepts != "chain" and isinstance(obj, TubularPattern):
         return obj  # the common case, without importing the chain and tree packages
-    from kinegami.chain import KinematicChain
+    from kinegami.chain.model import KinematicChain
     from kinegami.tree.model import KinematicTree
 
     if fmt.accepts == "chain":

@@ -63,17 +63,11 @@ from typing import TYPE_CHECKING, Any, TextIO
 
 import numpy as np
 
+from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
+from kinegami.clearance.solids import chain_parts, check_assembly, is_tree
 from kinegami.errors import InvalidParameterError
-from kinegami.export.mesh import (
-    chain_parts,
-    check_assembly,
-    is_tree,
-    mesh_factor,
-    shell_mass_properties,
-    stl_bytes,
-)
+from kinegami.export.mesh import mesh_factor, shell_mass_properties, stl_bytes
 from kinegami.geometry.frames import inverse
-from kinegami.joints import PrismaticJoint, RevoluteJoint
 from kinegami.validation import (
     check_bool,
     check_nonnegative,
@@ -83,7 +77,7 @@ from kinegami.validation import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
-    from kinegami.chain import KinematicChain
+    from kinegami.chain.model import KinematicChain
     from kinegami.tree.model import KinematicTree
 
 __all__ = [

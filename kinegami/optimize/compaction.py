@@ -21,18 +21,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinegami.bodies import check_margin, tree_worst_overlap, worst_overlap
-from kinegami.chain import KinematicChain, PlacementWarning
+from kinegami.chain.bodies import check_margin, worst_overlap
+from kinegami.chain.joints import Waypoint
+from kinegami.chain.model import KinematicChain
+from kinegami.clearance.tree_bodies import tree_worst_overlap
 from kinegami.errors import (
     ClearanceWarning,
     CompactionError,
     InvalidParameterError,
     InvalidTypeError,
     NoPathError,
+    PlacementWarning,
 )
 from kinegami.geometry.csc import csc_lengths
 from kinegami.geometry.frames import rotation_about_line
-from kinegami.joints import Waypoint
 from kinegami.progress import Progress, ProgressCallback, check_progress
 from kinegami.tree import KinematicTree
 from kinegami.tree.sheets import junction_problems

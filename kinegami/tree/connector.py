@@ -3,7 +3,7 @@
 A branch node B of a kinematic tree has a distal Dubins frame D and child links L_c, all
 starting at D. Near D the sibling tubes overlap; a 3D-printed connector holds them there. Its
 inputs are plain: the tube radius r, ``numSides`` n, D (4x4, world), the child links
-(:class:`~kinegami.links.LinkCSC`, each starting at D; children reached through zero-length
+(:class:`~kinegami.chain.links.LinkCSC`, each starting at D; children reached through zero-length
 waypoints are given by their own links), which child is the trunk (optional) and the options.
 Lengths are in the units of r; frames are 4x4 world arrays whose first axis is the tangent.
 
@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
+from kinegami.chain.links import LinkCSC
 from kinegami.errors import ExporterUnavailableError, InvalidParameterError, InvalidTypeError
 from kinegami.geometry.csc_centreline import (
     csc_distances,
@@ -32,7 +33,6 @@ from kinegami.geometry.csc_centreline import (
     csc_tangents,
     csc_transported_frame,
 )
-from kinegami.links import LinkCSC
 from kinegami.validation import (
     check_in_range,
     check_int,

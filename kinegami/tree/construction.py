@@ -30,6 +30,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinegami.chain.joints import (
+    EndTip,
+    ExtendedRevoluteJoint,
+    Joint,
+    PrismaticJoint,
+    RevoluteJoint,
+    StartTip,
+    Waypoint,
+    check_same_tube,
+    pose_array,
+)
 from kinegami.errors import (
     ClearanceWarning,
     DesignError,
@@ -41,17 +52,6 @@ from kinegami.errors import (
 )
 from kinegami.geometry.balls import Ball, merge_balls
 from kinegami.geometry.frames import rot_x, rot_y, rot_z, rotation_matrix, translation
-from kinegami.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
-    Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
-    check_same_tube,
-    pose_array,
-)
 from kinegami.tree.model import KinematicTree
 from kinegami.validation import (
     FILE_NUM_SIDES_MAX,

@@ -19,10 +19,12 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from kinegami.bodies import Overlap, link_polyline, tree_worst_overlap
-from kinegami.chain import RADIAL_VARIANTS, JointAssembly, KinematicChain
+from kinegami.chain.assembly import RADIAL_VARIANTS, JointAssembly
+from kinegami.chain.bodies import Overlap, link_polyline
+from kinegami.chain.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube
+from kinegami.chain.model import KinematicChain
+from kinegami.clearance.tree_bodies import tree_worst_overlap
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
-from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube
 from kinegami.validation import check_int, shown
 
 __all__ = ["KinematicTree"]

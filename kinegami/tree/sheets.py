@@ -36,8 +36,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from kinegami.chain.links import LinkCSC
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.links import LinkCSC
 from kinegami.pattern import TubularPattern
 from kinegami.pattern.catalog import check_pattern_size
 from kinegami.pattern.cutout import CutPattern, SheetHole
@@ -257,7 +257,7 @@ def _downstream(tree: KinematicTree) -> list[float]:
 def _check_tree(tree) -> KinematicTree:
     """``tree``, or InvalidTypeError unless it is a KinematicTree (a chain says how to get one)."""
     if not isinstance(tree, KinematicTree):
-        from kinegami.chain import KinematicChain
+        from kinegami.chain.model import KinematicChain
 
         hint = (" (KinematicTree.from_chain(chain) is the tree of a chain)"
                 if isinstance(tree, KinematicChain) else "")  # fmt: skip

@@ -20,7 +20,8 @@ capsules tries fewer heights, then fewer faces (evenly spread); ordinary trees t
 The folded body is measured as a tree of its own (:func:`takeoff_body`): the trunk's link is
 cut at every take-off point O (the trunk's axis point at the hole's centre) by a zero-length
 waypoint whose children are the rest of the trunk and the branches leaving there. So the
-clearance rules of :func:`kinegami.bodies.tree_worst_overlap` treat the trunk and a branch
+clearance rules of :func:`kinegami.clearance.tree_bodies.tree_worst_overlap` treat the trunk
+and a branch
 like the tubes leaving one joint: not where they still run together next to the take-off, and
 as any two branches beyond.
 """
@@ -35,12 +36,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from kinegami.bodies import Overlap, link_polyline, tree_worst_overlap
+from kinegami.chain.bodies import Overlap, link_polyline
+from kinegami.chain.joints import Waypoint
+from kinegami.chain.links import LinkCSC
+from kinegami.clearance.tree_bodies import tree_worst_overlap
 from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
 from kinegami.geometry.csc_centreline import csc_transported_frame
-from kinegami.joints import Waypoint
 from kinegami.limits import TAKEOFF_WORK
-from kinegami.links import LinkCSC
 from kinegami.pattern.takeoff import TakeoffJunction, takeoff_junction
 from kinegami.validation import check_in_range, check_int, check_radius
 
@@ -214,7 +216,7 @@ def takeoff_body(tree, takeoffs: Sequence[BodyTakeoff], cache: dict | None = Non
     """The folded body with take-offs as a tree: ``(joints, links, parents, original)``.
 
     Every trunk link with take-offs is cut at each take-off point O (arc length ``sigma``
-    along it) by a zero-length :class:`~kinegami.joints.Waypoint` whose Dubins frame is the
+    along it) by a zero-length :class:`~kinegami.chain.joints.Waypoint` whose Dubins frame is the
     link's frame there; the branches leaving at O are its children, with their take-off links;
     the rest of the trunk's link goes on to the trunk child. The cut pieces are the same CSC
     path. Nodes are in a topological order; ``original[k]`` is the tree index of node k (for
@@ -285,7 +287,8 @@ def takeoff_body(tree, takeoffs: Sequence[BodyTakeoff], cache: dict | None = Non
 def takeoff_overlap(tree, takeoffs: Sequence[BodyTakeoff], names=None,
                     cache: dict | None = None) -> Overlap | None:  # fmt: skip
     """The closest pair of parts of the folded body with ``takeoffs`` (:func:`takeoff_body`, by
-    the rules of :func:`kinegami.bodies.tree_worst_overlap`) closer than the tree's ``margin``
+    the rules of :func:`kinegami.clearance.tree_bodies.tree_worst_overlap`) closer than the
+    tree's ``margin``
     (0: the deepest overlap), its parts named by the tree's joint and link numbers (a cut trunk
     link's pieces as that link), or None when it is clear."""
     margin = tree.margin

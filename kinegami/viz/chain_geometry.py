@@ -6,7 +6,7 @@ matplotlib. Each takes one joint or one link on its own (a link carries its star
 frames), so the same functions draw a chain and a tree. The drawing in
 :mod:`kinegami.viz.chain_plot` only hands these arrays to matplotlib, so everything drawn can
 be tested without rendering. The shapes of the parts (the n-gons, the point sets whose hulls are
-the joints) come from :mod:`kinegami.bodies`, the body model shared with the mesh exporter and
+the joints) come from :mod:`kinegami.chain.bodies`, the body model shared with the mesh exporter and
 the clearance engine; their names stay importable from here.
 
 Polygons of a joint lie in the plane spanned by the second and third axes (b, c) of one of its
@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from kinegami.bodies import (
+from kinegami.chain.bodies import (
     circle_points,
     hinge_segment,
     polygon_side,
@@ -30,8 +30,7 @@ from kinegami.bodies import (
     shifted_frame,
     tip_hull_points,
 )
-from kinegami.geometry.frames import rotation
-from kinegami.joints import (
+from kinegami.chain.joints import (
     EndTip,
     ExtendedRevoluteJoint,
     Joint,
@@ -40,7 +39,8 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
-from kinegami.links import ELBOW_MIN_ANGLE
+from kinegami.chain.links import ELBOW_MIN_ANGLE
+from kinegami.geometry.frames import rotation
 
 __all__ = [
     "regular_polygon",
@@ -239,7 +239,7 @@ def frame_axes(frames, length: float) -> tuple[np.ndarray, np.ndarray]:
 def elbow_grids(arc, sides: int = 32) -> np.ndarray:
     """(count, 3, sides, 3): start circle, mitre ellipse and end circle of each elbow of ``arc``.
 
-    ``arc`` is an :class:`~kinegami.links.ElbowArc`. The mitre ellipse is the start circle
+    ``arc`` is an :class:`~kinegami.chain.links.ElbowArc`. The mitre ellipse is the start circle
     carried along the incoming axis to the plane through the vertex that bisects the turn.
     """
     count = arc.count

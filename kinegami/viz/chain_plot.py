@@ -5,7 +5,7 @@ Nothing here assumes that joint i follows joint i - 1: every joint is drawn at i
 and every link ``Links[i]`` along its own path, which runs from the distal frame of joint
 ``Parents[i]`` (i - 1 in a chain) to joint i, so a tree's branches are drawn from the joint
 they leave. ``showCollisions`` asks the object for its own ``clearance()`` (the tree's pair
-rule for a tree) and names parts by their index (:func:`kinegami.export.mesh.chain_parts`).
+rule for a tree) and names parts by their index (:func:`kinegami.clearance.solids.chain_parts`).
 
 The geometry comes from :mod:`kinegami.viz.chain_geometry`; this module only turns it into
 matplotlib artists, one collection per kind of thing (joint bodies, elbows, tubes, ...), each
@@ -36,7 +36,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.axes3d import Axes3D
 
-    from kinegami.chain import KinematicChain
+    from kinegami.chain.model import KinematicChain
     from kinegami.tree.model import KinematicTree
 
 __all__ = [
@@ -305,7 +305,7 @@ def _draw_junctions(scene, chain, opts):
     manifold3d missing) is left out with a warning saying why."""
     import warnings
 
-    from kinegami.chain import KinematicChain
+    from kinegami.chain.model import KinematicChain
 
     if isinstance(chain, KinematicChain) or not any(len(c) > 1 for c in chain.Children):
         return
@@ -450,12 +450,12 @@ _ELBOW_ORDINAL = re.compile(r"(\d+)(st|nd|rd|th) elbow|(\w+) elbow")
 
 
 def _labelled_parts(chain, label: str, parts) -> list:
-    """The mesh parts (:func:`kinegami.export.mesh.chain_parts`) of a part named in words by
+    """The mesh parts (:func:`kinegami.clearance.solids.chain_parts`) of a part named in words by
     the clearance engine ("link 3, second elbow", "joint 5, RevoluteJoint, distal half"): the
     arc that holds the elbow, the twist or tube, the joint or its half. Falls back to every
     part of the chain element when the named piece has no mesh part of its own (an arc too
     small to be modelled)."""
-    from kinegami.bodies import ORDINALS
+    from kinegami.chain.bodies import ORDINALS
 
     link = _LINK_LABEL.match(label)
     if link:
@@ -495,7 +495,7 @@ def _draw_collisions(scene, chain) -> str:
     returns the title text."""
     report = chain.clearance()
     if report.pairs:
-        from kinegami.export.mesh import chain_parts
+        from kinegami.clearance.solids import chain_parts
 
         parts = chain_parts(chain)
         chosen: dict[str, object] = {}

@@ -23,7 +23,7 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
-from kinegami.links import PATTERN_MIN_ANGLE
+from kinegami.chain.links import PATTERN_MIN_ANGLE
 
 
 def _modules(pattern, kind):

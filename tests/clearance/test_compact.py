@@ -146,7 +146,7 @@ def test_a_self_intersecting_chain_comes_out_clear():
 
 def test_compaction_error_when_no_start_is_clear(monkeypatch):
     import kinegami.optimize.compaction as optimize
-    from kinegami.bodies import Overlap
+    from kinegami.chain.bodies import Overlap
 
     def always(joints, links, r, *args, **kwargs):  # nothing is ever clear
         return Overlap(-1.0, "link 1, straight tube", "link 3, first elbow", (1, 5))
@@ -206,7 +206,7 @@ def test_a_shortest_choice_that_collides_is_banned_away(monkeypatch):
     from pathlib import Path
 
     import kinegami.optimize.compaction as optimize
-    from kinegami.bodies import worst_overlap
+    from kinegami.chain.bodies import worst_overlap
     from kinegami.design import load_design
 
     collided = []

@@ -25,9 +25,9 @@ from hypothesis import strategies as st
 from kinegami import (
     PrismaticJoint,
 )
-from kinegami.bodies import capsule_model
+from kinegami.chain.bodies import capsule_model
+from kinegami.clearance.solids import chain_parts
 from kinegami.design import load_design
-from kinegami.export.mesh import chain_parts
 from kinegami.pattern.folded import folded_form
 
 DESIGNS = CHAIN_DESIGNS  # a chain pattern's folded form (trees: one per sheet)

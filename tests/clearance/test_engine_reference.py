@@ -15,15 +15,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import kinegami.clearance as clearance_module
+import kinegami.clearance.engine as clearance_module
 from kinegami import KinematicChain, RevoluteJoint
-from kinegami.bodies import (
-    TURN_TOLERANCE,
-    capsule_model,
-    clear_limit,
-    tree_capsules,
-)
+from kinegami.chain.bodies import TURN_TOLERANCE, capsule_model, clear_limit
 from kinegami.clearance import ClearanceEngine, TreeMotion, sweep
+from kinegami.clearance.tree_bodies import tree_capsules
 from kinegami.design import load_design
 from kinegami.errors import ClearanceWarning
 from kinegami.geometry.segments import (
@@ -225,7 +221,7 @@ def test_free_intervals_test_only_the_pairs_a_joint_moves(name, monkeypatch):
     near at some state of that joint: the intervals are those of scans that test every pair."""
     design = load_design(DESIGNS[0].parent / f"{name}.json")
     chain = isinstance(design, KinematicChain)
-    motion = (clearance_module._ChainMotion(ClearanceEngine(design), 0.0) if chain
+    motion = (clearance_module.ChainMotion(ClearanceEngine(design), 0.0) if chain
               else TreeMotion(design))  # fmt: skip
     engine = motion.engine
     states = np.array([joint.state for joint in design.Joints])

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from kinegami.bodies import tree_worst_overlap
+from kinegami.clearance.tree_bodies import tree_worst_overlap
 from kinegami.design import load_design
 from kinegami.errors import ClearanceWarning, PlacementWarning
 

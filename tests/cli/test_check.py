@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from kinegami.chain.joints import RevoluteJoint
 from kinegami.clearance import chain_clearance, sweep
 from kinegami.design import load_design, load_design_with_info, read_design
 from kinegami.design.reader import origin_of
-from kinegami.joints import RevoluteJoint
 
 from .helpers import EXAMPLE1, GALLERY, ROOT, assert_clean_failure, fold_back, run, write
 

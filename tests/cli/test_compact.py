@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from kinegami import ClearanceWarning, cli
+from kinegami.chain.joints import Waypoint
 from kinegami.design import load_design, load_design_with_info
-from kinegami.joints import Waypoint
 from kinegami.optimize import CompactionError, tube_length
 
 from .helpers import ROOT, assert_clean_failure, fold_back, run, write

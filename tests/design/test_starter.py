@@ -9,6 +9,7 @@ import os
 
 import pytest
 
+from kinegami.chain.joints import EndTip, PrismaticJoint, RevoluteJoint, StartTip
 from kinegami.design import check_pattern, load_design_with_info, validate_design
 from kinegami.design.starter import (
     DesignFileExistsError,
@@ -17,7 +18,6 @@ from kinegami.design.starter import (
     write_starter_design,
 )
 from kinegami.errors import InvalidParameterError, KinegamiError
-from kinegami.joints import EndTip, PrismaticJoint, RevoluteJoint, StartTip
 
 
 def test_written_file_validates_builds_and_is_named_after_the_file(tmp_path):

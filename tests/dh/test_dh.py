@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from kinegami import *
-from kinegami.dh import dh_frames, dh_joint_frames, dh_tool_frame, dh_transform
+from kinegami.chain.dh import dh_frames, dh_joint_frames, dh_tool_frame, dh_transform
 from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
 from kinegami.optimize import shorten_by_axis_translations
 

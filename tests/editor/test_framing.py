@@ -11,10 +11,10 @@ import re
 import numpy as np
 import pytest
 
+from kinegami.clearance.solids import chain_parts
 from kinegami.editor import EditorModel
 from kinegami.editor.framing import box_corners, frame_box, grid_for_box, nice_step
 from kinegami.errors import InvalidParameterError
-from kinegami.export.mesh import chain_parts
 
 from .helpers import EXAMPLE1, HAND, ROOT
 

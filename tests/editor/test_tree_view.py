@@ -13,9 +13,9 @@ import pytest
 
 pytest.importorskip("viser")
 
+from kinegami.clearance.solids import chain_parts  # noqa: E402
 from kinegami.editor.server import EditorServer  # noqa: E402
 from kinegami.editor.view import ALL_SHEETS, COLLIDING_COLOR, download_data  # noqa: E402
-from kinegami.export.mesh import chain_parts  # noqa: E402
 
 from .helpers import EXAMPLE1, HAND, HAND_SHEET_JOINTS  # noqa: E402
 

@@ -11,6 +11,7 @@ from numpy.testing import assert_allclose
 
 pytest.importorskip("viser")
 
+from kinegami.clearance.solids import chain_parts, joint_parts, link_parts  # noqa: E402
 from kinegami.cli import main  # noqa: E402
 from kinegami.editor import EditorModel  # noqa: E402
 from kinegami.editor.autosave import autosave_path  # noqa: E402
@@ -22,7 +23,6 @@ from kinegami.editor.view import (  # noqa: E402
     SELECTED_COLOR,
     download_data,
 )
-from kinegami.export.mesh import chain_parts, joint_parts, link_parts  # noqa: E402
 
 from .helpers import EXAMPLE1  # noqa: E402
 

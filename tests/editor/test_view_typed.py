@@ -41,7 +41,7 @@ def view(server):
 
 
 def _mesh_points(view) -> np.ndarray:
-    from kinegami.export.mesh import chain_parts
+    from kinegami.clearance.solids import chain_parts
 
     return np.concatenate([part.vertices for part in chain_parts(view.model.chain)])
 

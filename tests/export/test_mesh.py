@@ -22,21 +22,18 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
-from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
-from kinegami.export.mesh import (
+from kinegami.chain.links import LinkCSC
+from kinegami.clearance.solids import (
     MESH_TOLERANCE,
     MIN_ARC_ANGLE,
-    chain_mesh,
     chain_parts,
     joint_parts,
     link_parts,
-    shell_mass_properties,
-    write_obj,
-    write_stl,
 )
+from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
+from kinegami.export.mesh import chain_mesh, shell_mass_properties, write_obj, write_stl
 from kinegami.geometry.frames import rotation_matrix
 from kinegami.limits import MIN_ANGLE_PER_ELBOW
-from kinegami.links import LinkCSC
 from kinegami.viz.chain_geometry import regular_polygon
 
 EXAMPLE_1_PARTS = [

@@ -16,9 +16,10 @@ import pytest
 import trimesh
 
 from kinegami import KinematicChain, KinematicTree
+from kinegami.clearance.solids import chain_parts
 from kinegami.design import load_design
 from kinegami.errors import ExporterUnavailableError, InvalidTypeError
-from kinegami.export.mesh import chain_mesh, chain_parts, obj_data, stl_data
+from kinegami.export.mesh import chain_mesh, obj_data, stl_data
 from kinegami.export.registry import export
 
 try:  # tests/ is not a package: reachable as tests.tree from the checkout, else as tree
@@ -79,7 +80,7 @@ def test_hand_has_the_parts_of_every_node(hand):
 
 def test_each_link_starts_at_its_parent(hand):
     """A link's first ring is the n-gon of its parent's distal Dubins frame."""
-    from kinegami.bodies import regular_polygon
+    from kinegami.chain.bodies import regular_polygon
 
     parts = chain_parts(hand)
     for k in range(1, len(hand.Joints)):

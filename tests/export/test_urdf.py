@@ -24,9 +24,9 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
+from kinegami.clearance.solids import chain_parts
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export import ExportError
-from kinegami.export.mesh import chain_parts
 from kinegami.export.registry import export
 from kinegami.export.urdf import urdf_model, write_urdf
 

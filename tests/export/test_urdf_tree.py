@@ -27,7 +27,7 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
-from kinegami.export.mesh import chain_parts
+from kinegami.clearance.solids import chain_parts
 from kinegami.export.registry import export
 from kinegami.export.urdf import chain_bodies, urdf_files
 

@@ -12,10 +12,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
 from kinegami.design import load_design
 from kinegami.geometry import screws
 from kinegami.geometry.frames import rotation_about_line, translation
-from kinegami.joints import PrismaticJoint, RevoluteJoint
 
 GALLERY = sorted((Path(__file__).resolve().parents[2] / "examples" / "designs").glob("*.json"))
 

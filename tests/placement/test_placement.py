@@ -14,9 +14,9 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
-from kinegami.bodies import link_polyline
+from kinegami.chain.bodies import link_polyline
+from kinegami.chain.placement import radial_safe_placement
 from kinegami.geometry.balls import Ball
-from kinegami.placement import radial_safe_placement
 
 
 def _pose(rotvec, translation):

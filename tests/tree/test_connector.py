@@ -9,11 +9,11 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
+from kinegami.chain.joints import RevoluteJoint, Waypoint
+from kinegami.chain.links import LinkCSC
 from kinegami.errors import ExporterUnavailableError, InvalidParameterError, NoPathError
 from kinegami.geometry.csc_centreline import csc_distances, csc_points
 from kinegami.geometry.frames import rot_x, rot_y, rotation_matrix, translation
-from kinegami.joints import RevoluteJoint, Waypoint
-from kinegami.links import LinkCSC
 from kinegami.tree.connector import (
     ConnectorOptions,
     junction_connector,

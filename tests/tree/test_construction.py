@@ -486,7 +486,7 @@ def test_report_cylinder_contains():
 
 
 def _two_waypoints():
-    from kinegami.joints import Waypoint
+    from kinegami.chain.joints import Waypoint
 
     above = np.eye(4)
     above[2, 3] = 5.0

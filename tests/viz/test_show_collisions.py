@@ -8,9 +8,9 @@ from matplotlib.colors import to_rgba
 from numpy.testing import assert_allclose
 
 from kinegami import KinematicChain, RevoluteJoint, StartTip, Waypoint
-from kinegami.bodies import _ordinal
+from kinegami.chain.bodies import _ordinal
+from kinegami.clearance.solids import chain_parts
 from kinegami.errors import ClearanceWarning, InvalidTypeError
-from kinegami.export.mesh import chain_parts
 from kinegami.viz.chain_plot import ARTIST_GIDS, _labelled_parts, resolve_chain_options
 
 FIXED = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrientation": True}

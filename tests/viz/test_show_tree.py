@@ -10,8 +10,8 @@ import pytest
 from spatialmath import SE3
 
 from kinegami import KinematicTree, RevoluteJoint, Waypoint
+from kinegami.clearance.solids import chain_parts
 from kinegami.errors import ClearanceWarning
-from kinegami.export.mesh import chain_parts
 from kinegami.style import linkSurfaceSides
 from kinegami.viz import chain_geometry as geo
 

@@ -23,9 +23,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from kinegami.chain.joints import EndTip, PrismaticJoint, RevoluteJoint
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.frames import rot_x, rot_z, translation
-from kinegami.joints import EndTip, PrismaticJoint, RevoluteJoint
 from kinegami.validation import (
     check_bool,
     check_num_sides,
@@ -36,7 +36,7 @@ from kinegami.validation import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
-    from kinegami.chain import KinematicChain
+    from kinegami.chain.model import KinematicChain
 
 __all__ = ["CONVENTIONS", "PLACEMENTS", "dh_frames", "dh_joint_frames", "dh_tool_frame",
            "dh_transform", "chain_from_dh", "parse_joint_types"]  # fmt: skip

@@ -336,7 +336,7 @@ class Joint(ReadOnlyAttributes):
     def transformed(self, T: np.ndarray) -> Joint:
         """A copy whose Pose is moved by the world transform ``T`` (Pose <- T Pose)."""
         new = self.with_pose(T @ self._T)
-        # the joint this one is a rigid copy of, and the transform from it (kinegami.bodies
+        # the joint this one is a rigid copy of, and the transform from it (kinegami.chain.bodies
         # moves that joint's cached capsules instead of rebuilding them)
         origin, moved = self.__dict__.get("_moved_from", (self, None))
         new.__dict__["_moved_from"] = (origin, T if moved is None else T @ moved)

@@ -1,4 +1,5 @@
-"""KinematicChain: append joints, place them, edit them, set their states.
+"""JointAssembly, what a chain and a tree share: append joints, place them, edit them, set
+their states.
 
 See docs/theory/chain.md (frames, balls, edits) and docs/placement.md (placement).
 
@@ -19,7 +20,16 @@ from collections.abc import Mapping, Sequence, Set
 
 import numpy as np
 
-from kinegami.bodies import check_margin, link_capsule_ends, worst_overlap
+from kinegami.chain.bodies import check_margin, link_capsule_ends, worst_overlap
+from kinegami.chain.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube, pose_array
+from kinegami.chain.links import LinkCSC
+from kinegami.chain.placement import (
+    compact_lambda,
+    compact_lambda_other_side,
+    orient_by_common_normal,
+    published_safe_placement,
+    radial_safe_placement,
+)
 from kinegami.errors import (
     ClearanceWarning,
     InvalidParameterError,
@@ -30,32 +40,30 @@ from kinegami.errors import (
 )
 from kinegami.geometry.balls import Ball, merge_balls
 from kinegami.geometry.frames import rotation_about_line, translation
-from kinegami.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube, pose_array
-from kinegami.links import LinkCSC
-from kinegami.placement import (
-    compact_lambda,
-    compact_lambda_other_side,
-    orient_by_common_normal,
-    published_safe_placement,
-    radial_safe_placement,
-)
 from kinegami.validation import (
     check_bool,
     check_max_angle_per_elbow,
     check_real,
     check_translation,
-    check_twist_portion,
     joint_count_refusal,
     shown,
 )
 
-__all__ = ["KinematicChain", "JointAssembly", "PlacementWarning", "ClearanceWarning"]
+__all__ = [
+    "JointAssembly",
+    "RADIAL_VARIANTS",
+    "SAFE_GROWTH_LIMIT",
+    "SAFE_PATH_LIMIT",
+    "caller_stack_level",
+    "propagate_flag",
+    "PROPAGATE_DEFAULT",
+]
+
+#: The kinegami package folder: frames in files under it are not the user's.
+_PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
-
-
-def _caller_level() -> int:
+def caller_stack_level() -> int:
     """Stack level of the first frame outside the kinegami package (for warnings)."""
     frame = sys._getframe(1)
     level = 1
@@ -75,17 +83,17 @@ class _DefaultTrue:
         return "True"
 
 
-_PROPAGATE_DEFAULT = _DefaultTrue()
+PROPAGATE_DEFAULT = _DefaultTrue()
 
 
-def _propagate_flag(propogate, propagate) -> bool:
+def propagate_flag(propogate, propagate) -> bool:
     """Accept the paper's spelling ``propogate`` and the correct ``propagate`` (not both)."""
     if propagate is None:
-        if propogate is _PROPAGATE_DEFAULT:
+        if propogate is PROPAGATE_DEFAULT:
             return True
         return check_bool("propogate", propogate)
     propagate = check_bool("propagate", propagate)
-    if propogate is not _PROPAGATE_DEFAULT:
+    if propogate is not PROPAGATE_DEFAULT:
         raise InvalidParameterError(
             f"give only one of propogate (the paper's spelling) and propagate, got "
             f"propogate={propogate!r} and propagate={propagate!r}"
@@ -273,7 +281,7 @@ class JointAssembly:
                     f"{what}: the {self._noun} passes through itself ({found})",
                     found.clearance, found.first, found.second,
                 ),
-                stacklevel=_caller_level(),
+                stacklevel=caller_stack_level(),
             )  # fmt: skip
         return True
 
@@ -298,7 +306,7 @@ class JointAssembly:
     def _reject(self, message: str) -> None:
         warnings.warn(
             f"{message}; the {self._noun} is unchanged", PlacementWarning,
-            stacklevel=_caller_level(),
+            stacklevel=caller_stack_level(),
         )  # fmt: skip
 
     def _parent_list(self) -> list[int]:
@@ -342,7 +350,7 @@ class JointAssembly:
         self,
         jointIndex: int,
         Transformation,
-        propogate: bool = _PROPAGATE_DEFAULT,
+        propogate: bool = PROPAGATE_DEFAULT,
         *,
         propagate: bool | None = None,
     ) -> bool:
@@ -357,7 +365,7 @@ class JointAssembly:
         """
         j = self._index(jointIndex)
         T = pose_array(Transformation, "Transformation", r=self.r)
-        prop = _propagate_flag(propogate, propagate)
+        prop = propagate_flag(propogate, propagate)
         return self._try_edit("transformJoint", lambda: self._moved(j, T, prop))
 
     def _axis_edit(
@@ -366,7 +374,7 @@ class JointAssembly:
         """Move joint ``jointIndex`` by ``T_of_joint(joint)``; with applyToPreviousWaypoint a
         Waypoint parent moves too, when j is its only child (otherwise j's siblings would)."""
         j = self._index(jointIndex)
-        prop = _propagate_flag(propogate, propagate)
+        prop = propagate_flag(propogate, propagate)
         applyToPreviousWaypoint = check_bool("applyToPreviousWaypoint", applyToPreviousWaypoint)
         T = T_of_joint(self._joints[j])
         w = self._parent_of(j) if j > 0 else -1
@@ -667,7 +675,7 @@ class JointAssembly:
         self,
         jointIndex: int,
         distance: float,
-        propogate: bool = _PROPAGATE_DEFAULT,
+        propogate: bool = PROPAGATE_DEFAULT,
         applyToPreviousWaypoint: bool = False,
         *,
         propagate: bool | None = None,
@@ -694,7 +702,7 @@ class JointAssembly:
         self,
         jointIndex: int,
         angle: float,
-        propogate: bool = _PROPAGATE_DEFAULT,
+        propogate: bool = PROPAGATE_DEFAULT,
         applyToPreviousWaypoint: bool = False,
         *,
         propagate: bool | None = None,
@@ -713,226 +721,13 @@ class JointAssembly:
         )
 
 
-class KinematicChain(JointAssembly):
-    """A serial chain of tubular origami joints joined by CSC links.
-
-    Parameters
-    ----------
-    startJoint : the root joint (copied; world coordinates).
-    maxAnglePerElbow : largest turn of a single elbow fitting, in (0, pi] (default pi/2).
-
-    Examples
-    --------
-    >>> chain = KinematicChain(StartTip(4, 1, Pose=SE3.Trans(3, 3, 0), length=1.5))
-    >>> chain.append(PrismaticJoint(4, 1, 3, 3, np.pi / 4, SE3.Trans(5, 5, 0)))
-    2
-    """
-
-    @classmethod
-    def from_dh(
-        cls,
-        table,
-        numSides: int,
-        r: float,
-        convention: str = "standard",
-        jointTypes=None,
-        *,
-        placement: str = "compact",
-        totalBendingAngle: float = np.pi,
-        numSinkLayers: int = 1,
-        neutralLength: float | None = None,
-        numLayers: int = 3,
-        coneAngle: float = np.pi / 4,
-        endTip: bool = True,
-        tipLength: float | None = None,
-        maxAnglePerElbow: float = np.pi / 2,
-    ) -> KinematicChain:
-        """A chain whose joints move about the axes of a Denavit-Hartenberg table.
-
-        Parameters
-        ----------
-        table : rows (theta, alpha, a, d), one per joint; radians and the chain's length unit;
-            |a| and |d| <= 1e6 r.
-        numSides, r : the tube (an even number of sides >= 4, radius > 0).
-        convention : ``"standard"`` (joint i moves about z of frame i-1; frame 0 = world) or
-            ``"modified"`` (Craig: joint i moves about z of frame i). See :mod:`kinegami.dh`.
-        jointTypes : None (all revolute), a string such as ``"RRP"``, or a sequence of
-            ``"revolute"``/``"prismatic"``, one per row.
-        placement : ``"compact"`` (default; docs/placement.md, DH roll kept) or ``"safe"``
-            (docs/placement.md; never fails). Joints only slide along their DH axes.
-        totalBendingAngle, numSinkLayers : of every revolute joint (default pi, 1).
-        neutralLength, numLayers, coneAngle : of every prismatic joint (default 3r, 3, pi/4).
-        endTip : add an EndTip on the tool frame (standard: frame n; modified: frame n
-            turned so that the tip points along its x axis), placed like the joints.
-        tipLength : the end tip's length (default 1.5 r).
-        maxAnglePerElbow : largest turn of one elbow fitting (default pi/2).
-
-        Raises
-        ------
-        NoPathError
-            When compact placement finds no link to a joint (the message suggests 'safe').
-
-        Examples
-        --------
-        >>> puma = KinematicChain.from_dh(
-        ...     [(np.pi/2, -np.pi/2, 0, 0), (0, 0, 431.8, 149.09), (np.pi/2, np.pi/2, -20.32, 0),
-        ...      (0, -np.pi/2, 0, 433.07), (0, np.pi/2, 0, 0), (0, 0, 0, 56.25)], 6, 100)
-        >>> len(puma.Joints)
-        7
-        """
-        from kinegami.dh import chain_from_dh
-
-        return chain_from_dh(
-            cls, table, numSides, r, convention, jointTypes, placement=placement,
-            totalBendingAngle=totalBendingAngle, numSinkLayers=numSinkLayers,
-            neutralLength=neutralLength, numLayers=numLayers, coneAngle=coneAngle,
-            endTip=endTip, tipLength=tipLength, maxAnglePerElbow=maxAnglePerElbow,
-        )  # fmt: skip
-
-    @property
-    def Parents(self) -> tuple[int, ...]:
-        """Parent index of every joint (-1 for the root)."""
-        return tuple(self._parent_list())
-
-    def __repr__(self) -> str:
-        kinds = ", ".join(type(j).__name__ for j in self._joints)
-        return (
-            f"KinematicChain({len(self._joints)} joints: {kinds}; "
-            f"path length {self.totalPathLength():.6g})"
-        )
-
-    # --- building ----------------------------------------------------------------------------
-    def append(
-        self,
-        newJoint: Joint,
-        relative: bool = True,
-        safe: bool = True,
-        fixedPosition: bool = False,
-        fixedOrientation: bool = False,
-    ) -> int | None:
-        """Add ``newJoint`` after the last joint and return its index.
-
-        Parameters
-        ----------
-        newJoint : the joint; its Pose gives the axis of motion (z). It is copied.
-        relative : the Pose is relative to the last joint's Pose (True) or global (False).
-        safe : place with the safe algorithm (waypoints; never fails) rather than compact.
-        fixedPosition : keep the given position (requires safe=False).
-        fixedOrientation : keep the given orientation (requires safe=False).
-
-        Returns the new joint's index, or None (with a PlacementWarning, chain unchanged) when
-        no link with turns < pi reaches it.
-        """
-        return self._place(
-            "append", len(self._joints) - 1, newJoint, relative, safe, fixedPosition,
-            fixedOrientation,
-        )  # fmt: skip
-
-    # --- edits ---------------------------------------------------------------------------------
-    def delete(self, jointIndex: int) -> bool:
-        """Remove joint ``jointIndex`` and join its neighbours by a new link.
-
-        Deleting the last joint drops it; deleting joint 0 makes joint 1 the root. Returns True,
-        or False with a PlacementWarning (chain unchanged) when the new link cannot be built or
-        the chain has a single joint.
-        """
-        j = self._index(jointIndex)
-        if len(self._joints) == 1:
-            self._reject("delete failed: a chain must keep at least one joint")
-            return False
-
-        def build():
-            joints = self._joints[:j] + self._joints[j + 1 :]
-            links = self._links[:j] + self._links[j + 1 :]
-            if j == 0:
-                links[0] = self._root_link(joints[0])
-            elif j < len(joints):
-                links[j] = self._link(joints[j - 1], joints[j])
-            return joints, links
-
-        return self._try_edit("delete", build)
-
-    # --- states --------------------------------------------------------------------------------
-    def setJointState(self, jointIndex: int, newState: float) -> bool:
-        """Set joint ``jointIndex`` to ``newState`` (radians or length); later joints follow.
-
-        Returns False with a PlacementWarning (chain unchanged) if ``newState`` is outside the
-        joint's ``stateRange()``. Link shapes never change: downstream links move rigidly.
-        """
-        j = self._index(jointIndex)
-        s = self._state_value(j, newState)
-        if s is None:
-            return False
-        joint = self._joints[j]
-        G = joint.state_transform(s - joint.state)
-        joints = list(self._joints)
-        links = list(self._links)
-        joints[j] = joint.with_state(s)
-        for k in range(j + 1, len(joints)):
-            joints[k] = joints[k].transformed(G)
-            links[k] = links[k].transformed(G)
-        return self._accept("setJointState", joints, links)
-
-    def setJointStates(self, states: Sequence[float]) -> bool:
-        """Set every joint's state at once (one value per joint, in index order);
-        all-or-nothing (``states``: see :meth:`_state_values`)."""
-        values = self._state_values(states)
-        if values is None:
-            return False
-        joints = list(self._joints)
-        links = list(self._links)
-        accumulated = None  # world motion of everything after the joints changed so far
-        for k in range(len(joints)):
-            if accumulated is not None:
-                joints[k] = joints[k].transformed(accumulated)
-                links[k] = links[k].transformed(accumulated)
-            joint = joints[k]
-            if values[k] != joint.state:
-                G = joint.state_transform(values[k] - joint.state)
-                joints[k] = joint.with_state(values[k])
-                accumulated = G if accumulated is None else G @ accumulated
-        return self._accept("setJointStates", joints, links)
-
-    # --- output --------------------------------------------------------------------------------
-    def creasePattern(self, twistPortion: float = 0.2):
-        """The chain's tubular crease pattern (docs/fabrication.md) as a TubularPattern."""
-        from kinegami.pattern import TubularPattern
-        from kinegami.pattern.catalog import build_pieces, check_pattern_size
-
-        twistPortion = check_twist_portion(twistPortion)
-        # every link's modules built together (the elbows of the whole chain in one batch)
-        pieces = [link.pattern_pieces(self.numSides, twistPortion) for link in self._links[1:]]
-        check_pattern_size([p for link in pieces for p in link]
-                           + [p for joint in self._joints for p in joint.pattern_pieces()])
-        built = iter(build_pieces([piece for link in pieces for piece in link]))
-        modules = [self._joints[0].pattern]
-        for link, joint in zip(pieces, self._joints[1:], strict=True):
-            modules.extend(next(built) for _ in link)
-            modules.append(joint.pattern)
-        return TubularPattern.concatenate(modules)
-
-    def clearance(self, states=None, margin=None):
-        """Self-intersection at the current states or at ``states`` (one per joint), with
-        ``margin`` (default: :attr:`margin`): a ClearanceReport (``.ok``, ``.min_clearance``,
-        ``.pairs``, ``.verdict()``). See kinegami.clearance."""
-        from kinegami.clearance import chain_clearance
-
-        return chain_clearance(self, states, margin=margin)
-
-    def show(self, **options):
-        """Draw the chain in 3D with matplotlib; returns (figure, axes). See kinegami.viz."""
-        from kinegami.viz.chain_plot import show_chain
-
-        return show_chain(self, **options)
-
-
 #: Safe placement keeps the published result when all new joints stay within this many r of
 #: the current ball's surface and its new links are at most SAFE_PATH_LIMIT r long.
 SAFE_GROWTH_LIMIT = 10.0
 SAFE_PATH_LIMIT = 40.0
 
 #: Variants of the radial safe placement, tried in order until one is clear of the chain
-#: (keyword arguments of :func:`kinegami.placement.radial_safe_placement`).
+#: (keyword arguments of :func:`kinegami.chain.placement.radial_safe_placement`).
 RADIAL_VARIANTS = (
     {},
     {"two_arcs_above": math.pi / 2.0, "bend_straight": 2.0},

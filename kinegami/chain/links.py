@@ -16,11 +16,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from kinegami.chain.joints import as_se3, pose_array
 from kinegami.errors import InvalidParameterError, InvalidTypeError, NoPathError
 from kinegami.geometry.balls import Ball, merge_balls
 from kinegami.geometry.csc import CSCPath, solve_csc
 from kinegami.geometry.frames import rotation_matrix, signed_angle
-from kinegami.joints import as_se3, pose_array
 from kinegami.validation import (
     ReadOnlyAttributes,
     check_max_angle_per_elbow,
@@ -365,7 +365,7 @@ class LinkCSC(ReadOnlyAttributes):
                 link.__dict__[name] = _readonly(T @ cache[name])
         if "twistAngle" in cache:
             link.__dict__["twistAngle"] = cache["twistAngle"]
-        # the link this one is a rigid copy of, and the transform from it (kinegami.bodies
+        # the link this one is a rigid copy of, and the transform from it (kinegami.chain.bodies
         # moves that link's cached capsules instead of rebuilding them)
         origin, moved = cache.get("_moved_from", (self, None))
         link.__dict__["_moved_from"] = (origin, T if moved is None else T @ moved)

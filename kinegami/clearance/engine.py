@@ -1,13 +1,13 @@
 """Self-intersection of a folded chain, at one configuration and over its range of motion.
 
 See docs/clearance.md. The chain's parts are enclosed by capsules of radius r along its
-centreline (:mod:`kinegami.bodies`). Two capsules are tested only when the centreline between
+centreline (:mod:`kinegami.chain.bodies`). Two capsules are tested only when the centreline between
 them turns by at least pi in total (arc angles plus |state| at every revolute hinge): a curve
 that turns by less than pi cannot come back to itself, and parts closer along the tube than
 that touch by construction (the two legs of an elbow, the halves of a joint, a link and its
 joints). The clearance of a tested pair is the distance between their segments minus 2r;
 negative values are overlap depths. The chain is clear when every tested pair has a clearance
-of at least ``margin - CONTACT_TOLERANCE * r`` (:func:`~kinegami.bodies.clear_limit`): the
+of at least ``margin - CONTACT_TOLERANCE * r`` (:func:`~kinegami.chain.bodies.clear_limit`): the
 margin is the clearance the design requires (chain units, ``chain.margin``, default 0: parts
 that touch, such as the legs of a U-turn exactly 2r apart, are clear). Every verdict is worded
 by :meth:`ClearanceReport.verdict`, which states the margin.
@@ -23,16 +23,14 @@ True
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import operator
 import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from kinegami.bodies import (
+from kinegami.chain.bodies import (
     CONTACT_TOLERANCE,
     JOINT_FIXED,
     JOINT_PRISMATIC,
@@ -42,241 +40,37 @@ from kinegami.bodies import (
     capsule_model,
     check_margin,
     clear_limit,
-    tree_capsules,
     with_joint_name,
 )
+from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
+from kinegami.clearance.reports import ClearanceReport, CollidingPair
+from kinegami.clearance.tree_bodies import tree_capsules
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.geometry.segments import (
     segment_distance,
     segment_distances,
     segment_distances_stacked,
 )
-from kinegami.joints import PrismaticJoint, RevoluteJoint
-from kinegami.limits import MAX_SAMPLED_STATES, MAX_SAMPLES
 from kinegami.validation import (
-    UNITS_IN_MM,
-    check_int,
     check_real,
-    check_samples,
-    shorten,
-    shown,
 )
 
 __all__ = [
     "CONTACT_TOLERANCE",
     "TURN_TOLERANCE",
-    "UNITS_IN_MM",
-    "Lengths",
-    "CollidingPair",
-    "ClearanceReport",
-    "SweepReport",
-    "chain_clearance",
-    "tree_clearance",
-    "clearance_report",
-    "sweep",
     "ClearanceEngine",
     "TreeEngine",
     "TreeMotion",
+    "ChainMotion",
     "engine_for",
+    "tree_engine",
     "keep_tree_engine",
+    "current_states",
 ]
 
 #: Pairs x configurations evaluated at once (memory bound of the batched broad phase).
 _BATCH_PAIRS = 1_500_000
 
-
-
-class Lengths:
-    """Lengths in words as every verdict prints them: in millimetres and, when the design's
-    unit is not mm, in that unit beside them ("9.9 mm (0.99 cm)"), to about r / 100; without
-    ``units``, plain numbers in chain units to 4 significant digits.
-
-    Parameters
-    ----------
-    r : float
-        The tube's circumradius (chain units): sets the digits.
-    units : {"mm", "cm", "m", "in"} or None
-        The design's length unit.
-    """
-
-    def __init__(self, r: float, units: str | None = None):
-        if units is not None and units not in UNITS_IN_MM:
-            raise InvalidParameterError(
-                f"units must be one of {', '.join(UNITS_IN_MM)}, got {shown(units)}"
-            )
-        self.units = units
-        self.factor = UNITS_IN_MM.get(units, 1.0)
-        size = r * self.factor if math.isfinite(r) and r > 0 else 1.0
-        self.mm_digits = max(0, 2 - math.floor(math.log10(size)))
-        self.own_digits = max(0, 2 - math.floor(math.log10(size / self.factor)))
-
-    @staticmethod
-    def _fixed(value: float, digits: int) -> str:
-        value = round(value, digits)
-        return f"{value if value else 0.0:.{digits}f}"  # no "-0.00"
-
-    def mm(self, value: float) -> str:
-        """``value`` (chain units) in mm only: "9.9 mm" (without units: "9.9")."""
-        if self.units is None:
-            return f"{value:.4g}"
-        return f"{self._fixed(value * self.factor, self.mm_digits)} mm"
-
-    def __call__(self, value: float) -> str:
-        """``value`` (chain units) in mm and in the design's unit: "9.9 mm (0.99 cm)"."""
-        if self.units in (None, "mm"):
-            return self.mm(value)
-        return f"{self.mm(value)} ({self._fixed(value, self.own_digits)} {self.units})"
-
-    def exact(self, value: float) -> str:
-        """A value the user chose (a margin), without rounding: "0.2 mm (0.02 cm)"."""
-        if self.units is None:
-            return f"{value:g}"
-        text = f"{value * self.factor:g} mm"
-        return text if self.units == "mm" else f"{text} ({value:g} {self.units})"
-
-    def span(self, low: float, high: float) -> str:
-        """An interval: "-8.8 to 12.4 mm (-0.88 to 1.24 cm)"."""
-        if self.units is None:
-            return f"{low:.4g} to {high:.4g}"
-        f, d = self.factor, self.mm_digits
-        text = f"{self._fixed(low * f, d)} to {self._fixed(high * f, d)} mm"
-        if self.units != "mm":
-            d = self.own_digits
-            text += f" ({self._fixed(low, d)} to {self._fixed(high, d)} {self.units})"
-        return text
-
-
-@dataclass(frozen=True)
-class CollidingPair:
-    """Two parts of the chain and how close they are.
-
-    Attributes
-    ----------
-    first, second : str
-        The parts in words, in order along the tube ("link 3, second elbow",
-        "joint 5, RevoluteJoint 'wrist', distal half").
-    clearance : float
-        Distance between the parts' capsules (chain units); negative: overlap depth.
-    points : tuple of two tuples
-        The closest points of the two capsule axes (world coordinates, chain units).
-    elements : tuple of two ints
-        The parts' places along the tube: 2 i for joint i, 2 i - 1 for link i (the link into
-        joint i).
-    """
-
-    first: str
-    second: str
-    clearance: float
-    points: tuple
-    elements: tuple = (-1, -1)
-
-    def __str__(self) -> str:
-        if self.clearance < 0.0:
-            return f"{self.first} and {self.second} overlap by {-self.clearance:.4g}"
-        return f"{self.first} and {self.second} are {self.clearance:.4g} apart"
-
-
-@dataclass(frozen=True)
-class ClearanceReport:
-    """The clearance of a chain at one configuration, judged with a margin.
-
-    Attributes
-    ----------
-    ok : bool
-        True when every tested pair of parts is at least the margin apart (clearance >=
-        margin - CONTACT_TOLERANCE r everywhere; margin 0: no two parts overlap).
-    min_clearance : float
-        Smallest clearance over the tested pairs (chain units; negative is the overlap depth;
-        inf when no pair of parts is far enough apart along the tube to be tested).
-    pairs : tuple of CollidingPair
-        Every pair of parts closer than the margin (margin 0: that overlap), closest first (one
-        entry per pair of parts).
-    closest : CollidingPair or None
-        The tested pair with the smallest clearance (None when nothing is tested).
-    states : tuple of float
-        The configuration (one state per joint).
-    margin : float
-        The clearance required (chain units, >= 0).
-    r : float
-        The tube's circumradius (chain units; sets the digits of :meth:`verdict`).
-    note : str
-        For a tree whose closest parts are two tubes leaving a junction: where (words
-        :meth:`verdict` appends), else "".
-    """
-
-    ok: bool
-    min_clearance: float
-    pairs: tuple
-    closest: CollidingPair | None
-    states: tuple
-    margin: float = 0.0
-    r: float = math.nan
-    note: str = ""
-
-    def verdict(self, units: str | None = None) -> str:
-        """The verdict in one line, as ``kinegami build``, ``kinegami check`` and the editor
-        print it: "clear with margin 0 mm: minimum clearance 9.9 mm (0.99 cm), between A and
-        B" or "self-intersects, parts closer than the margin 0 mm: minimum clearance -2.5 mm
-        (-0.25 cm), between A and B". Lengths in mm and the design's ``units`` (None: plain
-        numbers in chain units)."""
-        length = Lengths(self.r, units)
-        margin = length.exact(self.margin)
-        if self.closest is None:
-            return (f"clear with margin {margin}: no two parts are far enough apart along the "
-                    "tube to collide")  # fmt: skip
-        if self.ok:
-            return (f"clear with margin {margin}: minimum clearance "
-                    f"{length(self.min_clearance)}, between {self.closest.first} and "
-                    f"{self.closest.second}{self.note}")  # fmt: skip
-        first = self.pairs[0] if self.pairs else self.closest
-        overlapping = self.min_clearance < clear_limit(self.r if math.isfinite(self.r) else 0.0)
-        more = f"; {len(self.pairs)} pairs of parts" if len(self.pairs) > 1 else ""
-        return (f"{'self-intersects, ' if overlapping else ''}parts closer than the margin "
-                f"{margin}: minimum clearance {length(self.min_clearance)}, between "
-                f"{first.first} and {first.second}{more}")  # fmt: skip
-
-    def __str__(self) -> str:
-        lines = [self.verdict()]
-        if not self.ok:
-            lines += [f"  {pair}" for pair in self.pairs]
-        return "\n".join(lines)
-
-
-@dataclass(frozen=True)
-class SweepReport:
-    """Clearance over sampled configurations (see :func:`sweep`).
-
-    Attributes
-    ----------
-    samples : int
-        Number of configurations tested.
-    colliding : int
-        How many of them self-intersect.
-    worst_pairs : tuple of (CollidingPair, int)
-        The pairs of parts that were the deepest overlap of some configuration, each with the
-        number of configurations in which it was; deepest first, at most 10.
-    free_intervals : tuple
-        Per joint, ``(low, high)``: the interval of its own state around its current state
-        over which moving it alone keeps the chain clear (within its ``stateRange()``), or
-        None when the chain is not clear at its current states.
-    states : tuple of float
-        The current states the free intervals start from.
-    margin : float
-        The clearance required (chain units): a configuration whose parts come closer counts
-        as colliding.
-    """
-
-    samples: int
-    colliding: int
-    worst_pairs: tuple
-    free_intervals: tuple
-    states: tuple = field(default=())
-    margin: float = 0.0
-
-    @property
-    def colliding_fraction(self) -> float:
-        """Fraction of the sampled configurations that self-intersect."""
-        return self.colliding / self.samples if self.samples else 0.0
 
 
 def _rotations(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
@@ -424,7 +218,7 @@ class ClearanceEngine:
     """
 
     def __init__(self, chain, names=None):
-        from kinegami.chain import KinematicChain
+        from kinegami.chain.model import KinematicChain
 
         if not isinstance(chain, KinematicChain):
             raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
@@ -445,7 +239,8 @@ class ClearanceEngine:
                kinds, points, axes, states, ranges, pieces, lengths,
                caps=None) -> None:  # fmt: skip
         """Everything the queries need, from the capsules at the current configuration
-        (``caps``: a tree's :class:`~kinegami.bodies.TreeCapsules`, None for a chain)."""
+        (``caps``: a tree's :class:`~kinegami.clearance.tree_bodies.TreeCapsules`, None for a
+        chain)."""
         self.r = r = float(r)
         self.ranges = ranges
         self._caps = caps
@@ -1388,7 +1183,7 @@ _ENGINES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 def engine_for(chain, names=None) -> ClearanceEngine:
     """The chain's :class:`ClearanceEngine`, cached until the chain's joints or links change."""
-    from kinegami.chain import KinematicChain
+    from kinegami.chain.model import KinematicChain
 
     if not isinstance(chain, KinematicChain):
         raise InvalidTypeError(f"chain must be a KinematicChain, got {type(chain).__name__}")
@@ -1406,7 +1201,7 @@ def engine_for(chain, names=None) -> ClearanceEngine:
 _TREE_ENGINES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def _tree_engine(tree, names=None, margin: float = 0.0) -> TreeEngine:
+def tree_engine(tree, names=None, margin: float = 0.0) -> TreeEngine:
     """The tree's :class:`TreeEngine` for ``names`` and ``margin``, cached until its joints,
     links or parents change (a few per tree: one per margin and names asked for)."""
     joints, links, parents = tree.Joints, tree.Links, tuple(tree.Parents)
@@ -1440,250 +1235,11 @@ def _same_objects(known: tuple, now) -> bool:
     return len(known) == len(now) and all(map(operator.is_, known, now))
 
 
-def _current(chain) -> np.ndarray:
+def current_states(chain) -> np.ndarray:
     return np.array([joint.state for joint in chain.Joints], dtype=float)
 
 
-def clearance_report(assembly, names=None, margin=None, states=None) -> ClearanceReport:
-    """The one clearance verdict of a chain or a tree: what ``kinegami build``, ``kinegami
-    check``, ``kinegami compact`` and the editor report (:meth:`ClearanceReport.verdict` words
-    it).
-
-    Parameters
-    ----------
-    assembly : KinematicChain or KinematicTree
-    names : sequence of str or None, optional
-        Joint names for the parts (each shown on one line, at most 80 characters).
-    margin : float, optional
-        The clearance required (chain units, >= 0); default: ``assembly.margin``.
-    states : sequence of float, optional
-        A configuration; default: the current states.
-    """
-    from kinegami.chain import KinematicChain
-
-    if names is not None:
-        names = tuple(None if name is None else shorten(name) for name in names)
-    if isinstance(assembly, KinematicChain):
-        return chain_clearance(assembly, states, names, margin)
-    return tree_clearance(assembly, states, names, margin)
-
-
-def _margin_of(chain, margin) -> float:
-    """``margin`` checked, or the chain's (or tree's) own ``margin`` when None."""
-    if margin is None:
-        return float(getattr(chain, "margin", 0.0))
-    return check_margin(margin)
-
-
-def chain_clearance(chain, states=None, names=None, margin=None) -> ClearanceReport:
-    """The clearance of ``chain`` at its current states, or at ``states`` (one per joint).
-
-    Parameters
-    ----------
-    chain : KinematicChain
-    states : sequence of float, optional
-        A configuration (absolute states, each within its joint's ``stateRange()``); default:
-        the chain's current states. The chain is not changed.
-    names : sequence of str or None, optional
-        Joint names for the report.
-    margin : float, optional
-        The clearance required (chain units, >= 0); default: ``chain.margin``.
-
-    Raises
-    ------
-    InvalidParameterError
-        For ``states`` of the wrong length or outside a joint's range, or a negative margin.
-    """
-    margin = _margin_of(chain, margin)
-    engine = engine_for(chain, names)
-    return engine.report(_current(chain) if states is None else states, margin)
-
-
-def sweep(
-    chain,
-    samples: int = 1000,
-    seed: int = 0,
-    configurations=None,
-    *,
-    names=None,
-    resolution: int = 64,
-    progress=None,
-    margin=None,
-) -> SweepReport:
-    """Clearance over the range of motion of a chain or a tree.
-
-    Parameters
-    ----------
-    chain : KinematicChain or KinematicTree
-        A tree is tested configuration by configuration with the pair rule of trees
-        (:class:`TreeMotion`, docs/trees.md); a chain with its vectorised engine.
-    samples : int
-        Number of configurations drawn uniformly from the joints' state ranges (> 0, at most
-        kinegami.limits.MAX_SAMPLES, and samples x joints at most MAX_SAMPLED_STATES, as every
-        count of configurations here; ignored when ``configurations`` is given).
-    seed : int
-        Seed of the random configurations (numpy ``default_rng``; >= 0; ignored when
-        ``configurations`` is given).
-    configurations : sequence of sequences of float, optional
-        The configurations to test instead (absolute states, one per joint).
-    names : joint names for the report, optional.
-    resolution : int
-        Grid steps per joint and direction when searching the free intervals (1 to
-        kinegami.limits.MAX_SAMPLES).
-    progress : bool or callable, optional
-        ``progress(done, total)`` as configurations are tested (total: their count);
-        returning False stops the sweep with :class:`~kinegami.errors.Cancelled`. True or
-        None: a progress bar on stderr (None: when stderr is a terminal). docs/progress.md.
-    margin : float, optional
-        The clearance required (chain units, >= 0): a configuration whose parts come closer
-        counts as colliding; default: ``chain.margin``.
-
-    Returns
-    -------
-    SweepReport
-        The colliding fraction, the worst pairs, and each joint's free interval around the
-        chain's current states.
-    """
-    from kinegami.chain import JointAssembly, KinematicChain
-
-    margin = _margin_of(chain, margin)
-    if isinstance(chain, JointAssembly) and not isinstance(chain, KinematicChain):
-        engine = TreeMotion(chain, names, margin)  # a KinematicTree (a layer above this one)
-    else:
-        engine = _ChainMotion(engine_for(chain, names), margin)
-    if isinstance(resolution, bool) or not isinstance(resolution, int | np.integer):
-        raise InvalidTypeError(f"resolution must be an integer >= 1, got {shown(resolution)}")
-    if resolution < 1:
-        raise InvalidParameterError(f"resolution must be an integer >= 1, got {shown(resolution)}")
-    J = len(engine.ranges)
-    _check_scan(int(resolution))
-    if configurations is None:
-        if isinstance(samples, bool) or not isinstance(samples, int | np.integer):
-            raise InvalidTypeError(f"samples must be an integer > 0, got {shown(samples)}")
-        if samples <= 0:
-            raise InvalidParameterError(f"samples must be an integer > 0, got {shown(samples)}")
-        samples = check_samples("samples", samples, J)
-        seed = check_int("seed", seed, minimum=0, floats=False)
-        rng = np.random.default_rng(seed)
-        lo, hi = engine.ranges[:, 0], engine.ranges[:, 1]
-        Q = lo + (hi - lo) * rng.random((int(samples), lo.size))
-    else:
-        if isinstance(configurations, str | bytes) or not isinstance(
-            configurations, Sequence | np.ndarray
-        ):
-            raise InvalidTypeError(
-                "configurations must be a list of configurations (one state per joint), got "
-                f"{type(configurations).__name__}"
-            )
-        if len(configurations) == 0:
-            raise InvalidParameterError("configurations must not be empty")
-        count = len(configurations)
-        if count > MAX_SAMPLES or count * J > MAX_SAMPLED_STATES:
-            raise InvalidParameterError(
-                f"configurations: {count} configurations of {J} joints, more than "
-                f"{min(MAX_SAMPLES, MAX_SAMPLED_STATES // max(J, 1))} (each is a clearance "
-                "test of the whole chain; kinegami.limits.MAX_SAMPLES and MAX_SAMPLED_STATES)"
-            )
-        Q = np.array(
-            [engine.check_states(c, f"configurations[{k}]") for k, c in enumerate(configurations)]
-        )
-    found = _worst_with_progress(engine, Q, progress)
-    clearance, worst = engine.tally(Q, found)
-    current = _current(chain)
-    return SweepReport(
-        samples=int(Q.shape[0]),
-        colliding=int(np.count_nonzero(np.isfinite(clearance))),
-        worst_pairs=worst,
-        free_intervals=engine.free_intervals(current, int(resolution)),
-        states=tuple(float(x) for x in current),
-        margin=margin,
-    )
-
-
-def _check_scan(resolution: int) -> None:
-    """The free intervals scan ``resolution`` states of every joint and side: a motion check
-    of that many configurations each, at most MAX_SAMPLES (docs/limits.md)."""
-    if resolution > MAX_SAMPLES:
-        raise InvalidParameterError(
-            f"resolution must be an integer in [1, {MAX_SAMPLES}] (grid steps per joint and "
-            f"side of the free intervals; kinegami.limits.MAX_SAMPLES), got {shown(resolution)}"
-        )
-
-
-def _worst_with_progress(engine, Q: np.ndarray, progress) -> tuple:
-    """``engine.worst_arrays(Q)`` in chunks, reporting each chunk to ``progress`` (may
-    cancel)."""
-    from kinegami.progress import Progress
-
-    chunk = 4096
-    parts = []
-    with Progress(progress, Q.shape[0], desc="sweep", unit="configuration") as bar:
-        for start in range(0, Q.shape[0], chunk):
-            found = engine.worst_arrays(Q[start : start + chunk])
-            parts.append(found)
-            bar.update(found[0].shape[0])
-    return tuple(np.concatenate(column) for column in zip(*parts, strict=True))
-
-
-def tree_clearance(tree, states=None, names=None, margin=None) -> ClearanceReport:
-    """The clearance of a :class:`~kinegami.tree.KinematicTree` at its current states or at
-    ``states`` (one per joint, in index order), with ``margin`` (chain units, >= 0; default:
-    ``tree.margin``); the tree is not changed.
-
-    The pair rule of trees (docs/trees.md): parts on one path from the root are tested as in a
-    chain; parts on different branches always, except where two tubes leaving the same
-    branching joint run together inside the junction that joins them (until they are the
-    margin apart). A tree that is a chain gets the chain's report. When the closest parts of a
-    clear tree are two tubes leaving one junction, the report's ``note`` says so.
-
-    Raises
-    ------
-    InvalidParameterError, InvalidTypeError
-        For ``states`` of the wrong length or type, or outside a joint's range, or a negative
-        margin.
-    """
-    margin = _margin_of(tree, margin)
-    engine = _tree_engine(tree, names, margin)
-    report = engine.report(_current(tree) if states is None else states, margin)
-    if report.ok and report.closest is not None:
-        note = _junction_note(tree, report.closest)
-        if note:
-            report = dataclasses.replace(report, note=note)
-    return report
-
-
-def _junction_note(tree, pair: CollidingPair) -> str:
-    """When ``pair`` (the closest parts of a clear tree) are two tubes leaving the same
-    branching joint: "; closest where the tubes leaving joint J come out of its junction"
-    (they touch there by construction: the junction covers them up to where they are the
-    margin apart), else ""."""
-    from kinegami.joints import Waypoint
-
-    if any(e < 1 or e % 2 == 0 for e in pair.elements):
-        return ""
-    parents, joints = tree.Parents, tree.Joints
-    children = [0] * len(parents)
-    for p in parents:
-        if p >= 0:
-            children[p] += 1
-
-    def top(k: int) -> int | None:  # the child of a branching joint whose tube k continues
-        while k > 0:
-            parent = parents[k]
-            if children[parent] > 1:
-                return k
-            if not isinstance(joints[parent], Waypoint):
-                return None
-            k = parent
-        return None
-
-    a, b = (top((e + 1) // 2) for e in pair.elements)
-    if a is None or b is None or a == b or parents[a] != parents[b]:
-        return ""
-    return f"; closest where the tubes leaving joint {parents[a]} come out of its junction"
-
-
-class _ChainMotion:
+class ChainMotion:
     """A chain's :class:`ClearanceEngine` with a margin: the queries :func:`sweep` asks."""
 
     def __init__(self, engine: ClearanceEngine, margin: float):
@@ -1740,7 +1296,8 @@ class TreeEngine(ClearanceEngine):
         )  # fmt: skip
 
     def _named(self, row: int, text: str) -> str:
-        """``text`` with the joint's name (as :func:`~kinegami.bodies.part_label` words it)."""
+        """``text`` with the joint's name (as :func:`~kinegami.chain.bodies.part_label` words
+        it)."""
         return with_joint_name(text, int(self._element[row]), self._joints, self._names)
 
 
@@ -1757,7 +1314,7 @@ class TreeMotion:
 
     def __init__(self, tree, names=None, margin: float = 0.0):
         self.margin = check_margin(margin)
-        self.engine = _tree_engine(tree, names, self.margin)
+        self.engine = tree_engine(tree, names, self.margin)
         self.r = self.engine.r
         self.ranges = self.engine.ranges
         self.movable = np.flatnonzero(self.ranges[:, 1] > self.ranges[:, 0])

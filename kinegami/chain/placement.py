@@ -14,11 +14,11 @@ import math
 
 import numpy as np
 
+from kinegami.chain.joints import Joint, Waypoint
 from kinegami.errors import NoPathError
 from kinegami.geometry.balls import Ball
 from kinegami.geometry.frames import angle_between, any_perpendicular, rotation_matrix, unit
 from kinegami.geometry.lines import common_normal
-from kinegami.joints import Joint, Waypoint
 
 #: Plane side tests and line/plane parallelism (docs/theory/chain.md §0).
 PLANE_TOLERANCE = 1e-8

@@ -43,9 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.geometry.segments import point_segment_parameters, segment_distances
-from kinegami.joints import (
+from kinegami.chain.joints import (
     EndTip,
     ExtendedRevoluteJoint,
     Joint,
@@ -54,9 +52,16 @@ from kinegami.joints import (
     StartTip,
     Waypoint,
 )
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.geometry.segments import segment_distances
 from kinegami.validation import shown
 
 __all__ = [
+    "BALL_GROUP",
+    "near_capsule_pairs",
+    "link_capsule_arrays",
+    "joint_capsule_arrays",
+    "overlap_of_deepest_pair",
     "polygon_side",
     "regular_polygon",
     "circle_points",
@@ -69,19 +74,13 @@ __all__ = [
     "joint_label",
     "deepest_overlap",
     "worst_overlap",
-    "tree_worst_overlap",
-    "tree_pair_distances",
-    "TreeCapsules",
-    "tree_capsules",
     "part_label",
-    "junction_extent",
     "link_polyline",
     "link_capsule_ends",
     "Overlap",
     "CONTACT_TOLERANCE",
     "clear_limit",
     "check_margin",
-    "JUNCTION_REACH",
     "TURN_TOLERANCE",
     "JOINT_FIXED",
     "JOINT_REVOLUTE",
@@ -175,7 +174,7 @@ def elbow_rings(arc, n: int) -> np.ndarray | None:
     """Polygons an arc's elbows are swept through: the n-gon at each elbow frame and the mitre
     polygon between (2 count + 1, n, 3); None for an arc without elbows.
 
-    ``arc`` is a :class:`~kinegami.links.ElbowArc`. The mitre polygon is the start polygon
+    ``arc`` is a :class:`~kinegami.chain.links.ElbowArc`. The mitre polygon is the start polygon
     carried along the incoming axis to the plane through the vertex that bisects the turn.
     """
     if arc.count == 0:
@@ -467,12 +466,12 @@ def _arrays(rows) -> tuple:
 
 
 @functools.lru_cache(maxsize=16384)
-def _link_arrays(link, i: int, r: float, twistPortion: float) -> tuple:
+def link_capsule_arrays(link, i: int, r: float, twistPortion: float) -> tuple:
     """:func:`_arrays` of link i's rows, the rows whose labels they carry (those of the
     link it is a rigid copy of: labels need only lengths along a segment) and its turning."""
     moved = link.__dict__.get("_moved_from")
     if moved is not None:
-        (A, B, body, turn), rows, total = _link_arrays(moved[0], i, r, twistPortion)
+        (A, B, body, turn), rows, total = link_capsule_arrays(moved[0], i, r, twistPortion)
         R, t = moved[1][:3, :3], moved[1][:3, 3]
         return (A @ R.T + t, B @ R.T + t, body, turn), rows, total
     rows, total = _link_rows(link, i, r, twistPortion)
@@ -480,12 +479,12 @@ def _link_arrays(link, i: int, r: float, twistPortion: float) -> tuple:
 
 
 @functools.lru_cache(maxsize=16384)
-def _joint_arrays(joint, j: int, r: float) -> tuple:
+def joint_capsule_arrays(joint, j: int, r: float) -> tuple:
     """:func:`_arrays` of joint j's rows (labels without names) and the rows (those of the
     joint it is a rigid copy of, when it is one: labels need only lengths along a segment)."""
     moved = joint.__dict__.get("_moved_from")
     if moved is not None:
-        (A, B, body, turn), rows = _joint_arrays(moved[0], j, r)
+        (A, B, body, turn), rows = joint_capsule_arrays(moved[0], j, r)
         R, t = moved[1][:3, :3], moved[1][:3, 3]
         return (A @ R.T + t, B @ R.T + t, body, turn), rows
     rows = _joint_rows(joint, j, r, f"joint {j}, {type(joint).__name__}")
@@ -572,7 +571,7 @@ def _chain_arrays(joints, links, r: float) -> _ChainArrays:
     for j in range(k0, len(joints)):
         joint = joints[j]
         if j > 0:
-            (A, B, body, turn), link_rows, total = _link_arrays(links[j], j, r, 0.2)
+            (A, B, body, turn), link_rows, total = link_capsule_arrays(links[j], j, r, 0.2)
             if len(link_rows):
                 starts.append(A)
                 ends.append(B)
@@ -583,7 +582,7 @@ def _chain_arrays(joints, links, r: float) -> _ChainArrays:
             turning += total
             count += len(link_rows)
         first.append(count)
-        (A, B, body, turn), joint_rows = _joint_arrays(joint, j, r)
+        (A, B, body, turn), joint_rows = joint_capsule_arrays(joint, j, r)
         if len(joint_rows):
             starts.append(A)
             ends.append(B)
@@ -722,13 +721,17 @@ class Overlap:
                 f"the margin {self.margin:.4g}")  # fmt: skip
 
 
-#: A pair of parts with more capsule pairs than this is searched by groups of _BALL_GROUP
+#: Consecutive capsules (or balls) per group where parts are searched by groups (here and in
+#: kinegami.clearance.tree_bodies).
+BALL_GROUP = 32
+
+#: A pair of parts with more capsule pairs than this is searched by groups of BALL_GROUP
 #: consecutive capsules before its capsules are compared (a link of many elbows, or a long one,
 #: has a ball that prunes little).
 _NEAR_SPLIT = 4096
 
 
-def _near_pairs(element, tau, first, centre, half, reach: float,
+def near_capsule_pairs(element, tau, first, centre, half, reach: float,
                 wanted=None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Tested capsule pairs (i < j, j >= first[i]) whose segment balls come within ``reach``
     (with ``wanted``, a bool per capsule constant over each part: only pairs with a wanted
@@ -794,10 +797,10 @@ def _near_pairs(element, tau, first, centre, half, reach: float,
 
 
 def _group_blocks(e, f, starts, ends, first, centre, half, reach: float):
-    """The blocks of groups of at most ``_BALL_GROUP`` consecutive rows of parts e and f (for
+    """The blocks of groups of at most ``BALL_GROUP`` consecutive rows of parts e and f (for
     each pair of parts e[k], f[k]) that contain a tested pair and whose groups' balls come
     within ``reach``: (first row, rows) of each side and k."""
-    G = _BALL_GROUP
+    G = BALL_GROUP
     parts = np.unique(np.r_[e, f])
     count = -(-(ends[parts] - starts[parts]) // G)  # groups per part
     begin = np.zeros(starts.size, dtype=np.int64)
@@ -854,12 +857,12 @@ def worst_overlap(
         )
         if int(np.maximum(S - first, 0).sum()) == 0:
             return None
-        i, j = _near_pairs(arrays.elements, tau, first, arrays.centre, arrays.half,
+        i, j = near_capsule_pairs(arrays.elements, tau, first, arrays.centre, arrays.half,
                            2.0 * r + margin)
     if i.size == 0:
         return None
     dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
-    return _deepest(i, j, dist, s, t, rows, joints, names, r, margin)
+    return overlap_of_deepest_pair(i, j, dist, s, t, rows, joints, names, r, margin)
 
 
 def check_margin(value, name: str = "margin") -> float:
@@ -885,7 +888,7 @@ def clear_limit(r: float, margin: float = 0.0) -> float:
     return margin - CONTACT_TOLERANCE * r
 
 
-def _deepest(i, j, dist, s, t, rows, joints, names, r: float, margin: float = 0.0
+def overlap_of_deepest_pair(i, j, dist, s, t, rows, joints, names, r: float, margin: float = 0.0
              ) -> Overlap | None:  # fmt: skip
     """The Overlap of the closest of the candidate pairs (row indices i, j at distance
     ``dist``, curve parameters s, t), or None when even it is clear (at least ``margin``
@@ -959,12 +962,6 @@ def capsule_model(chain, names=None, twistPortion: float = 0.2) -> CapsuleModel:
     return model
 
 
-# --- trees -----------------------------------------------------------------------------------
-#: Longest stretch (in r, along each tube from the branching frame) that a junction body covers:
-#: tubes leaving the same joint may run within 2r of each other that far; beyond it they collide.
-JUNCTION_REACH = 5.0
-
-
 def link_polyline(link) -> np.ndarray:
     """The link's centreline polyline (units of r, world): its start, every elbow vertex of
     both arcs, its end; shape (k, 3). The tube lies within r of it except at mitred corners."""
@@ -978,627 +975,8 @@ def link_capsule_ends(link) -> np.ndarray:
     """Both ends of every capsule of the link (its polyline's edges and the mitre capsules at
     its elbow vertices), shape (2k, 3), world: the link lies within r of their convex hulls.
     Empty (0, 3) for a link of length 0."""
-    (starts, ends, _, _), _, _ = _link_arrays(link, 0, link.r, 0.2)
+    (starts, ends, _, _), _, _ = link_capsule_arrays(link, 0, link.r, 0.2)
     return np.concatenate([starts, ends]).reshape(-1, 3)
-
-
-def _polyline_samples(points: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
-    """Points every ``step`` (or closer) along a polyline and their distances from its start."""
-    d = np.diff(points, axis=0)
-    lengths = np.sqrt((d**2).sum(axis=1))
-    cumulative = np.concatenate([[0.0], np.cumsum(lengths)])
-    total = float(cumulative[-1])
-    if total <= 0.0:
-        return points[:1], np.zeros(1)
-    count = max(2, int(math.ceil(total / step)) + 1)
-    s = np.linspace(0.0, total, count)
-    k = np.clip(np.searchsorted(cumulative, s, side="right") - 1, 0, len(lengths) - 1)
-    safe = np.where(lengths[k] > 0.0, lengths[k], 1.0)
-    t = np.where(lengths[k] > 0.0, (s - cumulative[k]) / safe, 0.0)
-    return points[k] + t[:, None] * d[k], s
-
-
-#: Most (sample point, sibling segment) pairs junction_extent evaluates at once: its temporary
-#: arrays then hold at most 3 x 2**20 floats (24 MiB) each, however many siblings there are.
-_JUNCTION_CHUNK = 1 << 20
-#: Most (own segment, sibling segment) pairs whose intervals are computed at once.
-_JUNCTION_PAIRS = 262_144
-
-
-def junction_extent(
-    polyline: np.ndarray, own: tuple, siblings: tuple, r: float, margin: float = 0.0,
-    limit: float = math.inf,
-) -> float:
-    """How far (along ``polyline``, from its start) a tube leaving a branching joint runs
-    within 2r + ``margin`` of a sibling tube leaving the same frame: the distance along it of
-    the last point of its capsules (``own``: segment starts and ends) that close to a sibling
-    capsule (``siblings``), sampled every 0.02 r. The junction body covers the tube up to there
-    (docs/trees.md). 0 when nothing is that close. With ``limit``, the answer is wanted only up
-    to it: ``limit`` is returned as soon as the extent is known to reach it.
-
-    Only the samples that can be that close are evaluated (those within the finite cylinder of
-    radius 2r + margin around some sibling segment), a bounded number at a time, so tubes
-    1e6 r long cost no more memory than short ones (issue 29, docs/limits.md)."""
-    a, b = siblings
-    if a.shape[0] == 0 or own[0].shape[0] == 0:
-        return 0.0
-    starts, ends = own
-    lengths = np.sqrt(((ends - starts) ** 2).sum(axis=1))
-    counts = np.maximum(2, np.ceil(lengths / (0.02 * r)).astype(np.int64) + 1)
-    reach = (2.0 * r + margin) * (1.0 - CONTACT_TOLERANCE)
-    first = np.cumsum(counts) - counts  # global index of each segment's first sample
-    low, high = _candidate_samples(starts, ends, counts, first, a, b, reach)
-    # a sample is measured against the sibling segments whose balls it comes near (with a
-    # rounding allowance: the nearer ones decide whether it is within reach)
-    centre, half = 0.5 * (a + b), 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
-    scale = max(float(np.abs(starts).max()), float(np.abs(ends).max()),
-                float(np.abs(a).max()), float(np.abs(b).max()), 1.0)  # fmt: skip
-    near = reach * (1.0 + 1e-6) + 1e-9 * scale
-    found = -math.inf
-    for index in _descending_chunks(low, high, max(1, _JUNCTION_CHUNK // a.shape[0])):
-        i = np.searchsorted(first, index, side="right") - 1
-        u = (index - first[i]) / (counts[i] - 1)
-        points = starts[i] + u[:, None] * (ends - starts)[i]
-        p, q = _ball_pairs(points, np.zeros(points.shape[0]), centre, half, near)
-        t = _point_params(points[p], a[q], b[q])
-        nearest = a[q] + t[:, None] * (b - a)[q]
-        distance = np.sqrt(((points[p] - nearest) ** 2).sum(axis=1))
-        close = np.zeros(points.shape[0], dtype=bool)
-        close[p[distance < reach]] = True
-        if close.any():
-            found = max(found, float(_polyline_distance(points[close], polyline).max()))
-            if found + 0.02 * r >= limit:
-                return limit
-    if found == -math.inf:
-        return 0.0
-    return found + 0.02 * r
-
-
-def _descending_chunks(low: np.ndarray, high: np.ndarray, chunk: int):
-    """The integers of the disjoint intervals [low, high) (sorted), highest first, in arrays
-    of at most ``chunk`` (few of them: the scan may end early)."""
-    pieces: list[np.ndarray] = []
-    size = 0
-    for k in range(low.size - 1, -1, -1):
-        lo, hi = int(low[k]), int(high[k])
-        while hi > lo:
-            take = min(hi - lo, chunk - size)
-            pieces.append(np.arange(hi - take, hi, dtype=np.int64))
-            size += take
-            hi -= take
-            if size == chunk:
-                yield np.concatenate(pieces)
-                pieces, size = [], 0
-    if pieces:
-        yield np.concatenate(pieces)
-
-
-def _candidate_samples(starts, ends, counts, first, a, b, reach: float):
-    """Sorted disjoint intervals [low, high) of global sample indices (sample k of own segment
-    i is ``first[i] + k``, at parameter k / (counts[i] - 1)) that may lie within ``reach`` of
-    a sibling segment (a, b): those inside the cylinder of radius ``reach`` around the
-    sibling's line, between the planes ``reach`` beyond its ends (a superset of the capsule),
-    padded by two samples on each side against rounding. Only the (own, sibling) pairs whose
-    balls come that close are measured (:func:`_ball_pairs`)."""
-    e = b - a
-    length = np.sqrt((e**2).sum(axis=1))
-    e = np.where(length[:, None] > 0.0, e / np.where(length > 0.0, length, 1.0)[:, None], 0.0)
-    slack = reach * (1.0 + 1e-6) + 1e-9 * max(
-        float(np.abs(starts).max()), float(np.abs(ends).max()), float(np.abs(a).max()), 1.0)
-    # the region of a sibling lies within length / 2 + 2 slack of its midpoint: pairs whose
-    # balls are 3 slack apart have no sample in it
-    own_half = 0.5 * np.sqrt(((ends - starts) ** 2).sum(axis=1))
-    pairs_i, pairs_j = _ball_pairs(0.5 * (starts + ends), own_half, 0.5 * (a + b), 0.5 * length,
-                                   3.0 * slack)  # fmt: skip
-    found_low, found_high = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
-    for p0 in range(0, pairs_i.size, _JUNCTION_PAIRS):
-        i, j = pairs_i[p0 : p0 + _JUNCTION_PAIRS], pairs_j[p0 : p0 + _JUNCTION_PAIRS]
-        d, ej = (ends - starts)[i], e[j]
-        rel = starts[i] - a[j]  # (pairs, 3)
-        t0 = (rel * ej).sum(axis=1)  # axial coordinate at u = 0 and its rate
-        t1 = (d * ej).sum(axis=1)
-        w0 = rel - t0[:, None] * ej  # the part across the sibling's line
-        w1 = d - t1[:, None] * ej
-        ww = (w1**2).sum(axis=1)
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            # across: |w0 + u w1| < slack, an interval around the nearest u
-            centre = np.where(ww > 0.0, -(w0 * w1).sum(axis=1) / np.where(ww > 0.0, ww, 1.0),
-                              0.0)  # fmt: skip
-            gap = np.sqrt(((w0 + centre[:, None] * w1) ** 2).sum(axis=1))
-            half = np.where(ww > 0.0, np.sqrt(np.maximum(slack**2 - gap**2, 0.0) / ww), np.inf)
-            inside = gap < slack
-            lo, hi = centre - half, centre + half
-            # along: -slack < t0 + u t1 < length + slack
-            ua = (-slack - t0) / t1
-            ub = (length[j] + slack - t0) / t1
-            moving = t1 != 0.0
-            lo = np.where(moving, np.maximum(lo, np.minimum(ua, ub)), lo)
-            hi = np.where(moving, np.minimum(hi, np.maximum(ua, ub)), hi)
-            inside &= moving | ((t0 > -slack) & (t0 < length[j] + slack))
-        lo, hi = np.maximum(lo, 0.0), np.minimum(hi, 1.0)
-        inside &= lo <= hi
-        q = np.flatnonzero(inside)
-        steps = (counts[i[q]] - 1).astype(float)
-        k0 = np.maximum(np.floor(lo[q] * steps) - 2.0, 0.0).astype(np.int64)
-        k1 = np.minimum(np.ceil(hi[q] * steps) + 3.0, steps + 1.0).astype(np.int64)
-        found_low.append(first[i[q]] + k0)
-        found_high.append(first[i[q]] + k1)
-    low, high = np.concatenate(found_low), np.concatenate(found_high)
-    if low.size == 0:
-        return low, high
-    order = np.argsort(low, kind="stable")
-    low, high = low[order], high[order]
-    reach_end = np.maximum.accumulate(high)
-    new = np.ones(low.size, dtype=bool)
-    new[1:] = low[1:] > reach_end[:-1]
-    starts_at = np.flatnonzero(new)
-    return low[starts_at], np.maximum.reduceat(high, starts_at)
-
-
-#: Consecutive balls per group in :func:`_ball_pairs`, and about the most pairs (of groups, or
-#: of balls) it holds at once.
-_BALL_GROUP = 32
-_BALL_PAIRS = 1 << 18
-
-
-def _group_balls(centre: np.ndarray, half: np.ndarray, size: int):
-    """Balls around groups of ``size`` consecutive balls: (first index of each group, centre,
-    radius)."""
-    begin = np.arange(0, half.size, size)
-    count = np.diff(np.r_[begin, half.size])
-    c = np.add.reduceat(centre, begin, axis=0) / count[:, None]
-    owner = np.repeat(np.arange(begin.size), count)
-    spread = np.sqrt(((centre - c[owner]) ** 2).sum(axis=1)) + half
-    return begin, c, np.maximum.reduceat(spread, begin)
-
-
-def _ball_pairs(c1, h1, c2, h2, reach: float) -> tuple[np.ndarray, np.ndarray]:
-    """Index pairs (i, j) of balls (centres ``c1``, radii ``h1``) and (``c2``, ``h2``) whose
-    surfaces come within ``reach`` (|c1_i - c2_j| - h1_i - h2_j < reach), in no particular
-    order. Groups of consecutive balls (a tube's capsules) are compared first, so far-apart
-    stretches of two tubes cost one test per pair of groups; about 2**18 pairs (of groups or
-    of balls) are held at once while searching."""
-    empty = np.zeros(0, dtype=np.int64)
-    if h1.size == 0 or h2.size == 0:
-        return empty, empty
-    g = _BALL_GROUP
-    begin1, gc1, gr1 = _group_balls(c1, h1, g)
-    begin2, gc2, gr2 = _group_balls(c2, h2, g)
-    # a rounding allowance: the groups' balls may only keep more pairs than the exact test
-    slack = reach + 1e-9 * (1.0 + float(np.abs(gc1).max()) + float(np.abs(gc2).max())
-                            + float(gr1.max()) + float(gr2.max()))  # fmt: skip
-    sizes1, sizes2 = np.diff(np.r_[begin1, h1.size]), np.diff(np.r_[begin2, h2.size])
-    found_i, found_j = [empty], [empty]
-    rows = max(1, _BALL_PAIRS // begin2.size)
-    for r0 in range(0, begin1.size, rows):
-        d = gc1[r0 : r0 + rows, None, :] - gc2[None]
-        near = np.sqrt((d**2).sum(axis=2)) - gr1[r0 : r0 + rows, None] - gr2[None] < slack
-        ge, gf = np.nonzero(near)
-        ge += r0
-        block = sizes1[ge] * sizes2[gf]
-        # the near group pairs, a few at a time: at most _BALL_PAIRS ball pairs each
-        cut = np.searchsorted(np.cumsum(block), np.arange(1, 1 + int(block.sum()) //
-                                                          _BALL_PAIRS) * _BALL_PAIRS)
-        for part in np.split(np.arange(ge.size), np.unique(cut)):
-            if part.size == 0:
-                continue
-            n2, size = sizes2[gf[part]], block[part]
-            q = np.arange(int(size.sum())) - np.repeat(np.cumsum(size) - size, size)
-            n2_rep = np.repeat(n2, size)
-            i = np.repeat(begin1[ge[part]], size) + q // n2_rep
-            j = np.repeat(begin2[gf[part]], size) + q % n2_rep
-            d = c1[i] - c2[j]
-            keep = np.sqrt((d**2).sum(axis=1)) - h1[i] - h2[j] < reach
-            found_i.append(i[keep])
-            found_j.append(j[keep])
-    return np.concatenate(found_i), np.concatenate(found_j)
-
-
-def _point_params(points, a, b) -> np.ndarray:
-    return point_segment_parameters(points, a, b)
-
-
-#: Most (point, segment) pairs :func:`_polyline_distance` measures all at once; beyond, it
-#: measures each point against the segments that can be nearest, about _BALL_PAIRS at a time.
-_POLYLINE_DENSE = 1 << 16
-#: Consecutive segments per group in :func:`_polyline_distance` (fastest of 4, 8, 16, 32 on
-#: the rows of fuzzed trees' tubes).
-_POLYLINE_GROUP = 8
-
-
-def _polyline_distance(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
-    """Distance along ``polyline`` (from its start) of the point of it nearest each point
-    (of equally near segments, the first)."""
-    a, b = polyline[:-1], polyline[1:]
-    lengths = np.sqrt(((b - a) ** 2).sum(axis=1))
-    cumulative = np.concatenate([[0.0], np.cumsum(lengths)])
-    if points.shape[0] * a.shape[0] <= _POLYLINE_DENSE:
-        t = _point_params(points[:, None, :], a[None], b[None])
-        nearest = a[None] + t[..., None] * (b - a)[None]
-        k = np.sqrt(((points[:, None, :] - nearest) ** 2).sum(axis=2)).argmin(axis=1)
-        rows = np.arange(points.shape[0])
-        return cumulative[k] + t[rows, k] * lengths[k]
-    # groups of consecutive segments: the nearest segment lies in a group whose ball comes
-    # within the smallest distance to any group's far side (with a rounding allowance)
-    begin, gc, gr = _group_balls(0.5 * (a + b), 0.5 * lengths, _POLYLINE_GROUP)
-    sizes = np.diff(np.r_[begin, a.shape[0]])
-    allowance = 1e-9 * (1.0 + float(np.abs(points).max()) + float(np.abs(polyline).max())
-                        + 2.0 * float(gr.max()))  # fmt: skip
-    best = np.full(points.shape[0], np.inf)
-    best_k = np.zeros(points.shape[0], dtype=np.int64)
-    best_t = np.zeros(points.shape[0])
-    step = max(1, _BALL_PAIRS // begin.size)
-    for p0 in range(0, points.shape[0], step):
-        d = np.sqrt(((points[p0 : p0 + step, None, :] - gc[None]) ** 2).sum(axis=2))
-        upper = (d + gr[None]).min(axis=1)
-        pp, gg = np.nonzero(d - gr[None] <= upper[:, None] + allowance)  # by point, then group
-        pp += p0
-        size = sizes[gg]
-        cut = np.searchsorted(np.cumsum(size), np.arange(1, 1 + int(size.sum()) //
-                                                         _BALL_PAIRS) * _BALL_PAIRS)
-        for part in np.split(np.arange(pp.size), np.unique(cut)):
-            if part.size == 0:
-                continue
-            n = size[part]
-            q = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
-            i = np.repeat(pp[part], n)
-            k = np.repeat(begin[gg[part]], n) + q  # by point, then segment
-            t = _point_params(points[i], a[k], b[k])
-            nearest = a[k] + t[:, None] * (b - a)[k]
-            dist = np.sqrt(((points[i] - nearest) ** 2).sum(axis=1))
-            run = np.flatnonzero(np.r_[True, i[1:] != i[:-1]])
-            low = np.minimum.reduceat(dist, run)
-            hit = np.flatnonzero(dist == np.repeat(low, np.diff(np.r_[run, i.size])))
-            _, first_hit = np.unique(i[hit], return_index=True)  # each point's first nearest
-            at = hit[first_hit]
-            better = dist[at] < best[i[at]]  # earlier segments win ties
-            who = i[at][better]
-            best[who], best_k[who], best_t[who] = dist[at][better], k[at][better], t[at][better]
-    return cumulative[best_k] + best_t * lengths[best_k]
-
-
-@dataclass(frozen=True, eq=False)
-class TreeCapsules:
-    """The capsules of a tree at its current configuration and what its pair rule needs
-    (docs/trees.md); built by :func:`tree_capsules`. World coordinates, units of r.
-
-    Attributes
-    ----------
-    r : float
-        Capsule radius.
-    starts, ends : numpy.ndarray, shape (S, 3)
-        Every capsule's segment, row by row in joint order (a joint's link, then the joint).
-    start_joint, end_joint : numpy.ndarray of int, shape (S,)
-        The joint whose distal side each end moves with (-1: the root's base).
-    turning : numpy.ndarray, shape (S,)
-        Turning of the centreline from the root along the path to the row, links only: at a
-        configuration every revolute joint on the path to ``start_joint`` (itself included)
-        adds |state|.
-    element, node : numpy.ndarray of int, shape (S,)
-        2 j (joint j) or 2 j - 1 (the link into j), and j.
-    rows : tuple
-        The capsule rows (their labels: :func:`part_label`).
-    parents : tuple of int
-    ancestor : numpy.ndarray of bool, shape (n, n)
-        ``ancestor[x, y]``: joint y is x or an ancestor of x.
-    is_link : numpy.ndarray of bool, shape (S,)
-    top : numpy.ndarray of int, shape (n,)
-        For a joint on the tube leaving a branching joint (its child, continued through
-        waypoints with one child): that child; else -1.
-    extent : numpy.ndarray, shape (n,)
-        The junction extent of each such child (:func:`junction_extent`, at most
-        ``JUNCTION_REACH`` r); 0 elsewhere.
-    along : numpy.ndarray, shape (S, 2)
-        For the link rows of those tubes: how far along the tube (from the branching frame)
-        each end of the row lies; nan elsewhere.
-    """
-
-    r: float
-    starts: np.ndarray
-    ends: np.ndarray
-    start_joint: np.ndarray
-    end_joint: np.ndarray
-    turning: np.ndarray
-    element: np.ndarray
-    node: np.ndarray
-    rows: tuple
-    parents: tuple
-    ancestor: np.ndarray
-    is_link: np.ndarray
-    top: np.ndarray
-    extent: np.ndarray
-    along: np.ndarray
-
-    @property
-    def count(self) -> int:
-        """Number of capsules."""
-        return int(self.starts.shape[0])
-
-    def hinge_turning(self, joints) -> np.ndarray:
-        """(n,) the turning the revolute hinges add from the root to each joint's distal side
-        (itself included), at the states of ``joints``."""
-        n = len(self.parents)
-        kinks = np.zeros(n)
-        for j in range(n):
-            p = self.parents[j]
-            kink = abs(joints[j].state) if isinstance(joints[j], RevoluteJoint) else 0.0
-            kinks[j] = kink + (kinks[p] if p >= 0 else 0.0)
-        return kinks
-
-    def junction_pairs(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
-        """Which of the row pairs (i, j) are two link rows of the tubes leaving one branching
-        joint (on different tubes): those are tested only beyond the junction."""
-        nx, ny = self.node[i], self.node[j]
-        same_path = self.ancestor[nx, ny] | self.ancestor[ny, nx]
-        top, parents = self.top, np.asarray(self.parents, dtype=np.int64)
-        parent_of_top = np.where(top >= 0, parents[np.maximum(top, 0)], -2)
-        return (~same_path & self.is_link[i] & self.is_link[j] & (top[nx] >= 0)
-                & (top[ny] >= 0) & (parent_of_top[nx] == parent_of_top[ny]))  # fmt: skip
-
-    def beyond_junction(self, i: np.ndarray, j: np.ndarray, a=None, b=None) -> tuple:
-        """``(distance, s, t)`` of junction pairs (i, j): the part of each row beyond its
-        junction against the whole other row, the closer of the two ways (inf when neither row
-        reaches beyond its junction); s, t along the whole rows. ``a``, ``b``: the rows'
-        segments (default: ``starts``, ``ends``)."""
-        a = self.starts if a is None else a
-        b = self.ends if b is None else b
-        rest = np.full(i.size, np.inf)
-        rest_s, rest_t = np.zeros(i.size), np.zeros(i.size)
-        # the part of one row beyond its junction, against the whole other row (both ways);
-        # the closest points are those of the parts tested (parameters along the whole rows)
-        for first_is_mine, (mine, other) in ((True, (i, j)), (False, (j, i))):
-            e = self.extent[self.top[self.node[mine]]]
-            d0, d1 = self.along[mine, 0], self.along[mine, 1]
-            beyond = np.maximum(d0, d1) > e
-            span = d1 - d0
-            u = np.clip(np.where(span != 0.0, (e - d0) / np.where(span != 0.0, span, 1.0), 0.0),
-                        0.0, 1.0)  # fmt: skip
-            p0, p1 = a[mine], b[mine]
-            cut = p0 + u[:, None] * (p1 - p0)
-            lo = np.where((d1 < d0)[:, None], p0, cut)
-            hi = np.where((d1 < d0)[:, None], cut, p1)
-            dd, ss, tt = segment_distances(lo, hi, a[other], b[other])
-            dd = np.where(beyond, dd, np.inf)
-            # ss runs along [lo, hi]: the same point as a parameter along the whole row
-            point = lo + ss[:, None] * (hi - lo)
-            axis = p1 - p0
-            length2 = np.einsum("ij,ij->i", axis, axis)
-            along_row = np.einsum("ij,ij->i", point - p0, axis) / np.where(
-                length2 > 0, length2, 1.0
-            )
-            along_row = np.clip(np.where(length2 > 0, along_row, 0.0), 0.0, 1.0)
-            better = dd < rest
-            rest = np.where(better, dd, rest)
-            if first_is_mine:
-                rest_s = np.where(better, along_row, rest_s)
-                rest_t = np.where(better, tt, rest_t)
-            else:
-                rest_s = np.where(better, tt, rest_s)
-                rest_t = np.where(better, along_row, rest_t)
-        return rest, rest_s, rest_t
-
-
-#: Junction extents of the last few trees, by the link objects they were computed from (a
-#: state change moves a junction's tubes rigidly: their extents stay).
-_EXTENT_MEMO: dict = {}
-_EXTENT_MEMO_SIZE = 64
-_EXTENT_MEMO_LOCK = threading.Lock()
-
-
-def _rigid_origins(links) -> tuple | None:
-    """The links these are rigid copies of when all moved by one transform (or none moved),
-    else None."""
-    origins, moves = [], []
-    for link in links:
-        origin, T = link.__dict__.get("_moved_from", (link, None))
-        origins.append(origin)
-        moves.append(T)
-    if all(T is None for T in moves):
-        return tuple(origins)
-    if any(T is None for T in moves) or not all(np.array_equal(T, moves[0]) for T in moves):
-        return None
-    return tuple(origins)
-
-
-def _junction_extents(kids: list, paths: dict, links, r: float, margin: float) -> dict:
-    """The junction extent (at most ``JUNCTION_REACH`` r) of every child in ``kids`` of one
-    branching joint; ``paths[k]``: the joints whose links make the tube leaving towards k.
-
-    The tubes of a junction move together (they all hang from the branching joint), so when
-    they are rigid copies of links seen before, the extents are those of the originals
-    (computed on the originals: the same answer whatever the configuration)."""
-    nodes = [m for k in kids for m in paths[k]]
-    origins = _rigid_origins([links[m] for m in nodes])
-    key = None
-    if origins is not None:
-        key = (tuple(map(id, origins)), tuple(nodes), tuple(len(paths[k]) for k in kids), r,
-               margin)  # fmt: skip
-        with _EXTENT_MEMO_LOCK:
-            hit = _EXTENT_MEMO.get(key)
-        if hit is not None and all(map(operator.is_, hit[0], origins)):
-            return hit[1]
-        source = dict(zip(nodes, origins, strict=True))
-    else:
-        source = {m: links[m] for m in nodes}
-    tubes = {}
-    for k in kids:
-        arrays = [_link_arrays(source[m], m, r, 0.2)[0] for m in paths[k]]
-        points = [link_polyline(source[m]) for m in paths[k]]
-        polyline = np.concatenate([points[0]] + [pts[1:] for pts in points[1:]])
-        tubes[k] = (polyline, np.concatenate([x[0] for x in arrays]),
-                    np.concatenate([x[1] for x in arrays]))  # fmt: skip
-    extents = {}
-    for k in kids:
-        others = [tubes[o] for o in kids if o != k]
-        a = np.concatenate([t[1] for t in others])
-        b = np.concatenate([t[2] for t in others])
-        found = junction_extent(tubes[k][0], (tubes[k][1], tubes[k][2]), (a, b), r, margin,
-                                limit=JUNCTION_REACH * r)
-        extents[k] = min(found, JUNCTION_REACH * r)
-    if key is not None:
-        with _EXTENT_MEMO_LOCK:
-            _EXTENT_MEMO[key] = (origins, extents)
-            while len(_EXTENT_MEMO) > _EXTENT_MEMO_SIZE:
-                del _EXTENT_MEMO[next(iter(_EXTENT_MEMO))]
-    return extents
-
-
-def tree_capsules(joints, links, parents, r: float, margin: float = 0.0) -> TreeCapsules:
-    """The :class:`TreeCapsules` of a tree (its joints, links and parent list) at its current
-    configuration, with the junctions of ``margin`` (docs/trees.md)."""
-    parents = tuple(int(p) for p in parents)
-    n = len(joints)
-    children: list[list[int]] = [[] for _ in range(n)]
-    for k in range(1, n):
-        children[parents[k]].append(k)
-    link_total = np.zeros(n)
-    rows: list = []
-    pieces_a, pieces_b, owner_node, base_turn = [], [], [], []
-    for j in range(n):
-        if j > 0:
-            (A, B, _, turn), link_rows, total = _link_arrays(links[j], j, r, 0.2)
-            link_total[j] = total
-            if len(link_rows):
-                pieces_a.append(A)
-                pieces_b.append(B)
-                owner_node.append(np.full(len(link_rows), j))
-                base_turn.append(turn)
-                rows += link_rows
-        (A, B, _, turn), joint_rows = _joint_arrays(joints[j], j, r)
-        if len(joint_rows):
-            pieces_a.append(A)
-            pieces_b.append(B)
-            owner_node.append(np.full(len(joint_rows), j))
-            base_turn.append(turn)
-            rows += joint_rows
-    S = len(rows)
-    if S:
-        a, b = np.concatenate(pieces_a), np.concatenate(pieces_b)
-        node = np.concatenate(owner_node).astype(np.int64)
-        own = np.concatenate(base_turn)
-    else:
-        a, b, node, own = np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0)
-    element = np.fromiter((row[5] for row in rows), dtype=np.int64, count=S)
-    body_a = np.fromiter((row[2] for row in rows), dtype=np.int64, count=S)
-    body_b = np.fromiter((row[3] for row in rows), dtype=np.int64, count=S)
-    is_link = element % 2 == 1
-    path_links = np.zeros(n)  # link turning from the root to the end of joint j's link
-    for j in range(n):
-        p = parents[j]
-        path_links[j] = link_total[j] + (path_links[p] if p >= 0 else 0.0)
-    parent_of = np.array(parents, dtype=np.int64)
-    before = np.where(is_link, path_links[np.maximum(parent_of[node], 0)], path_links[node])
-    before = np.where(is_link & (parent_of[node] < 0), 0.0, before)
-    # a joint's distal half (body = its own index) moves with the joint; everything else of
-    # joint j (its link, a proximal half) with its parent (rows number bodies as in a chain,
-    # where the parent of j is j - 1)
-    start_joint = np.where(body_a == node, node, parent_of[node])
-    end_joint = np.where(body_b == node, node, parent_of[node])
-
-    # junctions: how far the tube to each child of a branching joint (continued through
-    # waypoints with one child, which add no part) runs with its siblings
-    extent = np.zeros(n)
-    top = np.full(n, -1, dtype=np.int64)
-    polylines: dict[int, np.ndarray] = {}
-    for kids in children:
-        if len(kids) < 2:
-            continue
-        paths = {}
-        for k in kids:
-            path = [k]
-            while isinstance(joints[path[-1]], Waypoint) and len(children[path[-1]]) == 1:
-                path.append(children[path[-1]][0])
-            top[path] = k
-            paths[k] = path
-            points = [link_polyline(links[m]) for m in path]
-            polylines[k] = np.concatenate([points[0]] + [pts[1:] for pts in points[1:]])
-        for k, value in _junction_extents(kids, paths, links, r, margin).items():
-            extent[k] = value
-    # distances along each tube of the end points of its rows
-    along = np.full((S, 2), np.nan)
-    for k, line in polylines.items():
-        rows_k = np.flatnonzero((top[node] == k) & is_link)
-        if rows_k.size:
-            d = _polyline_distance(np.concatenate([a[rows_k], b[rows_k]]), line)
-            along[rows_k, 0], along[rows_k, 1] = d[: rows_k.size], d[rows_k.size :]
-    ancestor = np.zeros((n, n), dtype=bool)  # ancestor[x, y]: y is x or an ancestor of x
-    for x in range(n):
-        ancestor[x, x] = True
-        if parents[x] >= 0:
-            ancestor[x] |= ancestor[parents[x]]
-    caps = TreeCapsules(r, a, b, start_joint, end_joint, own + before, element, node,
-                        tuple(rows), parents, ancestor, is_link, top, extent, along)  # fmt: skip
-    for value in vars(caps).values():
-        if isinstance(value, np.ndarray):
-            value.setflags(write=False)
-    return caps
-
-
-def tree_pair_distances(
-    joints, links, parents, r: float, since: int = 0, reach: float | None = None,
-    margin: float = 0.0,
-) -> tuple | None:
-    """The tested capsule pairs of a tree that come within ``reach`` (default 2r + ``margin``)
-    and their distances (docs/trees.md): ``(i, j, distance, s, t, rows, a, b)`` with ``i``,
-    ``j`` row indices, ``s``, ``t`` the closest points' parameters, ``rows`` the capsule rows
-    (labels) and ``a``, ``b`` their end points; None when nothing is tested.
-
-    Parts on one path from the root are tested as in a chain (when the centreline between
-    them turns by at least pi, hinges included). Parts on different branches are always tested,
-    except where two tubes leaving the same branching joint still run together within the
-    junction that joins them (:func:`junction_extent` of each, with ``margin``: the junction
-    covers them until they are the margin apart); on a chain the tested pairs are the chain's.
-    """
-    reach = 2.0 * r + margin if reach is None else reach
-    caps = tree_capsules(joints, links, parents, r, margin)
-    S = caps.count
-    if S < 2:
-        return None
-    a, b, node = caps.starts, caps.ends, caps.node
-    kinks = caps.hinge_turning(joints)
-    tau = caps.turning + np.where(caps.start_joint >= 0, kinks[caps.start_joint], 0.0)
-    centre = 0.5 * (a + b)
-    half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
-    wanted = node >= since if since > 0 else None  # a part's rows share their node
-    i, j = _near_pairs(caps.element, tau, np.arange(S) + 1, centre, half, reach, wanted)
-    if since > 0 and i.size:
-        keep = (node[i] >= since) | (node[j] >= since)
-        i, j = i[keep], j[keep]
-    if i.size == 0:
-        return None
-    # one path from the root (one node an ancestor of the other): the chain rule; different
-    # branches: always, but two parts of the tubes leaving one branching joint only beyond
-    # the junction
-    nx, ny = node[i], node[j]
-    same_path = caps.ancestor[nx, ny] | caps.ancestor[ny, nx]
-    tested = ~same_path | (np.abs(tau[j] - tau[i]) >= math.pi - TURN_TOLERANCE)
-    i, j = i[tested], j[tested]
-    if i.size == 0:
-        return None
-    dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
-    q = np.flatnonzero(caps.junction_pairs(i, j))
-    if q.size:
-        dist[q], s[q], t[q] = caps.beyond_junction(i[q], j[q])
-    return i, j, dist, s, t, caps.rows, a, b
-
-
-def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int = 0,
-                       margin: float = 0.0):  # fmt: skip
-    """:func:`worst_overlap` for a tree (docs/trees.md): the closest pair when it is closer
-    than ``margin``, or None.
-
-    Parts on one path from the root are tested as in a chain; parts on different branches are
-    always tested, except where two tubes leaving the same branching joint still run together
-    within the junction that joins them. On a chain it is :func:`worst_overlap`.
-    """
-    parents = [int(p) for p in parents]
-    if parents == list(range(-1, len(joints) - 1)):
-        return worst_overlap(joints, links, r, names=names, since=since, margin=margin)
-    found = tree_pair_distances(joints, links, parents, r, since, margin=margin)
-    if found is None:
-        return None
-    i, j, dist, s, t, rows, _, _ = found
-    return _deepest(i, j, dist, s, t, rows, joints, names, r, margin)
 
 
 def part_label(row, param: float, joints, names=None) -> str:
