@@ -243,7 +243,7 @@ def _use(rng: random.Random, chain, folder: Path, what: str) -> str:
 
     if what == "pattern":
         if isinstance(chain, KinematicTree):  # its sheets and junctions (the tree's patterns)
-            from kinegami.tree.sheets import fabricate
+            from kinegami.fabrication.sheets import fabricate
 
             fabricate(chain, junction=rng.choice(("connector", "takeoff", "auto")))
         else:

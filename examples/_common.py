@@ -168,12 +168,12 @@ def report(chain, name: str, written: list[Path], units: str = "mm") -> None:
 def tree_sheets(tree):
     """The sheets and junctions of a tree as ``kinegami build`` makes them: first every branch
     joint whose socket has no room on its link slides along its own axis (the kinematics stay;
-    ``kinegami.tree.sheets.fit_junctions``), then the tree is cut into one sheet per leaf.
+    ``kinegami.fabrication.sheets.fit_junctions``), then the tree is cut into one sheet per leaf.
 
     Returns ``(fabrication, slides)``: the ``TreeFabrication`` (``.sheets``, ``.junctions``)
     and the slides made, ``[(joint, distance), ...]`` in the tree's units.
     """
-    from kinegami.tree.sheets import fabricate, fit_junctions
+    from kinegami.fabrication.sheets import fabricate, fit_junctions
 
     fitted, slides = fit_junctions(tree)
     return fabricate(fitted), slides

@@ -566,8 +566,8 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
     from kinegami.design.reader import carry_origin
     from kinegami.errors import InvalidParameterError
     from kinegami.export.tree_build import FORMAT_LIBRARIES, write_tree_files
-    from kinegami.tree.sheets import fabricate, fit_junctions
-    from kinegami.tree.takeoffs import JUNCTION_KINDS
+    from kinegami.fabrication.sheets import fabricate, fit_junctions
+    from kinegami.fabrication.takeoffs import JUNCTION_KINDS
 
     kind = "connector" if args.junctions is None else args.junctions
     if kind not in JUNCTION_KINDS:
@@ -781,7 +781,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
         chain, info = _load(args.design)
         if tree:  # a crease pattern per sheet, and the junctions
-            from kinegami.tree.sheets import fabricate, fit_junctions
+            from kinegami.fabrication.sheets import fabricate, fit_junctions
 
             try:
                 fitted, moves = fit_junctions(chain)
@@ -1051,7 +1051,7 @@ def _compaction_lines(job: BuildJob, before: BuildJob | None = None) -> list[str
     counts = Counter(type(joint).__name__ for joint in chain.Joints)
     kinds = ", ".join(f"{count} {name}" for name, count in counts.items())
     if _is_tree(chain):
-        from kinegami.tree.sheets import junction_problems
+        from kinegami.fabrication.sheets import junction_problems
 
         problems = junction_problems(chain)
         leaves = sum(1 for c in chain.Children if not c)

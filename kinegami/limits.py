@@ -96,7 +96,7 @@ MAX_PDF_PAGES = 200
 MAX_INTEGER_DIGITS = 30
 
 # --- work inside one operation -------------------------------------------------------------
-#: Most capsule tests of one joint's take-off search (kinegami.tree.takeoffs): each candidate
+#: Most capsule tests of one joint's take-off search (kinegami.fabrication.takeoffs): each candidate
 #: placement is a clearance test of the whole folded body, so a body of S capsules (about two
 #: per elbow and two per joint) measures at most TAKEOFF_WORK / S candidates. Ordinary trees
 #: (a few hundred capsules: every face at 5 heights and 48 sets) stay within it; an 11-joint tree

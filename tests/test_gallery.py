@@ -425,7 +425,7 @@ def test_tree_design_equals_script(name, trees, scripts):
         warnings.simplefilter("ignore", ClearanceWarning)  # the paper's hand, as designed
         built = scripts(name).build()
         if name == "hand":  # the file is the hand as fabricated: its junction fitted
-            from kinegami.tree.sheets import fit_junctions
+            from kinegami.fabrication.sheets import fit_junctions
 
             built, _ = fit_junctions(built)
     assert isinstance(built, KinematicTree)

@@ -129,7 +129,7 @@ def test_a_tree_with_branches_1e6_r_long_builds_in_bounded_memory(far):
     assert done.stdout.split() == ["KinematicTree", "True"]
 
 
-# --- the printed connector's sibling overlap (kinegami.tree.connector) -------------------------
+# --- the printed connector's sibling overlap (kinegami.fabrication.connector) ---------------
 def _overlap_reference(links, r, step=None, distance=None) -> np.ndarray:
     """sibling_overlap_lengths as first written: every sample of every link in one array."""
     from kinegami.geometry.csc_centreline import csc_distances, csc_points
@@ -184,7 +184,7 @@ def _random_links(rng, r):
 
 
 def test_sibling_overlap_lengths_give_the_answers_of_sampling_everything():
-    from kinegami.tree.connector import sibling_overlap_lengths
+    from kinegami.fabrication.connector import sibling_overlap_lengths
 
     rng = np.random.default_rng(2029)
     for case in range(40):
@@ -203,7 +203,7 @@ def test_sibling_links_1e6_r_long_are_cheap():
     from spatialmath import SE3
 
     from kinegami import LinkCSC
-    from kinegami.tree.connector import sibling_overlap_lengths
+    from kinegami.fabrication.connector import sibling_overlap_lengths
 
     a = LinkCSC(1, SE3(), SE3.Trans(1e6, 6, 0))
     b = LinkCSC(1, SE3(), SE3.Trans(1e6, -6, 0))

@@ -27,7 +27,7 @@ from kinegami import (
 from kinegami.design import load_design
 from kinegami.pattern import catalog
 from kinegami.pattern.catalog import check_pattern_size, module_kind, module_vertices
-from kinegami.tree import takeoffs
+from kinegami.fabrication import takeoffs
 
 
 # --- joints through the API -------------------------------------------------------------------
@@ -120,7 +120,7 @@ def test_the_default_limit_builds_ordinary_and_large_patterns():
 
 
 def test_a_tree_whose_sheets_would_be_too_large_is_refused(monkeypatch):
-    from kinegami.tree.sheets import fabricate
+    from kinegami.fabrication.sheets import fabricate
 
     tree = KinematicTree(Waypoint(8, 1, SE3()))
     tree.addJoint(0, PrismaticJoint(8, 1, 4, 200, math.pi / 4, SE3.Trans(0, 0, 30)), safe=False)

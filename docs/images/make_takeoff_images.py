@@ -28,9 +28,9 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from kinegami import SE3, ClearanceWarning, EndTip, KinematicTree, RevoluteJoint, Waypoint  # noqa: E402
 from kinegami.design import load_design_with_info  # noqa: E402
-from kinegami.pattern.cut_graph import interior_point  # noqa: E402
 from kinegami.export.fold import sheet_graph  # noqa: E402
-from kinegami.tree.sheets import fabricate  # noqa: E402
+from kinegami.fabrication.sheets import fabricate  # noqa: E402
+from kinegami.pattern.cut_graph import interior_point  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent

@@ -119,7 +119,7 @@ def check_pattern(
     if not hasattr(chain, "creasePattern"):  # a tree: one pattern per sheet
         raise DesignError(
             f"the design loads as a KinematicTree of {len(chain.Joints)} joints, which has no "
-            "single crease pattern but one per sheet: kinegami.tree.sheets.fabricate(tree) "
+            "single crease pattern but one per sheet: kinegami.fabrication.sheets.fabricate(tree) "
             "builds them ('kinegami build' writes them)",
             file=file,
         )

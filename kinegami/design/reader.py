@@ -910,7 +910,7 @@ def carry_origin(source: KinematicChain, target: KinematicChain) -> DesignOrigin
     """Give ``target`` the origin (joint names, design entries) of ``source`` and return it.
 
     For a chain or tree made from a loaded one with the same joints in the same order (a
-    tree whose children :func:`kinegami.tree.sheets.fit_junctions` slid), every joint takes
+    tree whose children :func:`kinegami.fabrication.sheets.fit_junctions` slid), every joint takes
     the origin of its counterpart, waypoints included. When only the joints apart from
     waypoints match (:func:`kinegami.optimize.compact`: waypoints may move, appear or
     disappear), each non-waypoint joint takes the origin of the matching joint of ``source``

@@ -1074,7 +1074,7 @@ class SetOptions(Command):
 @dataclass(frozen=True)
 class FitJunctions(LongCommand):
     """Slide the branch children of a tree whose printed junction socket would not fit on
-    their link, along their axes (:func:`kinegami.tree.sheets.fit_junctions`: the kinematics
+    their link, along their axes (:func:`kinegami.fabrication.sheets.fit_junctions`: the kinematics
     stay, no new collision): what ``kinegami build`` does before it makes the sheets."""
 
     label: ClassVar[str] = "fit junctions"
@@ -1085,7 +1085,7 @@ class FitJunctions(LongCommand):
                   "with several children)")  # fmt: skip
 
     def _compute(self, chain, progress):
-        from kinegami.tree.sheets import fit_junctions
+        from kinegami.fabrication.sheets import fit_junctions
 
         return fit_junctions(chain, progress=progress)
 

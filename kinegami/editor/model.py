@@ -366,7 +366,7 @@ class EditorModel:
     def sheets(self, document: Document | None = None, fit: Callable | None = None) -> TreeSheets:
         """The sheets of the current tree (or of ``document``, a tree's), one per leaf, with
         its junctions, as ``kinegami build`` makes them (the tree fitted by
-        :func:`~kinegami.tree.sheets.fit_junctions` first, or by ``fit``, which computes the
+        :func:`~kinegami.fabrication.sheets.fit_junctions` first, or by ``fit``, which computes the
         same elsewhere): a :class:`~kinegami.editor.patterns.TreeSheets`. Computed once per
         document (a failure too: the same error is raised again); any thread may ask.
         InvalidTypeError for a chain (its one sheet is :meth:`pattern`)."""

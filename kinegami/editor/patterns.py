@@ -135,7 +135,7 @@ def _record_count(pattern, first: bool) -> int:
 
 def sheet_records(tree, sheet, twistPortion: float = 0.2,
                   cache: PatternCache | None = None) -> tuple[range, ...]:  # fmt: skip
-    """Per joint of ``sheet`` (a :class:`~kinegami.tree.sheets.TreeSheet` of ``tree``), the
+    """Per joint of ``sheet`` (a :class:`~kinegami.fabrication.sheets.TreeSheet` of ``tree``), the
     indices of its own records in ``sheet.pattern.modules``.
 
     A sheet is the composite of, for each of its joints in order, the modules of the link into
@@ -168,8 +168,8 @@ class TreeSheets:
 
     Attributes
     ----------
-    fabrication : the :class:`~kinegami.tree.sheets.TreeFabrication` (sheets and junctions)
-        of the tree after :func:`~kinegami.tree.sheets.fit_junctions`, as ``kinegami build``
+    fabrication : the :class:`~kinegami.fabrication.sheets.TreeFabrication` (sheets and junctions)
+        of the tree after :func:`~kinegami.fabrication.sheets.fit_junctions`, as ``kinegami build``
         makes it.
     slides : ``(joint, distance)`` of every slide the fit made (lengths in the tree's units;
         empty when every socket fits as designed).
@@ -186,7 +186,7 @@ class TreeSheets:
 
     @property
     def sheets(self) -> tuple:
-        """The :class:`~kinegami.tree.sheets.TreeSheet` of every leaf."""
+        """The :class:`~kinegami.fabrication.sheets.TreeSheet` of every leaf."""
         return self.fabrication.sheets
 
 
@@ -197,11 +197,11 @@ def tree_sheets(tree, twistPortion: float = 0.2, names=None, units: str = "mm",
     ``kinegami build`` does (raises InvalidParameterError when some socket cannot be made to
     fit; the message names the joint).
 
-    ``fit`` replaces :func:`~kinegami.tree.sheets.fit_junctions` (``fit(tree) -> (fitted,
+    ``fit`` replaces :func:`~kinegami.fabrication.sheets.fit_junctions` (``fit(tree) -> (fitted,
     slides)``; the view runs it in a worker process); ``cache`` gives the links' modules.
     """
     from kinegami.export.tree_build import sheet_labels
-    from kinegami.tree.sheets import fabricate, fit_junctions
+    from kinegami.fabrication.sheets import fabricate, fit_junctions
 
     fitted, slides = (fit_junctions if fit is None else fit)(tree)
     fabrication = fabricate(fitted, twistPortion=twistPortion)

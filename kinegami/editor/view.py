@@ -1685,7 +1685,7 @@ class EditorView:
         return self.redraw_sheets(model, document)
 
     def _remote_fit(self, tree):
-        from kinegami.tree.sheets import fit_junctions
+        from kinegami.fabrication.sheets import fit_junctions
 
         return self._worker.run(fit_junctions, tree)
 

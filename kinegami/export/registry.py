@@ -359,7 +359,7 @@ def _subject(obj: Any, fmt: ExportFormat, options: dict[str, Any]) -> Any:
         raise InvalidTypeError(
             f"{fmt.suffix} files hold one crease pattern, but a KinematicTree is folded from "
             f"{sheets} sheet{'s' if sheets != 1 else ''} (one per leaf): export each sheet's "
-            "pattern (kinegami.tree.sheets.fabricate(tree).sheets[k].pattern)"
+            "pattern (kinegami.fabrication.sheets.fabricate(tree).sheets[k].pattern)"
         )
     if not isinstance(obj, KinematicChain | TubularPattern):
         from kinegami.pattern.cutout import CutPattern

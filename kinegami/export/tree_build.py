@@ -55,7 +55,7 @@ FORMAT_LIBRARIES = {
 
 def sheet_labels(fabrication, names: Sequence[str | None] | None = None,
                  units: str | None = None) -> list[str]:  # fmt: skip
-    """The label of every sheet (:meth:`kinegami.tree.sheets.TreeSheet.label`; lengths in mm
+    """The label of every sheet (:meth:`kinegami.fabrication.sheets.TreeSheet.label`; lengths in mm
     when the design's ``units`` are given)."""
     length = None
     if units is not None:
@@ -74,7 +74,7 @@ def write_tree_files(
     twistPortion: float = 0.2,
     names: Sequence[str | None] | None = None,
 ) -> list[Path]:
-    """Write the files of ``formats`` for a :class:`~kinegami.tree.sheets.TreeFabrication`
+    """Write the files of ``formats`` for a :class:`~kinegami.fabrication.sheets.TreeFabrication`
     into ``folder`` and return their paths (in the order written).
 
     Raises

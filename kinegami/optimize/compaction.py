@@ -33,11 +33,11 @@ from kinegami.errors import (
     NoPathError,
     PlacementWarning,
 )
+from kinegami.fabrication.sheets import junction_problems
 from kinegami.geometry.csc import csc_lengths
 from kinegami.geometry.frames import rotation_about_line
 from kinegami.progress import Progress, ProgressCallback, check_progress
 from kinegami.tree import KinematicTree
-from kinegami.tree.sheets import junction_problems
 from kinegami.validation import (
     check_bool,
     check_int,
@@ -684,7 +684,7 @@ def compact(
         Configurations sampled for ``motion`` (>= 1).
     junctions : bool
         Trees only: also require that every printed junction can be made, i.e. each branch
-        child's socket fits on its link (:func:`kinegami.tree.sheets.junction_problems`).
+        child's socket fits on its link (:func:`kinegami.fabrication.sheets.junction_problems`).
     margin : float, optional
         The clearance required between the parts (chain units, >= 0; folded sheets have a
         thickness); default: ``chain.margin``. The result's ``margin`` is this value.

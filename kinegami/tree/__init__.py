@@ -1,5 +1,6 @@
-"""Kinematic trees: joints with several children (hands, legged bodies), the tree
-construction, and how a tree is fabricated from sheets and junctions (docs/trees.md).
+"""Kinematic trees: joints with several children (hands, legged bodies) and the tree
+construction (docs/trees.md). How a tree is made from sheets and junctions is
+:mod:`kinegami.fabrication`.
 
 ``KinematicTree`` (published name) is the model; a ``KinematicChain`` is the tree in which each
 joint's parent is the joint before it. ``from_specification`` builds a tree from a joint

@@ -69,7 +69,7 @@ class KinematicTree(JointAssembly):
     def _from_parts(cls, joints, links, parents, maxAnglePerElbow: float) -> KinematicTree:
         """A tree holding exactly ``joints``, ``links`` and ``parents`` (nothing re-solved; for
         a folded body whose links need not start at their parent's distal frame, such as a
-        take-off branch: kinegami.tree.sheets.TreeFabrication.folded_tree)."""
+        take-off branch: kinegami.fabrication.sheets.TreeFabrication.folded_tree)."""
         tree = cls(joints[0], maxAnglePerElbow)
         tree._commit(list(joints), list(links), None, [int(p) for p in parents])
         return tree

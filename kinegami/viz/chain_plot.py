@@ -10,7 +10,7 @@ rule for a tree) and names parts by their index (:func:`kinegami.clearance.solid
 The geometry comes from :mod:`kinegami.viz.chain_geometry`; this module only turns it into
 matplotlib artists, one collection per kind of thing (joint bodies, elbows, tubes, ...), each
 tagged with a ``gid`` (see :data:`ARTIST_GIDS`) so scripts and tests can find it. Defaults come
-from :mod:`kinegami.style`. matplotlib is imported only when a chain is drawn.
+from :mod:`kinegami.viz.style`. matplotlib is imported only when a chain is drawn.
 """
 
 from __future__ import annotations
@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from kinegami import style
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.validation import (
     check_bool,
@@ -29,6 +28,7 @@ from kinegami.validation import (
     resolve_options,
 )
 from kinegami.viz import chain_geometry as geo
+from kinegami.viz import style
 from kinegami.viz._backend import show_if_interactive
 from kinegami.viz.scale import check_units, length_text, nice_length, unit_text
 
@@ -118,7 +118,7 @@ _SCALE_OPTIONS = ("jointAxisScale", "globalAxisScale", "groundPlaneScale")
 
 
 def resolve_chain_options(options: dict[str, Any]) -> dict[str, Any]:
-    """All options of ``show_chain``: the defaults of :mod:`kinegami.style` updated by
+    """All options of ``show_chain``: the defaults of :mod:`kinegami.viz.style` updated by
     ``options``, checked.
 
     Raises InvalidTypeError for an unknown option name or a value of the wrong type, and
@@ -300,7 +300,7 @@ def _draw_joint_bodies(scene, chain, opts):
 
 
 def _draw_junctions(scene, chain, opts):
-    """A tree's printed junction connectors (kinegami.tree.sheets.fabricate), shaded; nothing
+    """A tree's printed junction connectors (kinegami.fabrication.sheets.fabricate), shaded; nothing
     for a chain. A connector that cannot be made (a socket that does not fit its link, or
     manifold3d missing) is left out with a warning saying why."""
     import warnings
@@ -310,7 +310,7 @@ def _draw_junctions(scene, chain, opts):
     if isinstance(chain, KinematicChain) or not any(len(c) > 1 for c in chain.Children):
         return
     from kinegami.errors import KinegamiError
-    from kinegami.tree.sheets import fabricate
+    from kinegami.fabrication.sheets import fabricate
 
     try:
         fabrication = fabricate(chain)
@@ -596,7 +596,7 @@ def show_chain(chain: KinematicChain | KinematicTree, **options) -> tuple[Figure
     ----------
     chain : the KinematicChain or KinematicTree to draw (a tree's links from their parents;
         ``showCollisions`` uses ``tree.clearance()``).
-    **options : see :data:`kinegami.style.CHAIN_PLOT_DEFAULTS` for names and defaults.
+    **options : see :data:`kinegami.viz.style.CHAIN_PLOT_DEFAULTS` for names and defaults.
         Lengths scale with the tube radius r: frames are r long, axes of motion
         p -+ jointAxisScale r z, the world frame globalAxisScale r, the ground plane
         [-groundPlaneScale r, groundPlaneScale r]^2 in cells of r. ``ax`` draws into an existing
@@ -622,7 +622,8 @@ def show_chain(chain: KinematicChain | KinematicTree, **options) -> tuple[Figure
 
 
 def show_fabrication(fabrication, **options) -> tuple[Figure, Axes3D]:
-    """Draw a tree as it is made (:meth:`kinegami.tree.sheets.TreeFabrication.show`): the tree as
+    """Draw a tree as it is made
+    (:meth:`kinegami.fabrication.sheets.TreeFabrication.show`): the tree as
     folded (take-off branches leaving their trunk's face) and this fabrication's own printed
     connectors, whichever kind each junction is. ``options`` as for :func:`show_chain`
     (``showJunctions`` defaults to True here)."""

@@ -22,7 +22,7 @@ from kinegami import ClearanceWarning
 from kinegami.design import load_design_with_info
 from kinegami.export._options import UNITS_IN_MM
 from kinegami.export.pdf import pdf_layout
-from kinegami.tree.sheets import fabricate, fit_junctions
+from kinegami.fabrication.sheets import fabricate, fit_junctions
 
 from .helpers import main_in_process
 

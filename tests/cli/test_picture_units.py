@@ -6,8 +6,8 @@ import pytest
 
 from kinegami import cli
 from kinegami.chain import KinematicChain
+from kinegami.fabrication.sheets import TreeFabrication
 from kinegami.pattern import TubularPattern
-from kinegami.tree.sheets import TreeFabrication
 
 
 @pytest.fixture

@@ -176,7 +176,7 @@ def takeoff_fabrication():
 
     from kinegami.design import load_design_with_info
     from kinegami.errors import ClearanceWarning
-    from kinegami.tree.sheets import fabricate
+    from kinegami.fabrication.sheets import fabricate
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ClearanceWarning)
@@ -295,7 +295,7 @@ def test_the_connector_build_fold_files_start_where_their_sheets_start(hand_buil
 
     from kinegami.design import load_design_with_info
     from kinegami.errors import ClearanceWarning
-    from kinegami.tree.sheets import fabricate, fit_junctions
+    from kinegami.fabrication.sheets import fabricate, fit_junctions
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ClearanceWarning)

@@ -141,7 +141,7 @@ def test_the_gallery_hand_is_the_papers_hand_as_build_fits_it():
     """One design, one verdict: the gallery's hand.json is the tree kinegami build makes of
     the paper's hand (fit_junctions slides the palm by -3 r), so build, check, the editor and
     the library judge the tree that is fabricated."""
-    from kinegami.tree.sheets import fit_junctions, junction_problems
+    from kinegami.fabrication.sheets import fit_junctions, junction_problems
 
     paper, gallery = _quietly(load_design, HAND), _quietly(load_design, GALLERY_HAND)
     fitted, moves = _quietly(fit_junctions, paper)
@@ -190,7 +190,7 @@ def test_edits_and_states_of_a_tree_design_use_names_and_tree_indices():
 
 def test_a_tree_has_a_crease_pattern_per_sheet():
     tree, info = _quietly(load_design_with_info, HAND)
-    with pytest.raises(DesignError, match="one per sheet: kinegami.tree.sheets.fabricate"):
+    with pytest.raises(DesignError, match="one per sheet: kinegami.fabrication.sheets.fabricate"):
         check_pattern(tree, info)
 
 

@@ -22,8 +22,8 @@ from kinegami.editor.background import JobProcess  # noqa: E402
 from kinegami.editor.commands import LongCommand, Outcome  # noqa: E402
 from kinegami.editor.server import EditorServer  # noqa: E402
 from kinegami.errors import Cancelled, InvalidParameterError  # noqa: E402
+from kinegami.fabrication.sheets import junction_problems  # noqa: E402
 from kinegami.optimize import tube_length  # noqa: E402
-from kinegami.tree.sheets import junction_problems  # noqa: E402
 
 from .helpers import EXAMPLE1, HAND, ROOT, snapshot  # noqa: E402
 

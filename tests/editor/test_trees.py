@@ -23,8 +23,8 @@ from kinegami.editor import (
 )
 from kinegami.editor.autosave import Autosaver, autosave_path, find_recovery
 from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.fabrication.sheets import fabricate, fit_junctions
 from kinegami.tree import KinematicTree
-from kinegami.tree.sheets import fabricate, fit_junctions
 from tests.editor.helpers import (
     GRIPPER,
     HAND,

@@ -308,7 +308,7 @@ def test_a_tree_pdfs_footers_lie_inside_its_pages(tmp_path):
     from kinegami.design import load_design_with_info
     from kinegami.design.reader import carry_origin
     from kinegami.export.tree_build import sheet_labels, write_tree_files
-    from kinegami.tree.sheets import fabricate, fit_junctions
+    from kinegami.fabrication.sheets import fabricate, fit_junctions
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -294,7 +294,7 @@ def test_random_trees_forward_kinematics(tmp_path_factory, tree, seed):
 def test_the_folded_tree_with_takeoffs_is_a_valid_robot(tmp_path, hand):
     """kinegami build --junctions takeoff writes the URDF of the tree as folded: the take-off
     branches leave their trunk's face (each trunk link cut there by a fixed waypoint)."""
-    from kinegami.tree.sheets import fabricate
+    from kinegami.fabrication.sheets import fabricate
 
     folded = fabricate(hand, junction="takeoff").folded_tree()
     assert len(folded.Joints) > len(hand.Joints)

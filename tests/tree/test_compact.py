@@ -23,8 +23,8 @@ from kinegami import (
     RevoluteJoint,
     Waypoint,
 )
+from kinegami.fabrication.sheets import junction_problems
 from kinegami.optimize import CompactionError, compact, tube_length
-from kinegami.tree.sheets import junction_problems
 
 from .helpers import quiet_hand
 

@@ -11,9 +11,8 @@ from mpl_toolkits.mplot3d.axes3d import Axes3D
 from numpy.testing import assert_allclose
 from spatialmath import SE3
 
-from kinegami import style
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.viz import _backend
+from kinegami.viz import _backend, style
 from kinegami.viz.chain_plot import CHAIN_PLOT_OPTIONS, show_chain
 
 from .conftest import build_long_chain
@@ -369,7 +368,7 @@ def _collection_gids(ax) -> set:
 
 def test_show_junctions_draws_every_connector_of_a_tree():
     pytest.importorskip("manifold3d")
-    from kinegami.tree.sheets import fabricate, fit_junctions
+    from kinegami.fabrication.sheets import fabricate, fit_junctions
 
     tree, _ = fit_junctions(_three_finger_tree())
     fig, ax = show_chain(tree, showJunctions=True)
@@ -432,7 +431,7 @@ def test_a_fabrication_shows_its_folded_tree_and_only_its_own_connectors():
 
     from kinegami import ClearanceWarning
     from kinegami.design import load_design
-    from kinegami.tree.sheets import fabricate, fit_junctions
+    from kinegami.fabrication.sheets import fabricate, fit_junctions
 
     design = Path(__file__).resolve().parents[2] / "examples/designs/quadruped.json"
     with warnings.catch_warnings():

@@ -12,8 +12,8 @@ from spatialmath import SE3
 from kinegami import KinematicTree, RevoluteJoint, Waypoint
 from kinegami.clearance.solids import chain_parts
 from kinegami.errors import ClearanceWarning
-from kinegami.style import linkSurfaceSides
 from kinegami.viz import chain_geometry as geo
+from kinegami.viz.style import linkSurfaceSides
 
 try:  # tests/ is not a package: reachable as tests.tree from the checkout, else as tree
     from tests.tree.helpers import hand_tree

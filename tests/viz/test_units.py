@@ -11,10 +11,11 @@ import warnings
 import numpy as np
 import pytest
 
-from kinegami import KinematicTree, style
+from kinegami import KinematicTree
 from kinegami.errors import InvalidParameterError
 from kinegami.pattern.sheet import flatten
 from kinegami.viz import chain_geometry as geo
+from kinegami.viz import style
 
 try:  # tests/ is not a package: reachable as tests.tree from the checkout, else as tree
     from tests.tree.helpers import hand_tree

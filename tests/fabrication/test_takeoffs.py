@@ -1,6 +1,6 @@
-"""A tree made with folded take-off junctions (kinegami.tree.sheets.fabricate(junction=...),
-kinegami.tree.takeoffs): the sheets, where each branch leaves its trunk, the two nets folded in
-the tree's world frame, the kinematics unchanged, and what cannot be made."""
+"""A tree made with folded take-off junctions (kinegami.fabrication.sheets.fabricate(junction=...),
+kinegami.fabrication.takeoffs): the sheets, where each branch leaves its trunk, the two nets
+folded in the tree's world frame, the kinematics unchanged, and what cannot be made."""
 
 from __future__ import annotations
 
@@ -15,14 +15,13 @@ from spatialmath import SE3
 from kinegami import ClearanceWarning, EndTip, KinematicTree, RevoluteJoint, Waypoint
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export.fold import sheet_graph
+from kinegami.fabrication.sheets import fabricate
+from kinegami.fabrication.takeoffs import TakeoffOptions, hole_name, takeoff_body
 from kinegami.geometry.csc_centreline import csc_transported_frame
 from kinegami.pattern import TubularPattern
 from kinegami.pattern.cutout import CutPattern
 from kinegami.pattern.folded import UVA_TO_DUBINS, unsnapped_form
-from kinegami.tree.sheets import fabricate
-from kinegami.tree.takeoffs import TakeoffOptions, hole_name, takeoff_body
-
-from .helpers import hand_tree, quiet_hand
+from tests.tree.helpers import hand_tree, quiet_hand
 
 #: The paper's hand's sheets (the same as with printed connectors: the trunk rule).
 HAND_SHEETS = [(0, 8, 9, 10, 11), (5, 6, 7), (1, 2, 3, 4)]
@@ -329,7 +328,7 @@ def test_a_trunk_without_a_straight_part_holds_no_hole():
 
 
 def test_the_folded_tree_of_printed_connectors_is_the_tree(hand):
-    from kinegami.tree.sheets import fit_junctions
+    from kinegami.fabrication.sheets import fit_junctions
 
     fitted, _ = fit_junctions(hand)
     fabrication = fabricate(fitted)
@@ -382,7 +381,7 @@ def test_a_takeoff_refusal_gives_lengths_in_r_for_a_tree_in_mm():
     from pathlib import Path
 
     from kinegami.design import load_design
-    from kinegami.tree.sheets import fit_junctions
+    from kinegami.fabrication.sheets import fit_junctions
 
     design = Path(__file__).resolve().parents[2] / "examples" / "designs" / "quadruped.json"
     with warnings.catch_warnings():

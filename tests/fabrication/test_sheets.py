@@ -25,15 +25,14 @@ from kinegami import (
     StartTip,
     Waypoint,
 )
-from kinegami.tree.sheets import (
+from kinegami.fabrication.sheets import (
     choose_trunks,
     default_trunks,
     fabricate,
     fit_junctions,
     junction_problems,
 )
-
-from .helpers import hand_tree
+from tests.tree.helpers import hand_tree
 
 RY = SE3.Ry(math.pi / 2)
 
@@ -227,7 +226,7 @@ def test_default_labels_give_lengths_as_multiples_of_r():
     from pathlib import Path
 
     from kinegami.design import load_design
-    from kinegami.tree.sheets import fit_junctions
+    from kinegami.fabrication.sheets import fit_junctions
 
     design = Path(__file__).resolve().parents[2] / "examples" / "designs" / "quadruped.json"
     with warnings.catch_warnings():

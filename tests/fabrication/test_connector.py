@@ -1,4 +1,4 @@
-"""The printed junction connector (kinegami.tree.connector, docs/junctions.md)."""
+"""The printed junction connector (kinegami.fabrication.connector, docs/junctions.md)."""
 
 import math
 import sys
@@ -12,9 +12,7 @@ from numpy.testing import assert_allclose
 from kinegami.chain.joints import RevoluteJoint, Waypoint
 from kinegami.chain.links import LinkCSC
 from kinegami.errors import ExporterUnavailableError, InvalidParameterError, NoPathError
-from kinegami.geometry.csc_centreline import csc_distances, csc_points
-from kinegami.geometry.frames import rot_x, rot_y, rotation_matrix, translation
-from kinegami.tree.connector import (
+from kinegami.fabrication.connector import (
     ConnectorOptions,
     junction_connector,
     junction_sockets,
@@ -23,6 +21,8 @@ from kinegami.tree.connector import (
     split_connector,
     trunk_split_plane,
 )
+from kinegami.geometry.csc_centreline import csc_distances, csc_points
+from kinegami.geometry.frames import rot_x, rot_y, rotation_matrix, translation
 
 pytest.importorskip("manifold3d")
 

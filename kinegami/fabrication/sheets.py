@@ -14,12 +14,12 @@ ends at exactly one leaf and every leaf ends one sheet: a tree has as many sheet
   along sheet 0 (joint by joint from the root, longest first), then those along sheet 1, ...
 * **Where a branch sheet starts.** The connector of the joint holds the tubes of its children
   over the first part of their links, where they still run within reach of each other, plus a
-  socket (:func:`kinegami.tree.connector.junction_sockets`). A branch child's sheet starts at
+  socket (:func:`kinegami.fabrication.connector.junction_sockets`). A branch child's sheet starts at
   its socket, on its link: its first modules are the rest of that link (the same CSC path from
   there on), then its joint, and so on to its leaf. The trunk's tube runs through the
   connector's sleeve, so the trunk's sheet simply continues.
 * **Folded take-offs** (``junction="takeoff"``): no connector; each side branch leaves a face of
-  the trunk's link (its plain tube part) at right angles (:mod:`kinegami.tree.takeoffs`). The
+  the trunk's link (its plain tube part) at right angles (:mod:`kinegami.fabrication.takeoffs`). The
   trunk's sheet gets a hole there; the branch's sheet starts with a skirt cut to the trunk's
   shape, with glue tabs that fold in and are glued inside the trunk around the hole, then a new
   link to the branch child (the joints stay where they are).
@@ -38,18 +38,18 @@ import numpy as np
 
 from kinegami.chain.links import LinkCSC
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.pattern import TubularPattern
-from kinegami.pattern.catalog import check_pattern_size
-from kinegami.pattern.cutout import CutPattern, SheetHole
-from kinegami.tree.connector import ConnectorOptions, JunctionSocket, junction_sockets
-from kinegami.tree.model import KinematicTree
-from kinegami.tree.takeoffs import (
+from kinegami.fabrication.connector import ConnectorOptions, JunctionSocket, junction_sockets
+from kinegami.fabrication.takeoffs import (
     JUNCTION_KINDS,
     Takeoff,
     TakeoffOptions,
     hole_name,
     place_takeoffs,
 )
+from kinegami.pattern import TubularPattern
+from kinegami.pattern.catalog import check_pattern_size
+from kinegami.pattern.cutout import CutPattern, SheetHole
+from kinegami.tree.model import KinematicTree
 from kinegami.validation import check_int, check_twist_portion, shown
 
 __all__ = [
@@ -77,7 +77,7 @@ class Junction:
     joint : the branching joint (tree index).
     children : its children (tree indices, in order).
     trunk : the child whose sheet runs through the connector.
-    sockets : one :class:`~kinegami.tree.connector.JunctionSocket` per child, in ``children``
+    sockets : one :class:`~kinegami.fabrication.connector.JunctionSocket` per child, in ``children``
         order (lengths along each child's link, in the tree's length units, those of r).
     parent_side : how the connector meets the joint behind it (``"base"`` for the root,
         ``"flange"`` otherwise; docs/junctions.md).
@@ -107,7 +107,7 @@ class TreeSheet:
         take-off holes or starts with a skirt.
     frame : world Dubins frame (4x4) where the sheet's pattern starts: its folded form lies on
         the tree from there.
-    takeoff : the name of the :class:`~kinegami.tree.takeoffs.Takeoff` it starts at, or None.
+    takeoff : the name of the :class:`~kinegami.fabrication.takeoffs.Takeoff` it starts at, or None.
     takeoff_sheet : the sheet holding that take-off's hole, or None.
     holes : ``(name, branch sheet)`` of every take-off hole in this sheet.
     tabs : number of glue tabs of its skirt (0 without one).
@@ -173,7 +173,8 @@ class TreeFabrication:
     sheets : one :class:`TreeSheet` per leaf.
     junctions : the printed connectors (:class:`Junction`).
     options : the connector options.
-    takeoffs : the folded take-off junctions (:class:`~kinegami.tree.takeoffs.Takeoff`), one per
+    takeoffs : the folded take-off junctions
+        (:class:`~kinegami.fabrication.takeoffs.Takeoff`), one per
         side branch that leaves its trunk through a face.
     notes : what the fabrication chose on its own (a joint given a connector because no
         take-off could be made there).
@@ -191,26 +192,26 @@ class TreeFabrication:
 
     def overlap(self, names=None):
         """The deepest overlap of the folded body (the tree's joints, :attr:`links`, every
-        trunk link cut at its take-off points: :func:`~kinegami.tree.takeoffs.takeoff_body`),
+        trunk link cut at its take-off points: :func:`~kinegami.fabrication.takeoffs.takeoff_body`),
         by the tree's clearance rules, or None when it does not pass through itself (``names``:
         the joints' names for the labels)."""
-        from kinegami.tree.takeoffs import takeoff_overlap
+        from kinegami.fabrication.takeoffs import takeoff_overlap
 
         return takeoff_overlap(self.tree, self._body_takeoffs(), names=names)
 
     def _body_takeoffs(self) -> list[tuple]:
-        """The take-offs as :func:`~kinegami.tree.takeoffs.takeoff_body` takes them."""
+        """The take-offs as :func:`~kinegami.fabrication.takeoffs.takeoff_body` takes them."""
         return [(t.trunk, t.arc, t.child, t.link) for t in self.takeoffs]
 
     def folded_tree(self) -> KinematicTree:
         """The tree as it is folded: :attr:`tree` itself, or, with take-offs, the tree whose
         take-off branches leave through their trunk's face (their :attr:`links`), every trunk
         link cut at its take-off points by a zero-length waypoint
-        (:func:`~kinegami.tree.takeoffs.takeoff_body`). What the whole-tree STL, OBJ and URDF
+        (:func:`~kinegami.fabrication.takeoffs.takeoff_body`). What the whole-tree STL, OBJ and URDF
         and the 3D picture of ``kinegami build`` show."""
         if not self.takeoffs:
             return self.tree
-        from kinegami.tree.takeoffs import takeoff_body
+        from kinegami.fabrication.takeoffs import takeoff_body
 
         joints, links, parents, _ = takeoff_body(self.tree, self._body_takeoffs())
         return KinematicTree._from_parts(joints, links, parents, self.tree.maxAnglePerElbow)
@@ -225,7 +226,7 @@ class TreeFabrication:
     def connector(self, k: int):
         """The printed connector of junction ``k`` as a watertight trimesh (world frame, units
         of r; needs manifold3d, ``pip install 'kinegami[print]'``)."""
-        from kinegami.tree.connector import junction_connector
+        from kinegami.fabrication.connector import junction_connector
 
         if isinstance(k, bool) or not isinstance(k, int | np.integer):
             raise InvalidTypeError(f"k must be a junction number, got {k!r}")
@@ -384,7 +385,7 @@ def fabricate(
         face, folded: the trunk's sheet gets a hole, the branch's sheet starts with a skirt and
         glue tabs), ``"auto"`` (take-offs where they can be made, else a connector, with a note
         in ``notes``), or ``{joint: kind}`` for some joints (the others: connectors).
-    takeoff : dimensions of the take-offs (:class:`~kinegami.tree.takeoffs.TakeoffOptions`).
+    takeoff : dimensions of the take-offs (:class:`~kinegami.fabrication.takeoffs.TakeoffOptions`).
 
     Raises
     ------

@@ -129,7 +129,8 @@ class TakeoffPlacement:
 
 @dataclass(frozen=True, eq=False)
 class Takeoff:
-    """A folded take-off junction of a fabricated tree (:func:`kinegami.tree.sheets.fabricate`).
+    """A folded take-off junction of a fabricated tree
+    (:func:`kinegami.fabrication.sheets.fabricate`).
 
     Attributes
     ----------
