@@ -311,22 +311,9 @@ def _clearance(chain):
 
 def _verdict_line(report, info) -> str:
     """The summary's clearance line, the same in build, check and compact: "  clearance: " and
-    the report's verdict (lengths in mm and the design's unit)."""
-    return "  clearance: " + _printable(report.verdict(info.units))
-
-
-def _lengths(r: float, units: str):
-    """Lengths of a design in words (kinegami.clearance.Lengths: mm, and the design's unit
-    beside them when it is not mm; to about r / 100)."""
-    from kinegami.clearance import Lengths
-
-    return Lengths(r, units)
-
-
-def _angle_span(low: float, high: float) -> str:
-    import math
-
-    return f"{math.degrees(low):.1f} to {math.degrees(high):.1f} deg"
+    the report's verdict (lengths in mm and the design's unit; ClearanceReport.summary)."""
+    (line,) = report.summary(info.units, listed=0)
+    return _printable(line)
 
 
 def _margin(args: argparse.Namespace, chain) -> None:
@@ -538,7 +525,9 @@ def _takeoff_summary(fabrication, info) -> list[str]:
     """The build summary's lines on folded take-offs (none for printed connectors only)."""
     if not fabrication.takeoffs and not fabrication.notes:
         return []
-    lengths = _lengths(fabrication.tree.r, info.units)
+    from kinegami.clearance import Lengths
+
+    lengths = Lengths(fabrication.tree.r, info.units)
     lines = [f"  take-offs: {len(fabrication.takeoffs)} (folded)"]
     for t in fabrication.takeoffs:
         lines.append(
@@ -846,14 +835,9 @@ def _pair_json(pair) -> dict:
     }
 
 
-def _movable(chain) -> list[int]:
-    """Indices of the joints that move (a state range that is not a single point)."""
-    ranges = [joint.stateRange() for joint in chain.Joints]
-    return [i for i, (low, high) in enumerate(ranges) if high > low]
-
-
 def _check_json(chain, info, design, report, motion, seed) -> dict:
     from kinegami.chain.joints import RevoluteJoint
+    from kinegami.clearance.reports import moving_joints
     from kinegami.design.reader import origin_of
 
     origin = origin_of(chain)
@@ -873,7 +857,7 @@ def _check_json(chain, info, design, report, motion, seed) -> dict:
     }
     if motion is not None:
         intervals = []
-        for i in _movable(chain):
+        for i in moving_joints(chain.Joints):
             joint = chain.Joints[i]
             free = motion.free_intervals[i]
             intervals.append({
@@ -898,62 +882,14 @@ def _check_json(chain, info, design, report, motion, seed) -> dict:
 
 
 def _check_lines(chain, info, design, report, motion, seed) -> list[str]:
-    from kinegami.chain.joints import RevoluteJoint
-
-    lengths = _lengths(chain.r, info.units)
+    """What ``check`` prints: the report's summary (ClearanceReport.summary, at most
+    LISTED_PAIRS pairs) and the sweep's (SweepReport.summary)."""
     title = f"{_printable(info.name)} ({design})" if info.name else design
-    lines = []
-    if report.ok:
-        lines.append(f"{title}: clear at its states")
-        lines.append(_verdict_line(report, info))
-    else:
-        count = len(report.pairs)
-        overlap = sum(1 for pair in report.pairs if pair.clearance < 0.0)
-        plural = "s" if count > 1 else ""
-        what = (f"{count} pair{plural} of parts overlap" if overlap == count
-                else f"{count} pair{plural} of parts closer than the margin "
-                f"{lengths.exact(report.margin)}")  # fmt: skip
-        lines.append(f"{title}: {'self-intersects' if overlap else 'not clear'} at its states "
-                     f"({what})")  # fmt: skip
-        lines.append(_verdict_line(report, info))
-        lines.append("  parts closer than the margin (closest first):")
-        for pair in report.pairs[:LISTED_PAIRS]:
-            how = (f"overlap {lengths(-pair.clearance)}" if pair.clearance < 0.0
-                   else f"{lengths(pair.clearance)} apart")  # fmt: skip
-            lines.append(f"    {pair.first} and {pair.second}: {how}")
-        if count > LISTED_PAIRS:
-            lines.append(f"    ... and {count - LISTED_PAIRS} more (--json lists them all)")
-    if motion is None:
-        return [_printable(line) for line in lines]
-    lines.append(
-        f"  motion: {motion.colliding} of {motion.samples} sampled configurations "
-        f"self-intersect ({100.0 * motion.colliding_fraction:.1f}%; seed {seed})"
-    )
-    if motion.worst_pairs:
-        lines.append("  pairs that overlap most over the motion:")
-        for pair, n in motion.worst_pairs:
-            lines.append(f"    {pair.first} and {pair.second}: the deepest overlap in {n} "
-                         f"configuration{'s' if n > 1 else ''}, up to "
-                         f"{lengths(-pair.clearance)}")  # fmt: skip
-    movable = _movable(chain)
-    if not movable:
-        lines.append("  free intervals: none (no joint moves)")
-    elif motion.free_intervals[movable[0]] is None:
-        lines.append("  free intervals: none (the design self-intersects at its states)")
-    else:
-        lines.append("  free intervals (each joint moved alone from its state, the others kept):")
-        names = _joint_names(chain)
-        for i in movable:
-            joint = chain.Joints[i]
-            low, high = motion.free_intervals[i]
-            lo, hi = joint.stateRange()
-            span = _angle_span if isinstance(joint, RevoluteJoint) else lengths.span
-            whole = low <= lo and high >= hi
-            label = f" '{names[i]}'" if names is not None and names[i] is not None else ""
-            lines.append(
-                f"    joint {i}, {type(joint).__name__}{label}: {span(low, high)}, "
-                + ("its whole range" if whole else f"of its range {span(lo, hi)}")
-            )
+    lines = report.summary(info.units, title=title, listed=LISTED_PAIRS)
+    if not report.ok and len(report.pairs) > LISTED_PAIRS:  # the last line: "... and N more"
+        lines[-1] += " (--json lists them all)"
+    if motion is not None:
+        lines += motion.summary(chain, info.units, names=_joint_names(chain), seed=seed)
     return [_printable(line) for line in lines]
 
 
@@ -1044,10 +980,11 @@ def _compaction_lines(job: BuildJob, before: BuildJob | None = None) -> list[str
     the change in length)."""
     from collections import Counter
 
+    from kinegami.clearance import Lengths
     from kinegami.optimize import tube_length
 
     chain = job.chain
-    lengths = _lengths(chain.r, job.info.units)
+    lengths = Lengths(chain.r, job.info.units)
     counts = Counter(type(joint).__name__ for joint in chain.Joints)
     kinds = ", ".join(f"{count} {name}" for name, count in counts.items())
     if _is_tree(chain):
@@ -1075,6 +1012,7 @@ def _compaction_lines(job: BuildJob, before: BuildJob | None = None) -> list[str
 
 
 def cmd_compact(args: argparse.Namespace) -> int:
+    from kinegami.clearance import Lengths
     from kinegami.design import save_design
     from kinegami.design.reader import carry_origin
     from kinegami.optimize import CompactionError, compact
@@ -1101,7 +1039,7 @@ def cmd_compact(args: argparse.Namespace) -> int:
     title = f"{_printable(info.name)} ({args.design})" if info.name else args.design
     lines = [
         f"{title}: compacted (seed {seed}{', motion kept' if args.motion else ''}, margin "
-        f"{_lengths(chain.r, info.units).exact(chain.margin)})",
+        f"{Lengths(chain.r, info.units).exact(chain.margin)})",
         "  before:",
         *_compaction_lines(before),
         "  after:",

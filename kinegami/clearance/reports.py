@@ -1,21 +1,38 @@
 """What a clearance check reports: the colliding pairs, one configuration's verdict, a sweep's
-figures, and the lengths they are worded in (docs/clearance.md)."""
+figures, and the lengths they are worded in (docs/clearance.md).
+
+The reports word themselves: ``kinegami check``, ``kinegami build``'s summary and the editor's
+panels print what :meth:`ClearanceReport.summary`, :meth:`ClearanceReport.markdown`,
+:meth:`SweepReport.summary` and :meth:`SweepReport.markdown` return."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from kinegami.chain.bodies import (
     clear_limit,
 )
+from kinegami.chain.joints import RevoluteJoint
 from kinegami.errors import InvalidParameterError
 from kinegami.validation import (
     UNITS_IN_MM,
     shown,
 )
 
-__all__ = ["Lengths", "CollidingPair", "ClearanceReport", "SweepReport"]
+if TYPE_CHECKING:
+    from kinegami.chain.joints import Joint
+    from kinegami.chain.model import KinematicChain
+
+__all__ = ["Lengths", "CollidingPair", "ClearanceReport", "SweepReport", "moving_joints"]
+
+
+def moving_joints(joints: Sequence[Joint]) -> list[int]:
+    """Indices of the joints that move: a state range that is not a single point."""
+    ranges = [joint.stateRange() for joint in joints]
+    return [i for i, (low, high) in enumerate(ranges) if high > low]
 
 
 class Lengths:
@@ -107,6 +124,13 @@ class CollidingPair:
             return f"{self.first} and {self.second} overlap by {-self.clearance:.4g}"
         return f"{self.first} and {self.second} are {self.clearance:.4g} apart"
 
+    def separation(self, length: Lengths) -> str:
+        """How close the parts are, in ``length``'s words: "overlap 0.7 mm (0.07 cm)" or
+        "2.2 mm apart"."""
+        if self.clearance < 0.0:
+            return f"overlap {length(-self.clearance)}"
+        return f"{length(self.clearance)} apart"
+
 
 @dataclass(frozen=True)
 class ClearanceReport:
@@ -167,6 +191,66 @@ class ClearanceReport:
                 f"{margin}: minimum clearance {length(self.min_clearance)}, between "
                 f"{first.first} and {first.second}{more}")  # fmt: skip
 
+    def headline(self, units: str | None = None) -> str:
+        """The state of the chain at its states in a few words, as ``kinegami check`` heads its
+        report: "clear at its states", "self-intersects at its states (2 pairs of parts
+        overlap)" or "not clear at its states (1 pair of parts closer than the margin 0.2 mm
+        (0.02 cm))" (no pair overlaps, some are closer than the margin)."""
+        if self.ok:
+            return "clear at its states"
+        count = len(self.pairs)
+        overlap = sum(1 for pair in self.pairs if pair.clearance < 0.0)
+        plural = "s" if count > 1 else ""
+        what = (f"{count} pair{plural} of parts overlap" if overlap == count
+                else f"{count} pair{plural} of parts closer than the margin "
+                f"{Lengths(self.r, units).exact(self.margin)}")  # fmt: skip
+        return f"{'self-intersects' if overlap else 'not clear'} at its states ({what})"
+
+    def summary(self, units: str | None = None, *, title: str | None = None,
+                listed: int | None = None) -> list[str]:  # fmt: skip
+        """The report in lines, as ``kinegami check`` prints it (``kinegami build`` and
+        ``compact``: the verdict's line alone, ``listed=0``).
+
+        Parameters
+        ----------
+        units : {"mm", "cm", "m", "in"} or None
+            The design's length unit (lengths in mm and in it; None: chain units).
+        title : str or None
+            The first line is "TITLE: " and :meth:`headline` (None: no such line).
+        listed : int or None
+            When the chain is not clear, the pairs closer than the margin, closest first, are
+            listed after the verdict: at most ``listed`` of them and a line "    ... and N
+            more" (None: all; 0: no list at all).
+
+        Returns
+        -------
+        list of str
+            "TITLE: clear at its states", "  clearance: " and :meth:`verdict`, "  parts closer
+            than the margin (closest first):", then one line per pair ("    A and B: overlap
+            0.7 mm (0.07 cm)").
+        """
+        length = Lengths(self.r, units)
+        lines = [] if title is None else [f"{title}: {self.headline(units)}"]
+        lines.append(f"  clearance: {self.verdict(units)}")
+        if self.ok or listed == 0:
+            return lines
+        shown = self.pairs if listed is None else self.pairs[:listed]
+        lines.append("  parts closer than the margin (closest first):")
+        lines += [f"    {p.first} and {p.second}: {p.separation(length)}" for p in shown]
+        if len(self.pairs) > len(shown):
+            lines.append(f"    ... and {len(self.pairs) - len(shown)} more")
+        return lines
+
+    def markdown(self, units: str | None = None, *, listed: int | None = None) -> str:
+        """The report as the editor's clearance panel shows it (Markdown): the :meth:`verdict`
+        when the chain is clear; otherwise the verdict in bold and the first ``listed`` pairs
+        closer than the margin (None: all) as a list, in chain units as ``str(pair)``."""
+        verdict = self.verdict(units)
+        if self.ok:
+            return verdict
+        shown = self.pairs if listed is None else self.pairs[:listed]
+        return "\n".join([f"**{verdict}**", ""] + [f"- {pair}" for pair in shown])
+
     def __str__(self) -> str:
         lines = [self.verdict()]
         if not self.ok:
@@ -209,3 +293,103 @@ class SweepReport:
     def colliding_fraction(self) -> float:
         """Fraction of the sampled configurations that self-intersect."""
         return self.colliding / self.samples if self.samples else 0.0
+
+    def summary(self, chain: KinematicChain, units: str | None = None, *,
+                names: Sequence[str | None] | None = None, seed: int = 0) -> list[str]:  # fmt: skip
+        """The sweep in lines, as ``kinegami check --motion`` prints them after the
+        :meth:`ClearanceReport.summary`.
+
+        Parameters
+        ----------
+        chain : KinematicChain or KinematicTree
+            What was swept (its joints' kinds and state ranges, and r).
+        units : {"mm", "cm", "m", "in"} or None
+            The design's length unit (lengths in mm and in it; None: chain units). Revolute
+            states are in degrees.
+        names : sequence of str or None, optional
+            One joint name (or None) per joint, quoted after the joint's kind.
+        seed : int
+            The seed the configurations were sampled with (named in the first line).
+
+        Returns
+        -------
+        list of str
+            "  motion: 28 of 150 sampled configurations self-intersect (18.7%; seed 3)", the
+            pairs that overlap most, then each moving joint's free interval ("    joint 3,
+            RevoluteJoint 'elbow': -12.3 to 90.0 deg, of its range -90.0 to 90.0 deg").
+        """
+        length = Lengths(chain.r, units)
+        share = f"{100.0 * self.colliding_fraction:.1f}%"
+        lines = [f"  motion: {self.colliding} of {self.samples} sampled configurations "
+                 f"self-intersect ({share}; seed {seed})"]  # fmt: skip
+        if self.worst_pairs:
+            lines.append("  pairs that overlap most over the motion:")
+            for pair, n in self.worst_pairs:
+                lines.append(f"    {pair.first} and {pair.second}: the deepest overlap in {n} "
+                             f"configuration{'s' if n > 1 else ''}, up to "
+                             f"{length(-pair.clearance)}")  # fmt: skip
+        movable = moving_joints(chain.Joints)
+        if not movable:
+            lines.append("  free intervals: none (no joint moves)")
+        elif self.free_intervals[movable[0]] is None:
+            lines.append("  free intervals: none (the design self-intersects at its states)")
+        else:
+            lines.append("  free intervals (each joint moved alone from its state, the others "
+                         "kept):")  # fmt: skip
+            for i in movable:
+                joint = chain.Joints[i]
+                low, high = self.free_intervals[i]
+                lo, hi = joint.stateRange()
+                span = _degrees if isinstance(joint, RevoluteJoint) else length.span
+                whole = low <= lo and high >= hi
+                label = f" '{names[i]}'" if names is not None and names[i] is not None else ""
+                lines.append(
+                    f"    joint {i}, {type(joint).__name__}{label}: {span(low, high)}, "
+                    + ("its whole range" if whole else f"of its range {span(lo, hi)}")
+                )
+        return lines
+
+    def markdown(self, chain: KinematicChain, *, names: Sequence[str | None] | None = None,
+                 seed: int = 0, listed: int | None = None,
+                 joints_listed: int | None = None) -> str:  # fmt: skip
+        """The sweep as the editor's motion panel shows it (Markdown): the share of colliding
+        configurations, the first ``listed`` pairs that were the deepest overlap (None: all)
+        and the free intervals of the first ``joints_listed`` moving joints (None: all), each
+        joint named by ``names[i]`` or its kind; lengths in chain units, revolute states in
+        degrees. ``chain``, ``names`` and ``seed`` as for :meth:`summary`."""
+        share = f"{100.0 * self.colliding_fraction:.1f}%"
+        lines = [f"**Motion check:** {self.colliding} of {self.samples} random configurations "
+                 f"self-intersect ({share}, seed {seed})"]  # fmt: skip
+        if self.worst_pairs:
+            lines += ["", "Deepest overlaps over the motion:", ""]
+            for pair, count in self.worst_pairs[:listed]:
+                lines.append(f"- {pair.first} and {pair.second}: up to {-pair.clearance:.3g} "
+                             f"({count} configuration{'s' if count > 1 else ''})")  # fmt: skip
+        movable = moving_joints(chain.Joints)
+        if movable and self.free_intervals[movable[0]] is None:
+            lines += ["", "Free intervals: none (the design self-intersects at its states)."]
+        elif movable:
+            lines += ["", "Free interval of each joint moved alone from its state:", ""]
+            for i in movable[:joints_listed]:
+                joint = chain.Joints[i]
+                low, high = self.free_intervals[i]
+                lo, hi = (float(v) for v in joint.stateRange())
+                name = names[i] if names is not None and names[i] else type(joint).__name__
+                whole = " (its whole range)" if low <= lo and high >= hi else ""
+                lines.append(f"- {i} {name}: [{_state(joint, low)}, {_state(joint, high)}]"
+                             f"{whole}")  # fmt: skip
+            if len(movable) > len(movable[:joints_listed]):
+                lines.append(f"- ... and {len(movable) - joints_listed} more joints")
+        return "\n".join(lines)
+
+
+def _degrees(low: float, high: float) -> str:
+    """An interval of revolute states (radians) in degrees: "-12.3 to 90.0 deg"."""
+    return f"{math.degrees(low):.1f} to {math.degrees(high):.1f} deg"
+
+
+def _state(joint: Joint, value: float) -> str:
+    """One state in the editor's words: degrees for a revolute joint, else 3 digits."""
+    if isinstance(joint, RevoluteJoint):
+        return f"{math.degrees(value):.1f} deg"
+    return f"{value:.3g}"

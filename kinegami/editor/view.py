@@ -702,16 +702,8 @@ class EditorView:
                     continue
                 kind = "joint" if element % 2 == 0 else "link"
                 self._colliding.add((kind, (element + 1) // 2))
-        self._clearance_text = self._clearance_words(report, self.model.document.verdict)
-
-    @staticmethod
-    def _clearance_words(report, verdict: str) -> str:
-        """The clearance panel: the document's verdict (Document.verdict, worded as kinegami
-        build and check print it), in bold with the first pairs listed when it is not clear."""
-        if report.ok:
-            return verdict
-        lines = [f"**{verdict}**", ""] + [f"- {pair}" for pair in report.pairs[:8]]
-        return "\n".join(lines)
+        # the verdict kinegami build and check print, in bold with the first pairs when not clear
+        self._clearance_text = report.markdown(self.model.document.units, listed=8)
 
     def colour_of(self, kind: str, index: int) -> tuple[int, int, int]:
         """The colour a joint or link is drawn in (selected, colliding or plain)."""
