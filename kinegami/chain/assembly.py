@@ -40,6 +40,7 @@ from kinegami.errors import (
 )
 from kinegami.geometry.balls import Ball, merge_balls
 from kinegami.geometry.frames import rotation_about_line, translation
+from kinegami.geometry.screws import JointScrews
 from kinegami.validation import (
     check_bool,
     check_max_angle_per_elbow,
@@ -312,6 +313,35 @@ class JointAssembly:
     def _parent_list(self) -> list[int]:
         """The parent of every joint (-1 for the root)."""
         return list(range(-1, len(self._joints) - 1))
+
+    def joint_screws(self) -> JointScrews:
+        """The joints as screws about their axes at the current states: the one forward
+        kinematics of chains, trees and the clearance engine (kinegami.geometry.screws)."""
+        joints = self._joints
+        poses = np.array([joint.pose_matrix for joint in joints]).reshape(len(joints), 4, 4)
+        return JointScrews([joint.motion for joint in joints], poses[:, :3, 2], poses[:, :3, 3],
+                           self._parent_list(), [joint.state for joint in joints])  # fmt: skip
+
+    def _configured(self, values: Sequence[float]) -> tuple[list, list]:
+        """Joint and link lists at the (checked) states ``values``, one per joint: every joint
+        and link beyond a changed state moved by the forward kinematics of
+        :meth:`joint_screws`; the others are the same objects."""
+        joints = list(self._joints)
+        links = list(self._links)
+        changed = [float(v) != joint.state for v, joint in zip(values, joints, strict=True)]
+        if not any(changed):
+            return joints, links
+        A = self.joint_screws().joint_motions(np.asarray(values, dtype=float))
+        moved = [False] * len(joints)  # whether joint k's distal side moves
+        for k, p in enumerate(self._parent_list()):
+            upstream = p >= 0 and moved[p]
+            if upstream:
+                joints[k] = joints[k].transformed(A[p])
+                links[k] = links[k].transformed(A[p])
+            if changed[k]:
+                joints[k] = joints[k].with_state(values[k])
+            moved[k] = upstream or changed[k]
+        return joints, links
 
     def _parent_of(self, j: int) -> int:
         """The parent of joint j > 0 (a chain: j - 1)."""

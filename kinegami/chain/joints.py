@@ -36,6 +36,7 @@ from kinegami.geometry.frames import (
     translation,
     unit,
 )
+from kinegami.geometry.screws import FIXED, PRISMATIC, REVOLUTE
 from kinegami.validation import (
     REAL_NUMBER_TYPES,
     ReadOnlyAttributes,
@@ -207,6 +208,10 @@ class Joint(ReadOnlyAttributes):
 
     #: Index of the Pose column that is the path direction (overridden by Waypoint).
     _PATH_INDEX = 2
+
+    #: How the joint moves what is beyond it (kinegami.geometry.screws): FIXED (tips,
+    #: waypoints), REVOLUTE (about the Pose z axis) or PRISMATIC (along it).
+    motion = FIXED
 
     def __init__(self, numSides, r, neutralLength, Pose):
         self._numSides = check_num_sides(numSides)
@@ -424,6 +429,8 @@ class RevoluteJoint(Joint):
     numSinkLayers : number of recursive sink gadget layers in the pattern (>= 1; stiffness).
     """
 
+    motion = REVOLUTE
+
     _PATH_INDEX = 0
 
     def __init__(self, numSides, r, totalBendingAngle, Pose, numSinkLayers=1):
@@ -477,6 +484,8 @@ class PrismaticJoint(Joint):
         [d/(2 sin coneAngle) - d, d/sin coneAngle - d].
     Pose : SE3 (or 4x4 array) of the joint centre at state 0; z is the axis of motion.
     """
+
+    motion = PRISMATIC
 
     def __init__(self, numSides, r, neutralLength, numLayers, coneAngle, Pose):
         n = check_num_sides(numSides)

@@ -196,18 +196,7 @@ class KinematicChain(JointAssembly):
         values = self._state_values(states)
         if values is None:
             return False
-        joints = list(self._joints)
-        links = list(self._links)
-        accumulated = None  # world motion of everything after the joints changed so far
-        for k in range(len(joints)):
-            if accumulated is not None:
-                joints[k] = joints[k].transformed(accumulated)
-                links[k] = links[k].transformed(accumulated)
-            joint = joints[k]
-            if values[k] != joint.state:
-                G = joint.state_transform(values[k] - joint.state)
-                joints[k] = joint.with_state(values[k])
-                accumulated = G if accumulated is None else G @ accumulated
+        joints, links = self._configured(values)
         return self._accept("setJointStates", joints, links)
 
     # --- output --------------------------------------------------------------------------------

@@ -46,6 +46,7 @@ from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
 from kinegami.clearance.reports import ClearanceReport, CollidingPair
 from kinegami.clearance.tree_bodies import tree_capsules
 from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.geometry.screws import JointScrews
 from kinegami.geometry.segments import (
     segment_distance,
     segment_distances,
@@ -72,19 +73,6 @@ __all__ = [
 _BATCH_PAIRS = 1_500_000
 
 
-
-def _rotations(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Rotation matrices about unit ``axes`` (3,) by ``angles`` (K,), shape (K, 3, 3)."""
-    k = axes
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    s = np.sin(angles)[:, None, None]
-    c = (1.0 - np.cos(angles))[:, None, None]
-    return np.eye(3) + s * K + c * (K @ K)
-
-
-_EYE3 = np.eye(3)
-_EYE4 = np.eye(4)
-_LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 #: Most capsules in one group (a part's run of capsules is split into groups this long).
 _GROUP_SIZE = 3
@@ -252,36 +240,23 @@ class ClearanceEngine:
         self._element = element
         self._states = np.asarray(states, dtype=float)
         S = starts.shape[0]
-        J = len(parents)
         self._S = S
-        # rigid bodies: the base (0) and one per movable joint, in joint order
-        body_of = np.zeros(J, dtype=np.int64)
-        body_joint, body_parent = [-1], [-1]
-        for k in range(J):
-            p = int(parents[k])
-            base = int(body_of[p]) if p >= 0 else 0
-            if kinds[k] != JOINT_FIXED:
-                body_of[k] = len(body_joint)
-                body_joint.append(k)
-                body_parent.append(base)
-            else:
-                body_of[k] = base
-        NB = len(body_joint)
+        # rigid bodies: the base (0) and one per movable joint, in joint order, moved by the
+        # one forward kinematics (kinegami.geometry.screws)
+        screws = JointScrews(kinds, axes, points, parents, self._states)
+        self.screws = screws
+        body_of = screws.body_of
+        body_parent = screws.body_parent
+        NB = screws.bodies
         self.bodies = NB
-        self.movable = np.array(body_joint[1:], dtype=np.int64)
-        self._body_parent = np.array(body_parent, dtype=np.int64)
-        self._chain_bodies = bool(np.all(self._body_parent[1:] == np.arange(NB - 1)))
+        self.movable = screws.moving
+        self._body_parent = body_parent
+        self._chain_bodies = screws.chain_bodies
         bj = self.movable
-        self._revolute_b = kinds[bj] == JOINT_REVOLUTE
+        self._revolute_b = screws.revolute
         self._any_revolute = bool(self._revolute_b.any())
-        self._all_revolute = bool(self._revolute_b.all())
-        self._movable_states = self._states[bj]
-        ax = axes[bj]
-        K1 = np.zeros((bj.size, 3, 3))
-        K1[:, 0, 1], K1[:, 0, 2], K1[:, 1, 2] = -ax[:, 2], ax[:, 1], -ax[:, 0]
-        K1[:, 1, 0], K1[:, 2, 0], K1[:, 2, 1] = ax[:, 2], -ax[:, 1], ax[:, 0]
-        self._K1, self._K2 = K1, K1 @ K1
-        self._hinge_point, self._axis = points[bj], ax
+        self._all_revolute = screws.all_revolute
+        self._hinge_point, self._axis = screws.points, screws.axes
 
         def body(joint_index: np.ndarray) -> np.ndarray:
             return np.where(joint_index >= 0, body_of[np.maximum(joint_index, 0)], 0)
@@ -497,35 +472,7 @@ class ClearanceEngine:
     def body_transforms(self, Q: np.ndarray) -> np.ndarray:
         """(K, bodies, 4, 4): world motion of every rigid body (0 = base) at each of the
         configurations ``Q`` (K, J), relative to the current configuration."""
-        Q = np.asarray(Q, dtype=float)
-        K, NB = Q.shape[0], self.bodies
-        B = np.empty((K, NB, 4, 4))
-        B[:, 0] = _EYE4
-        if NB == 1:
-            return B
-        delta = Q[:, self.movable] - self._movable_states
-        rev = self._revolute_b
-        # revolute: Rodrigues' rotation about the hinge line; prismatic: a slide along z
-        if self._all_revolute:
-            s = np.sin(delta)[..., None, None]
-            c = (1.0 - np.cos(delta))[..., None, None]
-        else:
-            s = np.where(rev, np.sin(delta), 0.0)[..., None, None]
-            c = np.where(rev, 1.0 - np.cos(delta), 0.0)[..., None, None]
-        R = _EYE3 + s * self._K1 + c * self._K2
-        p = self._hinge_point
-        M = np.empty((K, NB - 1, 4, 4))
-        M[..., 3, :] = _LAST_ROW
-        M[..., :3, :3] = R
-        if self._all_revolute:
-            M[..., :3, 3] = p - (R @ p[:, :, None])[..., 0]
-        else:
-            M[..., :3, 3] = np.where(rev[:, None], p - (R @ p[:, :, None])[..., 0],
-                                     delta[..., None] * self._axis)  # fmt: skip
-        parent = self._body_parent
-        for b in range(1, NB):
-            np.matmul(B[:, parent[b]], M[:, b - 1], out=B[:, b])
-        return B
+        return self.screws.body_motions(Q)
 
     def _segments_at(self, B: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
         """Segment starts and ends (S, 3) at configuration k of the body motions ``B``."""

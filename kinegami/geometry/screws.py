@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
+    "JointScrews",
     "FIXED",
     "REVOLUTE",
     "PRISMATIC",
@@ -37,6 +38,114 @@ __all__ = [
 #: Joint kinds: a joint that does not move (tip, waypoint), a rotation about its axis, a
 #: slide along it.
 FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
+
+
+class JointScrews:
+    """The joints of a chain or tree as screws about their axes at a reference configuration,
+    compiled once: the world motion of every rigid body, or of everything downstream of every
+    joint, at any batch of configurations.
+
+    Rigid bodies: the base (0) and one per moving joint (revolute or prismatic), in joint
+    order; a fixed joint (tip, waypoint) moves with its parent's body. Body b of moving joint
+    m hangs from the body of m's parent: B_b(q) = B_parent(b)(q) G_m(q_m - q_ref_m).
+
+    Parameters
+    ----------
+    kinds : (J,) FIXED, REVOLUTE or PRISMATIC per joint.
+    axes, points : (J, 3) unit axis directions and points on the axes (world, at ``q_ref``).
+    parents : (J,) parent index per joint (``parents[j] < j``; -1 for a root).
+    q_ref : (J,) the reference configuration (radians or length units per joint).
+    """
+
+    __slots__ = ("kinds", "parents", "q_ref", "body_of", "moving", "body_parent", "bodies",
+                 "chain_bodies", "revolute", "all_revolute", "axes", "points", "_K1", "_K2")
+
+    def __init__(self, kinds, axes, points, parents, q_ref) -> None:
+        kinds = np.asarray(kinds, dtype=np.int64)
+        parents = np.asarray(parents, dtype=np.int64)
+        J = kinds.shape[0]
+        body_of = np.zeros(J, dtype=np.int64)
+        moving, body_parent = [], [-1]
+        for k in range(J):
+            p = int(parents[k])
+            base = int(body_of[p]) if p >= 0 else 0
+            if kinds[k] != FIXED:
+                body_of[k] = len(body_parent)
+                moving.append(k)
+                body_parent.append(base)
+            else:
+                body_of[k] = base
+        self.kinds, self.parents = kinds, parents
+        self.q_ref = np.asarray(q_ref, dtype=float)
+        #: (J,) the body that joint j's distal side moves with.
+        self.body_of = body_of
+        #: (M,) the moving joints, in index order (joint moving[b - 1] moves body b).
+        self.moving = np.array(moving, dtype=np.int64)
+        #: (M + 1,) each body's parent body (-1 for the base).
+        self.body_parent = np.array(body_parent, dtype=np.int64)
+        self.bodies = len(body_parent)
+        #: True when every body hangs from the one before it (a chain's bodies).
+        self.chain_bodies = bool(np.all(self.body_parent[1:] == np.arange(self.bodies - 1)))
+        m = self.moving
+        self.revolute = kinds[m] == REVOLUTE
+        self.all_revolute = bool(self.revolute.all())
+        ax = np.asarray(axes, dtype=float).reshape(J, 3)[m]
+        K1 = np.zeros((m.size, 3, 3))
+        K1[:, 0, 1], K1[:, 0, 2], K1[:, 1, 2] = -ax[:, 2], ax[:, 1], -ax[:, 0]
+        K1[:, 1, 0], K1[:, 2, 0], K1[:, 2, 1] = ax[:, 2], -ax[:, 1], ax[:, 0]
+        self._K1, self._K2 = K1, K1 @ K1
+        #: (M, 3) the moving joints' axes and points on them, at ``q_ref``.
+        self.axes = ax
+        self.points = np.asarray(points, dtype=float).reshape(J, 3)[m]
+        for array in (kinds, parents, self.q_ref, body_of, self.moving, self.body_parent,
+                      self.revolute, ax, self.points, K1, self._K2):  # fmt: skip
+            array.setflags(write=False)
+
+    def body_motions(self, Q) -> np.ndarray:
+        """(K, bodies, 4, 4): the world motion of every rigid body (0 = base) from ``q_ref``
+        to each configuration of ``Q`` (K, J)."""
+        Q = np.asarray(Q, dtype=float)
+        K, NB = Q.shape[0], self.bodies
+        B = np.empty((K, NB, 4, 4))
+        B[:, 0] = _EYE4
+        if NB == 1:
+            return B
+        delta = Q[:, self.moving] - self.q_ref[self.moving]
+        rev = self.revolute
+        # revolute: Rodrigues' rotation about the hinge line; prismatic: a slide along the axis
+        if self.all_revolute:
+            s = np.sin(delta)[..., None, None]
+            c = (1.0 - np.cos(delta))[..., None, None]
+        else:
+            s = np.where(rev, np.sin(delta), 0.0)[..., None, None]
+            c = np.where(rev, 1.0 - np.cos(delta), 0.0)[..., None, None]
+        R = _EYE3 + s * self._K1 + c * self._K2
+        p = self.points
+        M = np.empty((K, NB - 1, 4, 4))
+        M[..., 3, :] = _LAST_ROW
+        M[..., :3, :3] = R
+        if self.all_revolute:
+            M[..., :3, 3] = p - (R @ p[:, :, None])[..., 0]
+        else:
+            M[..., :3, 3] = np.where(rev[:, None], p - (R @ p[:, :, None])[..., 0],
+                                     delta[..., None] * self.axes)  # fmt: skip
+        parent = self.body_parent
+        for b in range(1, NB):
+            np.matmul(B[:, parent[b]], M[:, b - 1], out=B[:, b])
+        return B
+
+    def joint_motions(self, Q) -> np.ndarray:
+        """A_j(q) of every joint: (K, J, 4, 4) for ``Q`` (K, J), (J, 4, 4) for one
+        configuration (J,). Everything downstream of joint j's motion is at A_j(q) times its
+        place at ``q_ref``; joint j's own pose and proximal side move by its parent's A."""
+        Q, single = _configurations(Q, self.kinds.shape[0])
+        A = self.body_motions(Q)[:, self.body_of]
+        return A[0] if single else A
+
+
+_EYE3 = np.eye(3)
+_EYE4 = np.eye(4)
+_LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 
 def _configurations(q, joints: int) -> tuple[np.ndarray, bool]:
@@ -106,11 +215,9 @@ def path_products(motions: np.ndarray, parents) -> np.ndarray:
 def forward_kinematics(kinds, axes, points, parents, q, q_ref) -> np.ndarray:
     """A_j(q) of every joint j, shape (K, J, 4, 4) (or (J, 4, 4) for one configuration):
     the world motion of everything downstream of joint j from the reference configuration
-    ``q_ref`` (J,) to ``q``. A frame F downstream of joint j is at ``A_j(q) @ F(q_ref)``."""
-    q, single = _configurations(q, np.asarray(kinds).shape[0])
-    d = q - np.asarray(q_ref, dtype=float)[None, :]
-    A = path_products(screw_motions(kinds, axes, points, d), parents)
-    return A[0] if single else A
+    ``q_ref`` (J,) to ``q``. A frame F downstream of joint j is at ``A_j(q) @ F(q_ref)``.
+    (:class:`JointScrews` compiled once, for one call.)"""
+    return JointScrews(kinds, axes, points, parents, q_ref).joint_motions(q)
 
 
 def world_axes(kinds, axes, points, parents, A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -364,26 +364,6 @@ class KinematicTree(JointAssembly):
             keep_tree_engine(self, engine, self._margin)
         return accepted
 
-    def _configured(self, values: Sequence[float]) -> tuple[list, list]:
-        """Joint and link lists at the (checked) states ``values``, one per joint."""
-        joints = list(self._joints)
-        links = list(self._links)
-        # the motion of everything beyond joint k's distal side, from the changes on its path
-        beyond: list[np.ndarray | None] = [None] * len(joints)
-        for k in range(len(joints)):
-            p = self._parents[k]
-            moved = beyond[p] if p >= 0 else None
-            if moved is not None:
-                joints[k] = joints[k].transformed(moved)
-                links[k] = links[k].transformed(moved)
-            joint = joints[k]
-            if values[k] != joint.state:
-                G = joint.state_transform(values[k] - joint.state)
-                joints[k] = joint.with_state(values[k])
-                moved = G if moved is None else G @ moved
-            beyond[k] = moved
-        return joints, links
-
     # --- output --------------------------------------------------------------------------------
     def clearance(self, states=None, margin=None):
         """Self-intersection at the current states or at ``states`` (one per joint), with

@@ -86,11 +86,35 @@ def _quiet_load(path: Path):
         return load_design(path)
 
 
+#: Designs whose states are set when they load: since setJointStates moves the chain by the
+#: one forward kinematics (kinegami.geometry.screws, products in another order), their last bits
+#: changed. They are compared to the chain they loaded as before, number by number, to 1e-12 r.
+STATES_SET = {"tests/example1b.json": "example1b_loaded_before_screws.json"}
+
+
+def assert_loaded_as_before(chain, name: str) -> None:
+    """``chain`` is the design ``name`` as it loaded before: bit for bit, or (for a design
+    with states) within 1e-12 r of every number it was made of."""
+    if name not in STATES_SET:
+        assert fingerprint(chain) in known("loaded", name)
+        return
+    before = json.loads((DATA / STATES_SET[name]).read_text(encoding="utf-8"))
+    r = chain.r
+    assert [j.state for j in chain.Joints] == before["states"]
+    for got, want in [([j.pose_matrix for j in chain.Joints], before["poses"]),
+                      ([j.distal_frame() for j in chain.Joints], before["distal"]),
+                      ([link.start_frame for link in chain.Links], before["link_start"]),
+                      ([link.end_frame for link in chain.Links], before["link_end"])]:  # fmt: skip
+        assert np.abs(np.array(got, dtype=float) - np.array(want)).max() <= 1e-12 * r
+    ball = chain.boundingBall
+    assert np.abs(np.array([*ball.c, ball.r]) - np.array(before["ball"])).max() <= 1e-12 * r
+
+
 @pytest.mark.parametrize("name", sorted(FINGERPRINTS["loaded"]))
 def test_version_1_designs_load_bit_for_bit_as_before(name):
     chain = _quiet_load(_path(name))
     assert type(chain) is KinematicChain
-    assert fingerprint(chain) in known("loaded", name)
+    assert_loaded_as_before(chain, name)
 
 
 @pytest.mark.parametrize("name", sorted(FINGERPRINTS["saved"]))
@@ -111,7 +135,7 @@ def test_a_version_1_design_written_as_version_2_is_the_same_chain(name):
     document["version"] = 2
     chain = chain_from_dict(document)
     assert type(chain) is KinematicChain
-    assert fingerprint(chain) in known("loaded", name)
+    assert_loaded_as_before(chain, name)
 
 
 def _joints_design(name: str) -> dict:

@@ -101,3 +101,56 @@ def test_bad_configurations_are_refused():
     with pytest.raises(ValueError, match=r"shape \(2,\) or \(K, 2\)"):
         screws.forward_kinematics([1, 2], np.eye(3)[:2], np.zeros((2, 3)), [-1, 0],
                                   np.zeros(3), np.zeros(2))  # fmt: skip
+
+
+def sequential_configuration(design, values):
+    """What setJointStates did before it used the screws: every joint's motion computed from
+    the joint already moved by its parent's, composed along the path (the reference)."""
+    joints, links = list(design.Joints), list(design.Links)
+    parents = list(getattr(design, "Parents", None) or range(-1, len(joints) - 1))
+    beyond = [None] * len(joints)
+    for k, p in enumerate(parents):
+        moved = beyond[p] if p >= 0 else None
+        if moved is not None:
+            joints[k] = joints[k].transformed(moved)
+            links[k] = links[k].transformed(moved)
+        if values[k] != joints[k].state:
+            G = joints[k].state_transform(values[k] - joints[k].state)
+            joints[k] = joints[k].with_state(values[k])
+            moved = G if moved is None else G @ moved
+        beyond[k] = moved
+    return joints, links
+
+
+@pytest.mark.parametrize("path", GALLERY, ids=lambda p: p.stem)
+def test_set_joint_states_moves_everything_as_before_to_1e12_r(path):
+    """States through the one forward kinematics equal the joint-by-joint composition they
+    replaced: poses, distal frames, link frames and the deepest overlap, to 1e-12 r."""
+    from kinegami.chain.bodies import worst_overlap
+    from kinegami.clearance.tree_bodies import tree_worst_overlap
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        design = load_design(path)
+    r = design.r
+    parents = list(design.Parents)
+    for q in random_states(design, np.random.default_rng(11), 3):
+        expected_joints, expected_links = sequential_configuration(design, list(q))
+        joints, links = design._configured(list(q))
+        for a, b in zip(joints, expected_joints, strict=True):
+            assert np.abs(a.pose_matrix - b.pose_matrix).max() <= 1e-12 * r
+            assert np.abs(a.distal_frame() - b.distal_frame()).max() <= 1e-12 * r
+            assert a.state == b.state
+        for a, b in zip(links[1:], expected_links[1:], strict=True):
+            assert np.abs(a.start_frame - b.start_frame).max() <= 1e-12 * r
+            assert np.abs(a.end_frame - b.end_frame).max() <= 1e-12 * r
+        if parents == list(range(-1, len(joints) - 1)):
+            now = worst_overlap(joints, links, r, margin=1e9 * r)
+            before = worst_overlap(expected_joints, expected_links, r, margin=1e9 * r)
+        else:
+            now = tree_worst_overlap(joints, links, parents, r, margin=1e9 * r)
+            before = tree_worst_overlap(expected_joints, expected_links, parents, r,
+                                        margin=1e9 * r)  # fmt: skip
+        assert (now is None) == (before is None)
+        if now is not None:
+            assert abs(now.clearance - before.clearance) <= 1e-12 * r
