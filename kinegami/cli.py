@@ -836,9 +836,9 @@ def _pair_json(pair) -> dict:
 
 
 def _check_json(chain, info, design, report, motion, seed) -> dict:
-    from kinegami.chain.joints import RevoluteJoint
     from kinegami.clearance.reports import moving_joints
     from kinegami.design.reader import origin_of
+    from kinegami.geometry.screws import REVOLUTE
 
     origin = origin_of(chain)
     data = {
@@ -864,7 +864,7 @@ def _check_json(chain, info, design, report, motion, seed) -> dict:
                 "joint": i,
                 "type": type(joint).__name__,
                 "name": None if origin is None else origin.names[i],
-                "kind": "revolute" if isinstance(joint, RevoluteJoint) else "prismatic",
+                "kind": "revolute" if joint.motion == REVOLUTE else "prismatic",
                 "state": motion.states[i],
                 "range": list(joint.stateRange()),
                 "free": None if free is None else list(free),

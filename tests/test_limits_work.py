@@ -25,9 +25,9 @@ from kinegami import (
     limits,
 )
 from kinegami.design import load_design
+from kinegami.fabrication import takeoffs
 from kinegami.pattern import catalog
 from kinegami.pattern.catalog import check_pattern_size, module_kind, module_vertices
-from kinegami.fabrication import takeoffs
 
 
 # --- joints through the API -------------------------------------------------------------------

@@ -21,7 +21,7 @@ from collections.abc import Mapping, Sequence, Set
 import numpy as np
 
 from kinegami.chain.bodies import check_margin, link_capsule_ends, worst_overlap
-from kinegami.chain.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube, pose_array
+from kinegami.chain.joints import Joint, check_same_tube, pose_array
 from kinegami.chain.links import LinkCSC
 from kinegami.chain.placement import (
     compact_lambda,
@@ -121,7 +121,7 @@ class JointAssembly:
     ):
         if not isinstance(startJoint, Joint):
             raise InvalidTypeError(f"startJoint must be a Joint, got {type(startJoint).__name__}")
-        if isinstance(startJoint, EndTip):
+        if startJoint.closes_end:
             raise InvalidParameterError("startJoint cannot be an EndTip (nothing may follow it)")
         self.maxAnglePerElbow = check_max_angle_per_elbow(maxAnglePerElbow)
         self.requireClearance = requireClearance
@@ -411,7 +411,7 @@ class JointAssembly:
         if (
             applyToPreviousWaypoint
             and w >= 0
-            and isinstance(self._joints[w], Waypoint)
+            and not self._joints[w].has_body
             and self._children_of(w) == [j]
         ):
             if prop:
@@ -456,10 +456,10 @@ class JointAssembly:
                 "keep the given orientation"
             )
         check_same_tube(newJoint, self.numSides, self.r)
-        if isinstance(newJoint, StartTip):
+        if newJoint.closes_start:
             raise InvalidParameterError(f"a StartTip can only be the first joint of a {self._noun}")
         parent = self._joints[p]
-        if isinstance(parent, EndTip):
+        if parent.closes_end:
             raise InvalidParameterError(
                 "nothing can be appended after an EndTip" if self._noun == "chain"
                 else f"joint {p} is an EndTip: nothing can follow it"

@@ -5,8 +5,8 @@ r) at the chain's current configuration:
 
 * **Shapes** (what meshes and pictures are made of): the n-gon of circumradius r in a Dubins
   frame (:func:`regular_polygon`), the point sets whose convex hulls are the joints
-  (:func:`revolute_hull_points`, :func:`tip_hull_points`, :func:`prismatic_prism_vertices`) and
-  the polygons an elbow fitting is swept through (:func:`elbow_rings`).
+  (each joint kind's :meth:`~kinegami.chain.joints.Joint.body_pieces`) and the polygons an elbow
+  fitting is swept through (:func:`elbow_rings`).
 * **Capsules** (what the clearance engine tests): the tube's centreline as a polyline of
   segments, each the axis of a capsule of radius r that encloses every part along it
   (:class:`CapsuleModel`, built by :func:`capsule_model`).
@@ -44,16 +44,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinegami.chain.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
     Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
 )
 from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.geometry.screws import FIXED, PRISMATIC, REVOLUTE
 from kinegami.geometry.segments import segment_distances
+from kinegami.geometry.shapes import (
+    regular_polygon,
+)
 from kinegami.validation import shown
 
 __all__ = [
@@ -62,12 +60,6 @@ __all__ = [
     "link_capsule_arrays",
     "joint_capsule_arrays",
     "overlap_of_deepest_pair",
-    "polygon_side",
-    "regular_polygon",
-    "circle_points",
-    "prismatic_prism_vertices",
-    "revolute_hull_points",
-    "tip_hull_points",
     "elbow_rings",
     "CapsuleModel",
     "capsule_model",
@@ -89,87 +81,6 @@ __all__ = [
 
 
 # --- shapes ----------------------------------------------------------------------------------
-def polygon_side(r: float, n: int) -> float:
-    """Side length 2 r sin(pi/n) of the regular n-gon of circumradius r."""
-    return 2.0 * r * math.sin(math.pi / n)
-
-
-def circle_points(centre, e1, e2, r: float, angles) -> np.ndarray:
-    """Points ``centre + r (cos t e1 + sin t e2)`` for each t in ``angles``, shape (m, 3)."""
-    t = np.asarray(angles, dtype=float)[:, None]
-    return (
-        np.asarray(centre, dtype=float)
-        + r * np.cos(t) * np.asarray(e1, dtype=float)
-        + r * np.sin(t) * np.asarray(e2, dtype=float)
-    )
-
-
-def regular_polygon(frame: np.ndarray, r: float, n: int) -> np.ndarray:
-    """(n, 3) vertices of the n-gon of circumradius ``r`` in the (b, c) plane of ``frame``.
-
-    ``frame`` is a 4x4 Dubins frame (first axis = path direction); the polygon is centred at
-    its origin and its vertex k lies at angle pi/n + 2 pi k/n from the frame's b axis, so two
-    sides are parallel to c (the revolute hinge line, the fold of a tip).
-    """
-    psi = math.pi / n + 2.0 * math.pi * np.arange(n) / n
-    return circle_points(frame[:3, 3], frame[:3, 1], frame[:3, 2], r, psi)
-
-
-def hinge_segment(centre, direction, length: float) -> np.ndarray:
-    """(2, 3): the segment of ``length`` centred at ``centre`` along unit ``direction``."""
-    d = 0.5 * length * np.asarray(direction, dtype=float)
-    return np.stack([centre - d, centre + d])
-
-
-def shifted_frame(frame: np.ndarray, distance: float) -> np.ndarray:
-    """``frame`` translated along its own first axis."""
-    out = np.array(frame)
-    out[:3, 3] += distance * frame[:3, 0]
-    return out
-
-
-def prismatic_prism_vertices(joint: PrismaticJoint) -> np.ndarray:
-    """(2, n, 3): the prism of a prismatic joint, from its proximal origin along z, L + state.
-
-    The polygon lies in the joint's x-y plane (about the joint's own axis of motion).
-    """
-    frame = joint.proximal_dubins_frame()
-    bottom = regular_polygon(frame, joint.r, joint.numSides)
-    top = bottom + (joint.neutralLength + joint.state) * joint.pose_matrix[:3, 2]
-    return np.stack([bottom, top])
-
-
-def revolute_hull_points(joint: RevoluteJoint) -> tuple[np.ndarray, np.ndarray]:
-    """Point sets whose hulls are the two halves of a revolute joint's body, each (n + 2, 3).
-
-    Each half is the n-gon of the proximal (distal) frame plus the hinge segment
-    p +- (side/2) z at the joint centre. For an extended revolute joint the polygons sit at the
-    ends of its straight tubes, ``tubeLength`` inside the proximal and distal frames.
-    """
-    n, r = joint.numSides, joint.r
-    T = joint.pose_matrix
-    hinge = hinge_segment(T[:3, 3], T[:3, 2], polygon_side(r, n))
-    h = joint.tubeLength if isinstance(joint, ExtendedRevoluteJoint) else 0.0
-    proximal = shifted_frame(joint.proximal_dubins_frame(), h)
-    distal = shifted_frame(joint.distal_dubins_frame(), -h)
-    return (
-        np.vstack([regular_polygon(proximal, r, n), hinge]),
-        np.vstack([regular_polygon(distal, r, n), hinge]),
-    )
-
-
-def tip_hull_points(joint: StartTip | EndTip) -> np.ndarray:
-    """(n + 2, 3): the n-gon at a tip's open end plus a segment of one side's length at the
-    closed end (along the frame's c axis, parallel to two sides of the polygon)."""
-    n, r = joint.numSides, joint.r
-    if isinstance(joint, StartTip):
-        open_end, closed_end = joint.distal_dubins_frame(), joint.proximal_dubins_frame()
-    else:
-        open_end, closed_end = joint.proximal_dubins_frame(), joint.distal_dubins_frame()
-    segment = hinge_segment(closed_end[:3, 3], closed_end[:3, 2], polygon_side(r, n))
-    return np.vstack([regular_polygon(open_end, r, n), segment])
-
-
 def elbow_rings(arc, n: int) -> np.ndarray | None:
     """Polygons an arc's elbows are swept through: the n-gon at each elbow frame and the mitre
     polygon between (2 count + 1, n, 3); None for an arc without elbows.
@@ -202,7 +113,7 @@ CONTACT_TOLERANCE = 1e-9
 TURN_TOLERANCE = 1e-9
 
 #: Joint motion codes of :class:`CapsuleModel`.
-JOINT_FIXED, JOINT_REVOLUTE, JOINT_PRISMATIC = 0, 1, 2
+JOINT_FIXED, JOINT_REVOLUTE, JOINT_PRISMATIC = FIXED, REVOLUTE, PRISMATIC
 
 ORDINALS = (
     "first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth", "tenth",
@@ -393,19 +304,12 @@ def _link_capsules(out: _Builder, link, i: int, turning: float, twistPortion: fl
 
 
 def _joint_capsules(out: _Builder, joint: Joint, j: int, turning: float, text: str) -> None:
-    """Add joint j (nothing for a waypoint)."""
-    if isinstance(joint, Waypoint):
-        return
-    proximal = joint.proximal_frame()[:3, 3]
-    distal = joint.distal_frame()[:3, 3]
-    if isinstance(joint, RevoluteJoint):
-        centre = joint.pose_matrix[:3, 3]
-        out.add(proximal, centre, j - 1, j - 1, turning, 2 * j, [], [f"{text}, proximal half"])
-        # the distal half moves with the joint; its hinge adds |state| to the turning
-        out.add(centre, distal, j, j, turning, 2 * j, [], [f"{text}, distal half"])
-        return
-    body_b = j if isinstance(joint, PrismaticJoint) else j - 1
-    out.add(proximal, distal, j - 1, body_b, turning, 2 * j, [], [text])
+    """Add joint j's centreline segments (:meth:`Joint.capsule_segments`): an end that moves
+    with the joint belongs to body j, the other to body j - 1."""
+    for segment in joint.capsule_segments():
+        out.add(segment.start, segment.end, j if segment.start_moves else j - 1,
+                j if segment.end_moves else j - 1, turning, 2 * j, [],
+                [text + segment.words])  # fmt: skip
 
 
 @functools.lru_cache(maxsize=16384)
@@ -601,7 +505,7 @@ def _chain_arrays(joints, links, r: float) -> _ChainArrays:
     a, b, body, turn, element = arrays
     # what the new rows add (the prefix's values are reused): hinge turnings, totals, balls
     n_old = 0 if known is None else len(known.rows)
-    kinks_new = [abs(j.state) if isinstance(j, RevoluteJoint) else 0.0 for j in joints[k0:]]
+    kinks_new = [abs(j.state) if j.motion == REVOLUTE else 0.0 for j in joints[k0:]]
     kinks = np.concatenate([[0.0] if known is None else known.kinks,
                             (0.0 if known is None else known.kinks[-1]) + np.cumsum(kinks_new)])
     a_new, b_new = a[n_old:], b[n_old:]
@@ -694,7 +598,7 @@ def _point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.n
 
 def _kink_prefix(joints) -> np.ndarray:
     """Turning added by the revolute hinges up to body b (index b + 1; b = -1: 0)."""
-    kinks = [abs(j.state) if isinstance(j, RevoluteJoint) else 0.0 for j in joints]
+    kinks = [abs(j.state) if j.motion == REVOLUTE else 0.0 for j in joints]
     return np.concatenate([[0.0], np.cumsum(kinks)])
 
 
@@ -934,10 +838,7 @@ def capsule_model(chain, names=None, twistPortion: float = 0.2) -> CapsuleModel:
         points[j] = T[:3, 3]
         axes[j] = T[:3, 2]
         states[j] = joint.state
-        if isinstance(joint, RevoluteJoint):
-            kinds[j] = JOINT_REVOLUTE
-        elif isinstance(joint, PrismaticJoint):
-            kinds[j] = JOINT_PRISMATIC
+        kinds[j] = joint.motion
 
     def column(k: int, dtype, shape: tuple = ()) -> np.ndarray:
         return np.array([row[k] for row in rows], dtype=dtype).reshape((len(rows), *shape))

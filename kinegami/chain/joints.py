@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from kinegami._record import Record
 from kinegami.errors import IncompatibleJointError, InvalidParameterError, InvalidTypeError
 from kinegami.geometry.balls import Ball
 from kinegami.geometry.frames import (
@@ -37,6 +38,7 @@ from kinegami.geometry.frames import (
     unit,
 )
 from kinegami.geometry.screws import FIXED, PRISMATIC, REVOLUTE
+from kinegami.geometry.shapes import hinge_segment, polygon_side, regular_polygon, shifted_frame
 from kinegami.validation import (
     REAL_NUMBER_TYPES,
     ReadOnlyAttributes,
@@ -53,6 +55,10 @@ from kinegami.validation import (
 
 __all__ = [
     "Joint",
+    "BodyPiece",
+    "CapsuleSegment",
+    "JOINT_KINDS",
+    "register_joint_kind",
     "RevoluteJoint",
     "ExtendedRevoluteJoint",
     "PrismaticJoint",
@@ -62,6 +68,32 @@ __all__ = [
     "EndTip",
     "pose_array",
 ]
+
+
+class BodyPiece(Record):
+    """A convex piece of a joint's solid (docs/clearance.md): the convex hull of ``points``
+    ((k, 3), world, units of r), moving with the joint's proximal side, its distal side, or
+    the joint as a whole (``side`` "proximal", "distal" or ""). ``drawn`` is None (pictures
+    draw the hull's faces) or how pictures draw it: ``("hull", points)`` and
+    ``("prism", bottom, top)`` items, whose union is the piece."""
+
+    side: str
+    points: np.ndarray
+    drawn: tuple | None = None
+
+
+class CapsuleSegment(Record):
+    """A segment of a joint's centreline (world, units of r): every part of the joint lies
+    within r of its segments. ``start_moves`` / ``end_moves``: whether that end moves with the
+    joint's own motion (its distal side) rather than with the body before the joint;
+    ``words`` is added to the joint's name in reports (", proximal half")."""
+
+    start: np.ndarray
+    end: np.ndarray
+    start_moves: bool
+    end_moves: bool
+    words: str = ""
+
 
 
 if TYPE_CHECKING:
@@ -212,6 +244,14 @@ class Joint(ReadOnlyAttributes):
     #: How the joint moves what is beyond it (kinegami.geometry.screws): FIXED (tips,
     #: waypoints), REVOLUTE (about the Pose z axis) or PRISMATIC (along it).
     motion = FIXED
+    #: False for a joint without a solid (a waypoint only routes the tube).
+    has_body = True
+    #: The joint closes the tube's start (nothing may precede it: only a root) or its end
+    #: (nothing may follow it).
+    closes_start = False
+    closes_end = False
+    #: The design-file fields that are angles (written in the file's angleUnits).
+    design_angles: tuple[str, ...] = ()
 
     def __init__(self, numSides, r, neutralLength, Pose):
         self._numSides = check_num_sides(numSides)
@@ -270,6 +310,43 @@ class Joint(ReadOnlyAttributes):
     def state_transform(self, delta: float) -> np.ndarray:
         """World motion G(delta) that a state change by ``delta`` applies downstream."""
         return np.eye(4)
+
+    # --- the joint's kind as data: its solid and its centreline (docs/architecture.md) ------
+    def body_pieces(self, split: bool = False) -> tuple[BodyPiece, ...]:
+        """The joint's solid at its current state as convex pieces (meshes, views and URDF
+        draw them). Here: the hull of the proximal and distal cross sections. ``split`` asks
+        for pieces that each move with one side of the joint (the URDF's rigid bodies)."""
+        n, r = self.numSides, self.r
+        points = np.vstack([regular_polygon(self.proximal_dubins_frame(), r, n),
+                            regular_polygon(self.distal_dubins_frame(), r, n)])  # fmt: skip
+        return (BodyPiece("", points),)
+
+    def capsule_segments(self) -> tuple[CapsuleSegment, ...]:
+        """The joint's centreline, which the clearance engine's capsules follow: here the
+        segment from the proximal to the distal origin, fixed to the body before the joint."""
+        ends_move = self.motion == PRISMATIC
+        return (CapsuleSegment(self.proximal_frame()[:3, 3], self.distal_frame()[:3, 3],
+                               False, ends_move),)  # fmt: skip
+
+    def design_fields(self) -> dict:
+        """The parameters a design file holds for this joint besides type, pose and
+        placement (radians, the chain's length units); see :data:`JOINT_KINDS`."""
+        raise InvalidTypeError(
+            f"cannot save a joint of type {type(self).__name__}: design files know "
+            f"{', '.join(JOINT_KINDS)}"
+        )
+
+    @classmethod
+    def design_defaults(cls, r: float) -> dict:
+        """Default values of the design fields (what a new joint of this kind gets in the
+        editor when a field is not given), for tube radius ``r``."""
+        return {}
+
+    @classmethod
+    def from_design(cls, numSides: int, r: float, pose, fields: dict):
+        """The joint of a design file's entry (``fields``: its parameters, angles in radians,
+        lengths in the chain's units; the inverse of :meth:`design_fields`)."""
+        raise InvalidTypeError(f"design files cannot hold a {cls.__name__}")
 
     def proximal_frame(self) -> np.ndarray:
         """Proximal frame (independent of the state) as a 4x4 array."""
@@ -378,14 +455,14 @@ class Joint(ReadOnlyAttributes):
 
         Patterns are values, so joints with the same parameters share one (built on first use).
         """
-        return _catalog_pattern(*self._pattern_recipe())
+        return _catalog_pattern(*self.pattern_recipe())
 
     def pattern_pieces(self) -> list[tuple[str, tuple]]:
         """What :attr:`pattern` is built from, as ``LinkCSC.pattern_pieces``: a (catalog kind,
         build arguments) pair per module, in order (nothing is built)."""
-        return list(self._pattern_recipe())
+        return list(self.pattern_recipe())
 
-    def _pattern_recipe(self) -> tuple:
+    def pattern_recipe(self) -> tuple:
         """The pieces of this joint's pattern: (catalog module kind, its build arguments) each,
         composed in order (see kinegami.pattern.catalog)."""
         raise InvalidTypeError(f"{type(self).__name__} has no crease pattern")
@@ -430,6 +507,7 @@ class RevoluteJoint(Joint):
     """
 
     motion = REVOLUTE
+    design_angles = ("totalBendingAngle",)
 
     _PATH_INDEX = 0
 
@@ -452,7 +530,50 @@ class RevoluteJoint(Joint):
     def state_transform(self, delta: float) -> np.ndarray:
         return rotation_about_line(self._T[:3, 2], self._T[:3, 3], delta)
 
-    def _pattern_recipe(self) -> tuple:
+    def hull_points(self) -> tuple[np.ndarray, np.ndarray]:
+        """Point sets whose hulls are the two halves of the body, each (n + 2, 3): the n-gon
+        of the proximal (distal) Dubins frame plus the hinge segment p +- (side/2) z at the
+        centre (for an extended joint, the n-gons at the inner ends of its tubes)."""
+        n, r = self.numSides, self.r
+        T = self._T
+        hinge = hinge_segment(T[:3, 3], T[:3, 2], polygon_side(r, n))
+        h = self._tube_length()
+        proximal = shifted_frame(self.proximal_dubins_frame(), h)
+        distal = shifted_frame(self.distal_dubins_frame(), -h)
+        return (np.vstack([regular_polygon(proximal, r, n), hinge]),
+                np.vstack([regular_polygon(distal, r, n), hinge]))  # fmt: skip
+
+    def _tube_length(self) -> float:
+        return 0.0
+
+    def body_pieces(self, split: bool = False) -> tuple[BodyPiece, ...]:
+        """Two halves, each the hull of one side's n-gon and the hinge segment; the distal
+        half turns with the state."""
+        first, second = self.hull_points()
+        return (BodyPiece("proximal", first), BodyPiece("distal", second))
+
+    def capsule_segments(self) -> tuple[CapsuleSegment, ...]:
+        """Proximal origin -> centre (fixed) and centre -> distal origin (turns with the
+        joint: a kink by the state at the hinge)."""
+        centre = self._T[:3, 3]
+        return (CapsuleSegment(self.proximal_frame()[:3, 3], centre, False, False,
+                               ", proximal half"),
+                CapsuleSegment(centre, self.distal_frame()[:3, 3], True, True,
+                               ", distal half"))  # fmt: skip
+
+    def design_fields(self) -> dict:
+        return {"totalBendingAngle": float(self.totalBendingAngle),
+                "numSinkLayers": int(self.numSinkLayers)}  # fmt: skip
+
+    @classmethod
+    def design_defaults(cls, r: float) -> dict:
+        return {"totalBendingAngle": math.pi, "numSinkLayers": 1}
+
+    @classmethod
+    def from_design(cls, numSides: int, r: float, pose, fields: dict):
+        return cls(numSides, r, fields["totalBendingAngle"], pose, fields.get("numSinkLayers", 1))
+
+    def pattern_recipe(self) -> tuple:
         return (("revolute", (self.numSides, self.r, self.totalBendingAngle, self.numSinkLayers)),)
 
     def _describe(self) -> str:
@@ -467,9 +588,40 @@ class ExtendedRevoluteJoint(RevoluteJoint):
         super().__init__(numSides, r, totalBendingAngle, Pose, numSinkLayers)
         self._neutralLength += 2.0 * self.tubeLength
 
-    def _pattern_recipe(self) -> tuple:
+    def pattern_recipe(self) -> tuple:
         tube = ("tube", (self.numSides, self.r, self.tubeLength))
-        return (tube, *super()._pattern_recipe(), tube)
+        return (tube, *super().pattern_recipe(), tube)
+
+    def _tube_length(self) -> float:
+        return self.tubeLength
+
+    def body_pieces(self, split: bool = False) -> tuple[BodyPiece, ...]:
+        """The two halves with their straight tubes (each half is convex)."""
+        first, second = self.hull_points()
+        n, r = self.numSides, self.r
+        h = self.tubeLength
+        pieces = []
+        for side, hull, frame, sign in (("proximal", first, self.proximal_dubins_frame(), 1.0),
+                                        ("distal", second, self.distal_dubins_frame(), -1.0)):
+            outer = regular_polygon(frame, r, n)
+            inner = regular_polygon(shifted_frame(frame, sign * h), r, n)
+            pieces.append(BodyPiece(side, np.vstack([hull, outer]),
+                                    (("hull", hull), ("prism", outer, inner))))
+        return tuple(pieces)  # fmt: skip
+
+    def design_fields(self) -> dict:
+        return {"totalBendingAngle": float(self.totalBendingAngle),
+                "tubeLength": float(self.tubeLength),
+                "numSinkLayers": int(self.numSinkLayers)}  # fmt: skip
+
+    @classmethod
+    def design_defaults(cls, r: float) -> dict:
+        return {"totalBendingAngle": math.pi, "tubeLength": 2.0 * r, "numSinkLayers": 1}
+
+    @classmethod
+    def from_design(cls, numSides: int, r: float, pose, fields: dict):
+        return cls(numSides, r, fields["totalBendingAngle"], fields["tubeLength"], pose,
+                   fields.get("numSinkLayers", 1))  # fmt: skip
 
 
 class PrismaticJoint(Joint):
@@ -486,6 +638,7 @@ class PrismaticJoint(Joint):
     """
 
     motion = PRISMATIC
+    design_angles = ("coneAngle",)
 
     def __init__(self, numSides, r, neutralLength, numLayers, coneAngle, Pose):
         n = check_num_sides(numSides)
@@ -512,6 +665,33 @@ class PrismaticJoint(Joint):
     def state_transform(self, delta: float) -> np.ndarray:
         return translation(delta * self._T[:3, 2])
 
+    def body_pieces(self, split: bool = False) -> tuple[BodyPiece, ...]:
+        """The n-gon prism from the proximal origin along z, length L + state; split: two
+        halves of length L/2 at either end (each moving with its side)."""
+        n, r = self.numSides, self.r
+        z = self._T[:3, 2]
+        bottom = regular_polygon(self.proximal_dubins_frame(), r, n)
+        L, s = self.neutralLength, self.state
+        if not split:
+            top = bottom + (L + s) * z
+            return (BodyPiece("", np.vstack([bottom, top]), (("prism", bottom, top),)),)
+        top = regular_polygon(self.distal_dubins_frame(), r, n)
+        return (BodyPiece("proximal", np.vstack([bottom, bottom + 0.5 * L * z])),
+                BodyPiece("distal", np.vstack([top - 0.5 * L * z, top])))  # fmt: skip
+
+    def design_fields(self) -> dict:
+        return {"neutralLength": float(self.neutralLength), "numLayers": int(self.numLayers),
+                "coneAngle": float(self.coneAngle)}  # fmt: skip
+
+    @classmethod
+    def design_defaults(cls, r: float) -> dict:
+        return {"neutralLength": 3.0 * r, "numLayers": 3, "coneAngle": math.pi / 4}
+
+    @classmethod
+    def from_design(cls, numSides: int, r: float, pose, fields: dict):
+        return cls(numSides, r, fields["neutralLength"], fields["numLayers"],
+                   fields["coneAngle"], pose)  # fmt: skip
+
     def distal_frame(self) -> np.ndarray:
         T = np.array(self._T)
         T[:3, 3] += (self._neutralLength / 2.0 + self._state) * T[:3, 2]
@@ -524,7 +704,7 @@ class PrismaticJoint(Joint):
             math.hypot(self._r, (self._neutralLength + s) / 2.0),
         )
 
-    def _pattern_recipe(self) -> tuple:
+    def pattern_recipe(self) -> tuple:
         args = (self.numSides, self.r, self.neutralLength, self.numLayers, self.coneAngle)
         return (("prismatic", args),)
 
@@ -556,8 +736,29 @@ class Waypoint(Joint):
     def boundingBall(self) -> Ball:
         return Ball(self._T[:3, 3], self._r)
 
-    def _pattern_recipe(self) -> tuple:
+    has_body = False
+
+    def pattern_recipe(self) -> tuple:
         return (("waypoint", (self.numSides, self.r)),)
+
+    def body_pieces(self, split: bool = False) -> tuple[BodyPiece, ...]:
+        """None: a waypoint has no solid."""
+        return ()
+
+    def capsule_segments(self) -> tuple[CapsuleSegment, ...]:
+        """None: a waypoint adds nothing to the tube."""
+        return ()
+
+    def design_fields(self) -> dict:
+        return {"pathIndex": int(self.pathIndex())}
+
+    @classmethod
+    def design_defaults(cls, r: float) -> dict:
+        return {"pathIndex": 2}
+
+    @classmethod
+    def from_design(cls, numSides: int, r: float, pose, fields: dict):
+        return cls(numSides, r, pose, fields.get("pathIndex", 2))
 
     def _describe(self) -> str:
         return f", pathIndex={self._path_index}"
@@ -575,19 +776,74 @@ class Tip(Joint):
     def _describe(self) -> str:
         return f", length={self.length:.6g}"
 
+    def open_and_closed_ends(self) -> tuple[np.ndarray, np.ndarray]:
+        """The Dubins frames of the tip's open end and of its closed (folded) end."""
+        raise NotImplementedError
+
+    def hull_points(self) -> np.ndarray:
+        """(n + 2, 3): the n-gon at the open end plus a segment of one side's length at the
+        closed end (along the frame's c axis, parallel to two sides of the polygon)."""
+        n, r = self.numSides, self.r
+        open_end, closed_end = self.open_and_closed_ends()
+        segment = hinge_segment(closed_end[:3, 3], closed_end[:3, 2], polygon_side(r, n))
+        return np.vstack([regular_polygon(open_end, r, n), segment])
+
+    def body_pieces(self, split: bool = False) -> tuple[BodyPiece, ...]:
+        """The hull of :meth:`hull_points`."""
+        return (BodyPiece("", self.hull_points()),)
+
+    def design_fields(self) -> dict:
+        return {"length": float(self.length)}
+
+    @classmethod
+    def design_defaults(cls, r: float) -> dict:
+        return {"length": 1.5 * r}
+
+    @classmethod
+    def from_design(cls, numSides: int, r: float, pose, fields: dict):
+        return cls(numSides, r, Pose=pose, length=fields["length"])
+
 
 class StartTip(Tip):
     """The closed start of the tube (nothing may precede it). Path direction: Pose z."""
 
-    def _pattern_recipe(self) -> tuple:
+    closes_start = True
+
+    def pattern_recipe(self) -> tuple:
         return (("start_tip", (self.numSides, self.r, self.length)),)
+
+    def open_and_closed_ends(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.distal_dubins_frame(), self.proximal_dubins_frame()
 
 
 class EndTip(Tip):
     """The closed end of the tube (nothing may follow it). Path direction: Pose z."""
 
-    def _pattern_recipe(self) -> tuple:
+    closes_end = True
+
+    def pattern_recipe(self) -> tuple:
         return (("end_tip", (self.numSides, self.r, self.length)),)
+
+    def open_and_closed_ends(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.proximal_dubins_frame(), self.distal_dubins_frame()
+
+
+#: The joint kinds design files know, by their "type" name (docs/architecture.md: a new kind is
+#: its class, which gives its solid, centreline, motion and design fields, plus one
+#: :func:`register_joint_kind`).
+JOINT_KINDS: dict[str, type[Joint]] = {}
+
+
+def register_joint_kind(cls: type[Joint]) -> type[Joint]:
+    """Make ``cls`` a joint kind of design files (under its class name); returns it."""
+    if not (isinstance(cls, type) and issubclass(cls, Joint)):
+        raise InvalidTypeError(f"a joint kind must be a Joint subclass, got {cls!r}")
+    JOINT_KINDS[cls.__name__] = cls
+    return cls
+
+
+for _kind in (StartTip, EndTip, RevoluteJoint, ExtendedRevoluteJoint, PrismaticJoint, Waypoint):
+    register_joint_kind(_kind)
 
 
 @functools.lru_cache(maxsize=256)

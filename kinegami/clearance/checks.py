@@ -246,7 +246,6 @@ def _junction_note(tree, pair: CollidingPair) -> str:
     branching joint: "; closest where the tubes leaving joint J come out of its junction"
     (they touch there by construction: the junction covers them up to where they are the
     margin apart), else ""."""
-    from kinegami.chain.joints import Waypoint
 
     if any(e < 1 or e % 2 == 0 for e in pair.elements):
         return ""
@@ -261,7 +260,7 @@ def _junction_note(tree, pair: CollidingPair) -> str:
             parent = parents[k]
             if children[parent] > 1:
                 return k
-            if not isinstance(joints[parent], Waypoint):
+            if joints[parent].has_body:
                 return None
             k = parent
         return None

@@ -32,9 +32,6 @@ import numpy as np
 
 from kinegami.chain.bodies import (
     CONTACT_TOLERANCE,
-    JOINT_FIXED,
-    JOINT_PRISMATIC,
-    JOINT_REVOLUTE,
     TURN_TOLERANCE,
     CapsuleModel,
     capsule_model,
@@ -42,7 +39,6 @@ from kinegami.chain.bodies import (
     clear_limit,
     with_joint_name,
 )
-from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
 from kinegami.clearance.reports import ClearanceReport, CollidingPair
 from kinegami.clearance.tree_bodies import tree_capsules
 from kinegami.errors import InvalidParameterError, InvalidTypeError
@@ -1226,9 +1222,7 @@ class TreeEngine(ClearanceEngine):
         self._joints = tuple(joints)
         self._names = None if names is None else tuple(names)
         J = len(joints)
-        kinds = np.array([JOINT_REVOLUTE if isinstance(j, RevoluteJoint) else
-                          JOINT_PRISMATIC if isinstance(j, PrismaticJoint) else JOINT_FIXED
-                          for j in joints], dtype=np.int64)  # fmt: skip
+        kinds = np.array([joint.motion for joint in joints], dtype=np.int64)
         poses = np.array([joint.pose_matrix for joint in joints]).reshape(J, 4, 4)
         rows = caps.rows
         self._setup(

@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING
 from kinegami.chain.bodies import (
     clear_limit,
 )
-from kinegami.chain.joints import RevoluteJoint
 from kinegami.errors import InvalidParameterError
+from kinegami.geometry.screws import REVOLUTE
 from kinegami.validation import (
     UNITS_IN_MM,
     shown,
@@ -340,7 +340,7 @@ class SweepReport:
                 joint = chain.Joints[i]
                 low, high = self.free_intervals[i]
                 lo, hi = joint.stateRange()
-                span = _degrees if isinstance(joint, RevoluteJoint) else length.span
+                span = _degrees if joint.motion == REVOLUTE else length.span
                 whole = low <= lo and high >= hi
                 label = f" '{names[i]}'" if names is not None and names[i] is not None else ""
                 lines.append(
@@ -390,6 +390,6 @@ def _degrees(low: float, high: float) -> str:
 
 def _state(joint: Joint, value: float) -> str:
     """One state in the editor's words: degrees for a revolute joint, else 3 digits."""
-    if isinstance(joint, RevoluteJoint):
+    if joint.motion == REVOLUTE:
         return f"{math.degrees(value):.1f} deg"
     return f"{value:.3g}"

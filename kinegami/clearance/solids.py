@@ -52,22 +52,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from kinegami.chain.assembly import JointAssembly
-from kinegami.chain.bodies import (
-    elbow_rings,
-    regular_polygon,
-    revolute_hull_points,
-    tip_hull_points,
-)
-from kinegami.chain.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
-    Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
-)
+from kinegami.chain.bodies import elbow_rings
+from kinegami.chain.joints import Joint
 from kinegami.errors import InvalidTypeError
+from kinegami.geometry.shapes import regular_polygon
 from kinegami.validation import check_twist_portion
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -238,10 +226,6 @@ def _hull(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return vertices, _outward(vertices, faces)
 
 
-def _polygon(frame: np.ndarray, r: float, n: int) -> np.ndarray:
-    return regular_polygon(frame, r, n)
-
-
 # --- joints --------------------------------------------------------------------------------
 
 
@@ -259,46 +243,10 @@ def joint_parts(joint: Joint, index: int, split: bool = False) -> list[MeshPart]
         ``joint_i_distal``: centre + state to the distal frame, length L/2), as the URDF needs.
         Revolute joints are always two halves.
     """
-    n, r = joint.numSides, joint.r
     name = f"joint_{index}"
-    if isinstance(joint, Waypoint):
-        return []
-    if isinstance(joint, PrismaticJoint):
-        z = joint.pose_matrix[:3, 2]
-        bottom = _polygon(joint.proximal_dubins_frame(), r, n)
-        L, s = joint.neutralLength, joint.state
-        if not split:
-            return [MeshPart(name, *_hull(np.vstack([bottom, bottom + (L + s) * z])), index, "")]
-        top = _polygon(joint.distal_dubins_frame(), r, n)
-        return [
-            MeshPart(
-                f"{name}_proximal",
-                *_hull(np.vstack([bottom, bottom + 0.5 * L * z])),
-                index,
-                "proximal",
-            ),
-            MeshPart(
-                f"{name}_distal", *_hull(np.vstack([top - 0.5 * L * z, top])), index, "distal"
-            ),
-        ]
-    if isinstance(joint, RevoluteJoint):
-        first, second = revolute_hull_points(joint)
-        if isinstance(joint, ExtendedRevoluteJoint):
-            first = np.vstack([first, _polygon(joint.proximal_dubins_frame(), r, n)])
-            second = np.vstack([second, _polygon(joint.distal_dubins_frame(), r, n)])
-        return [
-            MeshPart(f"{name}_proximal", *_hull(first), index, "proximal"),
-            MeshPart(f"{name}_distal", *_hull(second), index, "distal"),
-        ]
-    if isinstance(joint, StartTip | EndTip):
-        return [MeshPart(name, *_hull(tip_hull_points(joint)), index, "")]
-    points = np.vstack(
-        [
-            _polygon(joint.proximal_dubins_frame(), r, n),
-            _polygon(joint.distal_dubins_frame(), r, n),
-        ]
-    )
-    return [MeshPart(name, *_hull(points), index, "")]
+    return [MeshPart(f"{name}_{piece.side}" if piece.side else name, *_hull(piece.points), index,
+                     piece.side)
+            for piece in joint.body_pieces(split)]  # fmt: skip
 
 
 # --- links ---------------------------------------------------------------------------------
@@ -337,9 +285,9 @@ def link_parts(
     length = float(link.path.tMag)
     merge1 = length > tol and arc1.angle < MIN_ARC_ANGLE
     merge2 = length > tol and arc2.angle < MIN_ARC_ANGLE
-    near = _polygon(link.start_frame if merge1 else link.arc1_end_frame, r, n)
-    end = _polygon(link.arc2_start_frame, r, n)
-    far = _polygon(link.end_frame, r, n) if merge2 else end
+    near = regular_polygon(link.start_frame if merge1 else link.arc1_end_frame, r, n)
+    end = regular_polygon(link.arc2_start_frame, r, n)
+    far = regular_polygon(link.end_frame, r, n) if merge2 else end
     twist_length = twistPortion * length if link.hasTwist else 0.0
     straight = []  # (side, near polygon, far polygon, roll of the far polygon)
     if twist_length > tol:

@@ -26,10 +26,7 @@ from kinegami.chain.bodies import (
     overlap_of_deepest_pair,
     worst_overlap,
 )
-from kinegami.chain.joints import (
-    RevoluteJoint,
-    Waypoint,
-)
+from kinegami.geometry.screws import REVOLUTE
 from kinegami.geometry.segments import point_segment_parameters, segment_distances
 
 __all__ = [
@@ -385,7 +382,7 @@ class TreeCapsules:
         kinks = np.zeros(n)
         for j in range(n):
             p = self.parents[j]
-            kink = abs(joints[j].state) if isinstance(joints[j], RevoluteJoint) else 0.0
+            kink = abs(joints[j].state) if joints[j].motion == REVOLUTE else 0.0
             kinks[j] = kink + (kinks[p] if p >= 0 else 0.0)
         return kinks
 
@@ -570,7 +567,7 @@ def tree_capsules(joints, links, parents, r: float, margin: float = 0.0) -> Tree
         paths = {}
         for k in kids:
             path = [k]
-            while isinstance(joints[path[-1]], Waypoint) and len(children[path[-1]]) == 1:
+            while not joints[path[-1]].has_body and len(children[path[-1]]) == 1:
                 path.append(children[path[-1]][0])
             top[path] = k
             paths[k] = path

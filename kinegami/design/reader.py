@@ -28,12 +28,7 @@ import weakref
 from dataclasses import dataclass
 
 from kinegami.chain.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
+    JOINT_KINDS,
 )
 from kinegami.chain.model import KinematicChain
 from kinegami.design.errors import DesignError, json_path, numeric_errors
@@ -66,6 +61,7 @@ from kinegami.design.trees import (
     structure_of,
 )
 from kinegami.errors import ClearanceWarning, JointIndexError, KinegamiError, PlacementWarning
+from kinegami.geometry.screws import REVOLUTE
 from kinegami.tree import KinematicTree
 from kinegami.validation import LENGTH_UNITS, shorten, shown
 
@@ -545,34 +541,12 @@ def _make_joint(spec: dict, i: int, numSides: int, r: float, units: str, file):
     kind = spec["type"]
     path = ["joints", i]
     pose = pose_from_json(spec.get("pose", []), [*path, "pose"], units)
-    angle = {
-        key: to_radians(spec[key], units)
-        for key in ("totalBendingAngle", "coneAngle")
-        if key in spec
-    }
+    cls = JOINT_KINDS[kind]
+    fields = {key: to_radians(value, units) if key in cls.design_angles else value
+              for key, value in spec.items()}  # fmt: skip
     try:
         with numeric_errors(json_path(path), file):
-            if kind in ("StartTip", "EndTip"):
-                cls = StartTip if kind == "StartTip" else EndTip
-                return cls(numSides, r, Pose=pose, length=spec["length"])
-            if kind == "RevoluteJoint":
-                return RevoluteJoint(
-                    numSides, r, angle["totalBendingAngle"], pose, spec.get("numSinkLayers", 1)
-                )
-            if kind == "ExtendedRevoluteJoint":
-                return ExtendedRevoluteJoint(
-                    numSides,
-                    r,
-                    angle["totalBendingAngle"],
-                    spec["tubeLength"],
-                    pose,
-                    spec.get("numSinkLayers", 1),
-                )
-            if kind == "PrismaticJoint":
-                return PrismaticJoint(
-                    numSides, r, spec["neutralLength"], spec["numLayers"], angle["coneAngle"], pose
-                )
-            return Waypoint(numSides, r, pose, spec.get("pathIndex", 2))
+            return cls.from_design(numSides, r, pose, fields)
     except DesignError:
         raise
     except KinegamiError as error:
@@ -923,8 +897,8 @@ def carry_origin(source: KinematicChain, target: KinematicChain) -> DesignOrigin
     if tuple(origin.types) == _type_names(target):  # the same joints: names for every one
         _ORIGINS[target] = origin
         return origin
-    kept = [i for i, joint in enumerate(source.Joints) if type(joint) is not Waypoint]
-    others = [i for i, joint in enumerate(target.Joints) if type(joint) is not Waypoint]
+    kept = [i for i, joint in enumerate(source.Joints) if joint.has_body]
+    others = [i for i, joint in enumerate(target.Joints) if joint.has_body]
     if [origin.types[i] for i in kept] != [type(target.Joints[i]).__name__ for i in others]:
         return None
     sources = [None] * len(target.Joints)
@@ -1120,7 +1094,7 @@ def _apply_edits(chain: KinematicChain, plan: _Plan, file, sources: list) -> Non
             args = (_edit_index(args[0], plan, sources, deleted, where, file), *args[1:])
         if op == "setJointState":
             index, state = args
-            if -len(chain) <= index < len(chain) and isinstance(chain.Joints[index], RevoluteJoint):
+            if -len(chain) <= index < len(chain) and chain.Joints[index].motion == REVOLUTE:
                 args = (index, to_radians(state, plan.angle_units))
         try:
             ok, message = _recorded(
@@ -1174,12 +1148,12 @@ def _apply_states(chain: KinematicChain, plan: _Plan, file) -> None:
         )
     values = []
     for k, (joint, state) in enumerate(zip(joints, states, strict=True)):
-        if isinstance(joint, RevoluteJoint):
+        if joint.motion == REVOLUTE:
             state = to_radians(state, plan.angle_units)
         state = float(state)
         lo, hi = joint.stateRange()
         if not lo <= state <= hi:
-            unit = "radians" if isinstance(joint, RevoluteJoint) else "length units"
+            unit = "radians" if joint.motion == REVOLUTE else "length units"
             raise DesignError(
                 f"state of joint {k} ({type(joint).__name__}) outside its range "
                 f"[{lo!r}, {hi!r}] ({unit})",

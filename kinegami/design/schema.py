@@ -14,6 +14,7 @@ from importlib import resources
 
 import jsonschema
 
+from kinegami.chain.joints import JOINT_KINDS
 from kinegami.design.errors import DesignError, format_value, json_path
 from kinegami.design.limits import (
     MAX_DH_ROWS,
@@ -30,14 +31,8 @@ from kinegami.validation import shorten, shown
 
 __all__ = ["design_schema", "check_schema", "JOINT_TYPES", "EDIT_OPS", "PLACEMENT_KEYS"]
 
-JOINT_TYPES = (
-    "StartTip",
-    "EndTip",
-    "RevoluteJoint",
-    "ExtendedRevoluteJoint",
-    "PrismaticJoint",
-    "Waypoint",
-)
+#: The joint types design files know: the registered joint kinds (kinegami.chain.joints).
+JOINT_TYPES = tuple(JOINT_KINDS)
 EDIT_OPS = (
     "translateJointAlongAxisOfMotion",
     "rotateJointAboutAxisOfMotion",
@@ -140,15 +135,48 @@ def _version_2_field(document) -> str:
     return "a field of version 2"
 
 
-@functools.cache
 def design_schema() -> dict:
-    """The JSON Schema (draft 2020-12) of design files, as a dict (shipped as schema.json)."""
-    text = resources.files("kinegami.design").joinpath("schema.json").read_text("utf-8")
-    return json.loads(text)
+    """The JSON Schema (draft 2020-12) of design files, as a dict: schema.json as shipped, plus
+    an entry for every joint kind registered since (kinegami.chain.joints.register_joint_kind;
+    its fields are those of its ``design_defaults``)."""
+    return _schema_of(tuple(JOINT_KINDS))
 
 
 @functools.cache
+def _schema_of(kinds: tuple[str, ...]) -> dict:
+    """The schema with the joint kinds ``kinds`` (read once per set of kinds)."""
+    text = resources.files("kinegami.design").joinpath("schema.json").read_text("utf-8")
+    schema = json.loads(text)
+    _add_registered_kinds(schema)
+    return schema
+
+
+def _add_registered_kinds(schema: dict) -> None:
+    """Add the joint kinds the shipped schema does not describe (a kind a user registered)."""
+    defs = schema["$defs"]
+    joint = defs["joint"]
+    for name, kind in JOINT_KINDS.items():
+        if name in defs:
+            continue
+        joint["properties"]["type"]["enum"].append(name)
+        properties = dict(defs["Waypoint"]["properties"])  # type, name, pose, placement keys
+        properties.pop("pathIndex", None)
+        for key, value in kind.design_defaults(1.0).items():
+            properties[key] = {"type": "integer" if isinstance(value, int) else "number"}
+        defs[name] = {"properties": properties, "additionalProperties": False}
+        joint["allOf"].append({
+            "if": {"required": ["type"], "properties": {"type": {"const": name}}},
+            "then": {"$ref": f"#/$defs/{name}"},
+        })  # fmt: skip
+
+
 def _validator() -> jsonschema.Draft202012Validator:
+    return _validator_of(tuple(JOINT_KINDS))
+
+
+@functools.cache
+def _validator_of(kinds: tuple[str, ...]) -> jsonschema.Draft202012Validator:
+    """The validator of the schema with the joint kinds ``kinds`` (registered ones included)."""
     return jsonschema.Draft202012Validator(design_schema())
 
 
@@ -306,7 +334,7 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
         key = missing[0] if missing else expected[0]
         where = json_path([*path, key])
         if key == "type":
-            return fail(f"missing required field 'type' (one of: {', '.join(JOINT_TYPES)})", where)
+            return fail(f"missing required field 'type' (one of: {', '.join(JOINT_KINDS)})", where)
         if key == "op":
             return fail(f"missing required field 'op' (one of: {', '.join(EDIT_OPS)})", where)
         return fail(f"missing required field '{key}'", where)
@@ -328,7 +356,7 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
     if keyword == "enum":
         if name == "type" and len(path) >= 2 and path[0] == "joints":
             return fail(
-                f"unknown joint type {shown(value)}; known: {', '.join(JOINT_TYPES)}", value=value
+                f"unknown joint type {shown(value)}; known: {', '.join(JOINT_KINDS)}", value=value
             )
         if name == "op":
             known = ", ".join(EDIT_OPS)

@@ -24,13 +24,8 @@ from pathlib import Path
 from kinegami._atomic import write_atomic
 from kinegami.chain.bodies import worst_overlap
 from kinegami.chain.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
+    JOINT_KINDS,
     Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
 )
 from kinegami.chain.model import KinematicChain
 from kinegami.clearance.tree_bodies import tree_worst_overlap
@@ -47,35 +42,14 @@ _FIXED = {"relative": False, "safe": False, "fixedPosition": True, "fixedOrienta
 
 
 def _joint_parameters(joint: Joint) -> dict:
-    """The joint's type and constructor parameters (radians, chain length units)."""
-    if type(joint) is ExtendedRevoluteJoint:
-        return {
-            "type": "ExtendedRevoluteJoint",
-            "totalBendingAngle": float(joint.totalBendingAngle),
-            "tubeLength": float(joint.tubeLength),
-            "numSinkLayers": int(joint.numSinkLayers),
-        }
-    if type(joint) is RevoluteJoint:
-        return {
-            "type": "RevoluteJoint",
-            "totalBendingAngle": float(joint.totalBendingAngle),
-            "numSinkLayers": int(joint.numSinkLayers),
-        }
-    if type(joint) is PrismaticJoint:
-        return {
-            "type": "PrismaticJoint",
-            "neutralLength": float(joint.neutralLength),
-            "numLayers": int(joint.numLayers),
-            "coneAngle": float(joint.coneAngle),
-        }
-    if type(joint) is Waypoint:
-        return {"type": "Waypoint", "pathIndex": int(joint.pathIndex())}
-    if type(joint) in (StartTip, EndTip):
-        return {"type": type(joint).__name__, "length": float(joint.length)}
-    raise InvalidTypeError(
-        f"cannot save a joint of type {type(joint).__name__}: design files know StartTip, "
-        f"EndTip, RevoluteJoint, ExtendedRevoluteJoint, PrismaticJoint and Waypoint"
-    )
+    """The joint's type and constructor parameters (radians, chain length units): its kind's
+    :meth:`~kinegami.chain.joints.Joint.design_fields`."""
+    name = type(joint).__name__
+    if JOINT_KINDS.get(name) is not type(joint):
+        raise InvalidTypeError(
+            f"cannot save a joint of type {name}: design files know {', '.join(JOINT_KINDS)}"
+        )
+    return {"type": name, **joint.design_fields()}
 
 
 def _matrix(T) -> list[list[float]]:
@@ -172,7 +146,7 @@ def design_to_dict(
         document["structure"] = "tree"
     # Deleting joint 0 can leave an EndTip as root, which nothing can start with: then a
     # waypoint at the tip's proximal frame is written as root, and an edit deletes it again.
-    shift = 1 if isinstance(rest.Joints[0], EndTip) else 0
+    shift = 1 if rest.Joints[0].closes_end else 0
     parents = rest.Parents
     joints = []
     for i, joint in enumerate(rest.Joints):

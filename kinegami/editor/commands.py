@@ -19,11 +19,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from kinegami.chain.joints import (
+    JOINT_KINDS,
     EndTip,
-    ExtendedRevoluteJoint,
     Joint,
-    PrismaticJoint,
-    RevoluteJoint,
     StartTip,
     Waypoint,
 )
@@ -39,6 +37,7 @@ from kinegami.errors import (
     KinegamiError,
     PlacementWarning,
 )
+from kinegami.geometry.screws import PRISMATIC
 from kinegami.tree import KinematicTree
 from kinegami.validation import shown
 
@@ -83,15 +82,9 @@ class _Keep:
 #: Default of :class:`SetOptions` fields: leave the option as it is.
 KEEP: Any = _Keep()
 
-#: The joint types the editor can add, by name.
-JOINT_TYPES = {
-    "RevoluteJoint": RevoluteJoint,
-    "ExtendedRevoluteJoint": ExtendedRevoluteJoint,
-    "PrismaticJoint": PrismaticJoint,
-    "Waypoint": Waypoint,
-    "EndTip": EndTip,
-    "StartTip": StartTip,
-}
+#: The joint types the editor can add, by name: the registered joint kinds
+#: (kinegami.chain.joints.JOINT_KINDS).
+JOINT_TYPES = JOINT_KINDS
 
 #: How a new joint is placed: ``"safe"`` (safe placement, waypoints; never fails), ``"compact"``
 #: (slides along its axis to just beyond the chain) or ``"pose"`` (exactly at the given pose).
@@ -286,7 +279,7 @@ def _rebuilt(run: _Run, chain, joints: Sequence[Joint], keep: int = 0,
         start = keep
     else:
         root = joints[0]
-        if isinstance(root, EndTip):
+        if root.closes_end:
             _fail("a chain whose first joint is an EndTip cannot be rebuilt; add a joint first")
         angle = chain.maxAnglePerElbow if maxAnglePerElbow is None else maxAnglePerElbow
         kind = KinematicTree if _is_tree(chain) else KinematicChain
@@ -313,16 +306,8 @@ def _new_joint(kind: str, parameters: Mapping, pose: np.ndarray, numSides: int, 
         _fail(f"joint type must be one of {', '.join(JOINT_TYPES)}, got {shown(kind)}")
     if not isinstance(parameters, Mapping):
         _fail(f"parameters must be a mapping of parameter names to values, got {shown(parameters)}")
-    defaults = {
-        "RevoluteJoint": {"totalBendingAngle": math.pi, "numSinkLayers": 1},
-        "ExtendedRevoluteJoint": {
-            "totalBendingAngle": math.pi, "tubeLength": 2.0 * r, "numSinkLayers": 1,
-        },
-        "PrismaticJoint": {"neutralLength": 3.0 * r, "numLayers": 3, "coneAngle": math.pi / 4},
-        "Waypoint": {"pathIndex": 2},
-        "StartTip": {"length": 1.5 * r},
-        "EndTip": {"length": 1.5 * r},
-    }[kind]  # fmt: skip
+    cls = JOINT_TYPES[kind]
+    defaults = cls.design_defaults(r)
     unknown = [key for key in parameters if key not in defaults]
     if unknown:
         _fail(
@@ -330,27 +315,33 @@ def _new_joint(kind: str, parameters: Mapping, pose: np.ndarray, numSides: int, 
             f"{', '.join(defaults) or 'none'}"
         )
     p = {**defaults, **(base or {}), **parameters}
-    if kind in ("RevoluteJoint", "ExtendedRevoluteJoint"):
-        angle = _number("totalBendingAngle", p["totalBendingAngle"])
+    return cls.from_design(numSides, r, pose, {key: _checked_field(key, p[key], r) for key in p})
+
+
+def _checked_field(name: str, value, r: float):
+    """A joint parameter checked against the bounds of design files, with the editor's words;
+    a field these checks do not know is left to the joint kind's own constructor."""
+    if name == "totalBendingAngle":
+        angle = _number(name, value)
         if not 0.0 < angle < 2.0 * math.pi:
             _fail(f"totalBendingAngle must be in (0, 2pi) radians (0° to 360°), got {angle!r} "
                   f"({angle_text(angle)})")  # fmt: skip
-        layers = _integer("numSinkLayers", p["numSinkLayers"], 1, limits.NUM_SINK_LAYERS_MAX)
-        if kind == "RevoluteJoint":
-            return RevoluteJoint(numSides, r, angle, pose, layers)
-        tube = _length("tubeLength", p["tubeLength"], r)
-        return ExtendedRevoluteJoint(numSides, r, angle, tube, pose, layers)
-    if kind == "PrismaticJoint":
-        length = _length("neutralLength", p["neutralLength"], r)
-        layers = _integer("numLayers", p["numLayers"], 1, limits.NUM_LAYERS_MAX)
-        cone = _number("coneAngle", p["coneAngle"])
+        return angle
+    if name == "coneAngle":
+        cone = _number(name, value)
         if not math.pi / 6 <= cone < math.pi / 2:
             _fail(f"coneAngle must be in [pi/6, pi/2) radians ([30°, 90°)), got {cone!r} "
                   f"({angle_text(cone)})")  # fmt: skip
-        return PrismaticJoint(numSides, r, length, layers, cone, pose)
-    if kind == "Waypoint":
-        return Waypoint(numSides, r, pose, _integer("pathIndex", p["pathIndex"], 0, 2))
-    return JOINT_TYPES[kind](numSides, r, pose, _length("length", p["length"], r))
+        return cone
+    if name == "numSinkLayers":
+        return _integer(name, value, 1, limits.NUM_SINK_LAYERS_MAX)
+    if name == "numLayers":
+        return _integer(name, value, 1, limits.NUM_LAYERS_MAX)
+    if name in ("tubeLength", "neutralLength", "length"):
+        return _length(name, value, r)
+    if name == "pathIndex":
+        return _integer(name, value, 0, 2)
+    return value
 
 
 def _check_name(document: Document, name, j: int | None = None):
@@ -418,10 +409,10 @@ def _new_joint_of(command, document: Document, ref, what: str) -> _NewJoint:
     pose = _pose("pose", command.pose, chain.r)
     joint = _new_joint(command.kind, command.parameters, pose, chain.numSides, chain.r)
     name = _check_name(document, command.name)
-    if isinstance(joint, StartTip):
+    if joint.closes_start:
         noun = "tree" if _is_tree(chain) else "chain"
         _fail(f"a StartTip can only be the first joint of a {noun}, which already has one")
-    if isinstance(chain.Joints[parent], EndTip):
+    if chain.Joints[parent].closes_end:
         ends = "ends the chain" if not _is_tree(chain) else "is a leaf of the tree"
         _fail(f"nothing can follow {_label(document, parent)}: an EndTip {ends}")
     return _NewJoint(joint, parent, relative, _PLACEMENT_OPTIONS[command.placement], name)
@@ -468,7 +459,7 @@ class AddJoint(Command):
         spec = _new_joint_of(self, document, self.after, "after")
         joint, after = spec.joint, spec.parent
         parents = chain.Parents
-        if isinstance(joint, EndTip) and _children(chain, after):
+        if joint.closes_end and _children(chain, after):
             if _is_tree(chain):
                 _fail(
                     f"an EndTip can only be a leaf; after={after} has children (joints "
@@ -830,7 +821,7 @@ def _check_state(document: Document, j: int, value, name: str) -> float:
     joint = document.chain.Joints[j]
     lo, hi = joint.stateRange()
     if not lo <= s <= hi:
-        if isinstance(joint, PrismaticJoint):
+        if joint.motion == PRISMATIC:
             unit = f"(a length, {document.units})"
             got = repr(s)
         else:

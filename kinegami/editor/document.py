@@ -22,13 +22,7 @@ import numpy as np
 
 from kinegami._atomic import write_atomic
 from kinegami.chain.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
     Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
 )
 from kinegami.chain.model import KinematicChain
 from kinegami.design import DesignInfo, design_to_dict, dumps_design
@@ -58,29 +52,9 @@ def fork_chain(chain: KinematicChain | KinematicTree) -> KinematicChain | Kinema
 
 
 def joint_parameters(joint: Joint) -> dict:
-    """The joint's constructor parameters (radians, chain lengths), as in a design file."""
-    if type(joint) is ExtendedRevoluteJoint:
-        return {
-            "totalBendingAngle": float(joint.totalBendingAngle),
-            "tubeLength": float(joint.tubeLength),
-            "numSinkLayers": int(joint.numSinkLayers),
-        }
-    if type(joint) is RevoluteJoint:
-        return {
-            "totalBendingAngle": float(joint.totalBendingAngle),
-            "numSinkLayers": int(joint.numSinkLayers),
-        }
-    if type(joint) is PrismaticJoint:
-        return {
-            "neutralLength": float(joint.neutralLength),
-            "numLayers": int(joint.numLayers),
-            "coneAngle": float(joint.coneAngle),
-        }
-    if type(joint) is Waypoint:
-        return {"pathIndex": int(joint.pathIndex())}
-    if type(joint) in (StartTip, EndTip):
-        return {"length": float(joint.length)}
-    return {}
+    """The joint's constructor parameters (radians, chain lengths), as in a design file (its
+    kind's :meth:`~kinegami.chain.joints.Joint.design_fields`)."""
+    return joint.design_fields()
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ import numpy as np
 from kinegami.editor import sheet_drawing
 from kinegami.editor.background import Debounced, JobProcess, ProcessWorker
 from kinegami.editor.commands import (
+    JOINT_TYPES,
     Compact,
     Computed,
     FitJunctions,
@@ -59,6 +60,7 @@ from kinegami.editor.units import (
     state_unit,
 )
 from kinegami.errors import Cancelled, InvalidParameterError, InvalidTypeError, KinegamiError
+from kinegami.geometry.screws import FIXED
 from kinegami.limits import MAX_FILE_BYTES
 
 __all__ = ["EditorView", "DOWNLOADS", "SHEET_FORMATS", "MAX_UPLOAD_BYTES", "gallery",
@@ -81,7 +83,12 @@ JOINT_COLOR = (70, 140, 220)
 LINK_COLOR = (200, 200, 190)
 SELECTED_COLOR = (250, 180, 40)
 COLLIDING_COLOR = (220, 40, 40)
-JOINT_KINDS = ("RevoluteJoint", "PrismaticJoint", "ExtendedRevoluteJoint", "Waypoint", "EndTip")
+#: The kinds the "New joint" menu offers: every registered joint kind but the root-only ones
+#: (a StartTip), the moving kinds first.
+NEW_JOINT_KINDS = tuple(sorted(
+    (name for name, kind in JOINT_TYPES.items() if not kind.closes_start),
+    key=lambda name: JOINT_TYPES[name].motion == FIXED,
+))
 #: Seconds without a change before the crease-pattern panel is drawn again.
 PATTERN_DELAY = 0.2
 #: Width of the crease-pattern panel (pixels).
@@ -863,7 +870,7 @@ class EditorView:
             roll.on_click(lambda e: self.act(lambda: self.model.roll(
                 None, (1 if e.target.value == "+ roll" else -1)
                 * math.radians(float(self._angle.value)))))  # fmt: skip
-            self._kind = gui.add_dropdown("New joint", JOINT_KINDS)
+            self._kind = gui.add_dropdown("New joint", NEW_JOINT_KINDS)
             add = gui.add_button("Add joint after selected")
             add.on_click(lambda _: self.act(lambda: self.model.add_joint(str(self._kind.value))))
             branch = gui.add_button(

@@ -63,11 +63,11 @@ from typing import TYPE_CHECKING, Any, TextIO
 
 import numpy as np
 
-from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
 from kinegami.clearance.solids import chain_parts, check_assembly, is_tree
 from kinegami.errors import InvalidParameterError
 from kinegami.export.mesh import mesh_factor, shell_mass_properties, stl_bytes
 from kinegami.geometry.frames import inverse
+from kinegami.geometry.screws import FIXED, PRISMATIC, REVOLUTE
 from kinegami.validation import (
     check_bool,
     check_nonnegative,
@@ -152,7 +152,7 @@ class ChainBodies:
 def _joint_motion(joint, state: float) -> np.ndarray:
     """J(state) in the joint's own frame: Rz(state) or Trans(0, 0, state)."""
     T = np.eye(4)
-    if isinstance(joint, RevoluteJoint):
+    if joint.motion == REVOLUTE:
         c, s = math.cos(state), math.sin(state)
         T[:2, :2] = [[c, -s], [s, c]]
     else:
@@ -178,7 +178,7 @@ def chain_bodies(chain: KinematicChain | KinematicTree) -> ChainBodies:
         pose = joint.pose_matrix
         zero[k] = inverse(motions[body]) @ pose
         proximal.append(body)
-        if isinstance(joint, RevoluteJoint | PrismaticJoint):
+        if joint.motion != FIXED:
             movable.append(k)
             motions.append(pose @ _joint_motion(joint, joint.state) @ inverse(zero[k]))
             body = len(motions) - 1
@@ -350,7 +350,7 @@ def urdf_model(chain: KinematicChain | KinematicTree, **options: Any) -> UrdfMod
             robot,
             "joint",
             name=f"joint_{k}",
-            type="revolute" if isinstance(joint, RevoluteJoint) else "prismatic",
+            type="revolute" if joint.motion == REVOLUTE else "prismatic",
         )
         ET.SubElement(element, "parent", link=f"body_{parent}")
         ET.SubElement(element, "child", link=f"body_{b}")
@@ -358,7 +358,7 @@ def urdf_model(chain: KinematicChain | KinematicTree, **options: Any) -> UrdfMod
         ET.SubElement(element, "origin", xyz=_vector(offset), rpy="0 0 0")
         ET.SubElement(element, "axis", xyz=_vector(pose[:3, 2]))
         lo, hi = joint.stateRange()
-        if isinstance(joint, PrismaticJoint):
+        if joint.motion == PRISMATIC:
             lo, hi = lo * metres, hi * metres
         ET.SubElement(
             element,

@@ -22,7 +22,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinegami.chain.bodies import check_margin, worst_overlap
-from kinegami.chain.joints import Waypoint
 from kinegami.chain.model import KinematicChain
 from kinegami.clearance.tree_bodies import tree_worst_overlap
 from kinegami.errors import (
@@ -181,7 +180,7 @@ def _descend(
         for j in range(len(state.chain.Joints) - 1, 0, -1):
             if out_of_time():
                 break
-            if not isinstance(state.chain.Joints[j], Waypoint):
+            if state.chain.Joints[j].has_body:
                 continue
             if isinstance(state.chain, KinematicTree) and len(state.chain.Children[j]) > 1:
                 continue  # a branching waypoint holds its children's junction
@@ -429,7 +428,7 @@ def _coarse_options(
     ``rng``, the offsets are scaled and the rolls turned at random."""
     options = []
     for j in range(len(joints)):
-        if isinstance(joints[j], Waypoint) and j > 0:  # kept where it is
+        if not joints[j].has_body and j > 0:  # kept where it is
             options.append(np.zeros((1, 2)))
             continue
         T = joints[j].pose_matrix
@@ -466,7 +465,7 @@ def _fine_options(layers: _Layers, choice: list[int], level: int) -> list:
     options = []
     for j in range(len(choice)):
         t, th = layers.options[j][choice[j]]
-        if isinstance(layers.base[j], Waypoint) and j > 0:
+        if not layers.base[j].has_body and j > 0:
             options.append(np.array([(t, th)]))
             continue
         rolls = [th] if layers.base[j].pathIndex() == 2 else [th, th - delta, th + delta]
@@ -489,7 +488,7 @@ def _dp_search(chain, rng: np.random.Generator | None, motion, deadline, junctio
             found = _dp_search_joints(chain, list(chain.Joints), rng, motion, deadline,
                                       list(chain.Parents), junctions)  # fmt: skip
         return found
-    joints = [j for i, j in enumerate(chain.Joints) if i == 0 or not isinstance(j, Waypoint)]
+    joints = [j for i, j in enumerate(chain.Joints) if i == 0 or j.has_body]
     found = _dp_search_joints(chain, joints, rng, motion, deadline)
     if found is None and len(joints) < len(chain.Joints):
         found = _dp_search_joints(chain, list(chain.Joints), rng, motion, deadline)
@@ -501,7 +500,7 @@ def _without_waypoints(tree: KinematicTree) -> tuple[list[int], list[int]]:
     waypoints where the tree branches) and the parent of each among them."""
     children = tree.Children
     kept = [k for k, joint in enumerate(tree.Joints)
-            if k == 0 or not isinstance(joint, Waypoint) or len(children[k]) > 1]  # fmt: skip
+            if k == 0 or joint.has_body or len(children[k]) > 1]  # fmt: skip
     where = {k: i for i, k in enumerate(kept)}
     parents = []
     for k in kept:

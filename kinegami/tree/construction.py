@@ -31,12 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinegami.chain.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
+    JOINT_KINDS,
     Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
     Waypoint,
     check_same_tube,
     pose_array,
@@ -94,12 +90,6 @@ LATTICE_SIZE = 10_000
 #: Growth directions whose qualities differ by at most this count as tied.
 TIE_TOLERANCE = 1e-9
 _PLANE_TOLERANCE = 1e-8  # signed distances below this are 0 (docs/theory/chain.md §0)
-
-_JOINT_TYPES = {
-    cls.__name__: cls
-    for cls in (Waypoint, RevoluteJoint, ExtendedRevoluteJoint, PrismaticJoint, StartTip, EndTip)
-}
-
 
 # --- the specification -------------------------------------------------------------------------
 def _frozen(array) -> np.ndarray:
@@ -233,7 +223,7 @@ def _spec_index(index, count: int, name: str = "index") -> int:
 def _check_structure(joints: Sequence[Joint], parents: Sequence[int]) -> None:
     if parents[0] != -1:
         raise InvalidParameterError(f"Parents[0] (the root's parent) must be -1, got {parents[0]}")
-    if isinstance(joints[0], EndTip):
+    if joints[0].closes_end:
         raise InvalidParameterError("the root joint cannot be an EndTip (nothing may follow it)")
     for i in range(1, len(joints)):
         p = parents[i]
@@ -241,11 +231,11 @@ def _check_structure(joints: Sequence[Joint], parents: Sequence[int]) -> None:
             raise InvalidParameterError(
                 f"Parents[{i}] must be the index of an earlier joint, in [0, {i - 1}], got {p}"
             )
-        if isinstance(joints[p], EndTip):
+        if joints[p].closes_end:
             raise InvalidParameterError(
                 f"joint {i}'s parent, joint {p}, is an EndTip: nothing can follow it"
             )
-        if isinstance(joints[i], StartTip):
+        if joints[i].closes_start:
             raise InvalidParameterError(f"joint {i} is a StartTip: a StartTip can only be the root")
 
 
@@ -419,8 +409,8 @@ def _from_document(data, file=None) -> JointSpecification:
         if not isinstance(entry, Mapping):
             raise DesignError("must be an object", field=where, value=entry, file=file)
         kind = entry.get("type")
-        if kind not in _JOINT_TYPES:
-            raise DesignError(f"must be one of {', '.join(sorted(_JOINT_TYPES))}",
+        if kind not in JOINT_KINDS:
+            raise DesignError(f"must be one of {', '.join(sorted(JOINT_KINDS))}",
                               field=f"{where}.type", value=kind, file=file)  # fmt: skip
         parent = entry.get("parent", -1 if i == 0 else None)
         if (
@@ -465,7 +455,7 @@ def _from_document(data, file=None) -> JointSpecification:
             raise DesignError("must be an object", field=f"{where}.params", value=params,
                               file=file)  # fmt: skip
         try:
-            joint = _JOINT_TYPES[kind](numSides=n, r=r, Pose=T, **params)
+            joint = JOINT_KINDS[kind](numSides=n, r=r, Pose=T, **params)
         except TypeError as error:
             raise DesignError(f"wrong parameters for {kind}: {error}", field=f"{where}.params",
                               value=dict(params), file=file) from None  # fmt: skip

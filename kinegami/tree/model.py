@@ -21,7 +21,7 @@ import numpy as np
 
 from kinegami.chain.assembly import RADIAL_VARIANTS, JointAssembly
 from kinegami.chain.bodies import Overlap, link_polyline
-from kinegami.chain.joints import EndTip, Joint, StartTip, Waypoint, check_same_tube
+from kinegami.chain.joints import Joint, check_same_tube
 from kinegami.chain.model import KinematicChain
 from kinegami.clearance.tree_bodies import tree_worst_overlap
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
@@ -105,9 +105,9 @@ class KinematicTree(JointAssembly):
         placed, links, ball = [tree._joints[0]], [tree._links[0]], tree._ball
         for k in range(1, len(joints)):
             check_same_tube(joints[k], tree.numSides, tree.r)
-            if isinstance(joints[k], StartTip):
+            if joints[k].closes_start:
                 raise InvalidParameterError(f"joint {k}: a StartTip can only be the root")
-            if isinstance(placed[parents[k]], EndTip):
+            if placed[parents[k]].closes_end:
                 raise InvalidParameterError(
                     f"joint {k}: its parent {parents[k]} is an EndTip, which nothing can follow"
                 )
@@ -214,7 +214,7 @@ class KinematicTree(JointAssembly):
                 sides = points - np.outer(points @ d1, d1)
                 norms = np.sqrt((sides**2).sum(axis=1))
                 off = np.flatnonzero(norms > 1e-6 * self.r)
-                if off.size or not isinstance(self._joints[node], Waypoint):
+                if off.size or self._joints[node].has_body:
                     break
                 kids = self._children_of(node)
                 if len(kids) != 1:

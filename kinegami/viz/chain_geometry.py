@@ -20,27 +20,11 @@ import math
 
 import numpy as np
 
-from kinegami.chain.bodies import (
-    circle_points,
-    hinge_segment,
-    polygon_side,
-    prismatic_prism_vertices,
-    regular_polygon,
-    revolute_hull_points,
-    shifted_frame,
-    tip_hull_points,
-)
-from kinegami.chain.joints import (
-    EndTip,
-    ExtendedRevoluteJoint,
-    Joint,
-    PrismaticJoint,
-    RevoluteJoint,
-    StartTip,
-    Waypoint,
-)
+from kinegami.chain.joints import Joint
 from kinegami.chain.links import ELBOW_MIN_ANGLE
 from kinegami.geometry.frames import rotation
+from kinegami.geometry.screws import FIXED
+from kinegami.geometry.shapes import circle_points, hinge_segment, polygon_side, regular_polygon
 
 __all__ = [
     "regular_polygon",
@@ -50,9 +34,6 @@ __all__ = [
     "convex_hull_faces",
     "face_normals",
     "prism_faces",
-    "prismatic_prism_vertices",
-    "revolute_hull_points",
-    "tip_hull_points",
     "joint_body_faces",
     "joint_axis_segment",
     "joint_frames",
@@ -173,43 +154,23 @@ def prism_faces(bottom: np.ndarray, top: np.ndarray) -> list[np.ndarray]:
 
 # --- joints ---
 def joint_body_faces(joint: Joint) -> list[np.ndarray]:
-    """Polygons (each (k, 3)) of a joint's body; empty for a waypoint."""
-    if isinstance(joint, Waypoint):
-        return []
-    if isinstance(joint, PrismaticJoint):
-        bottom, top = prismatic_prism_vertices(joint)
-        return prism_faces(bottom, top)
-    if isinstance(joint, RevoluteJoint):
-        first, second = revolute_hull_points(joint)
-        T = joint.pose_matrix
-        faces = convex_hull_faces(first, T) + convex_hull_faces(second, T)
-        if isinstance(joint, ExtendedRevoluteJoint):
-            n, r, h = joint.numSides, joint.r, joint.tubeLength
-            for frame, sign in (
-                (joint.proximal_dubins_frame(), 1.0),
-                (joint.distal_dubins_frame(), -1.0),
-            ):
-                outer = regular_polygon(frame, r, n)
-                inner = regular_polygon(shifted_frame(frame, sign * h), r, n)
-                faces += prism_faces(outer, inner)
-        return faces
-    if isinstance(joint, StartTip | EndTip):
-        return convex_hull_faces(tip_hull_points(joint), joint.pose_matrix)
-    # Any other joint: the hull of its proximal and distal cross sections.
-    n, r = joint.numSides, joint.r
-    return convex_hull_faces(
-        np.vstack(
-            [
-                regular_polygon(joint.proximal_dubins_frame(), r, n),
-                regular_polygon(joint.distal_dubins_frame(), r, n),
-            ]
-        )
-    )
+    """Polygons (each (k, 3)) of a joint's body (its kind's
+    :meth:`~kinegami.chain.joints.Joint.body_pieces`, drawn as each piece says: prisms with
+    their quads, the rest as hulls); empty for a waypoint."""
+    faces: list[np.ndarray] = []
+    T = joint.pose_matrix
+    for piece in joint.body_pieces():
+        for item in piece.drawn or (("hull", piece.points),):
+            if item[0] == "prism":
+                faces += prism_faces(item[1], item[2])
+            else:
+                faces += convex_hull_faces(item[1], T)
+    return faces
 
 
 def joint_axis_segment(joint: Joint, scale: float) -> np.ndarray | None:
     """(2, 3) axis of motion p -+ scale r z of a revolute or prismatic joint, else None."""
-    if not isinstance(joint, RevoluteJoint | PrismaticJoint):
+    if joint.motion == FIXED:
         return None
     T = joint.pose_matrix
     return hinge_segment(T[:3, 3], T[:3, 2], 2.0 * scale * joint.r)
@@ -218,7 +179,7 @@ def joint_axis_segment(joint: Joint, scale: float) -> np.ndarray | None:
 def joint_frames(joint: Joint) -> dict[str, np.ndarray]:
     """The frames drawn for a joint: ``{'proximal', 'center', 'distal'}`` -> 4x4 (waypoints:
     only ``'center'``, the Pose)."""
-    if isinstance(joint, Waypoint):
+    if not joint.has_body:
         return {"center": np.array(joint.pose_matrix)}
     return {
         "proximal": joint.proximal_frame(),

@@ -494,13 +494,19 @@ def test_validate_does_not_place_joints(tmp_path, monkeypatch):
 
 def test_library_errors_become_design_errors_at_the_named_field(monkeypatch):
     """A joint constructor's own check (should it be stricter than the schema) names the field."""
-    import kinegami.design.reader as reader
+    from kinegami.chain.joints import JOINT_KINDS, RevoluteJoint
     from kinegami.errors import InvalidParameterError
 
-    def strict(*args, **kwargs):
-        raise InvalidParameterError("totalBendingAngle must lie in (0, 2pi), got 3.0")
+    def kind_raising(message):  # the registered kind, with a stricter constructor
+        class Strict(RevoluteJoint):
+            @classmethod
+            def from_design(cls, *args, **kwargs):
+                raise InvalidParameterError(message)
 
-    monkeypatch.setattr(reader, "RevoluteJoint", strict)
+        return Strict
+
+    monkeypatch.setitem(JOINT_KINDS, "RevoluteJoint",
+                        kind_raising("totalBendingAngle must lie in (0, 2pi), got 3.0"))
     with pytest.raises(DesignError) as info:
         chain_from_dict(BASE, file="a.json")
     assert info.value.field == "joints[2].totalBendingAngle"
@@ -508,10 +514,8 @@ def test_library_errors_become_design_errors_at_the_named_field(monkeypatch):
         "a.json: joints[2].totalBendingAngle: totalBendingAngle must lie in (0, 2pi), got 3.0"
     )
 
-    def other(*args, **kwargs):
-        raise InvalidParameterError("maxAnglePerElbow must lie in (0, pi], got 9")
-
-    monkeypatch.setattr(reader, "RevoluteJoint", other)
+    monkeypatch.setitem(JOINT_KINDS, "RevoluteJoint",
+                        kind_raising("maxAnglePerElbow must lie in (0, pi], got 9"))
     with pytest.raises(DesignError) as info:
         chain_from_dict(BASE)
     assert info.value.field == "maxAnglePerElbow"

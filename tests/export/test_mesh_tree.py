@@ -80,7 +80,7 @@ def test_hand_has_the_parts_of_every_node(hand):
 
 def test_each_link_starts_at_its_parent(hand):
     """A link's first ring is the n-gon of its parent's distal Dubins frame."""
-    from kinegami.chain.bodies import regular_polygon
+    from kinegami.geometry.shapes import regular_polygon
 
     parts = chain_parts(hand)
     for k in range(1, len(hand.Joints)):

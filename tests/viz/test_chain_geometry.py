@@ -58,8 +58,11 @@ def test_prismatic_prism_vertices_are_r_from_the_joint_axis(n, r, rx, ry, rz, st
     low, high = joint.stateRange()
     joint = joint.with_state(low + state_fraction * (high - low))
     T = joint.pose_matrix
-    prism = geo.prismatic_prism_vertices(joint)
-    assert prism.shape == (2, n, 3)
+    (piece,) = joint.body_pieces()
+    kind, *polygons = piece.drawn[0]
+    prism = np.stack(polygons)
+    assert kind == "prism" and prism.shape == (2, n, 3)
+    assert_allclose(piece.points, prism.reshape(-1, 3))
     assert_allclose(_distance_to_line(prism.reshape(-1, 3), T[:3, 3], T[:3, 2]), r, rtol=1e-9)
     # Bottom in the proximal plane, top L + state further along z.
     heights = (prism - joint.proximal_frame()[:3, 3]) @ T[:3, 2]
@@ -127,7 +130,7 @@ def test_convex_hull_of_flat_points_is_empty():
 # --- joint bodies ---
 def test_revolute_hull_points_polygons_and_hinge():
     joint = RevoluteJoint(4, 1.0, math.pi, SE3.Trans(1, 2, 3) * SE3.Ry(math.pi / 4))
-    first, second = geo.revolute_hull_points(joint)
+    first, second = joint.hull_points()
     T = joint.pose_matrix
     side = geo.polygon_side(1.0, 4)
     for pts, frame in ((first, joint.proximal_frame()), (second, joint.distal_frame())):
@@ -139,7 +142,7 @@ def test_revolute_hull_points_polygons_and_hinge():
 
 def test_revolute_distal_half_follows_the_state():
     joint = RevoluteJoint(6, 1.0, math.pi, SE3()).with_state(math.pi / 3)
-    _, second = geo.revolute_hull_points(joint)
+    _, second = joint.hull_points()
     distal = joint.distal_frame()
     assert_allclose(np.linalg.norm(second[:6] - distal[:3, 3], axis=1), 1.0)
     assert_allclose((second[:6] - distal[:3, 3]) @ distal[:3, 0], 0.0, atol=1e-12)
@@ -147,7 +150,7 @@ def test_revolute_distal_half_follows_the_state():
 
 def test_extended_revolute_body_has_tubes_and_hulls():
     joint = ExtendedRevoluteJoint(4, 1.0, math.pi, 2.0, SE3())
-    first, _ = geo.revolute_hull_points(joint)
+    first, _ = joint.hull_points()
     # The hull's polygon sits tubeLength inside the proximal frame.
     assert_allclose((first[:4] - joint.proximal_frame()[:3, 3]) @ (1, 0, 0), 2.0)
     faces = geo.joint_body_faces(joint)
@@ -158,7 +161,7 @@ def test_extended_revolute_body_has_tubes_and_hulls():
 @pytest.mark.parametrize("tip_class", [StartTip, EndTip])
 def test_tip_hull_points_open_and_closed_ends(tip_class):
     joint = tip_class(6, 1.0, SE3.Trans(0, 0, 5), 1.5)
-    pts = geo.tip_hull_points(joint)
+    pts = joint.hull_points()
     open_end, closed_end = joint.distal_frame(), joint.proximal_frame()
     if tip_class is EndTip:
         open_end, closed_end = closed_end, open_end
