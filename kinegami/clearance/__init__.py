@@ -19,19 +19,12 @@ Examples
 3
 >>> chain.clearance().ok
 True
+
+The names below load on first use (a module ``__getattr__``), so that importing one module of
+the folder (``kinegami.clearance.tree_bodies`` for a tree's checks) does not import the engine.
 """
 
-from kinegami.chain.bodies import CONTACT_TOLERANCE, TURN_TOLERANCE
-from kinegami.clearance.checks import chain_clearance, clearance_report, sweep, tree_clearance
-from kinegami.clearance.engine import (
-    ClearanceEngine,
-    TreeEngine,
-    TreeMotion,
-    engine_for,
-    keep_tree_engine,
-)
-from kinegami.clearance.reports import ClearanceReport, CollidingPair, Lengths, SweepReport
-from kinegami.validation import UNITS_IN_MM
+import importlib
 
 __all__ = [
     "CONTACT_TOLERANCE",
@@ -51,3 +44,37 @@ __all__ = [
     "engine_for",
     "keep_tree_engine",
 ]
+
+#: Names imported on first use: name -> module.
+_LAZY = {
+    "CONTACT_TOLERANCE": "kinegami.chain.bodies",
+    "TURN_TOLERANCE": "kinegami.chain.bodies",
+    "UNITS_IN_MM": "kinegami.validation",
+    "Lengths": "kinegami.clearance.reports",
+    "CollidingPair": "kinegami.clearance.reports",
+    "ClearanceReport": "kinegami.clearance.reports",
+    "SweepReport": "kinegami.clearance.reports",
+    "chain_clearance": "kinegami.clearance.checks",
+    "tree_clearance": "kinegami.clearance.checks",
+    "clearance_report": "kinegami.clearance.checks",
+    "sweep": "kinegami.clearance.checks",
+    "ClearanceEngine": "kinegami.clearance.engine",
+    "TreeEngine": "kinegami.clearance.engine",
+    "TreeMotion": "kinegami.clearance.engine",
+    "engine_for": "kinegami.clearance.engine",
+    "keep_tree_engine": "kinegami.clearance.engine",
+}
+
+
+def __getattr__(name: str):
+    try:
+        module_name = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module 'kinegami.clearance' has no attribute {name!r}") from None
+    value = getattr(importlib.import_module(module_name), name)
+    globals()[name] = value  # once imported, an ordinary attribute
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
