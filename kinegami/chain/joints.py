@@ -29,6 +29,7 @@ from kinegami._record import Record
 from kinegami.errors import IncompatibleJointError, InvalidParameterError, InvalidTypeError
 from kinegami.geometry.balls import Ball
 from kinegami.geometry.frames import (
+    cross3,
     dubins_frame,
     is_rigid_transform,
     rot_x,
@@ -439,7 +440,7 @@ class Joint(ReadOnlyAttributes):
         x = unit(x - (x @ z) * z)
         T = np.array(self._T)
         T[:3, 0] = x
-        T[:3, 1] = np.cross(z, x)
+        T[:3, 1] = cross3(z, x)
         return self.with_pose(T)
 
     def translated_along_z(self, distance: float) -> Joint:

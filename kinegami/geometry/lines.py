@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+
+from kinegami.geometry.frames import cross3
 
 
 def common_normal(p_from, z_from, p_to, z_to, tol: float) -> np.ndarray | None:
@@ -15,13 +19,13 @@ def common_normal(p_from, z_from, p_to, z_to, tol: float) -> np.ndarray | None:
     """
     v = np.asarray(p_to, dtype=float) - np.asarray(p_from, dtype=float)
     z1 = np.asarray(z_from, dtype=float)
-    c = np.cross(z1, np.asarray(z_to, dtype=float))
-    nc = float(np.linalg.norm(c))
+    c = cross3(z1, np.asarray(z_to, dtype=float))
+    nc = math.sqrt(float(c.dot(c)))
     if nc > 1e-9:
         n = c / nc
     else:
-        q = np.cross(z1, np.cross(v, z1))
-        nq = float(np.linalg.norm(q))
+        q = cross3(z1, cross3(v, z1))
+        nq = math.sqrt(float(q.dot(q)))
         if nq <= tol:
             return None
         n = q / nq
