@@ -843,8 +843,12 @@ def register_joint_kind(cls: type[Joint]) -> type[Joint]:
     return cls
 
 
-for _kind in (StartTip, EndTip, RevoluteJoint, ExtendedRevoluteJoint, PrismaticJoint, Waypoint):
-    register_joint_kind(_kind)
+register_joint_kind(StartTip)
+register_joint_kind(EndTip)
+register_joint_kind(RevoluteJoint)
+register_joint_kind(ExtendedRevoluteJoint)
+register_joint_kind(PrismaticJoint)
+register_joint_kind(Waypoint)
 
 
 @functools.lru_cache(maxsize=256)
