@@ -23,6 +23,7 @@ True
 
 from __future__ import annotations
 
+import bisect
 import math
 import operator
 import weakref
@@ -81,8 +82,14 @@ _GROUP_PAIRS_LISTED = 300_000
 #: Pair-configuration entries (group pairs, then capsule pairs) one batch holds at most.
 _BATCH_ENTRIES = 2_000_000
 
-#: Pairs a one-configuration report measures in plain floats before it turns to numpy.
-_ONE_BY_ONE = 6
+#: The coordinates after (y, z, x) and after those (z, x, y): a cross product's terms.
+_NEXT = np.array([1, 2, 0])
+_AFTER = np.array([2, 0, 1])
+
+#: Pairs a one-configuration report must measure (their bounds put them closer than the
+#: limit) above which it measures them at once with numpy rather than one by one in plain
+#: floats (a plain-float pair costs about 6 us, numpy's kernel about 60 us whatever the few).
+_ONE_BY_ONE = 16
 
 
 class _Layout:
@@ -147,22 +154,39 @@ class _OneConfiguration:
         S = e._S
         entry = np.repeat(np.arange(e._gp1.size), e._cp_count)
         i, j = e._cp_i, e._cp_j
-        self.pairs = int(i.size)
-        self.pi, self.pj = i.tolist(), j.tolist()
-        xyz = np.arange(3)[:, None]
-        self.centre_i, self.centre_j = 3 * i[None, :] + xyz, 3 * j[None, :] + xyz
-        self.ends = np.stack([3 * i + xyz, 3 * (S + i) + xyz, 3 * j + xyz, 3 * (S + j) + xyz])
-        self.twice_half = 2.0 * (e._half[i] + e._half[j])
-        self.rank = e._rank(i, j).tolist()
         # a pair on one path whose turning apart at the current states is below pi (with room
-        # for rounding) is tested at some configurations only; the others always: the hinge
-        # turning up to the farther part is never less than up to the nearer
+        # for rounding) is tested at some configurations only ("maybe"); the others always:
+        # the hinge turning up to the farther part is never less than up to the nearer. The
+        # pairs tested always come first (the ``sure`` first), then the maybe ones.
         same = e._gp_same[entry]
         turn = e._turning[j] - e._turning[i]
-        maybe = np.flatnonzero(same & (np.abs(turn) < math.pi - TURN_TOLERANCE + 1e-9))
-        self.maybe = maybe
-        self.maybe_turn = turn[maybe]
-        self.maybe_bi, self.maybe_bj = e.body_a[i[maybe]], e.body_a[j[maybe]]
+        maybe = same & (np.abs(turn) < math.pi - TURN_TOLERANCE + 1e-9)
+        order = np.r_[np.flatnonzero(~maybe), np.flatnonzero(maybe)]
+        i, j, turn = i[order], j[order], turn[order]
+        self.sure = int(order.size - np.count_nonzero(maybe))
+        self.pairs = int(i.size)
+        self.pi, self.pj = i.tolist(), j.tolist()
+        # flat indices: of the capsule centres' coordinates in (3, S) and of the end points'
+        # coordinates in (3, 2S) (rows x, y, z), and per pair its four end points
+        xyz = np.arange(3)[:, None]
+        self.centre_i, self.centre_j = S * xyz + i[None, :], S * xyz + j[None, :]
+        self.pair_ij = np.stack([i, j])
+        quad = np.stack([i, S + i, j, S + j])
+        self.ends = 2 * S * xyz[None] + quad[:, None, :]
+        self.quad = quad.T.copy()
+        self.twice_half = 2.0 * (e._half[i] + e._half[j])
+        self.rank = e._rank(i, j).tolist()
+        tail = slice(self.sure, None)
+        self.maybe_turn = turn[tail]
+        self.maybe_bi, self.maybe_bj = e.body_a[i[tail]], e.body_a[j[tail]]
+        self.maybe_lists = (self.maybe_turn.tolist(), self.maybe_bi.tolist(),
+                            self.maybe_bj.tolist())  # fmt: skip
+        # the turning the revolute hinges add up to every body (ClearanceEngine._kinks)
+        self.kink_joints = [int(m) if rev else -1 for m, rev in
+                            zip(e.movable.tolist(), e._revolute_b.tolist(), strict=True)]
+        self.kink_parents = None if e._chain_bodies else e._body_parent.tolist()
+        # the states' bounds (ClearanceEngine.check_states' test)
+        self.state_bounds = ((e.ranges[:, 0] - 1e-12).tolist(), (e.ranges[:, 1] + 1e-12).tolist())
         order = np.lexsort((e._static_rank, e._static_clearance))
         si, sj = e._static_pairs
         self.static_count = int(order.size)
@@ -177,7 +201,8 @@ class _OneConfiguration:
                              else (c, ranks[n], 1, -n - 1, s[n], t[n])
                              for n, c in enumerate(clear)]  # fmt: skip
         points = np.concatenate([e._starts, e._ends])
-        self.points = np.concatenate([points, np.ones((2 * S, 1))], axis=1)
+        # (1, 4, 2S): every end point, homogeneous, coordinate by coordinate
+        self.points = np.concatenate([points, np.ones((2 * S, 1))], axis=1).T[None].copy()
         self.rows = np.concatenate([e.body_a, e.body_b])
         self.slack = 1e-9 * (e._extent() + e.r)
         self.none = np.zeros(0, dtype=np.int64)
@@ -185,6 +210,22 @@ class _OneConfiguration:
     def static_key(self, n: int) -> tuple:
         """The report's sort key of the n-th static pair (in their order)."""
         return self._static_keys[n]
+
+    def kinks(self, values) -> list:
+        """:meth:`ClearanceEngine._kinks` at one configuration (``values``: its states), in
+        plain floats: the same sums in the same order, so the same bits."""
+        add = [abs(values[m]) if m >= 0 else 0.0 for m in self.kink_joints]
+        out = [0.0]
+        if self.kink_parents is None:  # a chain's bodies: a running sum (numpy.cumsum's)
+            total = 0.0
+            for a in add:  # 0.0 + a is a: every a is >= 0
+                total += a
+                out.append(total)
+            return out
+        parent = self.kink_parents
+        for b in range(1, len(parent)):
+            out.append(out[parent[b]] + add[b - 1])
+        return out
 
 
 class ClearanceEngine:
@@ -919,13 +960,16 @@ class ClearanceEngine:
     def report(self, states, margin: float = 0.0) -> ClearanceReport:
         """The :class:`ClearanceReport` at one configuration (absolute states, checked), with
         ``margin`` (chain units, >= 0) the clearance required."""
+        limit = clear_limit(self.r, margin)
+        if self._listed:
+            q = self._plain_states(states)
+            q = self.check_states(states) if q is None else q
+            Q = self._configurations(q[None, :])
+            return self._report_one(Q, tuple(Q[0].tolist()), limit, margin)
         q = self.check_states(states)
         Q = self._configurations(q[None, :])
         values = tuple(float(x) for x in Q[0]) if self._caps is not None \
             else tuple(float(x) for x in q)  # fmt: skip
-        limit = clear_limit(self.r, margin)
-        if self._listed:
-            return self._report_one(Q, values, limit, margin)
         threshold = (4.0 if self._listed else 0.5) * self.r + margin
         static = self._static_clearance
         static_min = float(static.min()) if static.size else math.inf
@@ -971,55 +1015,140 @@ class ClearanceEngine:
             self._one = _OneConfiguration(self)
         return self._one
 
+    def _measured(self, one: _OneConfiguration, W: np.ndarray, twice: np.ndarray,
+                  near: np.ndarray, low: np.ndarray, values: tuple, limit: float,
+                  static_min: float) -> list:  # fmt: skip
+        """The exact clearances ``(clearance, pair, s, t)`` of :meth:`_report_one`: of the
+        candidate pairs ``near`` (indices; ``low``: twice their lower bounds plus 4r; ``W``
+        the end points and ``twice`` twice the centres, (3, 2S) and (3, S)), in the order of
+        their bounds, those the turning rule tests, up to the first bound beyond the limit and
+        the smallest clearance found (and ``static_min``)."""
+        r2, slack, sure = 2.0 * self.r, one.slack, one.sure
+        # closer lower bounds of the candidates' distances (twice): (1) the gap between the
+        # two segments' shadows on the line through their centres (the centres' distance less
+        # both segments projected on it); (2) the distance between the two segments' lines,
+        # where they are far from parallel (the common normal is then accurate to 1e-10 of
+        # its length, a far smaller error than the slack)
+        S = self._S
+        k = near.size
+        X = np.concatenate([twice, W[:, S:] - W[:, :S]]).take(
+            one.pair_ij.take(near, axis=1).reshape(-1), axis=1).reshape(6, 2, k)
+        d = X[:3, 0] - X[:3, 1]
+        gap = d * d
+        gap = np.sqrt((gap[0] + gap[1]) + gap[2])
+        e = X[3:]  # (3, 2, k): both segments
+        along = e * d[:, None]
+        along = np.abs((along[0] + along[1]) + along[2])
+        shadow = gap - (along[0] + along[1]) / gap
+        turned = e.take(_NEXT, axis=0)
+        normal = turned[:, 0] * e.take(_AFTER, axis=0)[:, 1] - e.take(_AFTER, axis=0)[:, 0] \
+            * turned[:, 1]  # fmt: skip  # e_i x e_j
+        size = e * e
+        size = (size[0] + size[1]) + size[2]
+        n2 = normal * normal
+        n2 = (n2[0] + n2[1]) + n2[2]
+        across = normal * d
+        across = np.abs((across[0] + across[1]) + across[2])
+        line = np.where(n2 > 1e-12 * size[0] * size[1], across / np.sqrt(n2), -math.inf)
+        low = np.fmax(np.fmax(shadow, line), low)
+        order = low.argsort(kind="stable")
+        pairs = near.take(order)
+        lows = low.take(order).tolist()
+        must = bisect.bisect_right(lows, 2.0 * (limit + slack + r2))
+        kinks = None  # the turning up to every body, when a maybe pair needs it
+        turn_max = math.pi - TURN_TOLERANCE
+        turn, bi, bj = one.maybe_lists
+        listed = pairs.tolist()
+        # the pairs closer than the limit by their bounds that the turning rule tests
+        first = listed[:must]
+        if max(first, default=-1) >= sure:
+            kinks = one.kinks(values)
+            first = [n for n in first if n < sure or not abs(
+                (turn[n - sure] + kinks[bj[n - sure]]) - kinks[bi[n - sure]]) < turn_max]
+        found: list[tuple] = []
+        quad, ends = one.quad, W.T
+        if len(first) > _ONE_BY_ONE:  # many: at once
+            batch = np.array(first, dtype=np.int64)
+            dist, s, t = segment_distances_stacked(*W.take(one.ends[:, :, batch]))
+            clearance = (dist - r2).tolist()
+            found = list(zip(clearance, first, s.tolist(), t.tolist(), strict=True))
+        else:
+            for n in first:
+                a1, b1, a2, b2 = ends.take(quad[n], axis=0).tolist()
+                dist, s, t = segment_distance(a1, b1, a2, b2)
+                found.append((dist - r2, n, s, t))
+        best = min([entry[0] for entry in found], default=math.inf)
+        # then the others, up to the first bound beyond the limit and the closest found
+        for n, lw in zip(listed[must:], lows[must:], strict=True):
+            if lw > 2.0 * (max(limit, min(best, static_min)) + slack + r2):
+                break
+            if n >= sure:
+                if kinks is None:
+                    kinks = one.kinks(values)
+                m = n - sure
+                if abs((turn[m] + kinks[bj[m]]) - kinks[bi[m]]) < turn_max:
+                    continue  # the turning rule does not test it here
+            a1, b1, a2, b2 = ends.take(quad[n], axis=0).tolist()
+            dist, s, t = segment_distance(a1, b1, a2, b2)
+            found.append((dist - r2, n, s, t))
+            if dist - r2 < best:
+                best = dist - r2
+        return found
+
+    def _plain_states(self, states) -> np.ndarray | None:
+        """``states`` as :meth:`check_states` gives them when they are a list or tuple of
+        plain finite numbers, one per joint, each within its range (the common case, checked
+        in plain floats); else None (:meth:`check_states` then checks them and words the
+        error)."""
+        low, high = self._one_arrays().state_bounds
+        if type(states) not in (list, tuple) or len(states) != len(low) \
+                or not all(type(v) in _PLAIN_STATES for v in states):  # fmt: skip
+            return None
+        try:
+            values = [float(v) for v in states]
+        except OverflowError:  # an int beyond the float range
+            return None
+        if all(map(operator.le, low, values)) and all(map(operator.le, values, high)) \
+                and all(map(math.isfinite, values)):  # fmt: skip
+            return np.array(values, dtype=float)
+        return None
+
     def _report_one(self, Q: np.ndarray, values: tuple, limit: float,
                     margin: float) -> ClearanceReport:  # fmt: skip
         """:meth:`report` at one configuration ``Q`` (1, J) of a listed engine, in the fewest
         numpy calls: every listed capsule pair's clearance is bounded below by its capsule
-        centres' distance minus both half lengths and above by that distance; the pairs whose
-        lower bound is within the larger of the limit and the smallest upper bound (and of the
-        static pairs' smallest clearance) are measured exactly, the same arithmetic as the
-        batch (bit for bit), a few of them in plain floats
-        (:func:`~kinegami.geometry.segments.segment_distance`)."""
+        centres' distance minus both half lengths and above by that distance. The pairs are
+        measured exactly in the order of their lower bounds until the next bound exceeds both
+        the limit and the smallest clearance found (and the static pairs' smallest), so every
+        pair closer than the limit and the closest pair are measured; with the same
+        arithmetic as the batch (bit for bit), one by one in plain floats
+        (:func:`~kinegami.geometry.segments.segment_distance`), or at once when many pairs
+        are closer than the limit. The turning rule is applied to the pairs measured only."""
         one = self._one_arrays()
         r2 = 2.0 * self.r
-        # every end point moved (the arithmetic of _Layout.move), point-major (2S, 3)
-        B = self.body_transforms(Q)[0, :, :3, :].reshape(-1, 12)
-        P = one.points
-        M = B.take(one.rows, axis=0).reshape(-1, 3, 4) * P[:, None, :]
-        W = ((M[..., 0] + M[..., 1]) + M[..., 2]) + M[..., 3]
-        flat = W.reshape(-1)
+        # every end point moved (the arithmetic of _Layout.move), coordinate-major (3, 2S)
+        B = self.screws.body_motions_one(Q[0])
+        NB = B.shape[0]
+        M = B.reshape(NB, 16)[:, :12].T.take(one.rows, axis=1).reshape(3, 4, -1)
+        M *= one.points
+        W = ((M[:, 0] + M[:, 1]) + M[:, 2]) + M[:, 3]
         S = self._S
         static_min = one.static_first[0]
-        bound = limit
-        near = one.none
+        found: list[tuple] = []
         if one.pairs:
-            twice = (W[:S] + W[S:]).reshape(-1)  # twice the capsule centres
+            twice = W[:, :S] + W[:, S:]  # twice the capsule centres
             d = twice.take(one.centre_i) - twice.take(one.centre_j)
             d *= d
             twice_gap = np.sqrt((d[0] + d[1]) + d[2])  # twice the centres' distance
-            if one.maybe.size:  # the pairs the turning rule tests at some configurations only
-                kink = self._kinks(Q)[0]
-                turn = one.maybe_turn + kink.take(one.maybe_bj) - kink.take(one.maybe_bi)
-                untested = one.maybe[np.abs(turn) < math.pi - TURN_TOLERANCE]
-                twice_gap[untested] = math.inf
             low = twice_gap - one.twice_half  # twice (the lower bound + 2r)
-            top = 0.5 * float(twice_gap.min()) - r2
+            # an upper bound of the closest tested pair's clearance: the pairs tested always
+            top = 0.5 * float(twice_gap[: one.sure].min()) - r2 if one.sure else math.inf
             bound = max(limit, min(top, static_min))
-            if math.isfinite(bound):
-                near = np.flatnonzero(low <= 2.0 * (bound + one.slack + r2))
-        # measured exactly: a few in plain floats, more at once
-        found: list[tuple] = []
-        if 0 < near.size <= _ONE_BY_ONE:
-            pi, pj = one.pi, one.pj
-            for n in near.tolist():
-                i, j = pi[n], pj[n]
-                a1, b1, a2, b2 = W[[i, S + i, j, S + j]].tolist()
-                dist, s, t = segment_distance(a1, b1, a2, b2)
-                found.append((dist - r2, n, s, t))
-        elif near.size:
-            dist, s, t = segment_distances_stacked(*flat.take(one.ends[:, :, near]))
-            found = list(zip((dist - r2).tolist(), near.tolist(), s.tolist(), t.tolist(),
-                             strict=True))  # fmt: skip
+            near = np.flatnonzero(low <= 2.0 * (bound + one.slack + r2)) \
+                if math.isfinite(bound) else np.arange(one.pairs)  # fmt: skip
+            if near.size:
+                found = self._measured(one, W, twice, near, low.take(near), values, limit,
+                                       static_min)  # fmt: skip
         # in the report's order: clearance, then (chains) moving pairs before static ones,
         # then the tie order of :meth:`_rank`
         rank = one.rank
@@ -1038,7 +1167,7 @@ class ClearanceEngine:
         def make(entry: tuple) -> CollidingPair:
             c, _, _, n, s, t = entry
             i, j = (one.pi[n], one.pj[n]) if n >= 0 else statics[1][-n - 1]
-            a1, b1, a2, b2 = W[[i, S + i, j, S + j]].tolist()
+            a1, b1, a2, b2 = W.T[[i, S + i, j, S + j]].tolist()
             return self._pair(0, 1, s, t, (a1, a2), (b1, b2), c, i, j)
 
         closest = make(ordered[0])

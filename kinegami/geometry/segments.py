@@ -183,6 +183,81 @@ def segment_distance(a1, b1, a2, b2) -> tuple[float, float, float]:
     F = (vx * wx + vz * wz) + vy * wy
     ok1 = A > _DEGENERATE
     ok2 = E > _DEGENERATE
+    # every parameter clamped to [0, 1] as _unit does it, inline
+    if ok1 and ok2:
+        denom = A * E - B * B
+        if denom > 1e-14 * A * E:
+            s = (B * F - C * E) / denom
+            s = (s if s <= 1.0 else 1.0) if s >= 0.0 else 0.0
+        else:
+            s = 0.0
+        t = (B * s + F) / E
+        t = (t if t <= 1.0 else 1.0) if t >= 0.0 else 0.0
+        s = (B * t - C) / A
+        s = (s if s <= 1.0 else 1.0) if s >= 0.0 else 0.0
+        t = (B * s + F) / E
+        t = (t if t <= 1.0 else 1.0) if t >= 0.0 else 0.0
+        u0 = ((wx * vx + wz * vz) + wy * vy) / E
+        u0 = (u0 if u0 <= 1.0 else 1.0) if u0 >= 0.0 else 0.0
+        px, py, pz = bx - cx, by - cy, bz - cz  # b1 - a2
+        u1 = ((px * vx + pz * vz) + py * vy) / E
+        u1 = (u1 if u1 <= 1.0 else 1.0) if u1 >= 0.0 else 0.0
+        px, py, pz = cx - ax, cy - ay, cz - az  # a2 - a1
+        u2 = ((px * ux + pz * uz) + py * uy) / A
+        u2 = (u2 if u2 <= 1.0 else 1.0) if u2 >= 0.0 else 0.0
+        px, py, pz = ex - ax, ey - ay, ez - az  # b2 - a1
+        u3 = ((px * ux + pz * uz) + py * uy) / A
+        u3 = (u3 if u3 <= 1.0 else 1.0) if u3 >= 0.0 else 0.0
+    else:  # a segment is a point
+        return _segment_distance_guarded(a1, b1, a2, b2)
+    sqrt = math.sqrt
+    gx = (ax + s * ux) - (cx + t * vx)
+    gy = (ay + s * uy) - (cy + t * vy)
+    gz = (az + s * uz) - (cz + t * vz)
+    best, p, q = sqrt((gx * gx + gy * gy) + gz * gz), s, t
+    gx = (ax + 0.0 * ux) - (cx + u0 * vx)
+    gy = (ay + 0.0 * uy) - (cy + u0 * vy)
+    gz = (az + 0.0 * uz) - (cz + u0 * vz)
+    d = sqrt((gx * gx + gy * gy) + gz * gz)
+    if d < best:
+        best, p, q = d, 0.0, u0
+    gx = (ax + 1.0 * ux) - (cx + u1 * vx)
+    gy = (ay + 1.0 * uy) - (cy + u1 * vy)
+    gz = (az + 1.0 * uz) - (cz + u1 * vz)
+    d = sqrt((gx * gx + gy * gy) + gz * gz)
+    if d < best:
+        best, p, q = d, 1.0, u1
+    gx = (ax + u2 * ux) - (cx + 0.0 * vx)
+    gy = (ay + u2 * uy) - (cy + 0.0 * vy)
+    gz = (az + u2 * uz) - (cz + 0.0 * vz)
+    d = sqrt((gx * gx + gy * gy) + gz * gz)
+    if d < best:
+        best, p, q = d, u2, 0.0
+    gx = (ax + u3 * ux) - (cx + 1.0 * vx)
+    gy = (ay + u3 * uy) - (cy + 1.0 * vy)
+    gz = (az + u3 * uz) - (cz + 1.0 * vz)
+    d = sqrt((gx * gx + gy * gy) + gz * gz)
+    if d < best:
+        best, p, q = d, u3, 1.0
+    return best, p, q
+
+
+def _segment_distance_guarded(a1, b1, a2, b2) -> tuple[float, float, float]:
+    """:func:`segment_distance` with the guards of a segment that is a point."""
+    ax, ay, az = a1
+    bx, by, bz = b1
+    cx, cy, cz = a2
+    ex, ey, ez = b2
+    ux, uy, uz = bx - ax, by - ay, bz - az  # b1 - a1
+    vx, vy, vz = ex - cx, ey - cy, ez - cz  # b2 - a2
+    wx, wy, wz = ax - cx, ay - cy, az - cz  # a1 - a2
+    A = (ux * ux + uz * uz) + uy * uy
+    E = (vx * vx + vz * vz) + vy * vy
+    B = (ux * vx + uz * vz) + uy * vy
+    C = (ux * wx + uz * wz) + uy * wy
+    F = (vx * wx + vz * wz) + vy * wy
+    ok1 = A > _DEGENERATE
+    ok2 = E > _DEGENERATE
     A_safe = A if ok1 else 1.0
     E_safe = E if ok2 else 1.0
     denom = A * E - B * B
