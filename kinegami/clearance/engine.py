@@ -82,10 +82,6 @@ _GROUP_PAIRS_LISTED = 300_000
 #: Pair-configuration entries (group pairs, then capsule pairs) one batch holds at most.
 _BATCH_ENTRIES = 2_000_000
 
-#: The coordinates after (y, z, x) and after those (z, x, y): a cross product's terms.
-_NEXT = np.array([1, 2, 0])
-_AFTER = np.array([2, 0, 1])
-
 #: Pairs a one-configuration report must measure (their bounds put them closer than the
 #: limit) above which it measures them at once with numpy rather than one by one in plain
 #: floats (a plain-float pair costs about 6 us, numpy's kernel about 60 us whatever the few).
@@ -166,14 +162,13 @@ class _OneConfiguration:
         self.sure = int(order.size - np.count_nonzero(maybe))
         self.pairs = int(i.size)
         self.pi, self.pj = i.tolist(), j.tolist()
-        # flat indices: of the capsule centres' coordinates in (3, S) and of the end points'
-        # coordinates in (3, 2S) (rows x, y, z), and per pair its four end points
+        # flat indices of the capsule centres' coordinates in (3, S) (rows x, y, z), (3,
+        # pairs); the pairs' capsules, (2, pairs); flat indices of every pair's four end
+        # points' coordinates in (3, 2S), (4, 3, pairs)
         xyz = np.arange(3)[:, None]
         self.centre_i, self.centre_j = S * xyz + i[None, :], S * xyz + j[None, :]
         self.pair_ij = np.stack([i, j])
-        quad = np.stack([i, S + i, j, S + j])
-        self.ends = 2 * S * xyz[None] + quad[:, None, :]
-        self.quad = quad.T.copy()
+        self.ends = 2 * S * xyz[None] + np.stack([i, S + i, j, S + j])[:, None, :]
         self.twice_half = 2.0 * (e._half[i] + e._half[j])
         self.rank = e._rank(i, j).tolist()
         tail = slice(self.sure, None)
@@ -1015,20 +1010,19 @@ class ClearanceEngine:
             self._one = _OneConfiguration(self)
         return self._one
 
-    def _measured(self, one: _OneConfiguration, W: np.ndarray, twice: np.ndarray,
-                  near: np.ndarray, low: np.ndarray, values: tuple, limit: float,
-                  static_min: float) -> list:  # fmt: skip
+    def _measured(self, one: _OneConfiguration, W: np.ndarray, points: list,
+                  twice: np.ndarray, near: np.ndarray, low: np.ndarray, values: tuple,
+                  limit: float, static_min: float) -> list:  # fmt: skip
         """The exact clearances ``(clearance, pair, s, t)`` of :meth:`_report_one`: of the
         candidate pairs ``near`` (indices; ``low``: twice their lower bounds plus 4r; ``W``
-        the end points and ``twice`` twice the centres, (3, 2S) and (3, S)), in the order of
-        their bounds, those the turning rule tests, up to the first bound beyond the limit and
-        the smallest clearance found (and ``static_min``)."""
-        r2, slack, sure = 2.0 * self.r, one.slack, one.sure
-        # closer lower bounds of the candidates' distances (twice): (1) the gap between the
-        # two segments' shadows on the line through their centres (the centres' distance less
-        # both segments projected on it); (2) the distance between the two segments' lines,
-        # where they are far from parallel (the common normal is then accurate to 1e-10 of
-        # its length, a far smaller error than the slack)
+        the end points (3, 2S), also as a list of 2S points, and ``twice`` twice the
+        centres (3, S)), in the order of their bounds, those the turning rule tests, up to the
+        first bound beyond the limit and the smallest clearance found (and ``static_min``)."""
+        r2, slack, sure, pi, pj = 2.0 * self.r, one.slack, one.sure, one.pi, one.pj
+        # a closer lower bound of the candidates' distances (twice): the gap between the two
+        # segments' shadows on the line through their centres (the centres' distance less
+        # both segments projected on it; about 0 where the centres coincide: the projections
+        # are then divided by 1e-300, no more than the lengths)
         S = self._S
         k = near.size
         X = np.concatenate([twice, W[:, S:] - W[:, :S]]).take(
@@ -1039,18 +1033,8 @@ class ClearanceEngine:
         e = X[3:]  # (3, 2, k): both segments
         along = e * d[:, None]
         along = np.abs((along[0] + along[1]) + along[2])
-        shadow = gap - (along[0] + along[1]) / gap
-        turned = e.take(_NEXT, axis=0)
-        normal = turned[:, 0] * e.take(_AFTER, axis=0)[:, 1] - e.take(_AFTER, axis=0)[:, 0] \
-            * turned[:, 1]  # fmt: skip  # e_i x e_j
-        size = e * e
-        size = (size[0] + size[1]) + size[2]
-        n2 = normal * normal
-        n2 = (n2[0] + n2[1]) + n2[2]
-        across = normal * d
-        across = np.abs((across[0] + across[1]) + across[2])
-        line = np.where(n2 > 1e-12 * size[0] * size[1], across / np.sqrt(n2), -math.inf)
-        low = np.fmax(np.fmax(shadow, line), low)
+        shadow = gap - (along[0] + along[1]) / np.maximum(gap, 1e-300)
+        low = np.fmax(shadow, low)
         order = low.argsort(kind="stable")
         pairs = near.take(order)
         lows = low.take(order).tolist()
@@ -1066,7 +1050,6 @@ class ClearanceEngine:
             first = [n for n in first if n < sure or not abs(
                 (turn[n - sure] + kinks[bj[n - sure]]) - kinks[bi[n - sure]]) < turn_max]
         found: list[tuple] = []
-        quad, ends = one.quad, W.T
         if len(first) > _ONE_BY_ONE:  # many: at once
             batch = np.array(first, dtype=np.int64)
             dist, s, t = segment_distances_stacked(*W.take(one.ends[:, :, batch]))
@@ -1074,8 +1057,8 @@ class ClearanceEngine:
             found = list(zip(clearance, first, s.tolist(), t.tolist(), strict=True))
         else:
             for n in first:
-                a1, b1, a2, b2 = ends.take(quad[n], axis=0).tolist()
-                dist, s, t = segment_distance(a1, b1, a2, b2)
+                i, j = pi[n], pj[n]
+                dist, s, t = segment_distance(points[i], points[S + i], points[j], points[S + j])
                 found.append((dist - r2, n, s, t))
         best = min([entry[0] for entry in found], default=math.inf)
         # then the others, up to the first bound beyond the limit and the closest found
@@ -1088,8 +1071,8 @@ class ClearanceEngine:
                 m = n - sure
                 if abs((turn[m] + kinks[bj[m]]) - kinks[bi[m]]) < turn_max:
                     continue  # the turning rule does not test it here
-            a1, b1, a2, b2 = ends.take(quad[n], axis=0).tolist()
-            dist, s, t = segment_distance(a1, b1, a2, b2)
+            i, j = pi[n], pj[n]
+            dist, s, t = segment_distance(points[i], points[S + i], points[j], points[S + j])
             found.append((dist - r2, n, s, t))
             if dist - r2 < best:
                 best = dist - r2
@@ -1132,6 +1115,7 @@ class ClearanceEngine:
         M = B.reshape(NB, 16)[:, :12].T.take(one.rows, axis=1).reshape(3, 4, -1)
         M *= one.points
         W = ((M[:, 0] + M[:, 1]) + M[:, 2]) + M[:, 3]
+        points = W.T.tolist()
         S = self._S
         static_min = one.static_first[0]
         found: list[tuple] = []
@@ -1147,8 +1131,8 @@ class ClearanceEngine:
             near = np.flatnonzero(low <= 2.0 * (bound + one.slack + r2)) \
                 if math.isfinite(bound) else np.arange(one.pairs)  # fmt: skip
             if near.size:
-                found = self._measured(one, W, twice, near, low.take(near), values, limit,
-                                       static_min)  # fmt: skip
+                found = self._measured(one, W, points, twice, near, low.take(near), values,
+                                       limit, static_min)  # fmt: skip
         # in the report's order: clearance, then (chains) moving pairs before static ones,
         # then the tie order of :meth:`_rank`
         rank = one.rank
@@ -1167,8 +1151,8 @@ class ClearanceEngine:
         def make(entry: tuple) -> CollidingPair:
             c, _, _, n, s, t = entry
             i, j = (one.pi[n], one.pj[n]) if n >= 0 else statics[1][-n - 1]
-            a1, b1, a2, b2 = W.T[[i, S + i, j, S + j]].tolist()
-            return self._pair(0, 1, s, t, (a1, a2), (b1, b2), c, i, j)
+            return self._pair(0, 1, s, t, (points[i], points[j]), (points[S + i], points[S + j]),
+                              c, i, j)  # fmt: skip
 
         closest = make(ordered[0])
         min_clearance = ordered[0][0]
