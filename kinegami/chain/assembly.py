@@ -241,6 +241,11 @@ class JointAssembly:
             self._placement_check = (joints, links, (since, self._margin), found)
         return found
 
+    def _clear_of(self, joints, links, parents, since: int) -> bool:
+        """Whether the parts of joint ``since`` on are clear of everything (placement's test
+        of a candidate): ``_overlap(..., since) is None``."""
+        return self._overlap(joints, links, parents, since) is None
+
     def _own_overlap(self):
         """The deepest overlap of the chain as it is (an Overlap) or None, computed once per
         committed set of lists (they are replaced, never changed, by every operation)."""
@@ -513,7 +518,7 @@ class JointAssembly:
                 error = error or failure
                 continue
             # the rule's choice if it is clear of the chain, else the other side if that is
-            if self._overlap(extended[0], extended[1], extended[3], len(self._joints)) is None:
+            if self._clear_of(extended[0], extended[1], extended[3], len(self._joints)):
                 return extended
             first = first or extended
         if first is not None:
@@ -557,7 +562,7 @@ class JointAssembly:
 
         def clear(extended) -> bool:
             joints, links, _, parents = extended
-            return self._overlap(joints, links, parents, first_new) is None
+            return self._clear_of(joints, links, parents, first_new)
 
         fallbacks = []
         for reverse in (False, True) if self._published_placement_allowed(p) else ():

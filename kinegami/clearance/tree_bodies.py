@@ -8,6 +8,7 @@ within the junction that joins them.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import operator
 import threading
@@ -19,6 +20,7 @@ from kinegami.chain.bodies import (
     BALL_GROUP,
     CONTACT_TOLERANCE,
     TURN_TOLERANCE,
+    clear_limit,
     joint_capsule_arrays,
     link_capsule_arrays,
     link_polyline,
@@ -33,6 +35,7 @@ __all__ = [
     "JUNCTION_REACH",
     "junction_extent",
     "TreeCapsules",
+    "TreeGrowth",
     "tree_capsules",
     "tree_pair_distances",
     "tree_worst_overlap",
@@ -352,6 +355,8 @@ class TreeCapsules:
     along : numpy.ndarray, shape (S, 2)
         For the link rows of those tubes: how far along the tube (from the branching frame)
         each end of the row lies; nan elsewhere.
+    path_turning : numpy.ndarray, shape (n,)
+        Turning of the links from the root to the end of the link into each joint.
     """
 
     r: float
@@ -369,6 +374,7 @@ class TreeCapsules:
     top: np.ndarray
     extent: np.ndarray
     along: np.ndarray
+    path_turning: np.ndarray
 
     @property
     def count(self) -> int:
@@ -410,7 +416,10 @@ class TreeCapsules:
         for first_is_mine, (mine, other) in ((True, (i, j)), (False, (j, i))):
             e = self.extent[self.top[self.node[mine]]]
             d0, d1 = self.along[mine, 0], self.along[mine, 1]
-            beyond = np.maximum(d0, d1) > e
+            k = np.flatnonzero(np.maximum(d0, d1) > e)  # the rows that reach beyond it
+            if k.size == 0:
+                continue
+            mine, other, e, d0, d1 = mine[k], other[k], e[k], d0[k], d1[k]
             span = d1 - d0
             u = np.clip(np.where(span != 0.0, (e - d0) / np.where(span != 0.0, span, 1.0), 0.0),
                         0.0, 1.0)  # fmt: skip
@@ -419,7 +428,6 @@ class TreeCapsules:
             lo = np.where((d1 < d0)[:, None], p0, cut)
             hi = np.where((d1 < d0)[:, None], cut, p1)
             dd, ss, tt = segment_distances(lo, hi, a[other], b[other])
-            dd = np.where(beyond, dd, np.inf)
             # ss runs along [lo, hi]: the same point as a parameter along the whole row
             point = lo + ss[:, None] * (hi - lo)
             axis = p1 - p0
@@ -428,14 +436,14 @@ class TreeCapsules:
                 length2 > 0, length2, 1.0
             )
             along_row = np.clip(np.where(length2 > 0, along_row, 0.0), 0.0, 1.0)
-            better = dd < rest
-            rest = np.where(better, dd, rest)
+            better = dd < rest[k]
+            rest[k] = np.where(better, dd, rest[k])
             if first_is_mine:
-                rest_s = np.where(better, along_row, rest_s)
-                rest_t = np.where(better, tt, rest_t)
+                rest_s[k] = np.where(better, along_row, rest_s[k])
+                rest_t[k] = np.where(better, tt, rest_t[k])
             else:
-                rest_s = np.where(better, tt, rest_s)
-                rest_t = np.where(better, along_row, rest_t)
+                rest_s[k] = np.where(better, tt, rest_s[k])
+                rest_t[k] = np.where(better, along_row, rest_t[k])
         return rest, rest_s, rest_t
 
 
@@ -461,6 +469,26 @@ def _rigid_origins(links) -> tuple | None:
     return tuple(origins)
 
 
+def _tube(links, nodes, r: float) -> tuple:
+    """The tube made of ``links`` (those into ``nodes``, in order): its centreline polyline
+    and its capsules' segment starts and ends."""
+    arrays = [link_capsule_arrays(link, m, r, 0.2)[0] for link, m in zip(links, nodes,
+                                                                          strict=True)]
+    points = [link_polyline(link) for link in links]
+    polyline = np.concatenate([points[0]] + [pts[1:] for pts in points[1:]])
+    return (polyline, np.concatenate([x[0] for x in arrays]),
+            np.concatenate([x[1] for x in arrays]))  # fmt: skip
+
+
+def _tube_path(joints, children, k: int) -> list[int]:
+    """The joints whose links make the tube leaving towards child ``k`` of a branching joint:
+    k, continued through waypoints with one child."""
+    path = [k]
+    while not joints[path[-1]].has_body and len(children[path[-1]]) == 1:
+        path.append(children[path[-1]][0])
+    return path
+
+
 def _junction_extents(kids: list, paths: dict, links, r: float, margin: float) -> dict:
     """The junction extent (at most ``JUNCTION_REACH`` r) of every child in ``kids`` of one
     branching joint; ``paths[k]``: the joints whose links make the tube leaving towards k.
@@ -481,13 +509,7 @@ def _junction_extents(kids: list, paths: dict, links, r: float, margin: float) -
         source = dict(zip(nodes, origins, strict=True))
     else:
         source = {m: links[m] for m in nodes}
-    tubes = {}
-    for k in kids:
-        arrays = [link_capsule_arrays(source[m], m, r, 0.2)[0] for m in paths[k]]
-        points = [link_polyline(source[m]) for m in paths[k]]
-        polyline = np.concatenate([points[0]] + [pts[1:] for pts in points[1:]])
-        tubes[k] = (polyline, np.concatenate([x[0] for x in arrays]),
-                    np.concatenate([x[1] for x in arrays]))  # fmt: skip
+    tubes = {k: _tube([source[m] for m in paths[k]], paths[k], r) for k in kids}
     extents = {}
     for k in kids:
         others = [tubes[o] for o in kids if o != k]
@@ -566,9 +588,7 @@ def tree_capsules(joints, links, parents, r: float, margin: float = 0.0) -> Tree
             continue
         paths = {}
         for k in kids:
-            path = [k]
-            while not joints[path[-1]].has_body and len(children[path[-1]]) == 1:
-                path.append(children[path[-1]][0])
+            path = _tube_path(joints, children, k)
             top[path] = k
             paths[k] = path
             points = [link_polyline(links[m]) for m in path]
@@ -588,7 +608,8 @@ def tree_capsules(joints, links, parents, r: float, margin: float = 0.0) -> Tree
         if parents[x] >= 0:
             ancestor[x] |= ancestor[parents[x]]
     caps = TreeCapsules(r, a, b, start_joint, end_joint, own + before, element, node,
-                        tuple(rows), parents, ancestor, is_link, top, extent, along)  # fmt: skip
+                        tuple(rows), parents, ancestor, is_link, top, extent, along,
+                        path_links)  # fmt: skip
     for value in vars(caps).values():
         if isinstance(value, np.ndarray):
             value.setflags(write=False)
@@ -611,7 +632,27 @@ def tree_pair_distances(
     covers them until they are the margin apart); on a chain the tested pairs are the chain's.
     """
     reach = 2.0 * r + margin if reach is None else reach
-    caps = tree_capsules(joints, links, parents, r, margin)
+    return _tested_pairs(tree_capsules(joints, links, parents, r, margin), joints, since, reach)
+
+
+def _tested_pairs(caps: TreeCapsules, joints, since: int, reach: float) -> tuple | None:
+    """:func:`tree_pair_distances` of the tree whose capsules are ``caps``."""
+    found = _near_pairs(caps, joints, since, reach)
+    if found is None:
+        return None
+    i, j = found
+    a, b = caps.starts, caps.ends
+    dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
+    q = np.flatnonzero(caps.junction_pairs(i, j))
+    if q.size:
+        dist[q], s[q], t[q] = caps.beyond_junction(i[q], j[q])
+    return i, j, dist, s, t, caps.rows, a, b
+
+
+def _near_pairs(caps: TreeCapsules, joints, since: int, reach: float) -> tuple | None:
+    """The row pairs (i, j) that :func:`_tested_pairs` measures (None when there are none):
+    within ``reach`` by their balls, with a part of joint ``since`` or later when ``since`` >
+    0, and tested by the pair rule. Needs no junction extent."""
     S = caps.count
     if S < 2:
         return None
@@ -620,8 +661,10 @@ def tree_pair_distances(
     tau = caps.turning + np.where(caps.start_joint >= 0, kinks[caps.start_joint], 0.0)
     centre = 0.5 * (a + b)
     half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
-    wanted = node >= since if since > 0 else None  # a part's rows share their node
-    i, j = near_capsule_pairs(caps.element, tau, np.arange(S) + 1, centre, half, reach, wanted)
+    if since > 0:
+        i, j = _near_new_pairs(caps.element, node >= since, centre, half, reach)
+    else:
+        i, j = near_capsule_pairs(caps.element, tau, np.arange(S) + 1, centre, half, reach)
     if since > 0 and i.size:
         keep = (node[i] >= since) | (node[j] >= since)
         i, j = i[keep], j[keep]
@@ -636,11 +679,33 @@ def tree_pair_distances(
     i, j = i[tested], j[tested]
     if i.size == 0:
         return None
-    dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
-    q = np.flatnonzero(caps.junction_pairs(i, j))
-    if q.size:
-        dist[q], s[q], t[q] = caps.beyond_junction(i[q], j[q])
-    return i, j, dist, s, t, caps.rows, a, b
+    return i, j
+
+
+def _near_new_pairs(element, wanted, centre, half, reach: float) -> tuple:
+    """:func:`near_capsule_pairs` (i < j) with ``wanted`` (a bool per row, constant over each
+    part), the same pairs in the same order, measured among the parts that can be in one:
+    the wanted ones and those whose balls come within ``reach`` of a wanted one's (the test
+    near_capsule_pairs makes of every pair of parts). A new joint's parts are few, so the
+    test of all pairs of parts of a large tree is left out."""
+    S = element.size
+    starts = np.flatnonzero(np.r_[True, element[1:] != element[:-1]])
+    sizes = np.diff(np.r_[starts, S])
+    c = np.add.reduceat(centre, starts, axis=0) / sizes[:, None]
+    owner = np.repeat(np.arange(starts.size), sizes)
+    rho = np.maximum.reduceat(np.sqrt(((centre - c[owner]) ** 2).sum(axis=1)) + half, starts)
+    mine = np.flatnonzero(wanted[starts])
+    keep = np.zeros(starts.size, dtype=bool)
+    keep[mine] = True
+    # with a rounding allowance: keeping more parts changes nothing
+    allowance = reach + 1e-9 * (reach + float(np.abs(c).max(initial=0.0)) + float(rho.max()))
+    for e in mine:
+        d = c[e] - c
+        keep |= np.sqrt(np.einsum("ij,ij->i", d, d)) - rho[e] - rho < allowance
+    rows = np.flatnonzero(keep[owner])
+    i, j = near_capsule_pairs(element[rows], np.zeros(rows.size), np.arange(rows.size) + 1,
+                              centre[rows], half[rows], reach, wanted[rows])  # fmt: skip
+    return rows[i], rows[j]
 
 
 def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int = 0,
@@ -660,3 +725,252 @@ def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int 
         return None
     i, j, dist, s, t, rows, _, _ = found
     return overlap_of_deepest_pair(i, j, dist, s, t, rows, joints, names, r, margin)
+
+
+class TreeGrowth:
+    """The overlap test of a tree's extensions: the tree followed by new joints that hang, one
+    after the other, from one of its joints (what placement tries, candidate after candidate).
+
+    :meth:`overlap` answers what :func:`tree_worst_overlap` answers for the extension with
+    ``since`` = the tree's size (the pairs with a new part; the same Overlap), and
+    :meth:`clear` whether that is None, but both measure only what the new joints change: the
+    tree's own capsules, its junction tubes and their extents against each other are computed
+    once, and per extension only the new capsules, the junction the new tube joins (its extent
+    against its siblings' tubes and theirs against it: the extent against several tubes is the
+    largest against each) and the pairs with a new part (docs/trees.md). An extension of
+    another shape is measured by tree_worst_overlap.
+
+    Parameters
+    ----------
+    joints, links, parents : the tree (its lists are kept; an extension must begin with the
+        same joint and link objects).
+    r : tube radius.
+    margin : the clearance required (tree units, >= 0).
+    """
+
+    def __init__(self, joints, links, parents, r: float, margin: float = 0.0):
+        self.joints = tuple(joints)
+        self.links = tuple(links)
+        self.parents = tuple(int(p) for p in parents)
+        self.r = float(r)
+        self.margin = float(margin)
+        self._children: list[list[int]] = [[] for _ in self.parents]
+        for k, p in enumerate(self.parents):
+            if p >= 0:
+                self._children[p].append(k)
+        self._caps: TreeCapsules | None = None
+        self._junctions: dict[int, dict] = {}
+
+    def extends(self, joints, links, parents) -> bool:
+        """Whether the lists are this tree's (the same objects) followed by new joints."""
+        n0 = len(self.joints)
+        return (len(joints) == len(links) == len(parents) and len(joints) >= n0
+                and all(map(operator.is_, joints[:n0], self.joints))
+                and all(map(operator.is_, links[:n0], self.links))
+                and tuple(int(p) for p in parents[:n0]) == self.parents)  # fmt: skip
+
+    def overlap(self, joints, links, parents, names=None):
+        """The deepest pair with a new part closer than the margin (an Overlap), or None:
+        ``tree_worst_overlap(joints, links, parents, r, names, since=len(tree), margin)``."""
+        parents = [int(p) for p in parents]
+        p = self._grown_from(joints, links, parents)
+        if p < 0:
+            return tree_worst_overlap(joints, links, parents, self.r, names,
+                                      since=len(self.joints), margin=self.margin)  # fmt: skip
+        caps = self._extended(joints, links, parents, p)
+        found = _tested_pairs(self._with_junction(caps, joints, links, p), joints,
+                              len(self.joints), 2.0 * self.r + self.margin)  # fmt: skip
+        if found is None:
+            return None
+        i, j, dist, s, t, rows, _, _ = found
+        return overlap_of_deepest_pair(i, j, dist, s, t, rows, joints, names, self.r,
+                                       self.margin)  # fmt: skip
+
+    def clear(self, joints, links, parents) -> bool:
+        """Whether :meth:`overlap` is None, answered as soon as known: the pairs that no
+        junction covers are measured first, and the junction the new tube joins only when
+        none of them is too close."""
+        parents = [int(p) for p in parents]
+        p = self._grown_from(joints, links, parents)
+        if p < 0:
+            return self.overlap(joints, links, parents) is None
+        caps = self._extended(joints, links, parents, p)
+        found = _near_pairs(caps, joints, len(self.joints), 2.0 * self.r + self.margin)
+        if found is None:
+            return True
+        i, j = found
+        q = caps.junction_pairs(i, j)
+        limit = clear_limit(self.r, self.margin)
+        plain = np.flatnonzero(~q)
+        a, b = caps.starts, caps.ends
+        if plain.size:
+            k, m = i[plain], j[plain]
+            dist = segment_distances(a[k], b[k], a[m], b[m])[0]
+            if float(dist.min()) - 2.0 * self.r < limit:  # overlap_of_deepest_pair's test
+                return False
+        if q.any():
+            caps = self._with_junction(caps, joints, links, p)
+            dist = caps.beyond_junction(i[q], j[q])[0]
+            if float(dist.min()) - 2.0 * self.r < limit:
+                return False
+        return True
+
+    def _grown_from(self, joints, links, parents: list[int]) -> int:
+        """The joint the new joints hang from, or -1 when the extension is measured whole
+        (not one sub-chain from an old joint, a chain, or the lengthening of a junction's
+        tube)."""
+        n0, n = len(self.joints), len(joints)
+        if not self.extends(joints, links, parents):
+            raise ValueError("TreeGrowth: the lists do not extend the tree")
+        p = parents[n0] if n > n0 else -1
+        incremental = (
+            n > n0 and parents != list(range(-1, n - 1))  # a chain: worst_overlap's own way
+            and 0 <= p < n0 and all(parents[k] == k - 1 for k in range(n0 + 1, n))
+            # new links that are rigid copies would be measured as their originals
+            and not any("_moved_from" in links[k].__dict__ for k in range(n0, n))
+        )  # fmt: skip
+        if incremental and not self._children[p] and not joints[p].has_body:
+            # a leaf waypoint on a junction tube: the new joints would lengthen that tube
+            incremental = int(self._base().top[p]) < 0
+        return p if incremental else -1
+
+    def _base(self) -> TreeCapsules:
+        if self._caps is None:
+            self._caps = tree_capsules(self.joints, self.links, self.parents, self.r,
+                                       self.margin)  # fmt: skip
+        return self._caps
+
+    def _junction(self, p: int) -> dict:
+        """What the tubes leaving joint ``p`` (which has children) give every extension that
+        adds one more: each child's tube, rows, distances along it (``along``) and its extent
+        against the other children's tubes; the capsules of all of them."""
+        found = self._junctions.get(p)
+        if found is not None:
+            return found
+        caps, r = self._base(), self.r
+        kids = self._children[p]
+        paths = {k: _tube_path(self.joints, self._children, k) for k in kids}
+        tubes = {k: _tube([self.links[m] for m in paths[k]], paths[k], r) for k in kids}
+        rows, along = {}, {}
+        for k in kids:
+            rows[k] = np.flatnonzero(np.isin(caps.node, paths[k]) & caps.is_link)
+            if len(kids) > 1:  # a junction already: the tree's own distances along the tube
+                along[k] = caps.along[rows[k]]
+            elif rows[k].size:
+                d = _polyline_distance(np.concatenate([caps.starts[rows[k]],
+                                                       caps.ends[rows[k]]]), tubes[k][0])
+                along[k] = np.stack([d[: rows[k].size], d[rows[k].size :]], axis=1)
+            else:
+                along[k] = np.zeros((0, 2))
+        extent = {}
+        for k in kids:  # measured on these links, as the extension's junction is
+            others = [tubes[o] for o in kids if o != k]
+            extent[k] = 0.0
+            if others:
+                found_k = junction_extent(
+                    tubes[k][0], (tubes[k][1], tubes[k][2]),
+                    (np.concatenate([t[1] for t in others]),
+                     np.concatenate([t[2] for t in others])),
+                    r, self.margin, limit=JUNCTION_REACH * r)  # fmt: skip
+                extent[k] = min(found_k, JUNCTION_REACH * r)
+        found = {
+            "kids": kids, "paths": paths, "tubes": tubes, "rows": rows, "along": along,
+            "extent": extent,
+            "a": np.concatenate([tubes[k][1] for k in kids]),
+            "b": np.concatenate([tubes[k][2] for k in kids]),
+        }  # fmt: skip
+        self._junctions[p] = found
+        return found
+
+    def _new_tube_path(self, joints, p: int) -> list[int]:
+        """The new joints whose links make the tube leaving p towards the first of them."""
+        n0, n = len(self.joints), len(joints)
+        path = [n0]
+        while not joints[path[-1]].has_body and path[-1] + 1 < n:
+            path.append(path[-1] + 1)
+        return path
+
+    def _extended(self, joints, links, parents, p: int) -> TreeCapsules:
+        """The TreeCapsules of the extension as far as pairs with a new part use them, but
+        without the junction values (extent, along) of the junction at p (see
+        :meth:`_with_junction`); other junctions keep the tree's."""
+        caps, r = self._base(), self.r
+        n0, n = len(self.joints), len(joints)
+        path_turning = np.concatenate([caps.path_turning, np.zeros(n - n0)])
+        rows: list = []
+        pieces_a, pieces_b, owner_node, base_turn = [], [], [], []
+        for j in range(n0, n):
+            (A, B, _, turn), link_rows, total = link_capsule_arrays(links[j], j, r, 0.2)
+            path_turning[j] = total + path_turning[parents[j]]
+            for (A_, B_, _, turn_), part in (((A, B, None, turn), link_rows),
+                                             joint_capsule_arrays(joints[j], j, r)):
+                if len(part):
+                    pieces_a.append(A_)
+                    pieces_b.append(B_)
+                    owner_node.append(np.full(len(part), j))
+                    base_turn.append(turn_)
+                    rows += part
+        S1 = len(rows)
+        if S1:
+            a1, b1 = np.concatenate(pieces_a), np.concatenate(pieces_b)
+            node1 = np.concatenate(owner_node).astype(np.int64)
+            own1 = np.concatenate(base_turn)
+        else:
+            a1, b1, node1, own1 = (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int64),
+                                   np.zeros(0))  # fmt: skip
+        element1 = np.fromiter((row[5] for row in rows), dtype=np.int64, count=S1)
+        body_a = np.fromiter((row[2] for row in rows), dtype=np.int64, count=S1)
+        body_b = np.fromiter((row[3] for row in rows), dtype=np.int64, count=S1)
+        is_link1 = element1 % 2 == 1
+        parent_of = np.array(parents, dtype=np.int64)
+        before = np.where(is_link1, path_turning[parent_of[node1]], path_turning[node1])
+        ancestor = np.zeros((n, n), dtype=bool)
+        ancestor[:n0, :n0] = caps.ancestor
+        for x in range(n0, n):
+            ancestor[x] = ancestor[parents[x]]
+            ancestor[x, x] = True
+        top = np.concatenate([caps.top, np.full(n - n0, -1, dtype=np.int64)])
+        if self._children[p]:  # the new tube joins the junction at p (new if p had one child)
+            junction = self._junction(p)
+            top[self._new_tube_path(joints, p)] = n0
+            for k in junction["kids"]:
+                top[junction["paths"][k]] = k
+        return TreeCapsules(
+            r, np.concatenate([caps.starts, a1]), np.concatenate([caps.ends, b1]),
+            np.concatenate([caps.start_joint, np.where(body_a == node1, node1,
+                                                       parent_of[node1])]),
+            np.concatenate([caps.end_joint, np.where(body_b == node1, node1, parent_of[node1])]),
+            np.concatenate([caps.turning, own1 + before]),
+            np.concatenate([caps.element, element1]), np.concatenate([caps.node, node1]),
+            caps.rows + tuple(rows), tuple(parents), ancestor,
+            np.concatenate([caps.is_link, is_link1]), top,
+            np.concatenate([caps.extent, np.zeros(n - n0)]),
+            np.concatenate([caps.along, np.full((S1, 2), np.nan)]), path_turning,
+        )  # fmt: skip
+
+    def _with_junction(self, caps: TreeCapsules, joints, links, p: int) -> TreeCapsules:
+        """``caps`` (of :meth:`_extended`) with the extents of the tubes leaving p and the
+        distances along them of their rows."""
+        if not self._children[p]:
+            return caps
+        r, n0 = self.r, len(self.joints)
+        junction = self._junction(p)
+        new_path = self._new_tube_path(joints, p)
+        tube = _tube([links[m] for m in new_path], new_path, r)
+        limit = JUNCTION_REACH * r
+        extent, along = caps.extent.copy(), caps.along.copy()
+        extent[n0] = min(junction_extent(tube[0], (tube[1], tube[2]),
+                                         (junction["a"], junction["b"]), r, self.margin,
+                                         limit=limit), limit)  # fmt: skip
+        for k in junction["kids"]:
+            own = junction["tubes"][k]
+            against_new = junction_extent(own[0], (own[1], own[2]), (tube[1], tube[2]), r,
+                                          self.margin, limit=limit)  # fmt: skip
+            extent[k] = min(max(junction["extent"][k], against_new), limit)
+            along[junction["rows"][k]] = junction["along"][k]
+        rows_new = np.flatnonzero((caps.top[caps.node] == n0) & caps.is_link)
+        if rows_new.size:
+            d = _polyline_distance(np.concatenate([caps.starts[rows_new], caps.ends[rows_new]]),
+                                   tube[0])  # fmt: skip
+            along[rows_new, 0], along[rows_new, 1] = d[: rows_new.size], d[rows_new.size :]
+        return dataclasses.replace(caps, extent=extent, along=along)

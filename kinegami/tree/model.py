@@ -23,7 +23,7 @@ from kinegami.chain.assembly import RADIAL_VARIANTS, JointAssembly
 from kinegami.chain.bodies import Overlap, link_polyline
 from kinegami.chain.joints import Joint, check_same_tube
 from kinegami.chain.model import KinematicChain
-from kinegami.clearance.tree_bodies import tree_worst_overlap
+from kinegami.clearance.tree_bodies import TreeGrowth, tree_worst_overlap
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
 from kinegami.validation import check_int, shown
 
@@ -184,10 +184,34 @@ class KinematicTree(JointAssembly):
                 and parents is None:  # fmt: skip
             return known[2]
         parents = self._parents if parents is None else parents
+        if since > 0 and since == len(self._joints):
+            growth = self._growth()
+            if growth.extends(joints, links, parents):
+                # a placement candidate: only what the new joints change is measured
+                return growth.overlap(joints, links, parents)
         return tree_worst_overlap(joints, links, parents, self.r, since=since,
                                   margin=self.margin)  # fmt: skip
 
+    def _clear_of(self, joints, links, parents, since: int) -> bool:
+        if since == len(self._joints):
+            growth = self._growth()
+            if growth.extends(joints, links, parents):
+                return growth.clear(joints, links, parents)
+        return super()._clear_of(joints, links, parents, since)
+
+    def _growth(self) -> TreeGrowth:
+        """The overlap test of extensions of the tree as it is (TreeGrowth), made once per
+        committed set of lists and margin (they are replaced, never changed)."""
+        memo = self.__dict__.get("_growth_memo")
+        if (memo is None or memo[0] is not self._joints or memo[1] is not self._links
+                or memo[2] is not self._parents or memo[3] != self._margin):  # fmt: skip
+            growth = TreeGrowth(self._joints, self._links, self._parents, self.r, self._margin)
+            memo = (self._joints, self._links, self._parents, self._margin, growth)
+            self._growth_memo = memo
+        return memo[4]
+
     def _commit(self, joints, links, ball=None, parents=None):
+        self.__dict__.pop("_growth_memo", None)  # it measured extensions of the old lists
         super()._commit(joints, links, ball)
         if parents is not None:
             self._parents = list(parents)
