@@ -173,6 +173,7 @@ def radial_safe_placement(
     two_arcs_above: float = 2.0 * math.pi / 3.0,
     escape: np.ndarray | None = None,
     hold_past: np.ndarray | None = None,
+    outward: float = 0.0,
 ) -> list[Joint]:
     """Safe placement whose parts stay within a fixed distance of the ball (docs/placement.md).
 
@@ -208,6 +209,9 @@ def radial_safe_placement(
     that arrived at the parent: after a U-turn made of one elbow fitting (a large
     maxAnglePerElbow), the fitting's legs and mitre reach far behind the parent, along the
     way the tube comes back (W_a -> W_h is a straight tube: a CSC path with no turns).
+    ``outward`` (in r) adds that much to R': the joint sits farther out on its axis (a tree
+    uses it when a sibling already sits where the joint would go). Every link still exists
+    as above, and the ball grows by at most ``outward`` r more.
     """
     r = joint.r
     c, R = ball.c, ball.r
@@ -230,6 +234,8 @@ def radial_safe_placement(
     T = joint.pose_matrix
     p, z = T[:3, 3], T[:3, 2]
     radius = max(R + 4.0 * r + rho, float(np.linalg.norm(A - c)) + L / 2.0 + 9.0 * r)
+    if outward > 0.0:
+        radius += outward * r
     past = None if hold_past is None else np.asarray(hold_past, dtype=float).reshape(-1, 3)
 
     for _ in range(8):

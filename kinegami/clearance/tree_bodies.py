@@ -662,7 +662,10 @@ def _near_pairs(caps: TreeCapsules, joints, since: int, reach: float) -> tuple |
     centre = 0.5 * (a + b)
     half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
     if since > 0:
-        i, j = _near_new_pairs(caps.element, node >= since, centre, half, reach)
+        n = len(caps.parents)
+        one_path = all(caps.parents[k] == k - 1 for k in range(since + 1, n))
+        i, j = _near_new_pairs(caps.element, node >= since, centre, half, reach,
+                               tau if one_path else None)  # fmt: skip
     else:
         i, j = near_capsule_pairs(caps.element, tau, np.arange(S) + 1, centre, half, reach)
     if since > 0 and i.size:
@@ -682,12 +685,17 @@ def _near_pairs(caps: TreeCapsules, joints, since: int, reach: float) -> tuple |
     return i, j
 
 
-def _near_new_pairs(element, wanted, centre, half, reach: float) -> tuple:
+def _near_new_pairs(element, wanted, centre, half, reach: float, tau=None) -> tuple:
     """:func:`near_capsule_pairs` (i < j) with ``wanted`` (a bool per row, constant over each
     part), the same pairs in the same order, measured among the parts that can be in one:
     the wanted ones and those whose balls come within ``reach`` of a wanted one's (the test
     near_capsule_pairs makes of every pair of parts). A new joint's parts are few, so the
-    test of all pairs of parts of a large tree is left out."""
+    test of all pairs of parts of a large tree is left out.
+
+    With ``tau`` (the rows' turning, given when the wanted rows are the last ones and lie on
+    one path from the root), pairs of two wanted rows whose turning differs by less than pi
+    (which the pair rule does not test) are not listed either, the others in the same
+    order."""
     S = element.size
     starts = np.flatnonzero(np.r_[True, element[1:] != element[:-1]])
     sizes = np.diff(np.r_[starts, S])
@@ -703,8 +711,18 @@ def _near_new_pairs(element, wanted, centre, half, reach: float) -> tuple:
         d = c[e] - c
         keep |= np.sqrt(np.einsum("ij,ij->i", d, d)) - rho[e] - rho < allowance
     rows = np.flatnonzero(keep[owner])
-    i, j = near_capsule_pairs(element[rows], np.zeros(rows.size), np.arange(rows.size) + 1,
-                              centre[rows], half[rows], reach, wanted[rows])  # fmt: skip
+    first = np.arange(rows.size) + 1
+    new = np.flatnonzero(wanted[rows])
+    if tau is not None and new.size and new[0] == rows.size - new.size:
+        t = tau[rows[new]]
+        if bool(np.all(np.diff(t) >= 0.0)):
+            # along one path the turning does not decrease: a wanted row's pairs with the
+            # wanted rows after it start where the turning has grown by pi (less a rounding
+            # allowance: the pair rule decides exactly)
+            bound = t + (math.pi - TURN_TOLERANCE) - 1e-9 * (1.0 + np.abs(t))
+            first[new] = np.maximum(first[new], new[0] + np.searchsorted(t, bound, side="left"))
+    i, j = near_capsule_pairs(element[rows], np.zeros(rows.size), first, centre[rows],
+                              half[rows], reach, wanted[rows])  # fmt: skip
     return rows[i], rows[j]
 
 

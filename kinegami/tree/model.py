@@ -27,7 +27,11 @@ from kinegami.clearance.tree_bodies import TreeGrowth, tree_worst_overlap
 from kinegami.errors import InvalidParameterError, InvalidTypeError, KinegamiError, NoPathError
 from kinegami.validation import check_int, shown
 
-__all__ = ["KinematicTree"]
+__all__ = ["KinematicTree", "SIBLING_OUTWARD"]
+
+#: How much farther out (in r) the last variants of safe placement put a later sibling on its
+#: axis, when no route to the usual place is clear (docs/trees.md).
+SIBLING_OUTWARD = 4.0
 
 
 class KinematicTree(JointAssembly):
@@ -223,7 +227,8 @@ class KinematicTree(JointAssembly):
 
     def _radial_variants(self, distal: np.ndarray, k: int, p: int):
         """For a parent that already has children: the radial construction escaping first
-        away from the directions in which they leave, then sideways; then the chain's."""
+        away from the directions in which they leave, then sideways; then the chain's; then
+        the escapes again with the joint farther out."""
         if not self._children_of(p):
             yield from super()._radial_variants(distal, k, p)
             return
@@ -256,10 +261,17 @@ class KinematicTree(JointAssembly):
         diagonals = [
             (a * away + b * side) / np.sqrt(2.0) for a, b in ((1, 1), (1, -1), (-1, 1), (-1, -1))
         ]
-        for escape in (away, side, -side, -away, *diagonals):
+        escapes = (away, side, -side, -away, *diagonals)
+        for escape in escapes:
             for variant in RADIAL_VARIANTS:
                 yield {**variant, "escape": escape}
         yield from super()._radial_variants(distal, k, p)
+        # last, the same escapes with the joint SIBLING_OUTWARD r farther out on its axis: a
+        # sibling on the same or a nearby axis line can sit where the joint would go, and
+        # every route into that place runs beside it (docs/trees.md)
+        for escape in escapes:
+            for variant in RADIAL_VARIANTS:
+                yield {**variant, "escape": escape, "outward": SIBLING_OUTWARD}
 
     def _subtree(self, j: int, parents: Sequence[int] | None = None) -> list[int]:
         """j and its descendants in index order (children always follow their parent)."""
