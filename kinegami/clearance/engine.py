@@ -188,13 +188,12 @@ class _OneConfiguration:
         self.static_sorted = e._static_clearance[order]
         self.static_first = (float(self.static_sorted[0]) if order.size else math.inf,
                              list(zip(si[order].tolist(), sj[order].tolist(), strict=True)))
-        chain = e._caps is None
-        clear = self.static_sorted.tolist()
-        s, t = e._static_st[0][order].tolist(), e._static_st[1][order].tolist()
-        ranks = e._static_rank[order].tolist()
-        self._static_keys = [(c, 1, ranks[n], -n - 1, s[n], t[n]) if chain
-                             else (c, ranks[n], 1, -n - 1, s[n], t[n])
-                             for n, c in enumerate(clear)]  # fmt: skip
+        self._static_chain = e._caps is None
+        # kept as arrays, a key made when asked: a list of every static pair's key took
+        # gigabytes on a design of many parts (a MemoryError the fuzzer found)
+        self._static_s = e._static_st[0][order]
+        self._static_t = e._static_st[1][order]
+        self._static_ranks = e._static_rank[order]
         points = np.concatenate([e._starts, e._ends])
         # (1, 4, 2S): every end point, homogeneous, coordinate by coordinate
         self.points = np.concatenate([points, np.ones((2 * S, 1))], axis=1).T[None].copy()
@@ -204,7 +203,9 @@ class _OneConfiguration:
 
     def static_key(self, n: int) -> tuple:
         """The report's sort key of the n-th static pair (in their order)."""
-        return self._static_keys[n]
+        c, rank = float(self.static_sorted[n]), int(self._static_ranks[n])
+        s, t = float(self._static_s[n]), float(self._static_t[n])
+        return (c, 1, rank, -n - 1, s, t) if self._static_chain else (c, rank, 1, -n - 1, s, t)
 
     def kinks(self, values) -> list:
         """:meth:`ClearanceEngine._kinks` at one configuration (``values``: its states), in
