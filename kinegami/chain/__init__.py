@@ -6,8 +6,7 @@ shares with a tree (``assembly``), ``KinematicChain`` itself (``model``) and DH 
 folder (``kinegami.chain.joints`` for a joint's pattern) does not import the whole chain model.
 """
 
-import importlib
-
+from kinegami._lazy import lazy_names
 from kinegami.errors import ClearanceWarning, PlacementWarning
 
 __all__ = ["KinematicChain", "JointAssembly", "PlacementWarning", "ClearanceWarning"]
@@ -16,15 +15,4 @@ __all__ = ["KinematicChain", "JointAssembly", "PlacementWarning", "ClearanceWarn
 _LAZY = {"KinematicChain": "kinegami.chain.model", "JointAssembly": "kinegami.chain.assembly"}
 
 
-def __getattr__(name: str):
-    try:
-        module_name = _LAZY[name]
-    except KeyError:
-        raise AttributeError(f"module 'kinegami.chain' has no attribute {name!r}") from None
-    value = getattr(importlib.import_module(module_name), name)
-    globals()[name] = value  # once imported, an ordinary attribute
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names("kinegami.chain", globals(), _LAZY)

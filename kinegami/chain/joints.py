@@ -778,8 +778,11 @@ class Tip(Joint):
         return f", length={self.length:.6g}"
 
     def open_and_closed_ends(self) -> tuple[np.ndarray, np.ndarray]:
-        """The Dubins frames of the tip's open end and of its closed (folded) end."""
-        raise NotImplementedError
+        """The Dubins frames of the tip's open end and of its closed (folded) end: a tip that
+        closes the tube's start is closed at its proximal end, one that closes its end at its
+        distal end."""
+        proximal, distal = self.proximal_dubins_frame(), self.distal_dubins_frame()
+        return (distal, proximal) if self.closes_start else (proximal, distal)
 
     def hull_points(self) -> np.ndarray:
         """(n + 2, 3): the n-gon at the open end plus a segment of one side's length at the
@@ -813,9 +816,6 @@ class StartTip(Tip):
     def pattern_recipe(self) -> tuple:
         return (("start_tip", (self.numSides, self.r, self.length)),)
 
-    def open_and_closed_ends(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.distal_dubins_frame(), self.proximal_dubins_frame()
-
 
 class EndTip(Tip):
     """The closed end of the tube (nothing may follow it). Path direction: Pose z."""
@@ -824,9 +824,6 @@ class EndTip(Tip):
 
     def pattern_recipe(self) -> tuple:
         return (("end_tip", (self.numSides, self.r, self.length)),)
-
-    def open_and_closed_ends(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.proximal_dubins_frame(), self.distal_dubins_frame()
 
 
 #: The joint kinds design files know, by their "type" name (docs/architecture.md: a new kind is

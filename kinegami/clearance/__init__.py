@@ -1,16 +1,7 @@
 """Self-intersection of a folded chain, at one configuration and over its range of motion.
 
-See docs/clearance.md. The chain's parts are enclosed by capsules of radius r along its
-centreline (:mod:`kinegami.chain.bodies`). Two capsules are tested only when the centreline between
-them turns by at least pi in total (arc angles plus |state| at every revolute hinge): a curve
-that turns by less than pi cannot come back to itself, and parts closer along the tube than
-that touch by construction (the two legs of an elbow, the halves of a joint, a link and its
-joints). The clearance of a tested pair is the distance between their segments minus 2r;
-negative values are overlap depths. The chain is clear when every tested pair has a clearance
-of at least ``margin - CONTACT_TOLERANCE * r`` (:func:`~kinegami.chain.bodies.clear_limit`): the
-margin is the clearance the design requires (chain units, ``chain.margin``, default 0: parts
-that touch, such as the legs of a U-turn exactly 2r apart, are clear). Every verdict is worded
-by :meth:`ClearanceReport.verdict`, which states the margin.
+See docs/clearance.md; the rule of which capsules are tested, and the margin, are in
+:mod:`kinegami.clearance.engine`.
 
 Examples
 --------
@@ -24,7 +15,7 @@ The names below load on first use (a module ``__getattr__``), so that importing 
 the folder (``kinegami.clearance.tree_bodies`` for a tree's checks) does not import the engine.
 """
 
-import importlib
+from kinegami._lazy import lazy_names
 
 __all__ = [
     "CONTACT_TOLERANCE",
@@ -66,15 +57,4 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str):
-    try:
-        module_name = _LAZY[name]
-    except KeyError:
-        raise AttributeError(f"module 'kinegami.clearance' has no attribute {name!r}") from None
-    value = getattr(importlib.import_module(module_name), name)
-    globals()[name] = value  # once imported, an ordinary attribute
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names("kinegami.clearance", globals(), _LAZY)

@@ -6,7 +6,7 @@ The names below load on first use, so that importing one module of the folder do
 the others.
 """
 
-import importlib
+from kinegami._lazy import lazy_names
 
 __all__ = [
     "fabricate",
@@ -30,17 +30,4 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str):
-    try:
-        module_name = _LAZY[name]
-    except KeyError:
-        raise AttributeError(
-            f"module 'kinegami.fabrication' has no attribute {name!r}"
-        ) from None
-    value = getattr(importlib.import_module(module_name), name)
-    globals()[name] = value  # once imported, an ordinary attribute
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names("kinegami.fabrication", globals(), _LAZY)
