@@ -68,3 +68,19 @@ def wait_for(condition, what: str, timeout: float = 60.0, step: float = 0.1):
             return value
         time.sleep(step)
     raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+
+
+def choose(page, combobox: str, option: str, attempts: int = 5, timeout: float = 15.0) -> None:
+    """Pick ``option`` in the page's ``combobox`` (a Mantine select): click the box, then the
+    option. A panel the server draws again (a message, a design just opened) can close the
+    drop-down between the two clicks; then Escape and open it again, ``attempts`` times."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    for _ in range(attempts):
+        page.get_by_role("combobox", name=combobox, exact=True).click()
+        try:
+            page.get_by_role("option", name=option, exact=True).click(timeout=timeout * 1000)
+            return
+        except PlaywrightTimeout:
+            page.keyboard.press("Escape")
+    raise AssertionError(f"the {combobox!r} list never offered {option!r} ({attempts} tries)")

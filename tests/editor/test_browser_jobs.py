@@ -13,6 +13,7 @@ import shutil
 import headless_chromium
 import pytest
 
+from tests.editor.helpers import choose
 from tests.editor.helpers import wait_for as helpers_wait_for
 
 from .helpers import EXAMPLE1, HAND, ROOT
@@ -77,8 +78,7 @@ def served(browser, tmp_path):
 
 def pick(page, view, joint: int) -> None:
     label = ("(none)",) + view._labels()
-    page.get_by_role("combobox", name="Joint", exact=True).click()
-    page.get_by_role("option", name=label[joint + 1], exact=True).click()
+    choose(page, "Joint", label[joint + 1])
 
 
 def test_the_puma_answers_while_compact_runs_and_the_result_is_one_undo_step(served, tmp_path):
@@ -147,8 +147,7 @@ def _edit(page, view) -> None:
 
 
 def _open_puma(page) -> None:
-    page.get_by_role("combobox", name="Example", exact=True).click()
-    page.get_by_role("option", name="puma", exact=True).click()
+    choose(page, "Example", "puma")
     page.get_by_role("button", name="Open example", exact=True).click()
 
 

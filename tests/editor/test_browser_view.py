@@ -14,7 +14,7 @@ import headless_chromium
 import numpy as np
 import pytest
 
-from .helpers import EXAMPLE1, HAND, ROOT, snapshot
+from .helpers import EXAMPLE1, HAND, ROOT, choose, snapshot
 from .test_browser import TIMEOUT, wait_for
 
 pytestmark = [pytest.mark.browser,
@@ -140,8 +140,7 @@ def test_frame_all_after_opening_a_much_smaller_design(browser, servers, tmp_pat
     try:
         time.sleep(2.0)
         puma_grid = view.grid.section
-        page.get_by_role("combobox", name="Example", exact=True).click()
-        page.get_by_role("option", name="example1", exact=True).click()
+        choose(page, "Example", "example1")
         page.get_by_role("button", name="Open example").click()
         wait_for(lambda: view.model.document.units == "cm"
                  and view.grid.section * 50 < puma_grid, "Example 1 opened, its grid drawn")
@@ -167,8 +166,7 @@ def test_frame_all_after_opening_a_much_smaller_design(browser, servers, tmp_pat
 def test_the_hand_opened_after_the_puma_is_framed(browser, servers, tmp_path):
     page, view = open_tab(browser, servers["puma"])
     try:
-        page.get_by_role("combobox", name="Example", exact=True).click()
-        page.get_by_role("option", name="hand", exact=True).click()
+        choose(page, "Example", "hand")
         page.get_by_role("button", name="Open example").click()
         wait_for(lambda: view.model.is_tree and view.grid.section < 10.0, "the hand opened")
         time.sleep(1.5)
