@@ -96,11 +96,13 @@ MAX_PDF_PAGES = 200
 MAX_INTEGER_DIGITS = 30
 
 # --- work inside one operation -------------------------------------------------------------
-#: Most capsule tests of one joint's take-off search (kinegami.fabrication.takeoffs): each candidate
-#: placement is a clearance test of the whole folded body, so a body of S capsules (about two
-#: per elbow and two per joint) measures at most TAKEOFF_WORK / S candidates. Ordinary trees
-#: (a few hundred capsules: every face at 5 heights and 48 sets) stay within it; an 11-joint tree
-#: of one-degree elbows (2,700 capsules) measured 174 candidates at about 0.14 s each.
+#: Most capsule tests of one tree's take-off search (kinegami.fabrication.takeoffs, every joint's
+#: and every attempt of fabricate's together; each joint gets what is left over the joints still
+#: to place): each candidate placement is a clearance test of the whole folded body, so a body of
+#: S capsules (about two per elbow and two per joint) measures at most TAKEOFF_WORK / S
+#: candidates. Ordinary trees (a few hundred capsules: every face at 5 heights and 48 sets)
+#: stay within it; a 22-joint tree of one-degree elbows (3,820 capsules, four take-off joints)
+#: measures 26 candidates at about 0.2 s each.
 TAKEOFF_WORK = 100_000
 #: Most crease-pattern vertices of one chain's pattern or one tree's sheets, estimated from
 #: the counts before anything is built (kinegami.pattern.catalog.check_pattern_size): each count

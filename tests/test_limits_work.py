@@ -150,3 +150,28 @@ def test_the_takeoff_search_of_a_tree_of_many_capsules_is_bounded():
     assert capsules > 500  # many capsules: fewer candidates than every face at 5 heights
     assert per_branch < 8 * 5 and 1 <= sets < takeoffs.EVALUATED_SETS
     assert (2 * per_branch + sets) * capsules <= limits.TAKEOFF_WORK
+
+
+def test_the_takeoff_search_of_a_tree_of_many_branching_joints_shares_one_budget(monkeypatch):
+    """TAKEOFF_WORK bounds the whole tree's search, not each joint's: three take-off joints
+    measure about TAKEOFF_WORK / capsules candidates in all (each attempt at least one per
+    branch and one set), where a budget per joint measured three times as many."""
+    tree = KinematicTree(Waypoint(4, 1, SE3()), maxAnglePerElbow=math.pi / 60)
+    for parent, x, y in ((0, -6, 0), (0, 6, 0), (1, -9, 4), (1, -3, 4), (2, 3, 4), (2, 9, 4)):
+        pose = SE3.Trans(x, y, 10 if parent == 0 else 22) * SE3.Rx(2.0)
+        tree.addJoint(parent, RevoluteJoint(4, 1, math.pi, pose), safe=False)
+    capsules = takeoffs.body_capsules(tree)
+    monkeypatch.setattr(takeoffs, "TAKEOFF_WORK", 10 * capsules)  # ten whole-body tests
+    measured = []
+    overlap = takeoffs.takeoff_overlap
+
+    def counted(*args, **kwargs):
+        measured.append(1)
+        return overlap(*args, **kwargs)
+
+    monkeypatch.setattr(takeoffs, "takeoff_overlap", counted)
+    from kinegami.fabrication.sheets import fabricate
+
+    made = fabricate(tree, junction="takeoff")
+    assert len(made.takeoffs) == 3
+    assert len(measured) <= 10 + 3 * 2  # the budget, and each joint's one candidate and set

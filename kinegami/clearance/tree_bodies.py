@@ -498,17 +498,15 @@ def _junction_extents(kids: list, paths: dict, links, r: float, margin: float) -
     (computed on the originals: the same answer whatever the configuration)."""
     nodes = [m for k in kids for m in paths[k]]
     origins = _rigid_origins([links[m] for m in nodes])
-    key = None
-    if origins is not None:
-        key = (tuple(map(id, origins)), tuple(nodes), tuple(len(paths[k]) for k in kids), r,
-               margin)  # fmt: skip
-        with _EXTENT_MEMO_LOCK:
-            hit = _EXTENT_MEMO.get(key)
-        if hit is not None and all(map(operator.is_, hit[0], origins)):
-            return hit[1]
-        source = dict(zip(nodes, origins, strict=True))
-    else:
-        source = {m: links[m] for m in nodes}
+    # the extents depend on the links' geometry only (not on the joints' numbers): keyed by
+    # the links (or the links they are rigid copies of) tube by tube, checked by identity
+    sources = tuple(origins) if origins is not None else tuple(links[m] for m in nodes)
+    key = (tuple(map(id, sources)), tuple(len(paths[k]) for k in kids), r, margin)
+    with _EXTENT_MEMO_LOCK:
+        hit = _EXTENT_MEMO.get(key)
+    if hit is not None and all(map(operator.is_, hit[0], sources)):
+        return dict(zip(kids, hit[1], strict=True))
+    source = dict(zip(nodes, sources, strict=True))
     tubes = {k: _tube([source[m] for m in paths[k]], paths[k], r) for k in kids}
     extents = {}
     for k in kids:
@@ -518,11 +516,10 @@ def _junction_extents(kids: list, paths: dict, links, r: float, margin: float) -
         found = junction_extent(tubes[k][0], (tubes[k][1], tubes[k][2]), (a, b), r, margin,
                                 limit=JUNCTION_REACH * r)
         extents[k] = min(found, JUNCTION_REACH * r)
-    if key is not None:
-        with _EXTENT_MEMO_LOCK:
-            _EXTENT_MEMO[key] = (origins, extents)
-            while len(_EXTENT_MEMO) > _EXTENT_MEMO_SIZE:
-                del _EXTENT_MEMO[next(iter(_EXTENT_MEMO))]
+    with _EXTENT_MEMO_LOCK:
+        _EXTENT_MEMO[key] = (sources, [extents[k] for k in kids])
+        while len(_EXTENT_MEMO) > _EXTENT_MEMO_SIZE:
+            del _EXTENT_MEMO[next(iter(_EXTENT_MEMO))]
     return extents
 
 

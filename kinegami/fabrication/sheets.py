@@ -43,6 +43,7 @@ from kinegami.fabrication.takeoffs import (
     JUNCTION_KINDS,
     Takeoff,
     TakeoffOptions,
+    TakeoffWork,
     hole_name,
     place_takeoffs,
 )
@@ -409,9 +410,11 @@ def fabricate(
     kinds = {k: ("connector" if kind == "connector" else "takeoff")
              for k, kind in requested.items()}  # fmt: skip
     notes: list[str] = []
+    work = TakeoffWork()  # TAKEOFF_WORK for the whole tree, every attempt included
     while True:
         try:
-            return _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, tuple(notes))
+            return _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, tuple(notes),
+                              work)  # fmt: skip
         except _NoTakeoffError as failure:
             if requested[failure.joint] != "auto":
                 raise InvalidParameterError(
@@ -471,7 +474,8 @@ def _trunk_candidates(tree, joint: int, trunks, longest) -> list[int]:
     return sorted(tree.Children[joint], key=lambda c: (-longest[c], c))
 
 
-def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes) -> TreeFabrication:
+def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes,
+               work: TakeoffWork) -> TreeFabrication:  # fmt: skip
     from kinegami.pattern.folded import UVA_TO_DUBINS, unsnapped_form
 
     connector_kinds = {k for k, kind in kinds.items() if kind == "connector"}
@@ -505,6 +509,9 @@ def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes) -> Tr
     placed: dict[int, dict] = {}  # branch child -> its take-off (placement, trunk sheet, ...)
     fabricated_links = list(tree.Links)
     body: list = []  # the take-offs as the folded body needs them (takeoffs.takeoff_body)
+    # the take-off search's work (``work``: TAKEOFF_WORK for the whole tree): each take-off
+    # joint gets what is left over the joints still to place (docs/limits.md)
+    takeoff_joints = sum(1 for kind in kinds.values() if kind != "connector")
     starts = [0]
     while starts:
         first = starts.pop(0)
@@ -544,6 +551,7 @@ def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes) -> Tr
                 branches += [c for c in kids if c != t]
             else:
                 reasons = []
+                share = TakeoffWork(max(0, work.left) // max(1, takeoff_joints))
                 for t in _trunk_candidates(tree, k, trunks, longest):
                     link = tree.Links[t]
                     link_modules = link.pattern_modules(n, twistPortion)
@@ -559,13 +567,16 @@ def _fabricate(tree, kinds, trunks, options, twistPortion, takeoff, notes) -> Tr
                     tube_frame = tube.proximal @ UVA_TO_DUBINS
                     twist = twistPortion * link.path.tMag if link.hasTwist else 0.0
                     before = r * link.path.theta1 + twist  # arc length to the tube's start
+                    before_search = share.left
                     found, reason = place_takeoffs(tree, k, t, tube_frame, height, before,
-                                                   takeoff, body)  # fmt: skip
+                                                   takeoff, body, share)  # fmt: skip
+                    work.spend(before_search - share.left)
                     if found is not None:
                         break
                     reasons.append(f"trunk {t}: {reason}")
                 else:
                     raise _NoTakeoffError(k, "; ".join(reasons))
+                takeoff_joints -= 1
                 for placement in found:
                     name = hole_name(len(placed))
                     placed[placement.child] = {

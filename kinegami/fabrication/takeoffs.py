@@ -13,9 +13,10 @@ For each branch the face p and the hole's height y0 are chosen among every face 
 margin: those from which a CSC path to c exists, preferring the placement whose body passes
 least through itself (:func:`takeoff_overlap`), then the shortest new link; the branches of one
 joint are placed together, their holes (with margins) apart. Each candidate is a clearance test
-of the whole body, so one joint's search measures at most
-``kinegami.limits.TAKEOFF_WORK / capsules`` candidates (docs/limits.md): a body of many
-capsules tries fewer heights, then fewer faces (evenly spread); ordinary trees try them all.
+of the whole body, so one tree's search (every joint's together) measures at most
+``kinegami.limits.TAKEOFF_WORK / capsules`` candidates (:class:`TakeoffWork`, docs/limits.md):
+a body of many capsules tries fewer heights, then fewer faces (evenly spread); ordinary trees
+try them all.
 
 The folded body is measured as a tree of its own (:func:`takeoff_body`): the trunk's link is
 cut at every take-off point O (the trunk's axis point at the hole's centre) by a zero-length
@@ -49,6 +50,7 @@ from kinegami.validation import check_in_range, check_int, check_radius
 __all__ = [
     "JUNCTION_KINDS",
     "TakeoffOptions",
+    "TakeoffWork",
     "Takeoff",
     "TakeoffPlacement",
     "hole_name",
@@ -103,6 +105,21 @@ class TakeoffOptions:
         if heights > 50:
             raise InvalidParameterError(f"heights must be an integer in [1, 50], got {heights}")
         return TakeoffOptions(tab, stub, heights)
+
+
+@dataclass
+class TakeoffWork:
+    """The capsule tests a take-off search may still measure (a candidate measured on a body
+    of S capsules costs S): ``left`` of them, spent by :func:`place_takeoffs` as it measures.
+    :func:`~kinegami.fabrication.sheets.fabricate` gives each take-off joint its share of
+    ``TAKEOFF_WORK`` (what is left over the joints still to place), so the work of one tree
+    is bounded whatever its number of joints (docs/limits.md)."""
+
+    left: int = field(default_factory=lambda: TAKEOFF_WORK)
+
+    def spend(self, capsules: int) -> None:
+        """Charge one candidate measured on a body of ``capsules`` capsules."""
+        self.left -= capsules
 
 
 @dataclass(frozen=True, eq=False)
@@ -320,6 +337,7 @@ def place_takeoffs(
     tube_arc: float,
     options: TakeoffOptions,
     placed: Sequence[BodyTakeoff] = (),
+    work: TakeoffWork | None = None,
 ) -> tuple[list[TakeoffPlacement] | None, str]:
     """Where every branch child of ``joint`` leaves the trunk ``trunk``'s plain tube.
 
@@ -334,6 +352,9 @@ def place_takeoffs(
     tube_arc : arc length along the trunk's link where the tube module starts.
     options : resolved :class:`TakeoffOptions`.
     placed : the take-offs placed so far elsewhere in the tree (:data:`BodyTakeoff`).
+    work : the capsule tests this search may measure, spent as it measures (default: a fresh
+        ``TakeoffWork()``, all of ``TAKEOFF_WORK``); at least one candidate per branch and
+        one set are measured whatever is left.
 
     Returns
     -------
@@ -343,6 +364,7 @@ def place_takeoffs(
     if not isinstance(options, TakeoffOptions):
         raise InvalidTypeError(f"options must be TakeoffOptions, got {options!r}")
     n, r = tree.numSides, tree.r
+    work = TakeoffWork() if work is None else work
     placed = list(placed)
     cache: dict = {}  # the trunk's cut pieces, shared by every candidate
     branches = [c for c in tree.Children[joint] if c != trunk]
@@ -356,7 +378,8 @@ def place_takeoffs(
         )
     span = max(0.0, tube_height - 2.0 * e)
     count = 1 if span <= 1e-9 * r else options.heights
-    tests, sets = search_budget(tree, len(branches))
+    capsules = body_capsules(tree)
+    tests, sets = search_budget(tree, len(branches), work.left, capsules)
     count = min(count, max(1, tests // n))
     faces = range(n) if n <= tests else sorted({round(k * n / tests) for k in range(tests)})
     heights = [e + span * (0.5 if count == 1 else k / (count - 1)) for k in range(count)]
@@ -376,6 +399,7 @@ def place_takeoffs(
                     continue
                 trial = placed + [(trunk, tube_arc + y0, c, link)]
                 depth = _depth(takeoff_overlap(tree, trial, cache=cache))
+                work.spend(capsules)
                 found.append(TakeoffPlacement(c, J, T, link, depth))
         if not found:
             return None, (
@@ -385,30 +409,39 @@ def place_takeoffs(
         found.sort(key=lambda q: (round(q.depth / (DEPTH_TOLERANCE * r)), q.link.length,
                                   q.junction.face, q.junction.y0))  # fmt: skip
         candidates[c] = found
-    return _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache, sets)
+    sets = max(1, min(sets, work.left // max(1, capsules)))  # what the branches left
+    return _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache, sets,
+                    lambda: work.spend(capsules))  # fmt: skip
 
 
-def search_budget(tree, branches: int) -> tuple[int, int]:
+def body_capsules(tree) -> int:
+    """About how many capsules a clearance test of ``tree``'s folded body measures: two per
+    elbow and two per joint."""
+    return 2 * len(tree.Joints) + sum(2 * (len(link_polyline(link)) - 1)
+                                      for link in tree.Links[1:])  # fmt: skip
+
+
+def search_budget(tree, branches: int, work: int = TAKEOFF_WORK,
+                  capsules: int | None = None) -> tuple[int, int]:  # fmt: skip
     """How many placements of one branch (faces times heights) and how many sets of
     placements the take-off search at a joint with ``branches`` branches measures: within
-    ``TAKEOFF_WORK`` capsule tests in all (docs/limits.md), each test measuring the whole body
-    (about two capsules per elbow and two per joint), at least one of each."""
-    capsules = 2 * len(tree.Joints) + sum(2 * (len(link_polyline(link)) - 1)
-                                          for link in tree.Links[1:])  # fmt: skip
-    total = max(2, TAKEOFF_WORK // max(1, capsules))
+    ``work`` capsule tests in all (docs/limits.md), each test measuring the whole body
+    (``capsules``, default :func:`body_capsules`), at least one of each."""
+    capsules = body_capsules(tree) if capsules is None else capsules
+    total = max(2, work // max(1, capsules))
     sets = max(1, min(EVALUATED_SETS, total // 4))
     return max(1, (total - sets) // max(1, branches)), sets
 
 
 def _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache,
-             evaluated: int = EVALUATED_SETS):  # fmt: skip
+             evaluated: int = EVALUATED_SETS, measured=None):  # fmt: skip
     """The best set of placements, one per branch, whose holes are apart.
 
     Each branch contributes its best candidates and its best one at every height; the sets
     whose holes are apart are ranked by their worst single depth and total length, and the
     first ``evaluated`` (at most :data:`EVALUATED_SETS`) are measured together (the depth of
-    the tree with all their links). Without such a set (or with too many), branches are placed
-    one by one.
+    the tree with all their links; ``measured()``, when given, after each). Without such a
+    set (or with too many), branches are placed one by one.
     """
     pools = []
     for c in branches:
@@ -428,6 +461,8 @@ def _combine(tree, trunk, tube_arc, branches, candidates, placed, W, r, cache,
         for combo in sets[:evaluated]:
             trial = placed + [(trunk, tube_arc + q.junction.y0, q.child, q.link) for q in combo]
             depth = _depth(takeoff_overlap(tree, trial, cache=cache))
+            if measured is not None:
+                measured()
             key = (round(depth / scale), sum(q.link.length for q in combo))
             if best_key is None or key < best_key:
                 best, best_key = combo, key

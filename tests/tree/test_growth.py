@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from pathlib import Path
 
 import numpy as np
 from hypothesis import given, settings
@@ -161,3 +162,42 @@ def test_placement_does_not_measure_the_whole_tree_per_candidate(monkeypatch):
             assert tree.addJoint(0, RevoluteJoint(4, 1, math.pi, pose)) is not None
             assert calls["capsules"] <= 2 * (count + 1)
     assert calls["candidates"] >= 20 and len(tree.Children[0]) == 4 and tree.clearance().ok
+
+
+def test_junction_extents_are_remembered_by_the_links_not_the_joint_numbers(monkeypatch):
+    """A take-off candidate's folded body is a new tree whose joints are numbered anew and
+    whose links mix moved copies (the tree at its states) with new ones: the junctions whose
+    tubes are the same link objects are not measured again (the fuzzer's 22-joint tree spent
+    half of its 70 s there), and the extents are those measured afresh."""
+    import kinegami.clearance.tree_bodies as tree_bodies
+    from kinegami.chain.links import LinkCSC
+    from kinegami.design import load_design
+
+    tree = load_design(Path(__file__).parents[2] / "examples" / "designs" / "gripper.json")
+    tree.requireClearance = False
+    assert tree.setJointStates([0.2 * (-1) ** k if j.stateRange()[1] > 0.2 else 0.0
+                                for k, j in enumerate(tree.Joints)])  # fmt: skip
+    links = list(tree.Links)
+    assert any("_moved_from" in vars(link) for link in links)
+    m = next(k for k in range(2, len(links)) if len(tree.Children[tree.Parents[k]]) > 1)
+    assert "_moved_from" in vars(links[m])  # a junction that the states moved
+    old = links[m]  # a tube of a junction, replaced by a new link (not a moved copy)
+    links[m] = LinkCSC(tree.r, old.StartDubinsPose, old.EndDubinsPose, tree.maxAnglePerElbow)
+    measured = []
+    extent = tree_bodies.junction_extent
+
+    def counted(*args, **kwargs):
+        measured.append(1)
+        return extent(*args, **kwargs)
+
+    monkeypatch.setattr(tree_bodies, "junction_extent", counted)
+    monkeypatch.setattr(tree_bodies, "_EXTENT_MEMO", {})
+    first = tree_bodies.tree_capsules(tree.Joints, links, tree.Parents, tree.r)
+    assert measured
+    measured.clear()
+    again = tree_bodies.tree_capsules(tree.Joints, links, tree.Parents, tree.r)
+    assert not measured  # remembered
+    monkeypatch.setattr(tree_bodies, "_EXTENT_MEMO", {})
+    fresh = tree_bodies.tree_capsules(tree.Joints, links, tree.Parents, tree.r)
+    assert np.array_equal(first.extent, again.extent)
+    assert np.array_equal(again.extent, fresh.extent)
