@@ -71,7 +71,13 @@ def _case(rng):
     return polyline, (starts, ends), (a, b), r, margin
 
 
-def test_junction_extent_gives_the_answers_of_sampling_everything():
+@pytest.mark.parametrize("first_chunk", [1, 7, 256])
+def test_junction_extent_gives_the_answers_of_sampling_everything(monkeypatch, first_chunk):
+    """Also when the scan, highest samples first, goes in small chunks growing fourfold."""
+    import kinegami.clearance.tree_bodies as tree_bodies
+
+    monkeypatch.setattr(tree_bodies, "_JUNCTION_FIRST_CHUNK", first_chunk)
+    monkeypatch.setattr(tree_bodies._descending_chunks, "__defaults__", (first_chunk,))
     rng = np.random.default_rng(29)
     touching = 0
     for _ in range(600):
@@ -89,7 +95,19 @@ def test_tubes_running_together_for_1e6_r_are_cheap():
     polyline = np.array([[0.0, 0, 0], [0, 0, 1e6]])
     own = (polyline[:-1], polyline[1:])
     siblings = (np.array([[0.5, 0, 0]]), np.array([[0.5, 0, 1e6]]))
-    assert junction_extent(polyline, own, siblings, r, limit=5.0) == 5.0
+    import kinegami.clearance.tree_bodies as tree_bodies
+
+    measured = []
+    params = tree_bodies._point_params
+
+    def counted(points, a, b):
+        measured.append(len(points))
+        return params(points, a, b)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tree_bodies, "_point_params", counted)
+        assert junction_extent(polyline, own, siblings, r, limit=5.0) == 5.0
+    assert sum(measured) <= 1024  # the last samples decide it (not a first chunk of 1M / 1)
     # without a limit the answer is the whole length (1e6 samples, evaluated in pieces)
     short = polyline / 50
     assert junction_extent(short, (short[:-1], short[1:]), (siblings[0], siblings[1] / 50), r) \
