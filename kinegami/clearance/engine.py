@@ -86,6 +86,26 @@ _BATCH_ENTRIES = 2_000_000
 #: limit) above which it measures them at once with numpy rather than one by one in plain
 #: floats (a plain-float pair costs about 6 us, numpy's kernel about 60 us whatever the few).
 _ONE_BY_ONE = 16
+#: One-configuration reports an engine answers with numpy before it runs the compiled kernel
+#: (kinegami.clearance.kernels): a single query (a command line's check) does not pay for
+#: loading numba and its cached machine code (about 0.4 s); a loop of queries does, once.
+COMPILED_AFTER = 16
+
+
+_KERNEL: list = []  # [the compiled one-configuration kernel, or None where numba cannot run]
+
+
+def _kernel():
+    """:func:`kinegami.clearance.kernels.one_configuration`, loaded on first use; None where
+    numba cannot be imported or cannot keep its machine code (the numpy path then answers:
+    the same reports, slower)."""
+    if not _KERNEL:
+        try:
+            from kinegami.clearance.kernels import one_configuration
+        except (ImportError, OSError, RuntimeError):  # no numba, or no cache it can write
+            one_configuration = None
+        _KERNEL.append(one_configuration)
+    return _KERNEL[0]
 
 
 class _Layout:
@@ -200,6 +220,44 @@ class _OneConfiguration:
         self.rows = np.concatenate([e.body_a, e.body_b])
         self.slack = 1e-9 * (e._extent() + e.r)
         self.none = np.zeros(0, dtype=np.int64)
+        self._taken: dict[float, int] = {}  # static_taken's answers by limit
+        self.queries = 0  # one-configuration reports asked so far
+        self.compiled: tuple | None = None  # the kernel's arrays, made on its first use
+
+    def kernel_arrays(self, engine: ClearanceEngine) -> tuple:
+        """The fixed arguments of :func:`kinegami.clearance.kernels.one_configuration`."""
+        if self.compiled is None:
+            e = engine
+            pairs = self.pair_ij
+            self.compiled = (
+                np.ascontiguousarray(self.rows, dtype=np.int64),
+                np.ascontiguousarray(np.concatenate([e._starts, e._ends]), dtype=float),
+                np.ascontiguousarray(pairs[0], dtype=np.int64),
+                np.ascontiguousarray(pairs[1], dtype=np.int64),
+                np.ascontiguousarray(self.twice_half, dtype=float),
+                self.sure,
+                np.ascontiguousarray(self.maybe_turn, dtype=float),
+                np.ascontiguousarray(self.maybe_bi, dtype=np.int64),
+                np.ascontiguousarray(self.maybe_bj, dtype=np.int64),
+                np.array(self.kink_joints, dtype=np.int64),
+                np.array(self.kink_parents if self.kink_parents is not None else [],
+                         dtype=np.int64),  # fmt: skip
+            )
+        return self.compiled
+
+    def static_taken(self, limit: float) -> int:
+        """How many static pairs (in their order) a report with ``limit`` lists: those closer
+        than the limit, at least the closest (none without static pairs); kept for the last
+        few limits."""
+        if not self.static_count:
+            return 0
+        take = self._taken.get(limit)
+        if take is None:
+            take = max(1, int(np.searchsorted(self.static_sorted, limit)))
+            if len(self._taken) >= 8:
+                self._taken.clear()
+            self._taken[limit] = take
+        return take
 
     def static_key(self, n: int) -> tuple:
         """The report's sort key of the n-th static pair (in their order)."""
@@ -1110,16 +1168,25 @@ class ClearanceEngine:
         are closer than the limit. The turning rule is applied to the pairs measured only."""
         one = self._one_arrays()
         r2 = 2.0 * self.r
-        # every end point moved (the arithmetic of _Layout.move), coordinate-major (3, 2S)
         B = self.screws.body_motions_one(Q[0])
+        S = self._S
+        static_min = one.static_first[0]
+        found: list[tuple] = []
+        one.queries += 1
+        if one.pairs and one.queries > COMPILED_AFTER and _kernel() is not None:
+            one_configuration = _kernel()  # many queries: the compiled kernel
+            clearance, n, s, t, moved = one_configuration(
+                B, *one.kernel_arrays(self), Q[0], math.pi - TURN_TOLERANCE, limit, static_min,
+                one.slack, r2)  # fmt: skip
+            found = list(zip(clearance.tolist(), n.tolist(), s.tolist(), t.tolist(),
+                             strict=True))  # fmt: skip
+            return self._one_report(one, found, moved, values, limit, margin)
+        # every end point moved (the arithmetic of _Layout.move), coordinate-major (3, 2S)
         NB = B.shape[0]
         M = B.reshape(NB, 16)[:, :12].T.take(one.rows, axis=1).reshape(3, 4, -1)
         M *= one.points
         W = ((M[:, 0] + M[:, 1]) + M[:, 2]) + M[:, 3]
         points = W.T.tolist()
-        S = self._S
-        static_min = one.static_first[0]
-        found: list[tuple] = []
         if one.pairs:
             twice = W[:, :S] + W[:, S:]  # twice the capsule centres
             d = twice.take(one.centre_i) - twice.take(one.centre_j)
@@ -1134,6 +1201,14 @@ class ClearanceEngine:
             if near.size:
                 found = self._measured(one, W, points, twice, near, low.take(near), values,
                                        limit, static_min)  # fmt: skip
+        return self._one_report(one, found, points, values, limit, margin)
+
+    def _one_report(self, one: _OneConfiguration, found: list, points, values: tuple,
+                    limit: float, margin: float) -> ClearanceReport:  # fmt: skip
+        """The report of :meth:`_report_one` from the measured pairs ``found`` (clearance,
+        pair, s, t) and the moved end points ``points`` (2S rows of x, y, z: a list or an
+        array)."""
+        S = self._S
         # in the report's order: clearance, then (chains) moving pairs before static ones,
         # then the tie order of :meth:`_rank`
         rank = one.rank
@@ -1143,8 +1218,7 @@ class ClearanceEngine:
         statics = one.static_first
         if not moving and not one.static_count:
             return ClearanceReport(True, math.inf, (), None, values, margin, self.r)
-        take = max(1, int(np.searchsorted(one.static_sorted, limit))) \
-            if one.static_count else 0  # fmt: skip
+        take = one.static_taken(limit)
         ordered = moving + [one.static_key(n) for n in range(take)]
         if take and moving:
             ordered.sort()
@@ -1152,8 +1226,9 @@ class ClearanceEngine:
         def make(entry: tuple) -> CollidingPair:
             c, _, _, n, s, t = entry
             i, j = (one.pi[n], one.pj[n]) if n >= 0 else statics[1][-n - 1]
-            return self._pair(0, 1, s, t, (points[i], points[j]), (points[S + i], points[S + j]),
-                              c, i, j)  # fmt: skip
+            a_i, a_j, b_i, b_j = (points[i], points[j], points[S + i], points[S + j]) \
+                if isinstance(points, list) else points[[i, j, S + i, S + j]].tolist()  # fmt: skip
+            return self._pair(0, 1, s, t, (a_i, a_j), (b_i, b_j), c, i, j)
 
         closest = make(ordered[0])
         min_clearance = ordered[0][0]

@@ -138,3 +138,84 @@ def test_states_are_checked_as_before():
         with pytest.raises(error) as checked:
             listed.check_states(bad)
         assert str(raised.value) == str(checked.value)
+
+
+def _paths(name: str) -> tuple:
+    """Two listed engines of the design: one that always runs the compiled kernel and one
+    that never does (the numpy path)."""
+    key = ("paths", name)
+    if key not in _ENGINES:
+        design = load_design(DESIGNS / f"{name}.json")
+        build = ClearanceEngine if isinstance(design, KinematicChain) else TreeEngine
+        compiled, numpy_path = build(design), build(design)
+        compiled._one_arrays().queries = 10**12
+        numpy_path._one_arrays().queries = -(10**12)
+        _ENGINES[key] = (design, compiled, numpy_path)
+    return _ENGINES[key]
+
+
+@pytest.mark.filterwarnings("error::RuntimeWarning")
+@settings(max_examples=60, deadline=None)
+@given(name=st.sampled_from(NAMES),
+       fractions=st.lists(st.floats(0.0, 1.0), min_size=18, max_size=18),
+       margin=st.sampled_from([0.0, 0.05, 0.5, 3.0, 1e4]))  # fmt: skip
+def test_the_compiled_kernel_gives_the_numpy_report_bit_for_bit(name, fractions, margin):
+    """The compiled one-configuration kernel (kinegami.clearance.kernels) measures other pairs
+    than the numpy path (no shadow bound) but every pair closer than the limit and the
+    closest one, with the same arithmetic: the same report, every float the same bits."""
+    design, compiled, numpy_path = _paths(name)
+    q = configuration(compiled, fractions)
+    m = margin * float(design.r)
+    assert repr(compiled.report(q, m)) == repr(numpy_path.report(q, m))
+
+
+def test_an_engine_runs_the_kernel_once_asked_many_times(monkeypatch):
+    """A single query (a command line's check) stays on numpy; from the COMPILED_AFTER + 1-th
+    on, the engine runs the kernel, and the reports do not change."""
+    import kinegami.clearance.kernels as kernels
+
+    design = load_design(DESIGNS / "puma.json")
+    engine = ClearanceEngine(design)
+    calls = []
+    kernel = kernels.one_configuration
+
+    def counted(*args):
+        calls.append(1)
+        return kernel(*args)
+
+    monkeypatch.setattr(clearance_module, "_KERNEL", [counted])
+    rng = np.random.default_rng(6)
+    Q = [configuration(engine, f) for f in rng.random((40, 18))]
+    reports = [engine.report(q) for q in Q]
+    assert len(calls) == len(Q) - clearance_module.COMPILED_AFTER
+    fresh = ClearanceEngine(design)
+    fresh._one_arrays().queries = -(10**12)
+    assert [repr(fresh.report(q)) for q in Q] == [repr(x) for x in reports]
+
+
+@settings(max_examples=300, deadline=None)
+@given(coordinates=st.lists(st.floats(-50, 50, allow_subnormal=False), min_size=12,
+                            max_size=12),
+       degenerate=st.sampled_from([None, 0, 1, 2]))  # fmt: skip
+def test_the_compiled_segment_distance_is_the_plain_one_bit_for_bit(coordinates, degenerate):
+    from kinegami.clearance.kernels import segment_distance_compiled
+    from kinegami.geometry.segments import segment_distance
+
+    a1, b1, a2, b2 = (coordinates[k : k + 3] for k in range(0, 12, 3))
+    if degenerate in (0, 2):
+        b1 = list(a1)  # a point
+    if degenerate in (1, 2):
+        b2 = list(a2)
+    expected = segment_distance(a1, b1, a2, b2)
+    found = segment_distance_compiled(*a1, *b1, *a2, *b2)
+    assert repr(tuple(map(float, found))) == repr(expected)
+
+
+def test_without_numba_the_numpy_path_answers(monkeypatch):
+    """Where numba cannot run (no wheel, no cache it can write) the engine keeps to numpy."""
+    design, compiled, numpy_path = _paths("puma")
+    q = [joint.state for joint in design.Joints]
+    monkeypatch.setattr(clearance_module, "_KERNEL", [None])
+    engine = ClearanceEngine(design)
+    engine._one_arrays().queries = 10**12
+    assert repr(engine.report(q)) == repr(numpy_path.report(q)) == repr(compiled.report(q))
