@@ -471,6 +471,35 @@ def _cpu_median(fn, repeat: int) -> float:
     return statistics.median(times)
 
 
+def reach_rows() -> list[tuple[str, str, str]]:
+    """Issue 31: forward kinematics batched on a 6-joint arm (the PUMA), configurations per
+    second (median of 5 batches of 100,000: wall time, the throughput a user gets, and CPU
+    time, which counts both cores where the matrix products run on two BLAS threads), and
+    jacob0 per configuration (CPU)."""
+    from kinegami.design import load_design
+    from kinegami.reach import kinematics
+
+    puma = load_design(DESIGNS / "puma.json")
+    arm = kinematics(puma)
+    rng = np.random.default_rng(0)
+    low, high = arm.ranges[:, 0], arm.ranges[:, 1]
+    Q = low + (high - low) * rng.random((100_000, low.size))
+    arm.fkine(Q[:100])
+    walls = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        arm.fkine(Q)
+        walls.append(time.perf_counter() - t0)
+    t = _cpu_median(lambda: arm.fkine(Q), 5)
+    j = _cpu_median(lambda: arm.jacob0(Q[:20_000]), 5) / 20_000
+    return [
+        ("forward kinematics, PUMA, batches of 100,000 (wall / CPU)",
+         f"{Q.shape[0] / statistics.median(walls):,.0f} / {Q.shape[0] / t:,.0f} /s",
+         ">= 1,000,000 /s"),
+        ("jacob0, PUMA, batches of 20,000, per configuration", f"{j * 1e6:.2f} us", "-"),
+    ]  # fmt: skip
+
+
 def engine_rows() -> list[tuple[str, str, str]]:
     """Issue 29 section 4: the clearance engine fast enough to sample workspaces. CPU time
     (process_time, median of repeats) of sweep per configuration on the PUMA, the 9-joint
@@ -561,6 +590,7 @@ def steps(seeds: int, compact_seeds: int) -> list[tuple[str, Callable[[], Rows]]
         ("scale: 100-400-joint safe chains, a 1,000-row DH table", scale_rows),
         ("clearance engine and safe chains' clearance", lambda: clearance_rows(0)),
         ("clearance engine for workspaces: sweeps, one configuration, trees", engine_rows),
+        ("reach: forward kinematics and Jacobians", reach_rows),
     ]
     if compact_seeds > 0:
         out += [

@@ -319,6 +319,24 @@ class JointAssembly:
         """The parent of every joint (-1 for the root)."""
         return list(range(-1, len(self._joints) - 1))
 
+    def fkine(self, q=None, tip=None, tool=None):
+        """The tip's pose at ``q`` (default: the current states): a 4x4 array, (m, 4, 4) for
+        configurations (m, n); one state per joint of ``Joints``. See kinegami.reach."""
+        from kinegami.reach.forward import kinematics
+
+        return kinematics(self, tip, tool).fkine(self._states_or(q))
+
+    def jacob0(self, q=None, tip=None, tool=None):
+        """The tip's geometric Jacobian in the world frame at ``q`` (default: the current
+        states), rows (v, ω), one column per joint of ``Joints``. See kinegami.reach."""
+        from kinegami.reach.forward import kinematics
+
+        return kinematics(self, tip, tool).jacob0(self._states_or(q))
+
+    def _states_or(self, q):
+        """``q``, or the current states when None."""
+        return [joint.state for joint in self._joints] if q is None else q
+
     def joint_screws(self) -> JointScrews:
         """The joints as screws about their axes at the current states: the one forward
         kinematics of chains, trees and the clearance engine (kinegami.geometry.screws)."""

@@ -59,7 +59,7 @@ class JointScrews:
 
     __slots__ = ("kinds", "parents", "q_ref", "body_of", "moving", "body_parent", "bodies",
                  "chain_bodies", "revolute", "all_revolute", "axes", "points", "_K1", "_K2",
-                 "_ref_moving", "_parent_list")
+                 "_ref_moving", "_parent_list", "_elementary")
 
     def __init__(self, kinds, axes, points, parents, q_ref) -> None:
         kinds = np.asarray(kinds, dtype=np.int64)
@@ -100,6 +100,7 @@ class JointScrews:
         self.points = np.asarray(points, dtype=float).reshape(J, 3)[m]
         self._ref_moving = self.q_ref[m]
         self._parent_list = self.body_parent.tolist()
+        self._elementary = None  # frame_poses' constants, made on first use
         for array in (kinds, parents, self.q_ref, body_of, self.moving, self.body_parent,
                       self.revolute, ax, self.points, K1, self._K2, self._ref_moving):  # fmt: skip
             array.setflags(write=False)
@@ -170,6 +171,72 @@ class JointScrews:
         for b in range(1, NB):
             matmul(B[parent[b]], M[b - 1], out=B[b])
         return B
+
+    def frame_poses(self, Q, bodies, frames, axes: bool = False):
+        """Poses of frames fixed in rigid bodies, at many configurations: for frame l, fixed in
+        body ``bodies[l]`` and at ``frames[l]`` (4x4) at ``q_ref``, its pose at each
+        configuration of ``Q`` (K, J): ``body_motions(Q)[:, bodies] @ frames`` to rounding
+        (1e-15 relative), several times faster on large batches.
+
+        Each body's motion is written as a product of elementary transforms (Robotics
+        Toolbox's ETS form): with Z_b a frame whose z is body b's joint axis, S_b(q) =
+        B_b(q) Z_b = S_parent(b)(q) (Z_parent(b)^-1 Z_b) Rz(d_b) (Tz(d_b) for a sliding joint),
+        a constant 4x4 product (one matrix product over the batch) and a turn of two columns.
+        Returns the poses (K, L, 4, 4); with ``axes``, ``(poses, axes)`` with every moving
+        joint's axis at each configuration, (K, M, 3, 4): frames [x y z o] whose z is the axis
+        direction and whose origin o is on it (what Jacobians need)."""
+        Q = np.asarray(Q, dtype=float)
+        K, NB = Q.shape[0], self.bodies
+        if self._elementary is None:
+            self._elementary = self._elementary_constants()
+        steps, inverse = self._elementary
+        bodies = np.asarray(bodies, dtype=np.int64)
+        delta = Q[:, self.moving] - self._ref_moving  # (K, M)
+        S = [None] * NB  # S_b, (K, 3, 4): the rows that move (the last is 0 0 0 1)
+        frames_out = np.empty((K, NB - 1, 3, 4)) if axes else None
+        for b in range(1, NB):
+            pb = self._parent_list[b]
+            if pb == 0:  # from the base: the constant itself
+                A = np.broadcast_to(steps[b - 1][:3], (K, 3, 4)).copy()
+            else:  # [R | t] (K*3, 4) @ (4, 4): one matrix product for the batch
+                A = (S[pb].reshape(-1, 4) @ steps[b - 1]).reshape(K, 3, 4)
+            if frames_out is not None:
+                frames_out[:, b - 1] = A
+            d = delta[:, b - 1, None]
+            if self.revolute[b - 1]:  # columns x, y turned by Rz(d): (x + iy) e^(-id)
+                A.view(np.complex128)[:, :, 0] *= np.exp(-1j * d)
+            else:
+                A[:, :, 3] += d * A[:, :, 2]
+            S[b] = A
+        poses = np.empty((K, bodies.size, 4, 4))
+        poses[..., 3, :] = _LAST_ROW
+        for l, b in enumerate(bodies.tolist()):  # noqa: E741 - frame l
+            E = inverse[b] @ np.asarray(frames[l], dtype=float)  # Z_b^-1 F, constant
+            if b == 0:
+                poses[:, l] = E
+                continue
+            poses[:, l, :3] = (S[b].reshape(-1, 4) @ E).reshape(K, 3, 4)
+        return (poses, frames_out) if axes else poses
+
+    def _elementary_constants(self) -> tuple[list, list]:
+        """For :meth:`frame_poses`: per moving body b, Z_parent(b)^-1 Z_b, and every body's
+        Z_b^-1 (the base's: the identity)."""
+        frames = [np.eye(4)]
+        for a, p in zip(self.axes, self.points, strict=True):
+            helper = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+            x = np.cross(helper, a)
+            x /= np.linalg.norm(x)
+            Z = np.eye(4)
+            Z[:3, 0], Z[:3, 1], Z[:3, 2], Z[:3, 3] = x, np.cross(a, x), a, p
+            frames.append(Z)
+        inverse = []
+        for Z in frames:
+            inv = np.eye(4)
+            inv[:3, :3] = Z[:3, :3].T
+            inv[:3, 3] = -Z[:3, :3].T @ Z[:3, 3]
+            inverse.append(inv)
+        steps = [inverse[self._parent_list[b]] @ frames[b] for b in range(1, self.bodies)]
+        return steps, inverse
 
     def joint_motions(self, Q) -> np.ndarray:
         """A_j(q) of every joint: (K, J, 4, 4) for ``Q`` (K, J), (J, 4, 4) for one
