@@ -333,6 +333,14 @@ class JointAssembly:
 
         return kinematics(self, tip, tool).jacob0(self._states_or(q))
 
+    def ikine(self, target, **options):
+        """States that put the tip on ``target`` (a pose, a position, a Target; a tree: a
+        mapping of tip to target), clear of itself: ``kinegami.reach.solve(self, target,
+        **options)``'s answer (``.ok``, ``.states``, ``.reason``). See kinegami.reach."""
+        from kinegami.reach.inverse import solve
+
+        return solve(self, target, **options)
+
     def _states_or(self, q):
         """``q``, or the current states when None."""
         return [joint.state for joint in self._joints] if q is None else q

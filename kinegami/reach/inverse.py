@@ -1,0 +1,564 @@
+"""Inverse kinematics that answers only with configurations in which the design does not pass
+through itself (docs/reach.md).
+
+:func:`solve` finds states that put a design's tip (or, for a tree, several tips at once) on a
+target: a pose, a position, or a position with the direction of the tip's z axis. Damped least
+squares (Levenberg-Marquardt) on the compiled kinematics (:mod:`kinegami.reach.forward`), the
+residual in units of r and radians, every iterate projected onto the joints' ranges, several
+starts iterated together (one numpy step for all), further starts when one stalls or its
+answer passes through itself. An answer is ``ok`` only when it is exact (within ``tol``), in
+range and clear by the design's own clearance engine. :func:`solve_many` solves a list of
+targets, all starts of all targets in one batch, and spreads chunks over any
+``concurrent.futures.Executor``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.reach.forward import Kinematics, kinematics
+
+__all__ = ["Answer", "Target", "solve", "solve_many"]
+
+#: Starts iterated together for one target (the first: q0 or the design's states).
+STARTS = 8
+#: Most starts tried for one target before it is given up.
+MAX_STARTS = 64
+#: Iterations of one start before it counts as stalled.
+ITERATIONS = 60
+#: Damping: first value, bounds (in units of the residual squared).
+DAMPING, DAMPING_MIN, DAMPING_MAX = 1e-3, 1e-12, 1e8
+
+
+@dataclass(frozen=True, eq=False)
+class Target:
+    """Where a tip should be (the design's length units, world frame).
+
+    Attributes
+    ----------
+    position : (3,) array
+    axis : (3,) unit array or None
+        The direction the tip's z axis must point along (rotation about it free).
+    rotation : (3, 3) array or None
+        The tip's orientation (a pose target); then ``axis`` is None.
+    """
+
+    position: np.ndarray
+    axis: np.ndarray | None = None
+    rotation: np.ndarray | None = None
+
+    def __post_init__(self):
+        position = _vector(self.position, "target position")
+        object.__setattr__(self, "position", position)
+        if self.axis is not None and self.rotation is not None:
+            raise InvalidParameterError("a target has an axis or a rotation, not both")
+        if self.axis is not None:
+            axis = _vector(self.axis, "target axis")
+            norm = float(np.linalg.norm(axis))
+            if not norm > 1e-12:
+                raise InvalidParameterError(f"target axis must not be zero, got {axis.tolist()}")
+            object.__setattr__(self, "axis", axis / norm)
+        if self.rotation is not None:
+            R = np.asarray(self.rotation, dtype=float)
+            rigid = R.shape == (3, 3) and np.isfinite(R).all() \
+                and np.abs(R.T @ R - np.eye(3)).max() <= 1e-9 and np.linalg.det(R) > 0  # fmt: skip
+            if not rigid:
+                raise InvalidParameterError("target rotation must be a 3x3 rotation matrix")
+            object.__setattr__(self, "rotation", R)
+
+    @property
+    def kind(self) -> str:
+        """"pose", "axis" or "position"."""
+        return "pose" if self.rotation is not None else "axis" if self.axis is not None \
+            else "position"  # fmt: skip
+
+    @classmethod
+    def of(cls, target) -> Target:
+        """A Target from a Target, a 4x4 pose (array or SE3) or a 3-vector."""
+        if isinstance(target, Target):
+            return target
+        A = getattr(target, "A", target)  # SE3
+        try:
+            A = np.asarray(A, dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidTypeError(
+                "target must be a 4x4 pose (array or SE3), a position (3 numbers) or a Target, "
+                f"got {target!r}"
+            ) from None
+        if A.shape == (4, 4):
+            from kinegami.chain.joints import pose_array
+
+            T = pose_array(A, "target")
+            return cls(T[:3, 3], rotation=T[:3, :3])
+        if A.shape == (3,):
+            return cls(A)
+        raise InvalidParameterError(
+            f"target must be a 4x4 pose, a position (3 numbers) or a Target, got shape {A.shape}"
+        )
+
+
+def _vector(value, name: str) -> np.ndarray:
+    try:
+        v = np.asarray(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InvalidTypeError(f"{name} must be 3 numbers, got {value!r}") from None
+    if v.shape != (3,) or not np.isfinite(v).all():
+        raise InvalidParameterError(f"{name} must be 3 finite numbers, got {np.asarray(value)!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class Answer:
+    """The answer to one target.
+
+    Attributes
+    ----------
+    ok : bool
+        Exact (within ``tol``), every state in its range and, unless ``clear=False`` was
+        asked, the design clear of itself at ``states``.
+    states : tuple of float
+        A full configuration (one state per joint of ``design.Joints``) that
+        ``setJointStates`` accepts: the answer when ok, else the nearest one found.
+    position_error : float
+        Distance of the tip from the target's position (design units; several tips: the
+        largest).
+    angle_error : float
+        The tip's orientation error (rad; 0 for a position target).
+    clearance : float
+        The smallest clearance at ``states`` (design units; negative: overlap depth).
+    pair : str
+        The parts that bind (closest), in words ("" when nothing is tested).
+    iterations, restarts : int
+        Iterations over all starts, and starts beyond the first.
+    reason : str
+        Why not ok, in one sentence ("" when ok).
+    """
+
+    ok: bool
+    states: tuple
+    position_error: float
+    angle_error: float
+    clearance: float
+    pair: str
+    iterations: int
+    restarts: int
+    reason: str = ""
+    tips: tuple = field(default=())
+
+
+def solve(design, target, *, tip=None, tool=None, q0=None, seed: int = 0, clear: bool = True,
+          tol=(1e-9, 1e-9), margin=None) -> Answer:  # fmt: skip
+    """States that put ``design``'s tip on ``target``.
+
+    Parameters
+    ----------
+    design : KinematicChain or KinematicTree
+    target : 4x4 pose (array or SE3), 3-vector position, :class:`Target`; for a tree, a
+        mapping of tip joint index to any of these (every tip at once).
+    tip : int, optional
+        The tip joint (default: a chain's last joint; a tree needs a mapping or ``tip``).
+    tool : 4x4 array or SE3, optional
+        A fixed frame on the tip.
+    q0 : configuration, optional
+        The first start (default: the design's current states).
+    seed : int
+        The other starts' random seed (the answer is the same for the same seed).
+    clear : bool
+        Require the design to be clear of itself at the answer (default True).
+    tol : (position, angle)
+        Exactness: position error in units of r, angle error in rad (default 1e-9 each).
+    margin : float, optional
+        The clearance required (design units; default: the design's margin).
+    """
+    return solve_many(design, [target], tip=tip, tool=tool, q0=q0, seed=seed, clear=clear,
+                      tol=tol, margin=margin)[0]  # fmt: skip
+
+
+def solve_many(design, targets, *, tip=None, tool=None, q0=None, seed: int = 0,
+               clear: bool = True, tol=(1e-9, 1e-9), margin=None, executor=None,
+               chunk: int = 256) -> list[Answer]:  # fmt: skip
+    """:func:`solve` for every target of ``targets``, in order: the starts of all targets are
+    iterated in one batch; with ``executor`` (any ``concurrent.futures.Executor``: threads,
+    processes, a Dask cluster's), chunks of ``chunk`` targets run on it. A target's starts
+    come from ``seed`` and the target itself, so ``chunk=1`` gives :func:`solve`'s answers;
+    the same chunks give the same answers on any executor (larger batches may round the
+    iterates otherwise and settle on another solution, as good)."""
+    if not isinstance(targets, Sequence) or isinstance(targets, str):
+        raise InvalidTypeError(f"targets must be a list of targets, got {type(targets).__name__}")
+    tol_p, tol_a = _tolerance(tol)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise InvalidTypeError(f"seed must be an int, got {seed!r}")
+    if not isinstance(clear, bool):
+        raise InvalidTypeError(f"clear must be True or False, got {clear!r}")
+    if margin is not None:
+        from kinegami.validation import check_margin
+
+        margin = check_margin(margin)
+    goals = [_goals(design, t, tip) for t in targets]
+    tips = sorted({k for goal in goals for k in goal})
+    compiled = kinematics(design, tips if tips else None, tool)
+    start = compiled.configurations(
+        [joint.state for joint in design.Joints] if q0 is None else q0)[0][0]
+    options = (tol_p, tol_a, int(seed), clear, margin)
+    chunk = max(1, int(chunk))
+    pieces = [list(range(a, min(a + chunk, len(goals)))) for a in range(0, len(goals), chunk)]
+    if executor is None:
+        results = [_solve_chunk(design, compiled, [goals[k] for k in piece], piece, start,
+                                options) for piece in pieces]  # fmt: skip
+    else:
+        futures = [executor.submit(_solve_chunk, design, compiled, [goals[k] for k in piece],
+                                   piece, start, options) for piece in pieces]  # fmt: skip
+        results = [future.result() for future in futures]
+    return [answer for part in results for answer in part]
+
+
+def _tolerance(tol) -> tuple[float, float]:
+    try:
+        p, a = (float(x) for x in tol)
+    except (TypeError, ValueError):
+        raise InvalidTypeError(f"tol must be (position in r, angle in rad), got {tol!r}") from None
+    if not (p > 0 and a > 0 and math.isfinite(p) and math.isfinite(a)):
+        raise InvalidParameterError(f"tol must be two positive numbers, got {tol!r}")
+    return p, a
+
+
+def _goals(design, target, tip) -> dict[int, Target]:
+    """The target as {tip joint: Target}."""
+    n = len(design.Joints)
+    if isinstance(target, Mapping):
+        if tip is not None:
+            raise InvalidParameterError("give tip or a mapping of tip to target, not both")
+        out = {}
+        for k, t in target.items():
+            if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < n:
+                raise InvalidParameterError(f"target tip {k!r} is not a joint index: 0 to {n - 1}")
+            out[int(k)] = Target.of(t)
+        if not out:
+            raise InvalidParameterError("a mapping of tips to targets must not be empty")
+        return out
+    if tip is None:
+        leaves = [k for k in range(n) if k not in {p for p in design.Parents if p >= 0}]
+        if len(leaves) != 1:
+            raise InvalidParameterError(
+                f"the design has {len(leaves)} tips ({leaves}): give tip=J or a mapping "
+                "{tip: target, ...}"
+            )
+        tip = leaves[0]
+    if isinstance(tip, bool) or not isinstance(tip, (int, np.integer)) or not 0 <= tip < n:
+        raise InvalidParameterError(f"tip {tip!r} is not a joint index: 0 to {n - 1}")
+    return {int(tip): Target.of(target)}
+
+
+def _rotation_vector(R: np.ndarray) -> np.ndarray:
+    """(..., 3): the rotation vectors (axis times angle) of rotations R (..., 3, 3)."""
+    w = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
+                  R[..., 1, 0] - R[..., 0, 1]], axis=-1)  # fmt: skip
+    s = 0.5 * np.linalg.norm(w, axis=-1)
+    c = 0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0)
+    angle = np.arctan2(s, np.clip(c, -1.0, 1.0))
+    small = s < 1e-12
+    scale = np.where(small, 0.5, angle / (2.0 * np.where(small, 1.0, s)))
+    out = w * scale[..., None]
+    # near pi: the axis from the symmetric part
+    near_pi = small & (c < 0.0)
+    if near_pi.any():
+        B = 0.5 * (R[near_pi] + np.eye(3))
+        k = np.argmax(np.diagonal(B, axis1=-2, axis2=-1), axis=-1)
+        axis = B[np.arange(k.size), :, k]
+        axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+        out[near_pi] = axis * math.pi
+    return out
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    out = np.zeros(v.shape[:-1] + (3, 3))
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+class _Problem:
+    """Residuals and Jacobians of a batch of (target, start) rows: every row has the same tips
+    and target kinds (a chunk's targets are grouped by them)."""
+
+    def __init__(self, compiled: Kinematics, goals: list[dict[int, Target]], r: float):
+        self.K = compiled
+        self.r = r
+        self.tip_index = {t: k for k, t in enumerate(compiled.tips)}
+        self.keys = sorted(goals[0])
+        self.kinds = [goals[0][k].kind for k in self.keys]
+        self.position = np.array([[g[k].position for k in self.keys] for g in goals])  # (G,T,3)
+        self.axis = np.array([[g[k].axis if g[k].axis is not None else np.zeros(3)
+                               for k in self.keys] for g in goals])  # fmt: skip
+        self.rotation = np.array([[g[k].rotation if g[k].rotation is not None else np.eye(3)
+                                   for k in self.keys] for g in goals])  # fmt: skip
+        self.movable = compiled.movable
+
+    def evaluate(self, Q: np.ndarray, rows: np.ndarray, jacobian: bool):
+        """Residual (m, E) in units of r and rad, errors (m,) position (design units) and
+        angle (rad), and with ``jacobian`` the residual's Jacobian (m, E, movable)."""
+        if jacobian:
+            J, T = self.K.jacobians(Q)
+        else:
+            T = self.K.tip_poses(Q)
+        parts, jparts = [], []
+        pos_err = np.zeros(Q.shape[0])
+        ang_err = np.zeros(Q.shape[0])
+        for n, key in enumerate(self.keys):
+            k = self.tip_index[key]
+            p = T[:, k, :3, 3]
+            dp = self.position[rows, n] - p
+            parts.append(dp / self.r)
+            pos_err = np.maximum(pos_err, np.linalg.norm(dp, axis=-1))
+            if jacobian:
+                jparts.append(J[:, k, :3][:, :, self.movable] / self.r)
+            kind = self.kinds[n]
+            if kind == "pose":
+                R = T[:, k, :3, :3]
+                w = _rotation_vector(self.rotation[rows, n] @ np.swapaxes(R, -1, -2))
+                parts.append(w)
+                ang_err = np.maximum(ang_err, np.linalg.norm(w, axis=-1))
+                if jacobian:
+                    jparts.append(J[:, k, 3:][:, :, self.movable])
+            elif kind == "axis":
+                z = T[:, k, :3, 2]
+                a = self.axis[rows, n]
+                parts.append(a - z)  # zero exactly when z points along a
+                ang_err = np.maximum(ang_err, np.arctan2(np.linalg.norm(np.cross(z, a), axis=-1),
+                                                         np.sum(z * a, axis=-1)))  # fmt: skip
+                if jacobian:  # dz = w x z = -[z]x w
+                    jparts.append(-_skew(z) @ J[:, k, 3:][:, :, self.movable])
+        e = np.concatenate(parts, axis=-1)
+        if not jacobian:
+            return e, pos_err, ang_err
+        return e, pos_err, ang_err, np.concatenate(jparts, axis=1)
+
+
+def _solve_chunk(design, compiled: Kinematics, goals: list, indices: list, start: np.ndarray,
+                 options: tuple) -> list[Answer]:  # fmt: skip
+    """The answers to ``goals`` (target k of the whole list is ``indices[k]``: its starts'
+    seed). Targets with the same tips and kinds are iterated together."""
+    groups: dict[tuple, list[int]] = {}
+    for k, goal in enumerate(goals):
+        groups.setdefault(tuple((t, goal[t].kind) for t in sorted(goal)), []).append(k)
+    answers: list[Answer | None] = [None] * len(goals)
+    for members in groups.values():
+        found = _solve_group(design, compiled, [goals[k] for k in members],
+                             [indices[k] for k in members], start, options)  # fmt: skip
+        for k, answer in zip(members, found, strict=True):
+            answers[k] = answer
+    return answers  # type: ignore[return-value]
+
+
+def _solve_group(design, compiled, goals, indices, start, options) -> list[Answer]:
+    tol_p, tol_a, seed, clear, margin = options
+    r = float(design.r)
+    problem = _Problem(compiled, goals, r)
+    G = len(goals)
+    low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+    mov = compiled.movable
+    rngs = [np.random.default_rng([seed, *_words(goal)]) for goal in goals]
+
+    def fresh(g: int, first: bool) -> np.ndarray:
+        if first:
+            return np.clip(start, low, high)
+        return low + (high - low) * rngs[g].random(low.size)
+
+    # rows of the batch: (goal, start); STARTS rows per goal at first
+    owner = np.repeat(np.arange(G), STARTS)
+    Q = np.array([fresh(g, s == 0) for g in range(G) for s in range(STARTS)])
+    # a target a bound puts out of reach: one start, a few iterations for the nearest
+    # configuration, no restarts (the verdict is known)
+    hopeless = np.array([bool(_beyond_reach(compiled, goal)) for goal in goals])
+    if hopeless.any():
+        keep = ~hopeless[owner] | (np.arange(owner.size) % STARTS == 0)
+        owner, Q = owner[keep], Q[keep]
+    budget = np.where(hopeless, 1, MAX_STARTS)
+    patience = np.where(hopeless, 12, ITERATIONS)
+    damping = np.full(owner.size, DAMPING)
+    age = np.zeros(owner.size, dtype=np.int64)
+    started = np.where(hopeless, 1, STARTS)
+    iterations = np.zeros(G, dtype=np.int64)
+    done = np.zeros(G, dtype=bool)
+    best: list[tuple | None] = [None] * G  # (score, q, pos, ang, clearance, pair, clear_ok)
+    answers: list[Answer | None] = [None] * G
+    collided: list[str] = [""] * G
+    active = np.ones(owner.size, dtype=bool)
+    while active.any():
+        rows = np.flatnonzero(active)
+        g_rows = owner[rows]
+        e, pos, ang, J = problem.evaluate(Q[rows], g_rows, True)
+        np.add.at(iterations, g_rows, 1)
+        # converged rows: judged (range is kept by projection; clearance by the design)
+        exact = (pos <= tol_p * r) & (ang <= tol_a)
+        for i in np.flatnonzero(exact).tolist():
+            row, g = rows[i], g_rows[i]
+            if done[g]:
+                active[row] = False
+                continue
+            verdict = _judge(design, Q[row], clear, margin)
+            _keep(best, g, Q[row], pos[i], ang[i], verdict)
+            if verdict[2]:
+                done[g] = True
+                answers[g] = _answer(best[g], iterations[g], started[g] - 1, "", problem)
+            else:
+                collided[g] = verdict[1]
+            active[row] = False
+        # a damped least-squares step for the others
+        step_rows = np.flatnonzero(~exact)
+        if step_rows.size:
+            sr = rows[step_rows]
+            Jr, er = J[step_rows], e[step_rows]
+            lam = damping[sr]
+            A = Jr @ np.swapaxes(Jr, -1, -2)
+            A[:, np.arange(A.shape[1]), np.arange(A.shape[1])] += lam[:, None]
+            dq = np.einsum("kej,ke->kj", Jr, np.linalg.solve(A, er[..., None])[..., 0])
+            trial = Q[sr].copy()
+            trial[:, mov] = np.clip(trial[:, mov] + dq, low[mov], high[mov])
+            e2, pos2, ang2 = problem.evaluate(trial, owner[sr], False)
+            better = np.einsum("ke,ke->k", e2, e2) < np.einsum("ke,ke->k", er, er)
+            Q[sr[better]] = trial[better]
+            damping[sr] = np.clip(np.where(better, lam * 0.3, lam * 8.0), DAMPING_MIN,
+                                  DAMPING_MAX)  # fmt: skip
+            age[sr] += 1
+            now_pos = np.where(better, pos2, pos[step_rows])
+            now_ang = np.where(better, ang2, ang[step_rows])
+            for i in range(sr.size):  # the nearest so far, for an answer that is not ok
+                g = owner[sr[i]]
+                if not done[g]:
+                    _keep(best, g, Q[sr[i]], now_pos[i], now_ang[i], None)
+            # stalled starts (too old, or damped to nothing): a new start, within the budget
+            stalled = (age[sr] >= patience[owner[sr]]) | (damping[sr] >= DAMPING_MAX)
+            for row in sr[stalled].tolist():
+                g = owner[row]
+                if done[g] or started[g] >= budget[g]:
+                    active[row] = False
+                    continue
+                Q[row] = fresh(g, False)
+                started[g] += 1
+                damping[row], age[row] = DAMPING, 0
+        for row in np.flatnonzero(active).tolist():
+            if done[owner[row]]:
+                active[row] = False
+    for g in range(G):
+        if answers[g] is None:
+            answers[g] = _failure(design, best[g], iterations[g], started[g] - 1, collided[g],
+                                  options, compiled, goals[g], problem)  # fmt: skip
+    return answers  # type: ignore[return-value]
+
+
+def _words(goal: dict) -> list[int]:
+    """The target as 32-bit words: its starts' seed, so that a target gets the same starts
+    wherever it is in a list (and solve_many's answers are solve's)."""
+    parts = []
+    for tip in sorted(goal):
+        target = goal[tip]
+        parts += [np.array([tip], dtype=float), target.position]
+        parts += [x.reshape(-1) for x in (target.axis, target.rotation) if x is not None]
+    return np.frombuffer(np.concatenate(parts).tobytes(), dtype=np.uint32).tolist()
+
+
+def _judge(design, q: np.ndarray, clear: bool, margin) -> tuple[float, str, bool]:
+    """(clearance, binding pair in words, acceptable) of the design at ``q``."""
+    report = design.clearance(q.tolist(), margin)
+    pair = "" if report.closest is None else f"{report.closest.first} and {report.closest.second}"
+    return report.min_clearance, pair, (report.ok or not clear)
+
+
+def _keep(best: list, g: int, q, pos: float, ang: float, verdict) -> None:
+    """Keep the nearest configuration of goal g (an exact clear one over everything)."""
+    score = (0 if verdict is not None and verdict[2] else 1, float(pos), float(ang))
+    if best[g] is None or score < best[g][0]:
+        best[g] = (score, np.array(q, dtype=float), float(pos), float(ang), verdict)
+
+
+def _answer(kept, iterations, restarts, reason, problem) -> Answer:
+    _, q, pos, ang, verdict = kept
+    clearance, pair, ok = verdict if verdict is not None else (math.nan, "", False)
+    return Answer(ok and not reason, tuple(float(x) for x in q), pos, ang, float(clearance),
+                  pair, int(iterations), int(restarts), reason, tuple(problem.keys))  # fmt: skip
+
+
+def _failure(design, kept, iterations, restarts, collided, options, compiled, goal,
+             problem) -> Answer:  # fmt: skip
+    """The answer when no start gave an exact, clear configuration: the nearest one, and
+    why in one sentence."""
+    tol_p, tol_a, _, clear, margin = options
+    _, q, pos, ang, verdict = kept
+    if verdict is None:
+        verdict = _judge(design, q, clear, margin)
+    r = float(design.r)
+    reach = _beyond_reach(compiled, goal)
+    if reach:
+        reason = reach
+    elif collided and pos <= tol_p * r and ang <= tol_a:
+        reason = f"every solution found passes through itself ({collided})"
+    elif collided:
+        reason = f"every exact solution found passes through itself ({collided})"
+    elif pos <= tol_p * r:
+        reason = f"orientation not attainable: the nearest is {ang:.3g} rad off"
+    else:
+        at = _at_limit(compiled, q)
+        reason = f"not reached: the nearest tip position is {pos:.4g} away" + \
+            (f"; {at}" if at else "")  # fmt: skip
+    kept = (kept[0], q, pos, ang, verdict)
+    return _answer(kept, iterations, restarts, reason, problem)
+
+
+def _at_limit(compiled: Kinematics, q: np.ndarray) -> str:
+    low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+    at = [k for k in compiled.movable.tolist()
+          if q[k] <= low[k] + 1e-12 or q[k] >= high[k] - 1e-12]  # fmt: skip
+    if not at:
+        return ""
+    k = at[0]
+    return f"joint {k} is at its limit ({q[k]:.6g} of [{low[k]:.6g}, {high[k]:.6g}])"
+
+
+def _beyond_reach(compiled: Kinematics, goal: dict) -> str:
+    """A sentence when a bound proves a target position out of reach, else ""."""
+    screws = compiled.screws
+    if screws.moving.size == 0:
+        return ""
+    for tip, target in goal.items():
+        radius, centre = reach_bound(compiled, tip)
+        distance = float(np.linalg.norm(target.position - centre))
+        if distance > radius * (1.0 + 1e-9) + 1e-9:
+            return (f"beyond reach: the target is {distance:.6g} from the first moving joint's "
+                    f"axis point, and the tip reaches at most {radius:.6g} from it")
+    return ""
+
+
+def reach_bound(compiled: Kinematics, tip: int) -> tuple[float, np.ndarray]:
+    """(R, c): the tip of joint ``tip`` stays within R of c for every configuration; c is a
+    point on the axis of the first moving joint on its path (fixed in the base). Along the
+    path each revolute joint's axis point is fixed in the bodies on both sides, so the
+    distances between consecutive axis points (and to the tip) do not change; a prismatic
+    joint adds its stroke."""
+    screws = compiled.screws
+    k = compiled.tips.index(tip)
+    b = int(screws.body_of[tip])
+    path = []
+    while b > 0:
+        path.append(b - 1)
+        b = int(screws.body_parent[b])
+    path.reverse()
+    tip_point = compiled.tip_frames[k, :3, 3]
+    if not path:
+        return 0.0, tip_point
+    points = screws.points[path]
+    ranges = compiled.ranges[screws.moving[path]]
+    q_ref = screws.q_ref[screws.moving[path]]
+    radius = 0.0
+    for m in range(len(path)):
+        following = points[m + 1] if m + 1 < len(path) else tip_point
+        radius += float(np.linalg.norm(following - points[m]))
+        if not screws.revolute[path[m]]:
+            radius += float(np.abs(ranges[m] - q_ref[m]).max())
+    return radius, points[0]

@@ -1,0 +1,194 @@
+"""Inverse kinematics (kinegami.reach.inverse, docs/reach.md): targets that are tip poses of
+random clear configurations are reached, and every ok answer is checked through
+setJointStates and the design's own clearance, not the solver's numbers; unreachable targets
+say why without raising; trees reach every fingertip at once; solve_many gives solve's
+answers, also on an executor; bad input is one clear line."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+from spatialmath import SE3
+
+from kinegami.design import load_design
+from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.reach import Target, kinematics, solve, solve_many
+
+DESIGNS = Path(__file__).resolve().parents[2] / "examples" / "designs"
+
+
+def clear_configurations(design, count: int, seed: int) -> list[np.ndarray]:
+    compiled = kinematics(design)
+    rng = np.random.default_rng(seed)
+    low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+    found = []
+    while len(found) < count:
+        q = low + (high - low) * rng.random(low.size)
+        if design.clearance(q.tolist()).ok:
+            found.append(q)
+    return found
+
+
+def check(path: Path, answer, goals: dict) -> None:
+    """An ok answer, checked by the design itself: setJointStates accepts it (with
+    requireClearance on), the tips are on the targets, the design is clear."""
+    assert answer.ok, answer.reason
+    moved = load_design(path)
+    moved.requireClearance = True
+    assert moved.setJointStates(list(answer.states))
+    assert moved.clearance().ok
+    r = float(moved.r)
+    for tip, target in goals.items():
+        frame = moved.Joints[tip].distal_dubins_frame()
+        assert np.linalg.norm(frame[:3, 3] - target.position) <= 1e-9 * r + 1e-12 * r
+        if target.rotation is not None:
+            R = target.rotation @ frame[:3, :3].T
+            w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+            assert math.atan2(0.5 * np.linalg.norm(w), 0.5 * (np.trace(R) - 1)) <= 2e-9
+        if target.axis is not None:
+            assert np.degrees(math.acos(min(1.0, float(frame[:3, 2] @ target.axis)))) <= 1e-6
+
+
+@pytest.mark.parametrize("name", ["puma", "prismatic_spiral", "example1"])
+def test_poses_of_clear_configurations_are_reached(name):
+    path = DESIGNS / f"{name}.json"
+    design = load_design(path)
+    compiled = kinematics(design)
+    tip = compiled.tips[0]
+    for q in clear_configurations(design, 6, seed=1):
+        target = Target.of(compiled.fkine(q))
+        answer = solve(design, compiled.fkine(q))
+        check(path, answer, {tip: target})
+        assert answer.position_error <= 1e-9 * design.r and answer.angle_error <= 1e-9
+        assert answer.clearance >= 0.0 and answer.reason == ""
+
+
+def test_positions_and_axes_and_se3_targets():
+    path = DESIGNS / "puma.json"
+    design = load_design(path)
+    compiled = kinematics(design)
+    (q,) = clear_configurations(design, 1, seed=2)
+    T = compiled.fkine(q)
+    for target in (T[:3, 3], Target(T[:3, 3], axis=T[:3, 2]), SE3(T, check=False)):
+        answer = design.ikine(target)  # the chain's own word
+        check(path, answer, {compiled.tips[0]: Target.of(target)})
+
+
+def test_every_fingertip_of_a_hand_at_once():
+    path = DESIGNS / "hand.json"
+    hand = load_design(path)
+    compiled = kinematics(hand)
+    for q in clear_configurations(hand, 3, seed=3):
+        poses = compiled.fkine(q)
+        goals = {tip: Target(poses[k][:3, 3]) for k, tip in enumerate(compiled.tips)}
+        answer = solve(hand, goals)
+        check(path, answer, goals)
+        assert answer.tips == compiled.tips
+
+
+def test_a_target_beyond_reach_says_so_and_does_not_raise():
+    design = load_design(DESIGNS / "puma.json")
+    answer = solve(design, [1e5, 0.0, 0.0])
+    assert not answer.ok and answer.reason.startswith("beyond reach: the target is 100000")
+    assert answer.restarts == 0 and len(answer.states) == len(design.Joints)
+    low = [j.stateRange()[0] for j in design.Joints]
+    high = [j.stateRange()[1] for j in design.Joints]
+    assert all(lo <= s <= hi for s, lo, hi in zip(answer.states, low, high, strict=True))
+    assert design.setJointStates(list(answer.states)) in (True, False)  # accepted as input
+
+
+def test_an_orientation_the_tip_cannot_take_is_not_a_false_success():
+    """The example chain's tip cannot point every way at every position: a pose target whose
+    position is reachable but whose rotation is turned far away is not ok, and says why."""
+    design = load_design(DESIGNS / "example1.json")
+    compiled = kinematics(design)
+    (q,) = clear_configurations(design, 1, seed=4)
+    T = compiled.fkine(q) @ SE3.Rx(2.5).A @ SE3.Ry(1.2).A
+    answer = solve(design, T)
+    if answer.ok:  # then it really is exact: check it
+        check(DESIGNS / "example1.json", answer, {compiled.tips[0]: Target.of(T)})
+    else:
+        assert answer.reason and answer.angle_error > 1e-9
+
+
+def test_clear_false_accepts_a_colliding_answer_and_clear_true_never_does():
+    design = load_design(DESIGNS / "puma.json")
+    compiled = kinematics(design)
+    rng = np.random.default_rng(8)
+    low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+    while True:
+        q = low + (high - low) * rng.random(low.size)
+        if not design.clearance(q.tolist()).ok:
+            break
+    target = compiled.fkine(q)
+    loose = solve(design, target, q0=q, clear=False)
+    assert loose.ok and loose.position_error <= 1e-9 * design.r
+    strict = solve(design, target, q0=q)
+    if strict.ok:
+        assert design.clearance(list(strict.states)).ok
+    else:
+        assert "passes through itself" in strict.reason
+
+
+def test_answers_are_deterministic_and_solve_many_is_solve_on_any_executor():
+    design = load_design(DESIGNS / "prismatic_spiral.json")
+    compiled = kinematics(design)
+    targets = [compiled.fkine(q) for q in clear_configurations(design, 5, seed=5)]
+    targets.append([1e6, 0.0, 0.0])
+    one_by_one = [solve(design, t, seed=3) for t in targets]
+    assert [a.states for a in one_by_one] == [solve(design, t, seed=3).states for t in targets]
+    assert solve_many(design, targets, seed=3, chunk=1) == one_by_one
+    batched = solve_many(design, targets, seed=3, chunk=2)
+    with ThreadPoolExecutor(2) as pool:
+        spread = solve_many(design, targets, seed=3, executor=pool, chunk=2)
+    assert spread == batched
+    assert [a.ok for a in batched] == [a.ok for a in one_by_one] == [True] * 5 + [False]
+    assert solve_many(design, targets[::-1], seed=3, chunk=1) == one_by_one[::-1]
+
+
+def test_solve_many_on_a_dask_cluster():
+    distributed = pytest.importorskip("distributed")
+    design = load_design(DESIGNS / "prismatic_spiral.json")
+    compiled = kinematics(design)
+    targets = [compiled.fkine(q) for q in clear_configurations(design, 4, seed=6)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                      dashboard_address=None) as cluster:  # fmt: skip
+            with distributed.Client(cluster) as client:
+                answers = solve_many(design, targets, executor=client.get_executor(), chunk=2)
+    assert all(a.ok for a in answers)
+    assert [a.states for a in answers] == [a.states for a in solve_many(design, targets,
+                                                                        chunk=2)]  # fmt: skip
+
+
+@pytest.mark.parametrize("target, tip, error, words", [
+    ("here", None, InvalidTypeError, "target must be a 4x4 pose"),
+    ([1.0, 2.0], None, InvalidParameterError, "got shape \\(2,\\)"),
+    ([1.0, math.nan, 2.0], None, InvalidParameterError, "3 finite numbers"),
+    (np.ones((4, 4)), None, InvalidParameterError, "target"),
+    ([1.0, 2.0, 3.0], 99, InvalidParameterError, "tip 99 is not a joint index"),
+    ({99: [1.0, 2.0, 3.0]}, None, InvalidParameterError, "target tip 99"),
+])  # fmt: skip
+def test_bad_targets_are_one_clear_line(target, tip, error, words):
+    design = load_design(DESIGNS / "puma.json")
+    with pytest.raises(error, match=words) as raised:
+        solve(design, target, tip=tip)
+    assert "\n" not in str(raised.value)
+
+
+def test_bad_options_are_one_clear_line():
+    design = load_design(DESIGNS / "puma.json")
+    with pytest.raises(InvalidParameterError, match="tol must be two positive numbers"):
+        solve(design, [0.0, 0.0, 500.0], tol=(0.0, 1e-9))
+    with pytest.raises(InvalidTypeError, match="seed must be an int"):
+        solve(design, [0.0, 0.0, 500.0], seed=1.5)
+    with pytest.raises(InvalidParameterError, match="q must have shape"):
+        solve(design, [0.0, 0.0, 500.0], q0=[0.0])
+    with pytest.raises(InvalidParameterError, match="tips"):
+        solve(load_design(DESIGNS / "hand.json"), [0.0, 0.0, 1.0])  # a tree: which tip?
