@@ -635,7 +635,8 @@ def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEO
         if not queue:
             return
         proc = _spawn(kind, queue, memory, nice)
-        state = {"queue": queue, "current": None, "since": time.monotonic(), "cpu": 0.0}
+        state = {"queue": queue, "current": None, "since": time.monotonic(), "cpu": 0.0,
+                 "pending": b""}  # fmt: skip
         running[proc] = state
         selector.register(proc.stdout, selectors.EVENT_READ, proc)
 
@@ -676,22 +677,27 @@ def run(kind: str, seeds: list[int], *, workers: int = 1, timeout: float = TIMEO
         for key, _ in selector.select(timeout=0.5):
             proc = key.data
             state = running[proc]
-            line = proc.stdout.readline()
-            if not line:
+            # read what the pipe holds, not one line: a buffered readline may take two lines
+            # from the pipe and leave the second in its buffer, where the selector never
+            # sees it (a case's "start" lost that way was never judged a hang)
+            data = os.read(proc.stdout.fileno(), 1 << 16)
+            if not data:
                 stop(proc, "crash")
                 continue
-            event = json.loads(line)
-            if "start" in event:
-                state["current"], state["since"] = event["start"], time.monotonic()
-                state["cpu"] = _cpu_seconds(proc.pid)
-                continue
-            if event["status"] == "ok":
-                result["ok"] += 1
-                head = event["detail"].split(";")[0].split(":")[0].split(" of ")[0]
-                result["outcomes"][head] = result["outcomes"].get(head, 0) + 1
-            else:
-                problem(event["seed"], event["status"], event["detail"])
-            finish_case(state, event["seed"])
+            *lines, state["pending"] = (state["pending"] + data).split(b"\n")
+            for line in lines:
+                event = json.loads(line)
+                if "start" in event:
+                    state["current"], state["since"] = event["start"], time.monotonic()
+                    state["cpu"] = _cpu_seconds(proc.pid)
+                    continue
+                if event["status"] == "ok":
+                    result["ok"] += 1
+                    head = event["detail"].split(";")[0].split(":")[0].split(" of ")[0]
+                    result["outcomes"][head] = result["outcomes"].get(head, 0) + 1
+                else:
+                    problem(event["seed"], event["status"], event["detail"])
+                finish_case(state, event["seed"])
         now = time.monotonic()
         for proc, state in list(running.items()):
             if state["current"] is None:

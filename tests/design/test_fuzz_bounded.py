@@ -69,6 +69,28 @@ def test_the_runner_catches_hangs_memory_errors_and_bad_failures(fuzz):
     assert "MemoryError" in details[2] and "ValueError" in details[3]
 
 
+def test_events_that_arrive_together_are_all_read(fuzz, monkeypatch):
+    """A worker's lines can reach the runner in one read (a case that ends as the next
+    starts): every one of them counts, so the next case's start is seen and its hang caught
+    (a buffered readline kept the second line where the selector never looked: the runner
+    then waited for ever, as CI once did)."""
+    import subprocess
+
+    script = ("import sys, time; sys.stdout.write('{\"start\": 0}\\n{\"seed\": 0, "
+              "\"status\": \"ok\", \"detail\": \"fine\"}\\n{\"start\": 1}\\n'); "
+              "sys.stdout.flush(); end = time.monotonic() + 60\n"
+              "while time.monotonic() < end: pass")  # fmt: skip
+
+    def spawn(kind, seeds, memory, nice):
+        return subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)  # fmt: skip
+
+    monkeypatch.setattr(fuzz, "_spawn", spawn)
+    result = fuzz.run("selftest", [0, 1], workers=1, timeout=1.0)
+    assert result["ok"] == 1 and result["cases"] == 2
+    assert [(seed, status) for seed, status, _ in result["problems"]] == [(1, "hang")]
+
+
 def test_a_design_text_depends_on_its_seed_only(fuzz):
     assert fuzz.design_text(7) == fuzz.design_text(7)
     assert fuzz.design_text(7) != fuzz.design_text(8)
