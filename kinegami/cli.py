@@ -1054,6 +1054,122 @@ def cmd_compact(args: argparse.Namespace) -> int:
     return 0
 
 
+# --- reach ---------------------------------------------------------------------------------------
+#: Exit code of ``reach`` when the target is not reached (the reason is printed).
+NOT_REACHED = 3
+
+
+def _numbers(option: str, text: str, counts: tuple[int, ...]) -> list[float]:
+    """The comma-separated finite numbers of an option (as many as one of ``counts``)."""
+    import math
+
+    from kinegami.validation import shorten
+
+    parts = [part.strip() for part in text.split(",")]
+    try:
+        values = [float(part) for part in parts]
+    except ValueError:
+        values = []
+    if len(values) not in counts or not all(math.isfinite(v) for v in values):
+        spelled = " or ".join(str(c) for c in counts)
+        raise CommandError(f"{option}: must be {spelled} finite numbers separated by commas, "
+                           f"got {shorten(text)!r}")  # fmt: skip
+    return values
+
+
+def _reach_target(position: str, axis: str | None):
+    """A Target from ``--target X,Y,Z[,RX,RY,RZ]`` (the design's units; fixed-axis XYZ angles
+    in degrees: R = Rz(RZ) Ry(RY) Rx(RX)) and ``--axis AX,AY,AZ``."""
+    import math
+
+    import numpy as np
+
+    from kinegami.reach import Target
+
+    values = _numbers("--target", position, (3, 6))
+    if axis is not None:
+        if len(values) == 6:
+            raise CommandError("--axis: a target with angles (X,Y,Z,RX,RY,RZ) has no --axis")
+        return Target(values, axis=_numbers("--axis", axis, (3,)))
+    if len(values) == 3:
+        return Target(values)
+    rx, ry, rz = (math.radians(v) for v in values[3:])
+    cx, sx, cy, sy, cz, sz = (math.cos(rx), math.sin(rx), math.cos(ry), math.sin(ry),
+                              math.cos(rz), math.sin(rz))  # fmt: skip
+    Rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    Ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    Rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return Target(values[:3], rotation=Rz @ Ry @ Rx)
+
+
+def cmd_reach(args: argparse.Namespace) -> int:
+    import json
+    import math
+
+    from kinegami.clearance import Lengths
+    from kinegami.design import save_design
+    from kinegami.geometry.screws import REVOLUTE
+    from kinegami.reach import solve
+
+    seed = _integer("--seed", args.seed, 0)
+    axes = args.axis or []
+    if axes and len(axes) != len(args.target):
+        raise CommandError(f"--axis: give one per --target ({len(args.target)}), or none; got "
+                           f"{len(axes)}")  # fmt: skip
+    targets = [_reach_target(t, axes[k] if axes else None) for k, t in enumerate(args.target)]
+    out = None if args.output is None else Path(args.output)
+    if out is not None:
+        _check_design_output(out, args.design, args.force)
+    chain, info = _load(args.design)
+    _margin(args, chain)
+    n = len(chain.Joints)
+    tips = [_integer("--tip", t, 0, n - 1, "a joint index of the design") for t in args.tip]
+    if tips and len(tips) != len(targets):
+        raise CommandError(f"--tip: give one per --target ({len(targets)}); got {len(tips)}")
+    goal = dict(zip(tips, targets, strict=True)) if tips else targets[0]
+    if not tips and len(targets) > 1:
+        raise CommandError("--target: several targets need one --tip each")
+    answer = solve(chain, goal, seed=seed)
+    length = Lengths(chain.r, info.units)
+    names = _joint_names(chain) or (None,) * n
+    if args.json:
+        print(json.dumps({
+            "design": args.design, "reached": answer.ok, "reason": answer.reason,
+            "states": list(answer.states), "position_error": answer.position_error,
+            "angle_error": answer.angle_error,
+            "clearance": answer.clearance if math.isfinite(answer.clearance) else None,
+            "pair": answer.pair, "iterations": answer.iterations, "restarts": answer.restarts,
+            "tips": list(answer.tips), "seed": seed,
+        }, indent=2, allow_nan=False))  # fmt: skip
+    else:
+        title = f"{_printable(info.name)} ({args.design})" if info.name else args.design
+        verdict = "reached" if answer.ok else f"not reached: {answer.reason}"
+        lines = [f"{title}: {verdict}", "  states:"]
+        for k, (joint, state) in enumerate(zip(chain.Joints, answer.states, strict=True)):
+            if joint.stateRange() == (0.0, 0.0):
+                continue
+            name = f" {names[k]!r}" if names[k] else ""
+            value = f"{math.degrees(state):.6g} deg" if joint.motion == REVOLUTE \
+                else length(state)  # fmt: skip
+            lines.append(f"    joint {k}{name} ({type(joint).__name__}): {value}")
+        lines.append(f"  position error: {length.mm(answer.position_error)}; angle error: "
+                     f"{answer.angle_error:.3g} rad")  # fmt: skip
+        clear = "" if not answer.pair else f" ({answer.pair})"
+        lines.append(f"  clearance: {length(answer.clearance)}{clear}"
+                     if math.isfinite(answer.clearance) else "  clearance: nothing tested")
+        print("\n".join(_printable(line) for line in lines))
+    if out is not None and answer.ok:
+        chain.requireClearance = False  # judged above, with the design's margin
+        chain.setJointStates(list(answer.states))
+        written = save_design(chain, out, name=info.name, description=info.description,
+                              units=info.units, twistPortion=info.twistPortion)  # fmt: skip
+        if not args.json:
+            print(f"  written: {written}")
+    elif out is not None:
+        _note(args.command, f"{shown_path(out)} not written: the target was not reached")
+    return 0 if answer.ok else NOT_REACHED
+
+
 # --- parser ------------------------------------------------------------------------------------
 class _Parser(argparse.ArgumentParser):
     """argparse's parser, whose errors are one line as every other error of the command line
@@ -1177,6 +1293,45 @@ def make_parser() -> argparse.ArgumentParser:
         "default: the design's \"margin\", or 0: parts that touch are clear)",
     )  # fmt: skip
     check.set_defaults(run=cmd_check)
+
+    reach = commands.add_parser(
+        "reach",
+        help="find joint states that put a design's tip on a target, clear of itself",
+        description="Inverse kinematics (kinegami.reach.solve, docs/reach.md): joint states "
+        "that put the tip exactly on the target (1e-9 r, 1e-9 rad), every state in its range, "
+        "the design clear of itself. Prints the states, the errors, the clearance and the "
+        "verdict. Exit code 0: reached; 3: not reached (the reason is printed); 1: a design or "
+        "option error.",
+    )
+    reach.add_argument("design", metavar="DESIGN", help="design file (.json)")
+    reach.add_argument(
+        "--target", metavar="X,Y,Z[,RX,RY,RZ]", action="append", required=True,
+        help="the tip's position in the design's units, and optionally its orientation as "
+        "fixed-axis XYZ angles in degrees (R = Rz Ry Rx); write --target=-1,2,3 when the first "
+        "number is negative; repeat with --tip for a tree's tips",
+    )  # fmt: skip
+    reach.add_argument(
+        "--axis", metavar="AX,AY,AZ", action="append",
+        help="the direction the tip's z axis must point along (a position target; rotation "
+        "about it free); one per --target",
+    )  # fmt: skip
+    reach.add_argument(
+        "--tip", metavar="J", action="append", default=[],
+        help="the tip joint of the --target at the same place (default: the chain's last "
+        "joint); a tree names one per target",
+    )  # fmt: skip
+    reach.add_argument("-o", "--output", metavar="POSED", default=None,
+                       help="write the design at the found states to POSED (.json) when reached")
+    reach.add_argument("--force", action="store_true", help="let -o replace DESIGN itself")
+    reach.add_argument("--seed", metavar="S", default="0",
+                       help="seed of the solver's starts (an integer >= 0, default: %(default)s)")
+    reach.add_argument("--json", action="store_true", help="print one JSON object instead")
+    reach.add_argument(
+        "--margin", metavar="M", default=None,
+        help="the clearance required between parts, in the design's units (default: the "
+        "design's \"margin\", or 0)",
+    )  # fmt: skip
+    reach.set_defaults(run=cmd_reach)
 
     compact = commands.add_parser(
         "compact",
