@@ -8,7 +8,8 @@ the others.
 
 from kinegami._lazy import lazy_names
 
-__all__ = ["Answer", "Kinematics", "Target", "kinematics", "solve", "solve_many"]
+__all__ = ["Answer", "Kinematics", "Target", "Workspace", "kinematics", "solve", "solve_many",
+           "workspace"]
 
 #: Names imported on first use: name -> module.
 _LAZY = {
@@ -18,6 +19,8 @@ _LAZY = {
     "Target": "kinegami.reach.inverse",
     "solve": "kinegami.reach.inverse",
     "solve_many": "kinegami.reach.inverse",
+    "Workspace": "kinegami.reach.workspaces",
+    "workspace": "kinegami.reach.workspaces",
 }
 
 __getattr__, __dir__ = lazy_names("kinegami.reach", globals(), _LAZY)

@@ -196,7 +196,7 @@ def solve_many(design, targets, *, tip=None, tool=None, q0=None, seed: int = 0,
     if not isinstance(clear, bool):
         raise InvalidTypeError(f"clear must be True or False, got {clear!r}")
     if margin is not None:
-        from kinegami.validation import check_margin
+        from kinegami.chain.bodies import check_margin
 
         margin = check_margin(margin)
     goals = [_goals(design, t, tip) for t in targets]

@@ -192,3 +192,19 @@ def test_bad_options_are_one_clear_line():
         solve(design, [0.0, 0.0, 500.0], q0=[0.0])
     with pytest.raises(InvalidParameterError, match="tips"):
         solve(load_design(DESIGNS / "hand.json"), [0.0, 0.0, 1.0])  # a tree: which tip?
+
+
+def test_a_margin_is_kept_or_refused():
+    path = DESIGNS / "prismatic_spiral.json"
+    design = load_design(path)
+    compiled = kinematics(design)
+    (q,) = clear_configurations(design, 1, seed=9)
+    margin = 0.05 * design.r
+    answer = solve(design, compiled.fkine(q), margin=margin)
+    if answer.ok:
+        assert design.clearance(list(answer.states), margin).ok
+        assert answer.clearance >= margin - 1e-9 * design.r
+    else:
+        assert "passes through itself" in answer.reason
+    with pytest.raises(InvalidParameterError, match="margin"):
+        solve(design, compiled.fkine(q), margin=-1.0)
