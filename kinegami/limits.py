@@ -31,6 +31,7 @@ __all__ = [
     "MAX_DEPTH",
     "MAX_SAMPLES",
     "MAX_SAMPLED_STATES",
+    "MAX_WORKSPACE_SAMPLES",
     "MAX_STARTS",
     "MAX_PDF_PAGES",
     "MAX_INTEGER_DIGITS",
@@ -88,6 +89,10 @@ MAX_SAMPLES = 100_000
 #: Most sampled joint states held at once: configurations times the joints of the chain (the
 #: sampled configurations are one array, 8 bytes a state: 80 MB).
 MAX_SAMPLED_STATES = 10_000_000
+#: Most configurations one workspace draws (kinegami.reach.workspace keeps every clear one and
+#: its tip: 2,000,000 samples of a 7-joint design hold about 160 MB; drawn and tested in
+#: batches of 20,000).
+MAX_WORKSPACE_SAMPLES = 2_000_000
 #: Most starts of one compaction (``compact(starts=)``): each is a whole search.
 MAX_STARTS = 64
 #: Default most pages of a PDF (``max_pages``; the user may raise it per export).

@@ -18,13 +18,11 @@ import numpy as np
 
 from kinegami._atomic import write_atomic
 from kinegami.errors import InvalidParameterError, InvalidTypeError
+from kinegami.limits import MAX_WORKSPACE_SAMPLES
 from kinegami.reach.forward import kinematics
 
 __all__ = ["Workspace", "workspace"]
 
-#: Most configurations one workspace draws (its points and configurations are kept: 1e6
-#: samples of a 7-joint design hold about 80 MB).
-MAX_WORKSPACE_SAMPLES = 2_000_000
 #: Configurations per batch (tip positions and clearance, one task on an executor).
 CHUNK = 20_000
 
