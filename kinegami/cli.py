@@ -1170,6 +1170,59 @@ def cmd_reach(args: argparse.Namespace) -> int:
     return 0 if answer.ok else NOT_REACHED
 
 
+def cmd_workspace(args: argparse.Namespace) -> int:
+    import io
+    import json
+
+    import matplotlib
+
+    from kinegami._atomic import write_atomic
+    from kinegami.limits import MAX_WORKSPACE_SAMPLES
+    from kinegami.reach import workspace
+
+    samples = _integer("--samples", args.samples, 1, MAX_WORKSPACE_SAMPLES,
+                       "each clear sample is kept; kinegami.limits.MAX_WORKSPACE_SAMPLES")
+    seed = _integer("--seed", args.seed, 0)
+    out = Path(args.output)
+    _check_output(out)
+    chain, info = _load(args.design)
+    _margin(args, chain)
+    voxel = None
+    if args.voxel is not None:
+        voxel = _numbers("--voxel", args.voxel, (1,))[0]
+        if voxel <= 0:
+            raise CommandError(f"--voxel: must be a length > 0 in the design's units, got "
+                               f"{args.voxel!r}")  # fmt: skip
+    tip = None if args.tip is None else _integer("--tip", args.tip, 0, len(chain.Joints) - 1,
+                                                 "a joint index of the design")  # fmt: skip
+    cloud = workspace(chain, samples, seed=seed, voxel=voxel, tip=tip)
+    stem = Path(args.design).stem
+    written = [cloud.save(out / f"{stem}_workspace.npz"), cloud.save(out / f"{stem}_workspace.ply")]
+    matplotlib.use("Agg")  # a file, never a window
+    import matplotlib.pyplot as plt
+
+    figure = cloud.show(chain, units=info.units)
+    picture = out / f"{stem}_workspace.png"
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=120)
+    plt.close(figure)
+    write_atomic(picture, buffer.getvalue())
+    written.append(str(picture))
+    title = f"{_printable(info.name)} ({args.design})" if info.name else args.design
+    summary = cloud.summary(info.units)
+    if args.json:
+        print(json.dumps({
+            "design": args.design, "samples": cloud.samples, "clear": int(cloud.points.shape[0]),
+            "voxel": cloud.voxel, "voxels": int(cloud.voxels.shape[0]), "volume": cloud.volume,
+            "half_volume": cloud.half_volume, "convergence": cloud.convergence,
+            "lost_share": cloud.lost_share, "seed": seed, "files": [str(f) for f in written],
+        }, indent=2, allow_nan=False))  # fmt: skip
+    else:
+        print("\n".join([f"{title}: workspace", f"  {summary}", "  files written:",
+                         *(f"    {f}" for f in written)]))  # fmt: skip
+    return 0
+
+
 # --- parser ------------------------------------------------------------------------------------
 class _Parser(argparse.ArgumentParser):
     """argparse's parser, whose errors are one line as every other error of the command line
@@ -1332,6 +1385,34 @@ def make_parser() -> argparse.ArgumentParser:
         "design's \"margin\", or 0)",
     )  # fmt: skip
     reach.set_defaults(run=cmd_reach)
+
+    space = commands.add_parser(
+        "workspace",
+        help="sample what a design's tip can reach without passing through itself",
+        description="The sampled workspace (kinegami.reach.workspace, docs/reach.md): draws "
+        "configurations from the joints' ranges, keeps the clear ones, and writes DIR/"
+        "NAME_workspace.npz (every array), .ply (the clear tip positions, a point cloud) and "
+        ".png (three views); prints the volume at the voxel size with its sample count, how "
+        "much it grew over the second half of the samples, and the share lost to "
+        "self-collision. Exit code 0, or 1 for a design or option error.",
+    )
+    space.add_argument("design", metavar="DESIGN", help="design file (.json)")
+    space.add_argument("-o", "--output", metavar="DIR", required=True, help="output folder")
+    space.add_argument("--samples", metavar="N", default="20000",
+                       help="configurations to draw (default: %(default)s)")
+    space.add_argument("--voxel", metavar="H", default=None,
+                       help="voxel edge in the design's units (default: 2r)")
+    space.add_argument("--tip", metavar="J", default=None,
+                       help="the tip joint (default: the chain's last joint; a tree names one)")
+    space.add_argument("--seed", metavar="S", default="0",
+                       help="seed of the draw (an integer >= 0, default: %(default)s)")
+    space.add_argument("--json", action="store_true", help="print one JSON object instead")
+    space.add_argument(
+        "--margin", metavar="M", default=None,
+        help="the clearance required between parts, in the design's units (default: the "
+        "design's \"margin\", or 0)",
+    )  # fmt: skip
+    space.set_defaults(run=cmd_workspace)
 
     compact = commands.add_parser(
         "compact",

@@ -92,3 +92,25 @@ def test_bad_options_are_one_line():
     assert_clean_failure(run("reach", PUMA, "--target", "1,2,3", "-o", "x.txt"), "-o", ".json")
     usage = run("reach", PUMA)
     assert usage.returncode == 2 and "--target" in usage.stderr
+
+
+def test_workspace_writes_the_arrays_the_cloud_and_a_picture(tmp_path):
+    out = tmp_path / "space"
+    result = run("workspace", PUMA, "-o", out, "--samples", "2000", "--json")
+    assert result.returncode == 0, result.stderr
+    data = json.loads(result.stdout)
+    assert data["samples"] == 2000 and 0 < data["clear"] < 2000
+    assert data["volume"] == data["voxels"] * data["voxel"] ** 3
+    with np.load(out / "puma_workspace.npz") as arrays:
+        assert arrays["points"].shape == (data["clear"], 3)
+    assert (out / "puma_workspace.ply").read_bytes().startswith(b"ply\n")
+    assert (out / "puma_workspace.png").stat().st_size > 10_000
+    words = run("workspace", PUMA, "-o", out, "--samples", "500")
+    assert words.returncode == 0 and "lost to self-collision" in words.stdout
+
+
+def test_workspace_options_are_checked_in_one_line(tmp_path):
+    assert_clean_failure(run("workspace", PUMA, "-o", tmp_path, "--samples", "0"), "--samples")
+    assert_clean_failure(run("workspace", PUMA, "-o", tmp_path, "--voxel", "-1"), "--voxel")
+    assert_clean_failure(run("workspace", HAND, "-o", tmp_path, "--samples", "10"), "tip")
+    assert not any(tmp_path.iterdir())
