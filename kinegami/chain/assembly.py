@@ -20,7 +20,7 @@ from collections.abc import Mapping, Sequence, Set
 
 import numpy as np
 
-from kinegami.chain.bodies import check_margin, link_capsule_ends, worst_overlap
+from kinegami.chain.bodies import check_margin, link_capsule_ends, overlaps, worst_overlap
 from kinegami.chain.joints import Joint, check_same_tube, pose_array
 from kinegami.chain.links import LinkCSC
 from kinegami.chain.placement import (
@@ -243,7 +243,12 @@ class JointAssembly:
 
     def _clear_of(self, joints, links, parents, since: int) -> bool:
         """Whether the parts of joint ``since`` on are clear of everything (placement's test
-        of a candidate): ``_overlap(..., since) is None``."""
+        of a candidate): ``_overlap(..., since) is None``. A candidate that overlaps is told
+        by :func:`~kinegami.chain.bodies.overlaps`, which stops at its first overlapping
+        pairs; a clear one then gets the full test (cheap: it has few close pairs), whose
+        answer placement keeps for the commit."""
+        if overlaps(joints, links, self.r, since=since, margin=self._margin):
+            return False
         return self._overlap(joints, links, parents, since) is None
 
     def _own_overlap(self):
