@@ -1233,6 +1233,16 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {_printable(message)}; {usage}\n")
 
 
+def _add_margin_option(command: argparse.ArgumentParser, more: str = "") -> None:
+    """The ``--margin M`` option every command that judges clearance takes (read by
+    :func:`_margin`), its help ending with ``more``."""
+    command.add_argument(
+        "--margin", metavar="M", default=None,
+        help="the clearance required between parts, in the design's units (a number >= 0; "
+        "default: the design's \"margin\", or 0: parts that touch are clear)" + more,
+    )  # fmt: skip
+
+
 def make_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="kinegami",
@@ -1276,11 +1286,7 @@ def make_parser() -> argparse.ArgumentParser:
         "branch's sheet a skirt with glue tabs), auto (take-offs where they can be made, "
         "connectors elsewhere)",
     )  # fmt: skip
-    build.add_argument(
-        "--margin", metavar="M", default=None,
-        help="the clearance required between parts, in the design's units (a number >= 0; "
-        "default: the design's \"margin\", or 0: parts that touch are clear)",
-    )  # fmt: skip
+    _add_margin_option(build)
     build.set_defaults(run=cmd_build)
 
     show = commands.add_parser(
@@ -1340,11 +1346,7 @@ def make_parser() -> argparse.ArgumentParser:
     check.add_argument(
         "--json", action="store_true", help="print one JSON object instead (see docs/cli.md)"
     )
-    check.add_argument(
-        "--margin", metavar="M", default=None,
-        help="the clearance required between parts, in the design's units (a number >= 0; "
-        "default: the design's \"margin\", or 0: parts that touch are clear)",
-    )  # fmt: skip
+    _add_margin_option(check)
     check.set_defaults(run=cmd_check)
 
     reach = commands.add_parser(
@@ -1379,11 +1381,7 @@ def make_parser() -> argparse.ArgumentParser:
     reach.add_argument("--seed", metavar="S", default="0",
                        help="seed of the solver's starts (an integer >= 0, default: %(default)s)")
     reach.add_argument("--json", action="store_true", help="print one JSON object instead")
-    reach.add_argument(
-        "--margin", metavar="M", default=None,
-        help="the clearance required between parts, in the design's units (default: the "
-        "design's \"margin\", or 0)",
-    )  # fmt: skip
+    _add_margin_option(reach)
     reach.set_defaults(run=cmd_reach)
 
     space = commands.add_parser(
@@ -1407,11 +1405,7 @@ def make_parser() -> argparse.ArgumentParser:
     space.add_argument("--seed", metavar="S", default="0",
                        help="seed of the draw (an integer >= 0, default: %(default)s)")
     space.add_argument("--json", action="store_true", help="print one JSON object instead")
-    space.add_argument(
-        "--margin", metavar="M", default=None,
-        help="the clearance required between parts, in the design's units (default: the "
-        "design's \"margin\", or 0)",
-    )  # fmt: skip
+    _add_margin_option(space)
     space.set_defaults(run=cmd_workspace)
 
     compact = commands.add_parser(
@@ -1443,12 +1437,8 @@ def make_parser() -> argparse.ArgumentParser:
     compact.add_argument(
         "--force", action="store_true", help="allow OUT to be DESIGN itself (replaced atomically)"
     )
-    compact.add_argument(
-        "--margin", metavar="M", default=None,
-        help="the clearance required between parts, in the design's units (a number >= 0; "
-        "default: the design's \"margin\", or 0: parts that touch are clear); the compacted "
-        "design keeps its closest parts at least this far apart and is written with it",
-    )  # fmt: skip
+    _add_margin_option(compact, "; the compacted design keeps its closest parts at least this "
+                       "far apart and is written with it")  # fmt: skip
     compact.set_defaults(run=cmd_compact)
 
     edit = commands.add_parser(

@@ -243,13 +243,15 @@ class JointAssembly:
 
     def _clear_of(self, joints, links, parents, since: int) -> bool:
         """Whether the parts of joint ``since`` on are clear of everything (placement's test
-        of a candidate): ``_overlap(..., since) is None``. A candidate that overlaps is told
-        by :func:`~kinegami.chain.bodies.overlaps`, which stops at its first overlapping
-        pairs; a clear one then gets the full test (cheap: it has few close pairs), whose
-        answer placement keeps for the commit."""
+        of a candidate): ``_overlap(..., since) is None``, told by
+        :func:`~kinegami.chain.bodies.overlaps`, which stops at a colliding candidate's first
+        overlapping pairs. A clear answer has measured every pair ``_overlap`` would: it is
+        kept as ``_overlap``'s answer (None) for the commit of the same lists."""
         if overlaps(joints, links, self.r, since=since, margin=self._margin):
             return False
-        return self._overlap(joints, links, parents, since) is None
+        if since > 0:
+            self._placement_check = (joints, links, (since, self._margin), None)
+        return True
 
     def _own_overlap(self):
         """The deepest overlap of the chain as it is (an Overlap) or None, computed once per
