@@ -852,6 +852,7 @@ def _check_json(chain, info, design, report, motion, seed) -> dict:
         "min_clearance": report.min_clearance if report.closest is not None else None,
         "closest": None if report.closest is None else _pair_json(report.closest),
         "pairs": [_pair_json(pair) for pair in report.pairs],
+        "unlisted": report.unlisted,
         "states": list(report.states),
         "motion": None,
     }
@@ -886,8 +887,9 @@ def _check_lines(chain, info, design, report, motion, seed) -> list[str]:
     LISTED_PAIRS pairs) and the sweep's (SweepReport.summary)."""
     title = f"{_printable(info.name)} ({design})" if info.name else design
     lines = report.summary(info.units, title=title, listed=LISTED_PAIRS)
-    if not report.ok and len(report.pairs) > LISTED_PAIRS:  # the last line: "... and N more"
-        lines[-1] += " (--json lists them all)"
+    if not report.ok and report.pair_count > LISTED_PAIRS:  # the last line: "... and N more"
+        lines[-1] += " (--json lists them all)" if not report.unlisted else \
+            f" (--json lists the closest {len(report.pairs):,})"  # fmt: skip
     if motion is not None:
         lines += motion.summary(chain, info.units, names=_joint_names(chain), seed=seed)
     return [_printable(line) for line in lines]

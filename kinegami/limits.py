@@ -32,6 +32,7 @@ __all__ = [
     "MAX_SAMPLES",
     "MAX_SAMPLED_STATES",
     "MAX_WORKSPACE_SAMPLES",
+    "MAX_REPORTED_PAIRS",
     "MAX_STARTS",
     "MAX_PDF_PAGES",
     "MAX_INTEGER_DIGITS",
@@ -93,6 +94,10 @@ MAX_SAMPLED_STATES = 10_000_000
 #: its tip: 2,000,000 samples of a 7-joint design hold about 160 MB; drawn and tested in
 #: batches of 20,000).
 MAX_WORKSPACE_SAMPLES = 2_000_000
+#: Most pairs of parts one clearance report lists (closest first); it counts the others
+#: (``ClearanceReport.unlisted``). A chain folded onto itself out of one-degree elbows can have
+#: 600,000 overlapping pairs of parts.
+MAX_REPORTED_PAIRS = 1_000
 #: Most starts of one compaction (``compact(starts=)``): each is a whole search.
 MAX_STARTS = 64
 #: Default most pages of a PDF (``max_pages``; the user may raise it per export).

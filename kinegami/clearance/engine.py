@@ -49,6 +49,7 @@ from kinegami.geometry.segments import (
     segment_distances,
     segment_distances_stacked,
 )
+from kinegami.limits import MAX_REPORTED_PAIRS
 from kinegami.validation import (
     check_real,
 )
@@ -79,8 +80,11 @@ _GROUP_SIZE = 3
 #: the pairs that are near, not with all pairs).
 _GROUP_PAIRS_LISTED = 300_000
 
-#: Pair-configuration entries (group pairs, then capsule pairs) one batch holds at most.
+#: Pair-configuration entries (group pairs, moved points) one batch holds at most.
 _BATCH_ENTRIES = 2_000_000
+#: Capsule pair-configuration entries measured at once at most: their exact distances take
+#: about 400 bytes of temporaries each (100 MiB a slice).
+_PAIR_ENTRIES = 250_000
 
 #: Pairs a one-configuration report must measure (their bounds put them closer than the
 #: limit) above which it measures them at once with numpy rather than one by one in plain
@@ -778,27 +782,41 @@ class ClearanceEngine:
         """Exact clearances of the tested pairs that move relative to each other and whose
         capsule balls are within ``threshold`` of each other, at configurations ``Q`` (K, J).
 
-        Returns (k, i, j, clearance, s, t, xyz): configuration and capsule indices, the
-        clearance and closest-point parameters of each such pair, and :meth:`_world`'s points.
+        Returns (k, i, j, clearance, s, t, B): configuration and capsule indices, the
+        clearance and closest-point parameters of each such pair, and the body transforms.
         ``moving``: as in :meth:`worst_arrays`.
         """
+        B, parts = self._candidate_slices(Q, threshold, moving)
+        parts = list(parts)
+        if not parts:
+            none = np.zeros(0, dtype=np.int64)
+            return none, none, none, np.zeros(0), np.zeros(0), np.zeros(0), B
+        return (*(np.concatenate(column) for column in zip(*parts, strict=True)), B)
+
+    def _candidate_slices(self, Q: np.ndarray, threshold: float, moving=None) -> tuple:
+        """(B, slices): the body transforms at ``Q`` and an iterator of (k, i, j, clearance,
+        s, t), :meth:`_candidates`'s answer in order, a bounded number of capsule pairs
+        (:data:`_PAIR_ENTRIES`) at a time, so that memory stays bounded however many pairs
+        come near (a caller that keeps only a few of each slice holds no more)."""
         B = self.body_transforms(Q)
-        none = np.zeros(0, dtype=np.int64)
-        empty = (none, none, none, np.zeros(0), np.zeros(0), np.zeros(0), B)
         if self._listed and self._gp1.size == 0:
-            return empty
+            return B, iter(())
         xyz = self._centres.move(B)
         kk, g1, g2, same, n_gp = self._near_groups(xyz, threshold, moving)
         if kk.size == 0:
-            return empty
-        if self._listed:
-            return (*self._pairs_of(Q, B, xyz, threshold, kk, g1, g2, same, n_gp), B)
-        # many groups: their capsule pairs a bounded number at a time
-        step = max(1, _BATCH_ENTRIES // int(max(self._gsize.max(), 1) ** 2))
-        parts = [self._pairs_of(Q, B, xyz, threshold, kk[n : n + step], g1[n : n + step],
-                                g2[n : n + step], same[n : n + step], None)
-                 for n in range(0, kk.size, step)]  # fmt: skip
-        return (*(np.concatenate(column) for column in zip(*parts, strict=True)), B)
+            return B, iter(())
+        if self._listed:  # cut where the capsule pairs so far pass the batch
+            total = np.cumsum(self._cp_count[n_gp])
+            cuts = np.searchsorted(total, np.arange(1, int(total[-1]) // _PAIR_ENTRIES + 1)
+                                   * _PAIR_ENTRIES, side="right")  # fmt: skip
+            bounds = np.unique(np.r_[0, np.maximum(cuts, 1), kk.size]).tolist()
+        else:  # many groups: at most the batch in capsule pairs of the largest groups
+            step = max(1, _PAIR_ENTRIES // int(max(self._gsize.max(), 1) ** 2))
+            bounds = [*range(0, kk.size, step), kk.size]
+        slices = (self._pairs_of(Q, B, xyz, threshold, kk[a:b], g1[a:b], g2[a:b], same[a:b],
+                                 None if n_gp is None else n_gp[a:b])
+                  for a, b in zip(bounds[:-1], bounds[1:], strict=True))  # fmt: skip
+        return B, slices
 
     def _pairs_of(self, Q, B, xyz, threshold: float, kk, g1, g2, same, n_gp) -> tuple:
         """(k, i, j, clearance, s, t) of the capsule pairs of near group pairs (configuration
@@ -850,39 +868,53 @@ class ClearanceEngine:
         return k, i, j, dist - 2.0 * self.r, s, t
 
     def _chunk(self) -> int:
-        """Configurations per batch (bounds the batch's pair-configuration entries)."""
+        """Configurations per batch (bounds the batch's group-pair and moved-point entries;
+        :meth:`_candidate_slices` bounds its capsule pairs)."""
         if not self._listed:
             return 1
-        return int(min(1024, max(1, _BATCH_ENTRIES // max(self._gp1.size, 1))))
+        per = max(self._gp1.size, self._end_points.size, self._centres.size, 1)
+        return int(min(1024, max(1, _BATCH_ENTRIES // per)))
 
     # --- labels ----------------------------------------------------------------------------
     def _texts(self, rows: np.ndarray, s: np.ndarray) -> list[str]:
         """The part at parameter s of capsule row, in words, for every (row, s)."""
         if rows.size <= 8:  # a few: one by one
-            out = []
-            for row, at in zip(rows.tolist(), (s * self._lengths[rows]).tolist(), strict=True):
-                breaks, labels = self._pieces[row]
-                text = labels[-1]
-                for n, b in enumerate(breaks.tolist()):
-                    if at < b:
-                        text = labels[n]
-                        break
-                out.append(self._named(row, text))
-            return out
-        out = [""] * rows.size
-        for row in np.unique(rows).tolist():
-            n = np.flatnonzero(rows == row)
+            return [self._label(row, at) for row, at in zip(rows.tolist(), s.tolist(),
+                                                            strict=True)]  # fmt: skip
+        codes, texts = self.text_codes(rows, s)
+        return [texts[c] for c in codes.tolist()]
+
+    def text_codes(self, rows: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, list[str]]:
+        """The parts at parameters ``s`` of capsule ``rows`` as (codes, texts): ``texts`` the
+        distinct parts in words, in order of first appearance, and ``texts[codes[n]]`` the
+        part of entry n. Words are made once per distinct (row, piece), so millions of
+        entries cost a few array passes."""
+        rows = np.asarray(rows, dtype=np.int64)
+        s = np.asarray(s, dtype=float)
+        if rows.size == 0:
+            return np.zeros(0, dtype=np.int64), []
+        piece = np.zeros(rows.size, dtype=np.int64)
+        order = np.argsort(rows, kind="stable")
+        sorted_rows = rows[order]
+        cuts = np.flatnonzero(np.diff(sorted_rows)) + 1
+        for lo, hi in zip(np.r_[0, cuts].tolist(), np.r_[cuts, rows.size].tolist(),
+                          strict=True):  # fmt: skip
+            row = int(sorted_rows[lo])
             breaks, labels = self._pieces[row]
-            if len(breaks) == 0:
-                for m in n.tolist():
-                    out[m] = self._named(row, labels[-1])
-                continue
+            n = order[lo:hi]
             at = s[n] * self._lengths[row]
-            below = at[:, None] < breaks[None, :]
-            piece = np.where(below.any(axis=1), below.argmax(axis=1), len(labels) - 1)
-            for m, p in zip(n.tolist(), piece.tolist(), strict=True):
-                out[m] = self._named(row, labels[p])
-        return out
+            # the first break beyond the point, else the last piece (as _label)
+            found = np.searchsorted(breaks, at, side="right")
+            piece[n] = np.where(found < len(breaks), found, len(labels) - 1)
+        combo = rows * (int(piece.max()) + 1) + piece
+        distinct, first, inverse = np.unique(combo, return_index=True, return_inverse=True)
+        names: dict[str, int] = {}
+        code_of = np.empty(distinct.size, dtype=np.int64)
+        for m in np.argsort(first, kind="stable").tolist():  # in order of first appearance
+            row = int(rows[first[m]])
+            text = self._named(row, self._pieces[row][1][int(piece[first[m]])])
+            code_of[m] = names.setdefault(text, len(names))
+        return code_of[inverse.reshape(-1)], list(names)
 
     def _named(self, row: int, text: str) -> str:
         return text
@@ -935,10 +967,23 @@ class ClearanceEngine:
         for start in range(0, K, self._chunk()):
             Qc = Q[start : start + self._chunk()]
             mc = None if moving is None else moving[start : start + self._chunk()]
-            k, i, j, c, s, t, _ = self._candidates(Qc, margin, mc)
-            hit = np.flatnonzero(c < limit)
-            k, i, j, c, s, t = k[hit], i[hit], j[hit], c[hit], s[hit], t[hit]
-            rank = self._rank(i, j)
+            best = []  # per slice, the closest pair of each configuration closer than limit
+            for part in self._candidate_slices(Qc, margin, mc)[1]:
+                k, i, j, c, s, t = part
+                hit = np.flatnonzero(c < limit)
+                k, i, j, c, s, t = k[hit], i[hit], j[hit], c[hit], s[hit], t[hit]
+                rank = self._rank(i, j)
+                order = np.lexsort((rank, c, k))
+                first = order[np.r_[True, k[order][1:] != k[order][:-1]]] if k.size else order
+                best.append((k[first], i[first], j[first], c[first], s[first], t[first],
+                             rank[first]))  # fmt: skip
+            if best:
+                k, i, j, c, s, t, rank = (np.concatenate(column)
+                                          for column in zip(*best, strict=True))  # fmt: skip
+            else:
+                none = np.zeros(0, dtype=np.int64)
+                k, i, j, c, s, t, rank = none, none, none, np.zeros(0), np.zeros(0), \
+                    np.zeros(0), none  # fmt: skip
             if static:
                 si, sj = self._static_pairs
                 m = Qc.shape[0]
@@ -996,10 +1041,8 @@ class ClearanceEngine:
         hit = np.flatnonzero(np.isfinite(clearance))
         if hit.size == 0:
             return clearance, ()
-        texts = self._texts(np.r_[i[hit], j[hit]], np.r_[s[hit], t[hit]])
-        names: dict[str, int] = {}
-        codes = np.array([names.setdefault(x, len(names)) for x in texts], dtype=np.int64)
-        key = codes[: hit.size] * len(names) + codes[hit.size :]
+        codes, texts = self.text_codes(np.r_[i[hit], j[hit]], np.r_[s[hit], t[hit]])
+        key = codes[: hit.size] * len(texts) + codes[hit.size :]
         _, group, counts = np.unique(key, return_inverse=True, return_counts=True)
         # per group: its first configuration, and the first configuration of its deepest
         order = np.lexsort((hit, clearance[hit], group))
@@ -1053,15 +1096,28 @@ class ClearanceEngine:
                               float(cc[n]))  # fmt: skip
 
         closest = make(int(order[0]))
-        pairs: dict[tuple[str, str], CollidingPair] = {}
-        for n in order.tolist():
-            if cc[n] >= limit:
-                break
-            pair = make(n)
-            pairs.setdefault((pair.first, pair.second), pair)
+        hit = order[: int(np.searchsorted(cc[order], limit, side="left"))]
+        listed, unlisted, overlapping = self._distinct_pairs(ci[hit], cj[hit], cs[hit],
+                                                             ct[hit], cc[hit])  # fmt: skip
+        pairs = tuple(make(int(n)) for n in hit[listed].tolist())
         min_clearance = float(cc[order[0]])
-        return ClearanceReport(min_clearance >= limit, min_clearance, tuple(pairs.values()),
-                               closest, values, margin, self.r)  # fmt: skip
+        return ClearanceReport(min_clearance >= limit, min_clearance, pairs, closest, values,
+                               margin, self.r, unlisted=unlisted,
+                               unlisted_overlapping=overlapping)  # fmt: skip
+
+    def _distinct_pairs(self, i, j, s, t, clearance) -> tuple[np.ndarray, int, int]:
+        """Of capsule pairs (rows i and j at parameters s and t), closest first: the index of
+        the first (closest) of each pair of parts, at most MAX_REPORTED_PAIRS of them, the
+        number of pairs of parts left out and how many of those overlap. The parts' words are
+        codes for every entry (:meth:`text_codes`), so a report makes a pair only for the
+        first of each of the pairs it lists."""
+        n = np.asarray(i).size
+        codes, texts = self.text_codes(np.r_[i, j], np.r_[s, t])
+        key = codes[:n] * max(len(texts), 1) + codes[n:]
+        first = np.sort(np.unique(key, return_index=True)[1])
+        rest = first[MAX_REPORTED_PAIRS:]
+        overlapping = int((np.asarray(clearance, dtype=float)[rest] < 0.0).sum())
+        return first[:MAX_REPORTED_PAIRS], int(rest.size), overlapping
 
     def _one_arrays(self) -> _OneConfiguration:
         """What :meth:`_report_one` needs, built on first use."""
@@ -1232,14 +1288,21 @@ class ClearanceEngine:
 
         closest = make(ordered[0])
         min_clearance = ordered[0][0]
-        pairs: dict[tuple[str, str], CollidingPair] = {}
-        for entry in ordered:
-            if entry[0] >= limit:
-                break
-            pair = closest if entry is ordered[0] else make(entry)
-            pairs.setdefault((pair.first, pair.second), pair)
-        return ClearanceReport(min_clearance >= limit, min_clearance, tuple(pairs.values()),
-                               closest, values, margin, self.r)  # fmt: skip
+        hit = ordered[: bisect.bisect_left([entry[0] for entry in ordered], limit)]
+        if len(hit) <= 1:
+            pairs: tuple = (closest,) if hit else ()
+            unlisted = overlapping = 0
+        else:
+            rows = [one.pi[n] if n >= 0 else statics[1][-n - 1][0] for _, _, _, n, _, _ in hit]
+            cols = [one.pj[n] if n >= 0 else statics[1][-n - 1][1] for _, _, _, n, _, _ in hit]
+            listed, unlisted, overlapping = self._distinct_pairs(
+                np.array(rows, dtype=np.int64), np.array(cols, dtype=np.int64),
+                np.array([entry[4] for entry in hit]), np.array([entry[5] for entry in hit]),
+                np.array([entry[0] for entry in hit]))  # fmt: skip
+            pairs = tuple(closest if n == 0 else make(hit[n]) for n in listed.tolist())
+        return ClearanceReport(min_clearance >= limit, min_clearance, pairs, closest, values,
+                               margin, self.r, unlisted=unlisted,
+                               unlisted_overlapping=overlapping)  # fmt: skip
 
     def _extent(self) -> float:
         """Size of the assembly (for the search radius of :meth:`report`)."""

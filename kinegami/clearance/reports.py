@@ -145,8 +145,9 @@ class ClearanceReport:
         Smallest clearance over the tested pairs (chain units; negative is the overlap depth;
         inf when no pair of parts is far enough apart along the tube to be tested).
     pairs : tuple of CollidingPair
-        Every pair of parts closer than the margin (margin 0: that overlap), closest first (one
-        entry per pair of parts).
+        The pairs of parts closer than the margin (margin 0: that overlap), closest first (one
+        entry per pair of parts): every one, or the closest MAX_REPORTED_PAIRS (1,000; see
+        ``unlisted``).
     closest : CollidingPair or None
         The tested pair with the smallest clearance (None when nothing is tested).
     states : tuple of float
@@ -158,6 +159,11 @@ class ClearanceReport:
     note : str
         For a tree whose closest parts are two tubes leaving a junction: where (words
         :meth:`verdict` appends), else "".
+    unlisted : int
+        Pairs of parts closer than the margin beyond those in ``pairs`` (0 unless there are
+        more than MAX_REPORTED_PAIRS); :attr:`pair_count` counts them all.
+    unlisted_overlapping : int
+        How many of the unlisted pairs overlap.
     """
 
     ok: bool
@@ -168,6 +174,13 @@ class ClearanceReport:
     margin: float = 0.0
     r: float = math.nan
     note: str = ""
+    unlisted: int = 0
+    unlisted_overlapping: int = 0
+
+    @property
+    def pair_count(self) -> int:
+        """Pairs of parts closer than the margin, listed or not."""
+        return len(self.pairs) + self.unlisted
 
     def verdict(self, units: str | None = None) -> str:
         """The verdict in one line, as ``kinegami build``, ``kinegami check`` and the editor
@@ -186,7 +199,7 @@ class ClearanceReport:
                     f"{self.closest.second}{self.note}")  # fmt: skip
         first = self.pairs[0] if self.pairs else self.closest
         overlapping = self.min_clearance < clear_limit(self.r if math.isfinite(self.r) else 0.0)
-        more = f"; {len(self.pairs)} pairs of parts" if len(self.pairs) > 1 else ""
+        more = f"; {self.pair_count} pairs of parts" if self.pair_count > 1 else ""
         return (f"{'self-intersects, ' if overlapping else ''}parts closer than the margin "
                 f"{margin}: minimum clearance {length(self.min_clearance)}, between "
                 f"{first.first} and {first.second}{more}")  # fmt: skip
@@ -198,8 +211,9 @@ class ClearanceReport:
         (0.02 cm))" (no pair overlaps, some are closer than the margin)."""
         if self.ok:
             return "clear at its states"
-        count = len(self.pairs)
-        overlap = sum(1 for pair in self.pairs if pair.clearance < 0.0)
+        count = self.pair_count
+        overlap = sum(1 for pair in self.pairs if pair.clearance < 0.0) \
+            + self.unlisted_overlapping  # fmt: skip
         plural = "s" if count > 1 else ""
         what = (f"{count} pair{plural} of parts overlap" if overlap == count
                 else f"{count} pair{plural} of parts closer than the margin "
@@ -237,8 +251,8 @@ class ClearanceReport:
         shown = self.pairs if listed is None else self.pairs[:listed]
         lines.append("  parts closer than the margin (closest first):")
         lines += [f"    {p.first} and {p.second}: {p.separation(length)}" for p in shown]
-        if len(self.pairs) > len(shown):
-            lines.append(f"    ... and {len(self.pairs) - len(shown)} more")
+        if self.pair_count > len(shown):
+            lines.append(f"    ... and {self.pair_count - len(shown)} more")
         return lines
 
     def markdown(self, units: str | None = None, *, listed: int | None = None) -> str:
@@ -255,6 +269,8 @@ class ClearanceReport:
         lines = [self.verdict()]
         if not self.ok:
             lines += [f"  {pair}" for pair in self.pairs]
+            if self.unlisted:
+                lines.append(f"  ... and {self.unlisted} more")
         return "\n".join(lines)
 
 

@@ -484,7 +484,7 @@ def _clearance_title(report) -> str:
         return "clearance: no parts far enough apart along the tube to collide"
     if report.ok:
         return f"clearance: {report.min_clearance:.3g} (clear)"
-    count = len(report.pairs)
+    count = report.pair_count
     return (
         f"clearance: {report.min_clearance:.3g} ({count} colliding pair{'s' if count != 1 else ''})"
     )

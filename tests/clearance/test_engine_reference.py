@@ -8,6 +8,7 @@ measure pairs inside one rigid body once; none of that is allowed to change an a
 from __future__ import annotations
 
 import copy
+import json
 import math
 import warnings
 from pathlib import Path
@@ -19,8 +20,9 @@ import kinegami.clearance.engine as clearance_module
 from kinegami import KinematicChain, RevoluteJoint
 from kinegami.chain.bodies import TURN_TOLERANCE, capsule_model, clear_limit
 from kinegami.clearance import ClearanceEngine, TreeMotion, sweep
+from kinegami.clearance.engine import current_states
 from kinegami.clearance.tree_bodies import tree_capsules
-from kinegami.design import load_design
+from kinegami.design import load_design, loads_design
 from kinegami.errors import ClearanceWarning
 from kinegami.geometry.segments import (
     segment_distance,
@@ -129,6 +131,75 @@ def test_the_large_assembly_broad_phase_gives_the_same_answers(monkeypatch):
     q = list(Q[0])
     assert listed.report(q).min_clearance == pytest.approx(spatial.report(q).min_clearance,
                                                            abs=1e-12)
+
+
+@pytest.mark.parametrize("listed", [True, False], ids=["listed", "spatial"])
+def test_capsule_pairs_measured_in_small_slices_give_the_same_bits(listed, monkeypatch):
+    """Memory stays bounded however many capsule pairs come near: the engine measures them
+    _PAIR_ENTRIES at a time (fuzz operations seed 401209 needed 613 MiB at once). Slices of
+    7 pairs give the batch's and the report's answers bit for bit, pairs and words included."""
+    design = load_design(DESIGNS[0].parent / "puma.json")
+    Q = random_configurations(design, 40, seed=11)
+    if not listed:
+        monkeypatch.setattr(clearance_module, "_GROUP_PAIRS_LISTED", 0)
+    whole = ClearanceEngine(design)
+    assert whole._listed is listed
+    expected = {m: whole.worst_arrays(Q, m) for m in (0.0, 0.3, 2.0)}
+    reports = [whole.report(list(q), 0.3) for q in Q[:6]]
+    monkeypatch.setattr(clearance_module, "_PAIR_ENTRIES", 7)
+    sliced = ClearanceEngine(design)
+    hits = 0
+    for margin, found in expected.items():
+        again = sliced.worst_arrays(Q, margin)
+        for a, b in zip(found, again, strict=True):
+            assert np.array_equal(a, b)
+        hits += int(np.isfinite(found[0]).sum())
+    assert hits > 10  # the margins make some configurations close
+    if not listed:  # the general report measures through the same slices
+        for q, report in zip(Q[:6], reports, strict=True):
+            assert sliced.report(list(q), 0.3) == report
+
+
+@pytest.mark.parametrize("listed", [True, False], ids=["listed", "spatial"])
+def test_a_report_lists_at_most_the_closest_pairs_and_counts_the_rest(listed, monkeypatch):
+    """A report lists the closest MAX_REPORTED_PAIRS pairs of parts and counts the others (a
+    chain folded onto itself out of one-degree elbows had 631,583: 14 s to list): with the cap
+    at 2, the pairs are the first two of the full list, and the count, the headline, the
+    verdict and the summary's "... and N more" are the full report's."""
+    from tests.cli.helpers import fold_back
+
+    design = loads_design(json.dumps(fold_back(1.0)))
+    if not listed:
+        monkeypatch.setattr(clearance_module, "_GROUP_PAIRS_LISTED", 0)
+    full = ClearanceEngine(design).report(current_states(design), 0.5)
+    assert len(full.pairs) >= 4 and full.unlisted == 0
+    monkeypatch.setattr(clearance_module, "MAX_REPORTED_PAIRS", 2)
+    capped = ClearanceEngine(design).report(current_states(design), 0.5)
+    assert capped.pairs == full.pairs[:2] and capped.closest == full.closest
+    assert capped.unlisted == len(full.pairs) - 2 and capped.pair_count == len(full.pairs)
+    assert capped.unlisted_overlapping == sum(p.clearance < 0 for p in full.pairs[2:])
+    assert capped.headline("mm") == full.headline("mm")
+    assert capped.verdict("mm") == full.verdict("mm")
+    assert capped.summary("mm", listed=1) == full.summary("mm", listed=1)
+
+
+def test_words_of_many_entries_are_each_entrys_own():
+    """text_codes (the words of millions of pairs in a few array passes) gives every entry
+    the words label gives it alone, including points on the breaks between pieces."""
+    design = load_design(DESIGNS[0].parent / "puma.json")
+    engine = ClearanceEngine(design)
+    rng = np.random.default_rng(2)
+    rows = rng.integers(0, engine._S, 3000)
+    s = rng.random(3000)
+    s[:200] = rng.choice([0.0, 1.0], 200)
+    breaks = [(row, b / engine._lengths[row]) for row in range(engine._S)
+              for b in engine._pieces[row][0].tolist()]  # fmt: skip
+    for n, (row, at) in enumerate(breaks[:300]):
+        rows[200 + n], s[200 + n] = row, at
+    codes, texts = engine.text_codes(rows, s)
+    assert len(set(texts)) == len(texts) > 3
+    assert [texts[c] for c in codes.tolist()] == [engine.label(int(row), float(at))
+                                                  for row, at in zip(rows, s, strict=True)]
 
 
 def test_segment_distance_kernel_is_the_shared_one_bit_for_bit():

@@ -31,7 +31,7 @@ FOLD_BACK_PAIRS = [
     ("link 1, straight tube", "link 3, second elbow"),
 ]
 JSON_KEYS = {"design", "name", "units", "r", "ok", "margin", "verdict", "min_clearance",
-             "closest", "pairs", "states", "motion"}  # fmt: skip
+             "closest", "pairs", "unlisted", "states", "motion"}  # fmt: skip
 MOTION_KEYS = {"samples", "seed", "colliding", "colliding_fraction", "worst_pairs",
                "free_intervals"}  # fmt: skip
 INTERVAL_KEYS = {"joint", "type", "name", "kind", "state", "range", "free"}
@@ -202,7 +202,7 @@ def test_json_has_the_library_numbers():
     assert set(data) == JSON_KEYS
     assert data["design"] == str(EXAMPLE1)
     assert (data["name"], data["units"], data["r"]) == ("Example 1", "cm", 1.0)
-    assert data["ok"] is True and data["pairs"] == []
+    assert data["ok"] is True and data["pairs"] == [] and data["unlisted"] == 0
     assert data["margin"] == 0.0 and data["verdict"] == report.verdict("cm")
     # lengths in the design's units, as the library gives them
     assert data["min_clearance"] == report.min_clearance
