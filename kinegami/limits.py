@@ -33,6 +33,7 @@ __all__ = [
     "MAX_SAMPLED_STATES",
     "MAX_WORKSPACE_SAMPLES",
     "MAX_REPORTED_PAIRS",
+    "MEMO_CAPSULE_ROWS",
     "MAX_STARTS",
     "MAX_PDF_PAGES",
     "MAX_INTEGER_DIGITS",
@@ -98,6 +99,10 @@ MAX_WORKSPACE_SAMPLES = 2_000_000
 #: (``ClearanceReport.unlisted``). A chain folded onto itself out of one-degree elbows can have
 #: 600,000 overlapping pairs of parts.
 MAX_REPORTED_PAIRS = 1_000
+#: Capsule rows each memo of capsules by link or joint keeps (kinegami.chain.bodies; about
+#: 400 bytes a row: 100 MiB). Counted by entries alone, 16,384 links of 720 one-degree elbows
+#: could keep gigabytes: a fuzzer's worker grew past its 2 GiB over 600 cases.
+MEMO_CAPSULE_ROWS = 262_144
 #: Most starts of one compaction (``compact(starts=)``): each is a whole search.
 MAX_STARTS = 64
 #: Default most pages of a PDF (``max_pages``; the user may raise it per export).

@@ -35,7 +35,6 @@ them turns by at least pi.
 
 from __future__ import annotations
 
-import functools
 import math
 import operator
 import threading
@@ -43,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinegami._memo import weighted_lru_cache
 from kinegami.chain.joints import (
     Joint,
 )
@@ -52,6 +52,7 @@ from kinegami.geometry.segments import segment_distances
 from kinegami.geometry.shapes import (
     regular_polygon,
 )
+from kinegami.limits import MEMO_CAPSULE_ROWS
 from kinegami.validation import shown
 
 __all__ = [
@@ -312,7 +313,7 @@ def _joint_capsules(out: _Builder, joint: Joint, j: int, turning: float, text: s
                 [text + segment.words])  # fmt: skip
 
 
-@functools.lru_cache(maxsize=16384)
+@weighted_lru_cache(16384, MEMO_CAPSULE_ROWS, lambda found: len(found[0]))
 def _link_rows(link, i: int, r: float, twistPortion: float) -> tuple[tuple, float]:
     """Capsule rows of link i with turning measured from the link's start, and its turning.
 
@@ -329,7 +330,7 @@ def _link_rows(link, i: int, r: float, twistPortion: float) -> tuple[tuple, floa
     return tuple(out.rows), turning
 
 
-@functools.lru_cache(maxsize=16384)
+@weighted_lru_cache(16384, MEMO_CAPSULE_ROWS, len)
 def _joint_rows(joint, j: int, r: float, text: str) -> tuple:
     """Capsule rows of joint j with turning 0 (the chain adds the turning before it)."""
     out = _Builder(r)
@@ -369,7 +370,7 @@ def _arrays(rows) -> tuple:
             np.array([row[4] for row in rows], dtype=float))  # fmt: skip
 
 
-@functools.lru_cache(maxsize=16384)
+@weighted_lru_cache(16384, MEMO_CAPSULE_ROWS, lambda found: len(found[1]))
 def link_capsule_arrays(link, i: int, r: float, twistPortion: float) -> tuple:
     """:func:`_arrays` of link i's rows, the rows whose labels they carry (those of the
     link it is a rigid copy of: labels need only lengths along a segment) and its turning."""
@@ -382,7 +383,7 @@ def link_capsule_arrays(link, i: int, r: float, twistPortion: float) -> tuple:
     return _arrays(rows), rows, total
 
 
-@functools.lru_cache(maxsize=16384)
+@weighted_lru_cache(16384, MEMO_CAPSULE_ROWS, lambda found: len(found[1]))
 def joint_capsule_arrays(joint, j: int, r: float) -> tuple:
     """:func:`_arrays` of joint j's rows (labels without names) and the rows (those of the
     joint it is a rigid copy of, when it is one: labels need only lengths along a segment)."""
