@@ -71,12 +71,15 @@ def _case(rng):
     return polyline, (starts, ends), (a, b), r, margin
 
 
-@pytest.mark.parametrize("first_chunk", [1, 7, 256])
-def test_junction_extent_gives_the_answers_of_sampling_everything(monkeypatch, first_chunk):
-    """Also when the scan, highest samples first, goes in small chunks growing fourfold."""
+@pytest.mark.parametrize("first_chunk, first_segments", [(1, 1), (7, 2), (256, 64)])
+def test_junction_extent_gives_the_answers_of_sampling_everything(monkeypatch, first_chunk,
+                                                                  first_segments):  # fmt: skip
+    """Also when the scan, highest samples first, goes in small chunks growing fourfold, and
+    the candidate samples are found a block of own segments at a time, the last first."""
     import kinegami.clearance.tree_bodies as tree_bodies
 
     monkeypatch.setattr(tree_bodies, "_JUNCTION_FIRST_CHUNK", first_chunk)
+    monkeypatch.setattr(tree_bodies, "_JUNCTION_FIRST_SEGMENTS", first_segments)
     monkeypatch.setattr(tree_bodies._descending_chunks, "__defaults__", (first_chunk,))
     rng = np.random.default_rng(29)
     touching = 0
@@ -108,6 +111,22 @@ def test_tubes_running_together_for_1e6_r_are_cheap():
         patch.setattr(tree_bodies, "_point_params", counted)
         assert junction_extent(polyline, own, siblings, r, limit=5.0) == 5.0
     assert sum(measured) <= 1024  # the last samples decide it (not a first chunk of 1M / 1)
+    # a tube of many segments reaching its sibling far along: the candidates of its last
+    # block of segments decide it (fuzz operations seed 404900: a margin of 1e8 r made all 41
+    # million samples of 1,316 segments candidates, 0.24 s a junction; now 0.04 s)
+    long = np.linspace([0.0, 0, 0], [0, 0, 1e4], 1317)
+    found = []
+    samples = tree_bodies._candidate_samples
+
+    def candidates(starts, *args):
+        found.append(len(starts))
+        return samples(starts, *args)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tree_bodies, "_candidate_samples", candidates)
+        assert junction_extent(long, (long[:-1], long[1:]), siblings, r, margin=1e8,
+                               limit=5.0) == 5.0  # fmt: skip
+    assert found == [tree_bodies._JUNCTION_FIRST_SEGMENTS]
     # without a limit the answer is the whole length (1e6 samples, evaluated in pieces)
     short = polyline / 50
     assert junction_extent(short, (short[:-1], short[1:]), (siblings[0], siblings[1] / 50), r) \

@@ -92,31 +92,50 @@ def junction_extent(
     counts = np.maximum(2, np.ceil(lengths / (0.02 * r)).astype(np.int64) + 1)
     reach = (2.0 * r + margin) * (1.0 - CONTACT_TOLERANCE)
     first = np.cumsum(counts) - counts  # global index of each segment's first sample
-    low, high = _candidate_samples(starts, ends, counts, first, a, b, reach)
     # a sample is measured against the sibling segments whose balls it comes near (with a
     # rounding allowance: the nearer ones decide whether it is within reach)
     centre, half = 0.5 * (a + b), 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
     scale = max(float(np.abs(starts).max()), float(np.abs(ends).max()),
                 float(np.abs(a).max()), float(np.abs(b).max()), 1.0)  # fmt: skip
     near = reach * (1.0 + 1e-6) + 1e-9 * scale
+    # the candidate samples of the own segments a block at a time, the last block first (its
+    # samples are the scan's first): a tube that reaches its sibling far along stops within
+    # its first block (a margin of 1e8 made every sample of 1,316 segments a candidate, 0.2 s
+    # of intervals for a scan that ended in its first chunk); each segment's samples are its
+    # own, so the blocks give the same candidates in the same order
+    chunk = max(1, _JUNCTION_CHUNK // a.shape[0])
+    own_scale = max(float(np.abs(starts).max()), float(np.abs(ends).max()),
+                    float(np.abs(a).max()), 1.0)  # fmt: skip
     found = -math.inf
-    for index in _descending_chunks(low, high, max(1, _JUNCTION_CHUNK // a.shape[0])):
-        i = np.searchsorted(first, index, side="right") - 1
-        u = (index - first[i]) / (counts[i] - 1)
-        points = starts[i] + u[:, None] * (ends - starts)[i]
-        p, q = _ball_pairs(points, np.zeros(points.shape[0]), centre, half, near)
-        t = _point_params(points[p], a[q], b[q])
-        nearest = a[q] + t[:, None] * (b - a)[q]
-        distance = np.sqrt(((points[p] - nearest) ** 2).sum(axis=1))
-        close = np.zeros(points.shape[0], dtype=bool)
-        close[p[distance < reach]] = True
-        if close.any():
-            found = max(found, float(_polyline_distance(points[close], polyline).max()))
-            if found + 0.02 * r >= limit:
-                return limit
+    end, block = starts.shape[0], _JUNCTION_FIRST_SEGMENTS
+    while end > 0:
+        begin = max(0, end - block)
+        part = slice(begin, end)
+        low, high = _candidate_samples(starts[part], ends[part], counts[part], first[part], a,
+                                       b, reach, own_scale)  # fmt: skip
+        end, block = begin, 4 * block
+        for index in _descending_chunks(low, high, chunk):
+            i = np.searchsorted(first, index, side="right") - 1
+            u = (index - first[i]) / (counts[i] - 1)
+            points = starts[i] + u[:, None] * (ends - starts)[i]
+            p, q = _ball_pairs(points, np.zeros(points.shape[0]), centre, half, near)
+            t = _point_params(points[p], a[q], b[q])
+            nearest = a[q] + t[:, None] * (b - a)[q]
+            distance = np.sqrt(((points[p] - nearest) ** 2).sum(axis=1))
+            close = np.zeros(points.shape[0], dtype=bool)
+            close[p[distance < reach]] = True
+            if close.any():
+                found = max(found, float(_polyline_distance(points[close], polyline).max()))
+                if found + 0.02 * r >= limit:
+                    return limit
     if found == -math.inf:
         return 0.0
     return found + 0.02 * r
+
+
+#: Own segments of junction_extent's first block of candidate samples; each next block is four
+#: times larger.
+_JUNCTION_FIRST_SEGMENTS = 64
 
 
 #: Samples of junction_extent's first chunk; each next chunk is four times larger (up to its
@@ -149,18 +168,23 @@ def _descending_chunks(low: np.ndarray, high: np.ndarray, chunk: int,
         yield np.concatenate(pieces)
 
 
-def _candidate_samples(starts, ends, counts, first, a, b, reach: float):
+def _candidate_samples(starts, ends, counts, first, a, b, reach: float,
+                       scale: float | None = None):  # fmt: skip
     """Sorted disjoint intervals [low, high) of global sample indices (sample k of own segment
     i is ``first[i] + k``, at parameter k / (counts[i] - 1)) that may lie within ``reach`` of
     a sibling segment (a, b): those inside the cylinder of radius ``reach`` around the
     sibling's line, between the planes ``reach`` beyond its ends (a superset of the capsule),
     padded by two samples on each side against rounding. Only the (own, sibling) pairs whose
-    balls come that close are measured (:func:`_ball_pairs`)."""
+    balls come that close are measured (:func:`_ball_pairs`). ``scale``: the size that sets
+    the rounding allowance (default: of these segments and the siblings' starts), so that the
+    segments taken a block at a time get the intervals they get all together."""
     e = b - a
     length = np.sqrt((e**2).sum(axis=1))
     e = np.where(length[:, None] > 0.0, e / np.where(length > 0.0, length, 1.0)[:, None], 0.0)
-    slack = reach * (1.0 + 1e-6) + 1e-9 * max(
-        float(np.abs(starts).max()), float(np.abs(ends).max()), float(np.abs(a).max()), 1.0)
+    if scale is None:
+        scale = max(float(np.abs(starts).max()), float(np.abs(ends).max()),
+                    float(np.abs(a).max()), 1.0)  # fmt: skip
+    slack = reach * (1.0 + 1e-6) + 1e-9 * scale
     # the region of a sibling lies within length / 2 + 2 slack of its midpoint: pairs whose
     # balls are 3 slack apart have no sample in it
     own_half = 0.5 * np.sqrt(((ends - starts) ** 2).sum(axis=1))
