@@ -24,10 +24,11 @@ Joints
     N) and ``velocity`` (rad/s or m/s).
 
 Frames
-    Every body frame is parallel to the world frame when all joint states are 0 and sits at the
-    centre (Pose origin, state 0) of the joint that starts the body (``body_0``: the world
-    origin). Joint origins are therefore pure translations (``rpy="0 0 0"``, no Euler-angle
-    round-off) and ``<axis>`` is the joint's z axis at state 0 in world coordinates. Forward
+    Every body frame is, when all joint states are 0, the Pose of the joint that starts the body
+    (its origin the joint's centre, its z axis the joint's axis; ``body_0``: the world frame).
+    A joint's ``<origin>`` is that Pose seen from its parent body's frame (``xyz`` and ``rpy``,
+    fixed-axis roll, pitch, yaw in radians) and its ``<axis>`` is ``0 0 1``: every reader takes
+    the axis the same way (Robotics Toolbox 1.5 misreads an axis other than z). Forward
     kinematics at a configuration q (one value per URDF joint, i.e. per movable chain joint in
     chain order) reproduces the chain (tree) after ``setJointStates`` with those states: a
     revolute joint turns everything after it about its z axis through its centre, a prismatic
@@ -142,11 +143,16 @@ class ChainBodies:
             return np.zeros(3)
         return self.zero_poses[self.movable[body - 1], :3, 3].copy()
 
+    def zero_frame(self, body: int) -> np.ndarray:
+        """A body frame at the zero configuration (world, chain units): the Pose of the joint
+        that starts the body (its z axis the joint's axis), the world frame for body 0."""
+        if body == 0:
+            return np.eye(4)
+        return self.zero_poses[self.movable[body - 1]].copy()
+
     def frame(self, body: int) -> np.ndarray:
         """Current world pose of a body frame (4x4, chain units)."""
-        T = np.eye(4)
-        T[:3, 3] = self.origin(body)
-        return self.motions[body] @ T
+        return self.motions[body] @ self.zero_frame(body)
 
 
 def _joint_motion(joint, state: float) -> np.ndarray:
@@ -209,6 +215,22 @@ def _number(value: float) -> str:
 
 def _vector(values) -> str:
     return " ".join(_number(v) for v in values)
+
+
+def roll_pitch_yaw(R: np.ndarray) -> tuple[float, float, float]:
+    """URDF's ``rpy`` of a rotation matrix: (roll, pitch, yaw) in radians with R = Rz(yaw)
+    Ry(pitch) Rx(roll) (fixed axes x, y, z); at pitch +-pi/2 the roll is 0."""
+    R = np.asarray(R, dtype=float)
+    pitch = math.atan2(-R[2, 0], math.hypot(R[0, 0], R[1, 0]))
+    roll = math.atan2(R[2, 1], R[2, 2]) if math.hypot(R[2, 1], R[2, 2]) > 1e-12 else 0.0
+    # the yaw from what is left, R Rx(roll)^T Ry(pitch)^T = Rz(yaw): near pitch +-pi/2 the
+    # roll is ill-conditioned, but the yaw taken this way absorbs its error (the rotation is
+    # rebuilt to rounding)
+    cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
+    Rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+    Ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
+    M = R @ Rx.T @ Ry.T
+    return roll, pitch, math.atan2(M[1, 0], M[0, 0])
 
 
 def _check_name(name: Any, what: str) -> str:
@@ -308,8 +330,8 @@ def urdf_model(chain: KinematicChain | KinematicTree, **options: Any) -> UrdfMod
     robot.append(
         ET.Comment(
             f" kinegami {what}, {len(bodies.movable)} movable; "
-            f"metres (1 chain unit = {_number(metres)} m); body frames parallel to the world "
-            f"at zero configuration "
+            f"metres (1 chain unit = {_number(metres)} m); each body frame the Pose of the "
+            f"joint that starts it at zero configuration, z along its axis "
         )
     )
     # MuJoCo's URDF importer (in older releases) keeps only the file name of a mesh path
@@ -354,9 +376,12 @@ def urdf_model(chain: KinematicChain | KinematicTree, **options: Any) -> UrdfMod
         )
         ET.SubElement(element, "parent", link=f"body_{parent}")
         ET.SubElement(element, "child", link=f"body_{b}")
-        offset = (pose[:3, 3] - bodies.origin(parent)) * metres
-        ET.SubElement(element, "origin", xyz=_vector(offset), rpy="0 0 0")
-        ET.SubElement(element, "axis", xyz=_vector(pose[:3, 2]))
+        # the joint frame is the joint's Pose, seen from its parent body's frame: its z is
+        # the axis (RTB reads an axis other than z as a rotation: its issues #253, #441)
+        relative = inverse(bodies.zero_frame(parent)) @ pose
+        ET.SubElement(element, "origin", xyz=_vector(relative[:3, 3] * metres),
+                      rpy=_vector(roll_pitch_yaw(relative[:3, :3])))  # fmt: skip
+        ET.SubElement(element, "axis", xyz="0 0 1")
         lo, hi = joint.stateRange()
         if joint.motion == PRISMATIC:
             lo, hi = lo * metres, hi * metres

@@ -28,7 +28,7 @@ from kinegami.clearance.solids import chain_parts
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export import ExportError
 from kinegami.export.registry import export
-from kinegami.export.urdf import urdf_model, write_urdf
+from kinegami.export.urdf import roll_pitch_yaw, urdf_model, write_urdf
 
 from .test_mesh import mixed_chain, random_chains, random_states
 
@@ -188,19 +188,33 @@ def test_random_chains_forward_kinematics(tmp_path_factory, chain, data):
 # --- conventions -----------------------------------------------------------------------------
 
 
-def test_frames_are_world_aligned_at_the_joint_centres(tmp_path, example_1a):
+def test_every_joint_turns_about_its_own_z(tmp_path, example_1a):
+    """Each joint's frame is its Pose (state 0) and its axis is z (``0 0 1``): Robotics
+    Toolbox 1.5 reads ``<axis xyz="-1 0 0">`` as a 1-radian rotation (its issues #253, #441),
+    which put the PUMA's tip 1.7 m off. yourdfpy's body frames at zero are the joints' Poses."""
     path = export(example_1a, tmp_path / "e.urdf", meshes=False)
     root = ET.parse(path).getroot()
-    for joint in root.iter("joint"):
-        assert joint.find("origin").get("rpy") == "0 0 0"
+    axes = [joint.find("axis").get("xyz") for joint in root.iter("joint")]
+    assert axes and set(axes) == {"0 0 1"}
     robot = load(path)
     for b, k in enumerate(movable_indices(example_1a), start=1):
         T = robot.get_transform(f"body_{b}")
-        np.testing.assert_allclose(T[:3, :3], np.eye(3), atol=0)
-        np.testing.assert_allclose(T[:3, 3], 1e-3 * example_1a.Joints[k].pose_matrix[:3, 3],
-                                   atol=1e-15)  # fmt: skip
-        axis = robot.joint_map[f"joint_{k}"].axis
-        np.testing.assert_allclose(axis, example_1a.Joints[k].pose_matrix[:3, 2], atol=1e-15)
+        pose = example_1a.Joints[k].pose_matrix
+        np.testing.assert_allclose(T[:3, :3], pose[:3, :3], atol=1e-15)
+        np.testing.assert_allclose(T[:3, 3], 1e-3 * pose[:3, 3], atol=1e-15)
+
+
+@given(st.floats(-math.pi, math.pi), st.floats(-math.pi / 2, math.pi / 2),
+       st.floats(-math.pi, math.pi), st.sampled_from([0.0, 1e-14, 1e-9, 1e-5]))
+def test_roll_pitch_yaw_rebuilds_the_rotation(roll, pitch, yaw, lock):
+    """URDF's rpy of any rotation, at and near pitch +-pi/2 (gimbal lock) too."""
+    from scipy.spatial.transform import Rotation
+
+    if lock:
+        pitch = math.copysign(math.pi / 2 - lock, pitch)
+    R = Rotation.from_euler("xyz", [roll, pitch, yaw]).as_matrix()
+    again = Rotation.from_euler("xyz", roll_pitch_yaw(R)).as_matrix()
+    assert np.abs(again - R).max() <= 1e-13
 
 
 def test_limits_effort_and_velocity(tmp_path, example_1a):
