@@ -187,9 +187,7 @@ class JointScrews:
         direction and whose origin o is on it (what Jacobians need)."""
         Q = np.asarray(Q, dtype=float)
         K, NB = Q.shape[0], self.bodies
-        if self._elementary is None:
-            self._elementary = self._elementary_constants()
-        steps, inverse = self._elementary
+        steps, inverse = self.elementary()
         bodies = np.asarray(bodies, dtype=np.int64)
         delta = Q[:, self.moving] - self._ref_moving  # (K, M)
         S = [None] * NB  # S_b, (K, 3, 4): the rows that move (the last is 0 0 0 1)
@@ -217,6 +215,14 @@ class JointScrews:
                 continue
             poses[:, l, :3] = (S[b].reshape(-1, 4) @ E).reshape(K, 3, 4)
         return (poses, frames_out) if axes else poses
+
+    def elementary(self) -> tuple[list, list]:
+        """:meth:`frame_poses`' constants, made once: per moving body b (1..), the step
+        Z_parent(b)^-1 Z_b from its parent's axis frame to its own (4x4), and every body's
+        Z_b^-1 (the base's: the identity). Compiled solvers use them as frame_poses does."""
+        if self._elementary is None:
+            self._elementary = self._elementary_constants()
+        return self._elementary
 
     def _elementary_constants(self) -> tuple[list, list]:
         """For :meth:`frame_poses`: per moving body b, Z_parent(b)^-1 Z_b, and every body's

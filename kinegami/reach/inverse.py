@@ -348,7 +348,11 @@ def _solve_chunk(design, compiled: Kinematics, goals: list, indices: list, start
     for k, goal in enumerate(goals):
         groups.setdefault(tuple((t, goal[t].kind) for t in sorted(goal)), []).append(k)
     answers: list[Answer | None] = [None] * len(goals)
-    for members in groups.values():
+    for key, members in groups.items():
+        if len(key) == 1 and _kernel() is not None:  # one tip: each target compiled
+            for k in members:
+                answers[k] = _solve_compiled(design, compiled, goals[k], start, options)
+            continue
         found = _solve_group(design, compiled, [goals[k] for k in members],
                              [indices[k] for k in members], start, options)  # fmt: skip
         for k, answer in zip(members, found, strict=True):
@@ -451,6 +455,102 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
             answers[g] = _failure(design, best[g], iterations[g], started[g] - 1, collided[g],
                                   options, compiled, goals[g], problem)  # fmt: skip
     return answers  # type: ignore[return-value]
+
+
+_KERNEL: list = []  # [kinegami.reach.kernels.descend, or None where numba cannot run]
+
+
+def _kernel():
+    """The compiled descent (:mod:`kinegami.reach.kernels`), loaded on first use; None where
+    numba cannot be imported or cannot keep its machine code (the numpy path then answers)."""
+    if not _KERNEL:
+        try:
+            from kinegami.reach.kernels import descend
+        except (ImportError, OSError, RuntimeError):
+            descend = None
+        _KERNEL.append(descend)
+    return _KERNEL[0]
+
+
+_KINDS = {"position": 0, "axis": 1, "pose": 2}
+
+
+def _tip_path(compiled: Kinematics, tip: int) -> tuple:
+    """What the compiled descent needs of one tip: the moving bodies from the root to it (in
+    order), their joints' columns of a configuration, revolute flags, reference states and
+    ranges, the steps between their axis frames and the tip's frame in its body's."""
+    screws = compiled.screws
+    b = int(screws.body_of[tip])
+    tip_body = b
+    path = []
+    while b > 0:
+        path.append(b)
+        b = int(screws.body_parent[b])
+    path.reverse()
+    steps, inverse = screws.elementary()
+    moving = np.array([b - 1 for b in path], dtype=np.int64)
+    columns = screws.moving[moving]
+    E = inverse[tip_body] @ compiled.tip_frames[compiled.tips.index(tip)]
+    return (np.ascontiguousarray(np.stack(steps) if steps else np.zeros((0, 4, 4))),
+            np.array(path, dtype=np.int64), np.ascontiguousarray(screws.revolute[moving]),
+            np.ascontiguousarray(screws.q_ref[columns]), np.ascontiguousarray(E), columns,
+            np.ascontiguousarray(compiled.ranges[columns, 0]),
+            np.ascontiguousarray(compiled.ranges[columns, 1]))  # fmt: skip
+
+
+def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
+                    options: tuple) -> Answer:  # fmt: skip
+    """:func:`_solve_group`'s answer for a target of one tip, each start iterated by the
+    compiled descent (:func:`kinegami.reach.kernels.descend`) in turn: the first from
+    ``start``, the others drawn from the target's own random stream, until one is exact and
+    clear or the budget is spent."""
+    tol_p, tol_a, seed, clear, margin = options
+    descend = _kernel()
+    r = float(design.r)
+    (tip, target), = goal.items()
+    steps, path, revolute, reference, E, columns, low_p, high_p = _tip_path(compiled, tip)
+    low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+    problem = _Problem(compiled, [goal], r)
+    rng = np.random.default_rng([seed, *_words(goal)])
+    hopeless = bool(_beyond_reach(compiled, goal))
+    budget, patience = (1, 12) if hopeless else (MAX_STARTS, ITERATIONS)
+    kind = _KINDS[target.kind]
+    axis = target.axis if target.axis is not None else np.zeros(3)
+    rotation = target.rotation if target.rotation is not None else np.eye(3)
+    best: list = [None]
+    collided = ""
+    iterations = 0
+    q = np.clip(start, low, high)
+    for started in range(budget):
+        if started:
+            q = low + (high - low) * rng.random(low.size)
+        if path.size == 0:  # nothing moves the tip: one evaluation
+            exact, count, pos, ang = _still(problem, q, tol_p, tol_a, r)
+            near, near_pos, near_ang = q[columns], pos, ang
+        else:
+            exact, count, pos, ang, near, near_pos, near_ang = descend(
+                steps, path, revolute, reference, E, low_p, high_p, kind, target.position,
+                rotation, axis, r, tol_p, tol_a, q[columns].copy(), patience, DAMPING,
+                DAMPING_MIN, DAMPING_MAX)  # fmt: skip
+        iterations += count
+        found = q.copy()
+        found[columns] = near
+        if exact:
+            verdict = _judge(design, found, clear, margin)
+            _keep(best, 0, found, near_pos, near_ang, verdict)
+            if verdict[2]:
+                return _answer(best[0], iterations, started, "", problem)
+            collided = verdict[1]
+        else:
+            _keep(best, 0, found, near_pos, near_ang, None)
+    return _failure(design, best[0], iterations, budget - 1, collided, options, compiled, goal,
+                    problem)  # fmt: skip
+
+
+def _still(problem: _Problem, q: np.ndarray, tol_p: float, tol_a: float, r: float) -> tuple:
+    """(exact, 1, position error, angle error) of a tip that no joint moves, at ``q``."""
+    _, pos, ang = problem.evaluate(q[None, :], np.zeros(1, dtype=np.int64), False)
+    return bool(pos[0] <= tol_p * r and ang[0] <= tol_a), 1, float(pos[0]), float(ang[0])
 
 
 def _words(goal: dict) -> list[int]:

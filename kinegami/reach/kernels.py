@@ -1,0 +1,181 @@
+"""Compiled damped least squares for one tip (numba; docs/reach.md, "Speed").
+
+:func:`kinegami.reach.inverse.solve` on a target of one tip spends its time in the fixed cost
+of some hundred small numpy calls per iteration, not in arithmetic: a 6-joint arm's forward
+kinematics, Jacobian and 6x6 solve are a few hundred floating-point operations. This module
+runs one start's whole iteration compiled: the tip's pose by the product of elementary
+transforms of :meth:`kinegami.geometry.screws.JointScrews.frame_poses` (the constant step to
+each joint's axis frame, then its turn or slide), the geometric Jacobian from the axes, the
+damped step with the same damping rule as the numpy path, and the projection onto the ranges.
+
+Compiled once per machine (``cache=True``); :func:`kinegami.reach.inverse.solve` loads this
+module on first use and keeps the numpy path where numba cannot run.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["descend"]
+
+#: Target kinds.
+POSITION, AXIS, POSE = 0, 1, 2
+
+
+@njit(cache=True)
+def _frames(steps, path, revolute, delta, E, axes, T):
+    """The tip's pose T (4, 4) and every path joint's axis frame (P, 3, 4) at ``delta`` (the
+    path joints' states minus the reference ones)."""
+    S = np.eye(4)
+    A = np.empty((3, 4))
+    for m in range(path.size):
+        step = steps[path[m] - 1]
+        for i in range(3):
+            for j in range(4):
+                A[i, j] = S[i, 0] * step[0, j] + S[i, 1] * step[1, j] + S[i, 2] * step[2, j] \
+                    + S[i, 3] * step[3, j]
+        axes[m] = A
+        d = delta[m]
+        if revolute[m]:
+            c, s = math.cos(d), math.sin(d)
+            for i in range(3):
+                x, y = A[i, 0], A[i, 1]
+                S[i, 0] = c * x + s * y
+                S[i, 1] = c * y - s * x
+                S[i, 2] = A[i, 2]
+                S[i, 3] = A[i, 3]
+        else:
+            for i in range(3):
+                S[i, 0], S[i, 1], S[i, 2] = A[i, 0], A[i, 1], A[i, 2]
+                S[i, 3] = A[i, 3] + d * A[i, 2]
+    for i in range(3):
+        for j in range(4):
+            T[i, j] = S[i, 0] * E[0, j] + S[i, 1] * E[1, j] + S[i, 2] * E[2, j] + S[i, 3] * E[3, j]
+    T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0
+
+
+@njit(cache=True)
+def _rotation_vector(R, out):
+    """The rotation vector (axis times angle) of R into out (3,), as inverse's numpy one."""
+    wx, wy, wz = R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]
+    s = 0.5 * math.sqrt(wx * wx + wy * wy + wz * wz)
+    c = 0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1.0)
+    c = min(max(c, -1.0), 1.0)
+    angle = math.atan2(s, c)
+    if s >= 1e-12:
+        scale = angle / (2.0 * s)
+        out[0], out[1], out[2] = wx * scale, wy * scale, wz * scale
+        return
+    if c >= 0.0:
+        out[0], out[1], out[2] = 0.5 * wx, 0.5 * wy, 0.5 * wz
+        return
+    # near pi: the axis from the symmetric part's largest diagonal
+    k = 0
+    for i in range(1, 3):
+        if R[i, i] > R[k, k]:
+            k = i
+    ax, ay, az = 0.5 * R[0, k], 0.5 * R[1, k], 0.5 * R[2, k]
+    if k == 0:
+        ax += 0.5
+    elif k == 1:
+        ay += 0.5
+    else:
+        az += 0.5
+    norm = math.sqrt(ax * ax + ay * ay + az * az)
+    out[0], out[1], out[2] = ax / norm * math.pi, ay / norm * math.pi, az / norm * math.pi
+
+
+@njit(cache=True)
+def _residual(T, kind, target_p, target_R, target_a, r, e, w):
+    """Residual e (3 or 6; units of r, then rad) of pose T; returns (position error in design
+    units, angle error in rad)."""
+    dx, dy, dz = target_p[0] - T[0, 3], target_p[1] - T[1, 3], target_p[2] - T[2, 3]
+    e[0], e[1], e[2] = dx / r, dy / r, dz / r
+    pos = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if kind == POSE:
+        M = np.empty((3, 3))
+        for i in range(3):
+            for j in range(3):
+                M[i, j] = target_R[i, 0] * T[j, 0] + target_R[i, 1] * T[j, 1] \
+                    + target_R[i, 2] * T[j, 2]
+        _rotation_vector(M, w)
+        e[3], e[4], e[5] = w[0], w[1], w[2]
+        return pos, math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    if kind == AXIS:
+        zx, zy, zz = T[0, 2], T[1, 2], T[2, 2]
+        ax, ay, az = target_a[0], target_a[1], target_a[2]
+        e[3], e[4], e[5] = ax - zx, ay - zy, az - zz
+        cx, cy, cz = zy * az - zz * ay, zz * ax - zx * az, zx * ay - zy * ax
+        return pos, math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), zx * ax + zy * ay + zz * az)
+    return pos, 0.0
+
+
+@njit(cache=True)
+def descend(steps, path, revolute, reference, E, low, high, kind, target_p, target_R, target_a,
+            r, tol_p, tol_a, q, patience, damping, damping_min, damping_max):  # fmt: skip
+    """Iterate one start: ``q`` (P,) the path joints' states, changed in place to the last
+    iterate. Returns (exact, iterations, position error, angle error, best q, its position and
+    angle errors): exact when the tip is within ``tol_p`` r and ``tol_a`` rad; otherwise the
+    start stalled (``patience`` iterations, or damped to ``damping_max``) and best is its
+    nearest iterate (position error, then angle error)."""
+    P = path.size
+    size = 3 if kind == POSITION else 6
+    axes = np.empty((P, 3, 4))
+    T = np.empty((4, 4))
+    e = np.empty(size)
+    e2 = np.empty(size)
+    w = np.empty(3)
+    J = np.zeros((size, P))
+    trial = np.empty(P)
+    best = q.copy()
+    _frames(steps, path, revolute, q - reference, E, axes, T)
+    pos, ang = _residual(T, kind, target_p, target_R, target_a, r, e, w)
+    best_pos, best_ang = pos, ang
+    lam = damping
+    for iteration in range(patience):
+        if pos <= tol_p * r and ang <= tol_a:
+            return True, iteration + 1, pos, ang, q.copy(), pos, ang
+        # the geometric Jacobian of the residual
+        for m in range(P):
+            dx, dy, dz = axes[m, 0, 2], axes[m, 1, 2], axes[m, 2, 2]
+            if revolute[m]:
+                px, py, pz = T[0, 3] - axes[m, 0, 3], T[1, 3] - axes[m, 1, 3], \
+                    T[2, 3] - axes[m, 2, 3]
+                vx, vy, vz = dy * pz - dz * py, dz * px - dx * pz, dx * py - dy * px
+                wx, wy, wz = dx, dy, dz
+            else:
+                vx, vy, vz = dx, dy, dz
+                wx, wy, wz = 0.0, 0.0, 0.0
+            J[0, m], J[1, m], J[2, m] = vx / r, vy / r, vz / r
+            if kind == POSE:
+                J[3, m], J[4, m], J[5, m] = wx, wy, wz
+            elif kind == AXIS:  # dz/dt = w x z
+                zx, zy, zz = T[0, 2], T[1, 2], T[2, 2]
+                J[3, m], J[4, m], J[5, m] = wy * zz - wz * zy, wz * zx - wx * zz, wx * zy - wy * zx
+        A = J @ J.T
+        for i in range(size):
+            A[i, i] += lam
+        step = J.T @ np.linalg.solve(A, e)
+        for m in range(P):
+            trial[m] = min(max(q[m] + step[m], low[m]), high[m])
+        _frames(steps, path, revolute, trial - reference, E, axes, T)
+        pos2, ang2 = _residual(T, kind, target_p, target_R, target_a, r, e2, w)
+        if np.dot(e2, e2) < np.dot(e, e):
+            q[:] = trial
+            e[:] = e2
+            pos, ang = pos2, ang2
+            lam = max(lam * 0.3, damping_min)
+            if pos < best_pos or (pos == best_pos and ang < best_ang):
+                best[:] = q
+                best_pos, best_ang = pos, ang
+        else:
+            lam = min(lam * 8.0, damping_max)
+            _frames(steps, path, revolute, q - reference, E, axes, T)  # back to q
+            if lam >= damping_max:
+                return False, iteration + 1, pos, ang, best, best_pos, best_ang
+    if pos <= tol_p * r and ang <= tol_a:
+        return True, patience, pos, ang, q.copy(), pos, ang
+    return False, patience, pos, ang, best, best_pos, best_ang
