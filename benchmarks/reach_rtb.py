@@ -1,0 +1,155 @@
+"""kinegami.reach side by side with Robotics Toolbox for Python (issue 31's goals).
+
+RTB (``roboticstoolbox-python``) is a benchmark-only extra (``pip install -e .[bench]``), never
+a test dependency: without it these rows say so. Its robot is built from our own joint poses
+(the elementary transforms of :meth:`kinegami.geometry.screws.JointScrews.elementary`: a fixed
+step to each joint's axis frame, then Rz or tz), so both solve the same kinematics; an RTB
+configuration is ours minus the design's reference states, in the movable joints.
+
+On the same targets (tip poses of random clear configurations) it measures the share each
+reaches and, for RTB, how many of its answers the design's own clearance engine finds clear
+(RTB knows nothing of a tube passing through itself), and the median wall time per target:
+kinegami's ``solve`` (clearance included), RTB's C++ ``ik_LM`` and its Python ``ikine_LM``.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+DESIGNS = Path(__file__).resolve().parents[1] / "examples" / "designs"
+
+
+def rtb_robot(compiled):
+    """An RTB ``Robot`` of the compiled design's first tip, and the columns of our
+    configuration its joints are (RTB q = ours[columns] - reference)."""
+    import roboticstoolbox as rtb
+    from spatialmath import SE3
+
+    screws = compiled.screws
+    tip = compiled.tips[0]
+    body = int(screws.body_of[tip])
+    tip_body, path = body, []
+    while body > 0:
+        path.append(body)
+        body = int(screws.body_parent[body])
+    path.reverse()
+    steps, inverse = screws.elementary()
+    ets = rtb.ETS()
+    columns = []
+    for b in path:
+        ets = ets * rtb.ET.SE3(SE3(steps[b - 1], check=False))
+        ets = ets * (rtb.ET.Rz() if screws.revolute[b - 1] else rtb.ET.tz())
+        columns.append(int(screws.moving[b - 1]))
+    ets = ets * rtb.ET.SE3(SE3(inverse[tip_body] @ compiled.tip_frames[0], check=False))
+    robot = rtb.Robot(ets)
+    columns = np.array(columns)
+    reference = screws.q_ref[columns]
+    robot.qlim = (compiled.ranges[columns] - reference[:, None]).T
+    return robot, columns, reference
+
+
+def clear_targets(design, compiled, count: int, seed: int = 0):
+    """(configurations, poses) of ``count`` random clear configurations."""
+    rng = np.random.default_rng(seed)
+    low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+    found = []
+    while len(found) < count:
+        q = low + (high - low) * rng.random(low.size)
+        if design.clearance(q.tolist()).ok:
+            found.append(q)
+    return found, [compiled.fkine(q) for q in found]
+
+
+def _median_ms(times) -> str:
+    return f"{statistics.median(times) * 1e3:.2f} ms"
+
+
+def rows(names=("puma", "spherical_series"), count: int = 40) -> list[tuple[str, str, str]]:
+    """The side-by-side rows (name, result, goal) for each design."""
+    from kinegami.design import load_design
+    from kinegami.reach import kinematics, solve
+
+    try:
+        import roboticstoolbox  # noqa: F401
+    except ImportError:
+        return [("RTB side by side", "skipped: roboticstoolbox-python is not installed "
+                 "(pip install -e .[bench])", "-")]  # fmt: skip
+    out = []
+    goals = {"puma": ("0.25 ms", "14.5 ms"), "spherical_series": ("0.39 ms", "14.3 ms")}
+    for name in names:
+        design = load_design(DESIGNS / f"{name}.json")
+        compiled = kinematics(design)
+        robot, columns, reference = rtb_robot(compiled)
+        configurations, targets = clear_targets(design, compiled, count)
+        r = float(design.r)
+        # the RTB robot is the design: same tip at the same configurations
+        gap = max(float(np.abs(robot.fkine(q[columns] - reference).A - T).max())
+                  for q, T in zip(configurations, targets, strict=True))  # fmt: skip
+        ours, ours_ok = [], 0
+        for T in targets:
+            t0 = time.perf_counter()
+            answer = solve(design, T)
+            ours.append(time.perf_counter() - t0)
+            ours_ok += answer.ok and _checked(DESIGNS / f"{name}.json", answer.states, T,
+                                              1e-9 * r)  # fmt: skip
+        fast, fast_ok, fast_clear = _rtb(design, robot.ik_LM, targets, columns, reference, r)
+        slow, slow_ok, slow_clear = _rtb(design, robot.ikine_LM, targets, columns, reference, r)
+        ik_goal, ikine_goal = goals.get(name, ("-", "-"))
+        out += [
+            (f"{name}: RTB robot from our poses, tip gap over {count} configurations",
+             f"{gap:.1e}", "<= 1e-9"),
+            (f"{name}: kinegami solve, {count} clear pose targets (reached exact and clear, "
+             "median)", f"{ours_ok}/{count}, {_median_ms(ours)}",
+             "99.9%; <= 3x ik_LM, <= 1/5 ikine_LM"),
+            (f"{name}: RTB ik_LM (C++): reached at 1e-5 r, of them clear, median",
+             f"{fast_ok}/{count}, {fast_clear} clear, {_median_ms(fast)}",
+             f"issue: {ik_goal}"),
+            (f"{name}: RTB ikine_LM (Python): reached at 1e-5 r, of them clear, median",
+             f"{slow_ok}/{count}, {slow_clear} clear, {_median_ms(slow)}",
+             f"issue: {ikine_goal}"),
+        ]  # fmt: skip
+    return out
+
+
+def _rtb(design, method, targets, columns, reference, r):
+    times, reached, clear = [], 0, 0
+    base = np.array([joint.state for joint in design.Joints], dtype=float)
+    for T in targets:
+        t0 = time.perf_counter()
+        found = method(T)
+        times.append(time.perf_counter() - t0)
+        if not found.success:
+            continue
+        q = base.copy()
+        q[columns] = reference + np.asarray(found.q, dtype=float)
+        if _reaches(design, q, T, 1e-5 * r):
+            reached += 1
+            clear += bool(design.clearance(q.tolist()).ok)
+    return times, reached, clear
+
+
+def _reaches(design, q, T, tolerance: float) -> bool:
+    from kinegami.reach import kinematics
+
+    return float(np.abs(kinematics(design).fkine(q) - T).max()) <= tolerance
+
+
+def _checked(path: Path, states, T, tolerance: float) -> bool:
+    """The answer as the design takes it: setJointStates with requireClearance on, the tip on
+    the target."""
+    from kinegami.design import load_design
+
+    check = load_design(path)
+    check.requireClearance = True
+    if not check.setJointStates(list(states)):
+        return False
+    return float(np.abs(check.Joints[-1].distal_dubins_frame() - T).max()) <= tolerance
+
+
+if __name__ == "__main__":
+    for row in rows():
+        print(" | ".join(row))
