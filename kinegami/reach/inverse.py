@@ -519,7 +519,7 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
     rotation = target.rotation if target.rotation is not None else np.eye(3)
     best: list = [None]
     collided = ""
-    iterations = 0
+    iterations = escapes = 0
     q = np.clip(start, low, high)
     for started in range(budget):
         if started:
@@ -537,6 +537,14 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
         found[columns] = near
         if exact:
             verdict = _judge(design, found, clear, margin)
+            if not verdict[2] and path.size > (3 if kind == 0 else 6) and escapes < ESCAPES:
+                # a redundant arm: move along the solutions, away from the binding pair
+                escapes += 1
+                arguments = (steps, path, revolute, reference, E, low_p, high_p, kind,
+                             target.position, rotation, axis, r, tol_p, tol_a)  # fmt: skip
+                found, verdict, count = _escape(design, compiled, found, columns, descend,
+                                                arguments, verdict, clear, margin)  # fmt: skip
+                iterations += count
             _keep(best, 0, found, near_pos, near_ang, verdict)
             if verdict[2]:
                 return _answer(best[0], iterations, started, "", problem)
@@ -545,6 +553,57 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
             _keep(best, 0, found, near_pos, near_ang, None)
     return _failure(design, best[0], iterations, budget - 1, collided, options, compiled, goal,
                     problem)  # fmt: skip
+
+
+#: Exact solutions that pass through themselves that one target moves away from (redundant
+#: arms), and the steps of each move.
+ESCAPES, ESCAPE_STEPS = 16, 24
+
+
+def _escape(design, compiled: Kinematics, q: np.ndarray, columns: np.ndarray, descend,
+            arguments: tuple, verdict: tuple, clear: bool, margin) -> tuple:  # fmt: skip
+    """For an arm with more joints on the tip's path than the target fixes: from the exact
+    solution ``q`` that passes through itself, steps that raise the smallest clearance (its
+    gradient by finite differences, projected onto the Jacobian's null space so that the tip
+    stays put to first order), each followed by the compiled descent back onto the target.
+    Returns (q, verdict, iterations): the first exact, clear solution met, or the last exact
+    one."""
+    (steps, path, revolute, reference, E, low_p, high_p, kind, position, rotation, axis, r,
+     tol_p, tol_a) = arguments
+    rows = 3 if kind == 0 else 6
+    iterations = 0
+    h = 1e-6
+    for _ in range(ESCAPE_STEPS):
+        base = float(design.clearance(q.tolist(), margin).min_clearance)
+        gradient = np.zeros(columns.size)
+        for m, c in enumerate(columns.tolist()):
+            moved = q.copy()
+            moved[c] = min(moved[c] + h * (1.0 if revolute[m] else r), high_p[m])
+            if moved[c] == q[c]:
+                moved[c] = q[c] - h * (1.0 if revolute[m] else r)
+            gradient[m] = (float(design.clearance(moved.tolist(), margin).min_clearance) - base) \
+                / (moved[c] - q[c])  # fmt: skip
+        J = compiled.jacob0(q)[:, columns]
+        J = np.vstack([J[:3] / r, J[3:]])[: rows if kind != 1 else 6]
+        null = np.eye(columns.size) - np.linalg.pinv(J) @ J
+        direction = null @ gradient
+        size = float(np.linalg.norm(direction))
+        if size < 1e-12:
+            break
+        trial = q.copy()
+        trial[columns] = np.clip(q[columns] + 0.05 * direction / size, low_p, high_p)
+        exact, count, _, _, near, _, _ = descend(
+            steps, path, revolute, reference, E, low_p, high_p, kind, position, rotation, axis,
+            r, tol_p, tol_a, trial[columns].copy(), 12, DAMPING, DAMPING_MIN, DAMPING_MAX)
+        iterations += count
+        if not exact:
+            break
+        trial[columns] = near
+        q = trial
+        verdict = _judge(design, q, clear, margin)
+        if verdict[2]:
+            break
+    return q, verdict, iterations
 
 
 def _still(problem: _Problem, q: np.ndarray, tol_p: float, tol_a: float, r: float) -> tuple:

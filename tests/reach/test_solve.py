@@ -103,6 +103,25 @@ def test_both_descents_reach_every_kind_of_target(compiled_path, kind, monkeypat
             check(path, answer, {compiled.tips[0]: Target.of(target)})
 
 
+def test_a_redundant_arm_moves_along_its_solutions_away_from_itself(monkeypatch):
+    """The 9-joint spherical series has three joints more than a pose fixes: an exact
+    solution that passes through itself is moved along the Jacobian's null space, up the
+    clearance's gradient, and brought back onto the target. Target 4 of these (seed 0) is
+    reached from its second start that way; without the moves every solution found for it
+    passes through itself."""
+    import kinegami.reach.inverse as inverse
+
+    path = DESIGNS / "spherical_series.json"
+    design = load_design(path)
+    compiled = kinematics(design)
+    T = compiled.fkine(clear_configurations(design, 5, seed=0)[4])
+    answer = solve(design, T)
+    check(path, answer, {compiled.tips[0]: Target.of(T)})
+    monkeypatch.setattr(inverse, "ESCAPES", 0)
+    blind = solve(design, T)
+    assert not blind.ok and blind.reason.startswith("every solution found passes through")
+
+
 def test_every_fingertip_of_a_hand_at_once():
     path = DESIGNS / "hand.json"
     hand = load_design(path)
