@@ -9,6 +9,8 @@ returns its report as text for the panel (:func:`motion_check`).
 
 from __future__ import annotations
 
+import numpy as np
+
 __all__ = ["MOTION_SAMPLES", "TREE_MOTION_SAMPLES", "motion_check"]
 
 #: Configurations a motion check samples for a chain (vectorised: about a second for the PUMA).
@@ -30,3 +32,18 @@ def motion_check(chain, names, samples: int, seed: int = 0, *, progress=None) ->
     report = sweep(chain, samples=samples, seed=seed, names=names, progress=progress)
     return report.markdown(chain, names=names, seed=seed, listed=LISTED,
                            joints_listed=LISTED_JOINTS)  # fmt: skip
+
+
+#: Configurations the editor's Workspace button samples.
+WORKSPACE_SAMPLES = 20_000
+
+
+def workspace_points(chain, samples: int, tip: int, seed: int = 0, *,
+                     progress=None) -> tuple:  # fmt: skip
+    """The editor's workspace cloud of ``chain``'s joint ``tip``: the tip positions of the
+    clear configurations among ``samples`` random ones (:func:`kinegami.reach.workspace`),
+    as ``(points (N, 3), summary in one line)``."""
+    from kinegami.reach import workspace
+
+    found = workspace(chain, samples, seed=seed, tip=tip, progress=progress)
+    return np.asarray(found.points, dtype=float), found.summary()

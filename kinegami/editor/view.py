@@ -41,7 +41,13 @@ from kinegami.editor.commands import (
 )
 from kinegami.editor.document import Document
 from kinegami.editor.framing import Framing, box_corners, frame_box, grid_for_box, nice_step
-from kinegami.editor.jobs import MOTION_SAMPLES, TREE_MOTION_SAMPLES, motion_check
+from kinegami.editor.jobs import (
+    MOTION_SAMPLES,
+    TREE_MOTION_SAMPLES,
+    WORKSPACE_SAMPLES,
+    motion_check,
+    workspace_points,
+)
 from kinegami.editor.keys import keys_script, shortcuts_markdown
 from kinegami.editor.model import Change, CommandResult, EditorModel
 from kinegami.editor.page_script import run_javascript, unsaved_changes_script
@@ -328,6 +334,12 @@ class EditorView:
         self._pattern_redraw = Debounced(self.redraw_pattern, pattern_delay,
                                          name="kinegami-pattern")  # fmt: skip
         self._jobs = JobProcess() if background else None
+        self._target_handle = None  # the reach target's handle (made when first shown)
+        self._target_marker = None
+        self._reach_point: np.ndarray | None = None
+        self.reach_answer = None  # the last answer of reach_to (tests read it)
+        self._workspace_cloud = None
+        self.workspace_points: np.ndarray | None = None  # the last workspace drawn
         self._job: Job | None = None
         #: A finished job's command waiting for an answer (the design changed meanwhile).
         self.pending_result: Computed | None = None
@@ -915,6 +927,30 @@ class EditorView:
                 "as kinegami build does (the kinematics stay)",
             )  # fmt: skip
             self._fit.on_click(lambda _: self.fit_junctions())
+        with gui.add_folder("Reach"):
+            units = self.model.document.units
+            self._reach_target = gui.add_vector3(
+                f"Target ({units})", initial_value=tuple(self.tip_position().tolist()),
+                step=0.1, hint="where the tip should go, in the design's units (world frame)",
+            )  # fmt: skip
+            reach = gui.add_button(
+                "Reach target", hint="states that put the tip on the target, clear of "
+                "itself, found from the current states (Undo takes them back)",
+            )  # fmt: skip
+            reach.on_click(lambda _: self.reach_to(self._reach_target.value))
+            self._reach_handle = gui.add_checkbox(
+                "Target handle", initial_value=False,
+                hint="drag the target in the scene: the design follows it",
+            )  # fmt: skip
+            self._reach_handle.on_update(lambda _: self.show_target(bool(self._reach_handle.value)))
+            self._reach_status = gui.add_markdown("")
+            space = gui.add_button(
+                "Workspace", hint=f"sample {WORKSPACE_SAMPLES:,} configurations in the "
+                "background and show the tip positions that are clear of the design",
+            )  # fmt: skip
+            space.on_click(lambda _: self.show_workspace())
+            self._hide_space = gui.add_button("Hide workspace", visible=False)
+            self._hide_space.on_click(lambda _: self.hide_workspace())
         with gui.add_folder("File"):
             self._save_file = gui.add_button(
                 "Save to " + (self.model.path.name if self.model.path else "file"),
@@ -943,6 +979,125 @@ class EditorView:
             open_example.on_click(lambda _: self.open_example(str(self._example.value)))
             upload = gui.add_upload_button("Upload design", mime_type="application/json")
             upload.on_upload(lambda e: self.upload(e.target.value.name, e.target.value.content))
+
+    # --- reach --------------------------------------------------------------------------------
+    def reach_tip(self) -> int:
+        """The tip the target is for: a chain's last joint; on a tree, the selected joint when
+        it is a leaf, else the first leaf."""
+        chain = self.model.chain
+        parents = {int(p) for p in chain.Parents if p is not None and int(p) >= 0}
+        leaves = [k for k in range(len(chain.Joints)) if k not in parents]
+        selected = self.model.selected
+        return selected if selected in leaves else leaves[0]
+
+    def tip_position(self) -> np.ndarray:
+        """Where the reach tip is now (world, design units)."""
+        joint = self.model.chain.Joints[self.reach_tip()]
+        return np.asarray(joint.distal_dubins_frame(), dtype=float)[:3, 3].copy()
+
+    @_locked
+    def reach_to(self, position, *, preview: bool = False):
+        """Put the tip on ``position`` (3 numbers, design units, world frame) by inverse
+        kinematics warm-started from the current states (:func:`kinegami.reach.solve`: exact,
+        in range and clear of itself). Reached: the states are set (one command; with
+        ``preview``, a preview, as a handle drag shows). Not reached: the design stays, the
+        target turns red and the panel says why. Returns the solver's answer (None for a
+        position that is not three finite numbers)."""
+        from kinegami.reach import solve
+
+        self.stop_animation()
+        try:
+            point = np.asarray(position, dtype=float).reshape(3)
+        except (TypeError, ValueError):
+            point = None
+        if point is None or not np.isfinite(point).all():
+            self._say(f"**Refused:** reach: the target must be three finite numbers, got "
+                      f"{position!r}")  # fmt: skip
+            return None
+        chain = self.model.chain
+        q0 = [float(joint.state) for joint in chain.Joints]
+        answer = solve(chain, point, tip=self.reach_tip(), q0=q0)
+        self.reach_answer = answer
+        self._draw_target(point, answer.ok)
+        units = self.model.document.units
+        if not answer.ok:
+            self._reach_status.content = f"**Cannot reach:** {answer.reason}"
+            return answer
+        if preview:
+            self.model.preview(SetJointStates(list(answer.states)))
+        else:
+            result = self.run(self.model.set_states(list(answer.states)))
+            if not result.ok:
+                self._reach_status.content = f"**Cannot reach:** {result.reason}"
+                return answer
+        self._reach_status.content = (
+            f"reached: tip {answer.position_error:.1e} {units} from the target, clearance "
+            f"{answer.clearance:.3g} {units}")  # fmt: skip
+        return answer
+
+    def _draw_target(self, point: np.ndarray, ok: bool) -> None:
+        """The target's marker: a small ball, the tip's colour when reached, red when not."""
+        self._reach_point = point
+        color = (40, 160, 80) if ok else COLLIDING_COLOR
+        self._target_marker = self.scene.add_icosphere(
+            "/reach/target", radius=0.4 * self._r, color=color, position=tuple(point.tolist()))
+
+    @_locked
+    def show_target(self, visible: bool = True) -> None:
+        """Show (or hide) the target's handle: dragging it makes the design follow, previewed
+        while it moves, one command when it is let go."""
+        if not visible:
+            if self._target_handle is not None:
+                self._target_handle.visible = False
+            return
+        point = np.asarray(self._reach_target.value, dtype=float)
+        if self._target_handle is None:
+            self._target_handle = self.scene.add_transform_controls(
+                "/reach/handle", scale=3.0 * self._r, disable_rotations=True,
+                disable_sliders=True, depth_test=False, translation_limits=((-1e9, 1e9),) * 3,
+            )  # fmt: skip
+            self._target_handle.on_update(self._on_target_handle)
+        self._target_handle.visible = True
+        self._target_handle.position = tuple(point.tolist())
+        self._draw_target(point, True)
+
+    def _on_target_handle(self, event) -> None:
+        phase = getattr(event, "phase", "end")
+        position = tuple(float(x) for x in self._target_handle.position)
+        self._reach_target.value = position
+        if phase == "update":
+            self.reach_to(position, preview=True)
+        elif phase == "end":
+            self.reach_to(position)
+
+    def show_workspace(self, samples: int = None) -> Job | None:
+        """Sample the workspace in the background (the Workspace button): ``samples``
+        configurations (default :data:`WORKSPACE_SAMPLES`), and the tip positions of the clear
+        ones drawn as a cloud. Nothing changes in the design."""
+        with self.lock:
+            document = self.model.base_document
+            tip = self.reach_tip()
+        count = WORKSPACE_SAMPLES if samples is None else int(samples)
+
+        def finish(job: Job, found) -> None:
+            points, summary = found
+            self.workspace_points = points
+            self._workspace_cloud = self.scene.add_point_cloud(
+                "/reach/workspace", points=points.astype(np.float32), colors=(90, 120, 220),
+                point_size=0.3 * self._r, precision="float32")  # fmt: skip
+            self._hide_space.visible = True
+            self._say(f"workspace: {summary}")
+
+        return self.start_job("workspace", "Sampling the workspace", "configurations",
+                              workspace_points, (document.chain, count, tip), finish)  # fmt: skip
+
+    @_locked
+    def hide_workspace(self) -> None:
+        """Remove the workspace cloud."""
+        if self._workspace_cloud is not None:
+            self._workspace_cloud.remove()
+            self._workspace_cloud = None
+        self._hide_space.visible = False
 
     def _undo(self) -> CommandResult:
         return self.model.undo()
