@@ -199,3 +199,40 @@ def test_closing_the_tab_with_unsaved_changes_warns(served):
     page.get_by_role("button", name="Undo", exact=True).click()  # back to the saved design
     wait_for(lambda: not view.model.dirty, "undo to the saved design")
     wait_for(lambda: page.evaluate(BEFORE_UNLOAD) is False, "no warning once clean again")
+
+
+def test_the_puma_reaches_a_target_says_why_it_cannot_and_draws_its_workspace(served, tmp_path):
+    """The Reach folder in Chromium: Reach target puts the PUMA's tip on a target (one undo
+    step), a target out of reach is refused with its reason on the page, and Workspace draws
+    the cloud from a background job (issue 31, docs/editor.md Reach)."""
+    import numpy as np
+
+    from kinegami.reach import kinematics
+
+    path, page, view = served(PUMA)
+    before = view.model.document
+    compiled = kinematics(view.model.chain)
+    rng = np.random.default_rng(3)
+    low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+    while True:
+        q = low + (high - low) * rng.random(low.size)
+        if view.model.chain.clearance(q.tolist()).ok:
+            break
+    target = compiled.fkine(q)[:3, 3]
+    view._reach_target.value = tuple(target.tolist())
+    page.get_by_role("button", name="Reach target", exact=True).click()
+    page.get_by_text("reached: tip", exact=False).first.wait_for()
+    wait_for(lambda: view.model.dirty, "the states found to be set")
+    tip = np.asarray(view.model.chain.Joints[-1].distal_dubins_frame())[:3, 3]
+    assert np.abs(tip - target).max() <= 1e-9 * view.model.chain.r
+    page.screenshot(path=tmp_path / "1_reached.png")
+    page.get_by_role("button", name="Undo", exact=True).click()
+    wait_for(lambda: view.model.document is before, "undo to give the states back")
+    view._reach_target.value = (1e6, 0.0, 0.0)
+    page.get_by_role("button", name="Reach target", exact=True).click()
+    page.get_by_text("Cannot reach:", exact=False).first.wait_for()
+    assert view.model.document is before
+    page.get_by_role("button", name="Workspace", exact=True).click()
+    page.get_by_role("button", name="Hide workspace", exact=True).wait_for(timeout=300_000)
+    assert view.workspace_points is not None and view.workspace_points.shape[0] > 1_000
+    page.screenshot(path=tmp_path / "2_workspace.png")
