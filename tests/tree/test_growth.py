@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import warnings
 from pathlib import Path
+from unittest import mock
 
 import numpy as np
 from hypothesis import given, settings
@@ -92,6 +93,8 @@ def test_the_incremental_test_answers_as_the_whole_tree_test(steps, margin, elbo
         expected = tree_worst_overlap(*after, tree.r, since=len(before[0]), margin=tree.margin)
         assert _same(growth.overlap(*after), expected)
         assert TreeGrowth(*before, tree.r, tree.margin).clear(*after) is (expected is None)
+        with mock.patch("kinegami.clearance.tree_bodies._CLEAR_CHUNK", 3):  # its first chunk
+            assert TreeGrowth(*before, tree.r, tree.margin).clear(*after) is (expected is None)
         checked += 1
     assert checked or len(tree.Joints) == 1
 
