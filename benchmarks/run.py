@@ -537,14 +537,18 @@ def _ik_rows(puma, arm) -> list[tuple[str, str, str]]:
             tip = check.Joints[-1].distal_dubins_frame() if check.setJointStates(
                 list(answer.states)) else None  # fmt: skip
             reached += tip is not None and np.abs(tip - T).max() <= 1e-9 * puma.r
-    t0 = time.perf_counter()
-    solve(puma, [1e5, 0.0, 0.0])
-    far = time.perf_counter() - t0
+    far_times = []
+    for x in (1e5, 2e5, 3e5, 4e5, 5e5):  # the median of five (a single call met a collection)
+        t0 = time.perf_counter()
+        solve(puma, [x, 0.0, 0.0])
+        far_times.append(time.perf_counter() - t0)
+    far = statistics.median(far_times)
     return [
         ("solve, PUMA, 40 clear pose targets: reached / median per target (wall)",
          f"{reached}/40, {statistics.median(times) * 1e3:.1f} ms",
          "99.9% reached; <= 0.75 ms (3x RTB ik_LM 0.25 ms on the issue's machine)"),
-        ("solve, PUMA, a target beyond reach (wall)", f"{far * 1e3:.1f} ms", "<= 5 ms"),
+        ("solve, PUMA, a target beyond reach (wall, median of 5)", f"{far * 1e3:.1f} ms",
+         "<= 5 ms"),
     ]  # fmt: skip
 
 
