@@ -208,3 +208,40 @@ def test_a_takeoff_candidate_is_charged_for_its_junction_extents(monkeypatch):
             pass  # no placement: the search measured all the same
     assert spent and min(spent) > capsules
     assert sum(spent) <= limits.TAKEOFF_WORK + sum(costs) + max(spent)
+
+
+def test_a_takeoff_candidate_is_charged_the_pairs_it_measured(monkeypatch):
+    """A body folded onto itself costs per near pair, not per capsule (fuzz operations seed
+    409604 spent 165 s in its take-off search; now 25 s): each candidate is charged
+    max(its capsule cost, pairs measured / NEAR_PAIRS_PER_TEST), and a branch stops measuring
+    once the budget is spent (after its first candidate)."""
+    tree = KinematicTree(Waypoint(4, 1, SE3()), maxAnglePerElbow=math.pi / 60)
+    for parent, x, y in ((0, -6, 0), (0, 6, 0), (1, -9, 4), (1, -3, 4)):
+        pose = SE3.Trans(x, y, 10 if parent == 0 else 22) * SE3.Rx(2.0)
+        tree.addJoint(parent, RevoluteJoint(4, 1, math.pi, pose), safe=False)
+    from kinegami.fabrication.sheets import fabricate
+
+    def run(per_test: int) -> tuple[list, list]:
+        monkeypatch.setattr(takeoffs, "NEAR_PAIRS_PER_TEST", per_test)
+        spent, pairs = [], []
+        spend, overlap = takeoffs.TakeoffWork.spend, takeoffs.takeoff_overlap
+
+        def counted(*args, measured=None, **kwargs):
+            found = overlap(*args, measured=measured, **kwargs)
+            if measured is not None:
+                pairs.append(sum(measured))
+            return found
+
+        monkeypatch.setattr(takeoffs.TakeoffWork, "spend",
+                            lambda self, c: (spent.append(c), spend(self, c)))  # fmt: skip
+        monkeypatch.setattr(takeoffs, "takeoff_overlap", counted)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fabricate(tree, junction="takeoff")
+        return spent, pairs
+
+    spent, pairs = run(16)
+    assert sum(pairs) > 0
+    charged, counted_pairs = run(1)  # every pair a capsule test: the budget is spent sooner
+    assert len(counted_pairs) < len(pairs)
+    assert sum(charged) >= sum(counted_pairs)

@@ -650,7 +650,7 @@ def tree_capsules(joints, links, parents, r: float, margin: float = 0.0) -> Tree
 
 def tree_pair_distances(
     joints, links, parents, r: float, since: int = 0, reach: float | None = None,
-    margin: float = 0.0,
+    margin: float = 0.0, measured: list | None = None,
 ) -> tuple | None:
     """The tested capsule pairs of a tree that come within ``reach`` (default 2r + ``margin``)
     and their distances (docs/trees.md): ``(i, j, distance, s, t, rows, a, b)`` with ``i``,
@@ -664,12 +664,17 @@ def tree_pair_distances(
     covers them until they are the margin apart); on a chain the tested pairs are the chain's.
     """
     reach = 2.0 * r + margin if reach is None else reach
-    return _tested_pairs(tree_capsules(joints, links, parents, r, margin), joints, since, reach)
+    return _tested_pairs(tree_capsules(joints, links, parents, r, margin), joints, since, reach,
+                         measured)  # fmt: skip
 
 
-def _tested_pairs(caps: TreeCapsules, joints, since: int, reach: float) -> tuple | None:
-    """:func:`tree_pair_distances` of the tree whose capsules are ``caps``."""
+def _tested_pairs(caps: TreeCapsules, joints, since: int, reach: float,
+                  measured: list | None = None) -> tuple | None:  # fmt: skip
+    """:func:`tree_pair_distances` of the tree whose capsules are ``caps``; ``measured``,
+    when given, gets the number of pairs measured appended (what the test cost)."""
     found = _near_pairs(caps, joints, since, reach)
+    if measured is not None:
+        measured.append(0 if found is None else int(found[0].size))
     if found is None:
         return None
     i, j = found
@@ -759,7 +764,7 @@ def _near_new_pairs(element, wanted, centre, half, reach: float, tau=None) -> tu
 
 
 def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int = 0,
-                       margin: float = 0.0):  # fmt: skip
+                       margin: float = 0.0, measured: list | None = None):  # fmt: skip
     """:func:`worst_overlap` for a tree (docs/trees.md): the closest pair when it is closer
     than ``margin``, or None.
 
@@ -770,7 +775,8 @@ def tree_worst_overlap(joints, links, parents, r: float, names=None, since: int 
     parents = [int(p) for p in parents]
     if parents == list(range(-1, len(joints) - 1)):
         return worst_overlap(joints, links, r, names=names, since=since, margin=margin)
-    found = tree_pair_distances(joints, links, parents, r, since, margin=margin)
+    found = tree_pair_distances(joints, links, parents, r, since, margin=margin,
+                                measured=measured)  # fmt: skip
     if found is None:
         return None
     i, j, dist, s, t, rows, _, _ = found
