@@ -31,12 +31,7 @@ def rtb_robot(compiled):
 
     screws = compiled.screws
     tip = compiled.tips[0]
-    body = int(screws.body_of[tip])
-    tip_body, path = body, []
-    while body > 0:
-        path.append(body)
-        body = int(screws.body_parent[body])
-    path.reverse()
+    tip_body, path = int(screws.body_of[tip]), compiled.path(tip).tolist()
     steps, inverse = screws.elementary()
     ets = rtb.ETS()
     columns = []

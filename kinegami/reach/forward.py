@@ -142,6 +142,17 @@ class Kinematics:
             tip[:, 3:, cols] = w.transpose(0, 2, 1)
         return out, tips
 
+    def path(self, tip: int) -> np.ndarray:
+        """The moving bodies (1 .. M; body b moves with joint ``screws.moving[b - 1]``) from
+        the root to joint ``tip``'s body, in order: the joints that move that tip."""
+        screws = self.screws
+        b = int(screws.body_of[tip])
+        path = []
+        while b > 0:
+            path.append(b)
+            b = int(screws.body_parent[b])
+        return np.array(path[::-1], dtype=np.int64)
+
     def _ancestors(self) -> list[np.ndarray]:
         """Per tip, a mask over the moving joints: those on the path from the root to it."""
         screws = self.screws

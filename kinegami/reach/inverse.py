@@ -480,19 +480,14 @@ def _tip_path(compiled: Kinematics, tip: int) -> tuple:
     order), their joints' columns of a configuration, revolute flags, reference states and
     ranges, the steps between their axis frames and the tip's frame in its body's."""
     screws = compiled.screws
-    b = int(screws.body_of[tip])
-    tip_body = b
-    path = []
-    while b > 0:
-        path.append(b)
-        b = int(screws.body_parent[b])
-    path.reverse()
+    tip_body = int(screws.body_of[tip])
+    path = compiled.path(tip)
     steps, inverse = screws.elementary()
-    moving = np.array([b - 1 for b in path], dtype=np.int64)
+    moving = path - 1
     columns = screws.moving[moving]
     E = inverse[tip_body] @ compiled.tip_frames[compiled.tips.index(tip)]
     return (np.ascontiguousarray(np.stack(steps) if steps else np.zeros((0, 4, 4))),
-            np.array(path, dtype=np.int64), np.ascontiguousarray(screws.revolute[moving]),
+            path, np.ascontiguousarray(screws.revolute[moving]),
             np.ascontiguousarray(screws.q_ref[columns]), np.ascontiguousarray(E), columns,
             np.ascontiguousarray(compiled.ranges[columns, 0]),
             np.ascontiguousarray(compiled.ranges[columns, 1]))  # fmt: skip
@@ -574,7 +569,7 @@ def _escape(design, compiled: Kinematics, q: np.ndarray, columns: np.ndarray, de
     iterations = 0
     h = 1e-6
     for _ in range(ESCAPE_STEPS):
-        base = float(design.clearance(q.tolist(), margin).min_clearance)
+        base = float(verdict[0])  # _judge's clearance of this q (measured once)
         gradient = np.zeros(columns.size)
         for m, c in enumerate(columns.tolist()):
             moved = q.copy()
@@ -702,12 +697,7 @@ def reach_bound(compiled: Kinematics, tip: int) -> tuple[float, np.ndarray]:
     joint adds its stroke."""
     screws = compiled.screws
     k = compiled.tips.index(tip)
-    b = int(screws.body_of[tip])
-    path = []
-    while b > 0:
-        path.append(b - 1)
-        b = int(screws.body_parent[b])
-    path.reverse()
+    path = (compiled.path(tip) - 1).tolist()
     tip_point = compiled.tip_frames[k, :3, 3]
     if not path:
         return 0.0, tip_point

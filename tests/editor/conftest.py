@@ -1,5 +1,6 @@
 """Every editor test gets its own data folder (``XDG_DATA_HOME``), so that autosaves never go
-to the real one of the user running the tests."""
+to the real one of the user running the tests; ``view`` is the editor view of the module's own
+``server`` fixture (each module serves its design)."""
 
 from __future__ import annotations
 
@@ -12,3 +13,11 @@ def data_home(tmp_path_factory, monkeypatch):
     path = tmp_path_factory.mktemp("data")
     monkeypatch.setenv("XDG_DATA_HOME", str(path))
     return path
+
+
+@pytest.fixture
+def view(server):
+    """An EditorView on the module's ``server`` (no browser: the server's own scene)."""
+    view = server.new_view(server.server)
+    yield view
+    view.close()

@@ -122,13 +122,6 @@ def server(design):
     server.stop()
 
 
-@pytest.fixture
-def view(server):
-    view = server.new_view(server.server)
-    yield view
-    view.close()
-
-
 def _finished(job) -> str:
     assert job is not None
     assert job.finished.wait(LIVE), "the job did not finish"

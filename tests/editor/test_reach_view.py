@@ -27,13 +27,6 @@ def server():
     server.stop()
 
 
-@pytest.fixture
-def view(server):
-    view = server.new_view(server.server)
-    yield view
-    view.close()
-
-
 def _clear_tip(design, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """A clear configuration of ``design`` and its tip position."""
     compiled = kinematics(design)

@@ -28,13 +28,6 @@ def server():
     server.stop()
 
 
-@pytest.fixture
-def view(server):
-    view = server.new_view(server.server)
-    yield view
-    view.close()
-
-
 def test_the_tree_is_drawn_part_by_part(view):
     assert view.meshes_sent == len(chain_parts(view.model.chain))
     assert len(view._joints) == 12 and view._links[0] is None

@@ -34,13 +34,6 @@ def server():
     server.stop()
 
 
-@pytest.fixture
-def view(server):
-    view = server.new_view(server.server)
-    yield view
-    view.close()
-
-
 def test_server_binds_localhost_by_default(server):
     assert server.url.startswith("http://127.0.0.1:")
     assert server.port > 0

@@ -33,13 +33,6 @@ def server():
     server.stop()
 
 
-@pytest.fixture
-def view(server):
-    view = server.new_view(server.server)
-    yield view
-    view.close()
-
-
 def _mesh_points(view) -> np.ndarray:
     from kinegami.clearance.solids import chain_parts
 
