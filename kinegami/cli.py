@@ -1128,9 +1128,11 @@ def cmd_reach(args: argparse.Namespace) -> int:
     tips = [_integer("--tip", t, 0, n - 1, "a joint index of the design") for t in args.tip]
     if tips and len(tips) != len(targets):
         raise CommandError(f"--tip: give one per --target ({len(targets)}); got {len(tips)}")
-    goal = dict(zip(tips, targets, strict=True)) if tips else targets[0]
     if not tips and len(targets) > 1:
         raise CommandError("--target: several targets need one --tip each")
+    if not tips:
+        _one_tip(chain)
+    goal = dict(zip(tips, targets, strict=True)) if tips else targets[0]
     answer = solve(chain, goal, seed=seed)
     length = Lengths(chain.r, info.units)
     names = _joint_names(chain) or (None,) * n
@@ -1172,6 +1174,17 @@ def cmd_reach(args: argparse.Namespace) -> int:
     return 0 if answer.ok else NOT_REACHED
 
 
+def _one_tip(design) -> None:
+    """Refuse, in the command line's words, a design with several tips and no ``--tip``."""
+    from kinegami.reach import kinematics
+
+    tips = kinematics(design).tips
+    if len(tips) != 1:
+        listed = ", ".join(str(t) for t in tips)
+        raise CommandError(f"--tip: the design has {len(tips)} tips (joints {listed}); give "
+                           "--tip J (for reach, one --tip per --target)")  # fmt: skip
+
+
 def cmd_workspace(args: argparse.Namespace) -> int:
     import io
     import json
@@ -1195,6 +1208,8 @@ def cmd_workspace(args: argparse.Namespace) -> int:
         if voxel <= 0:
             raise CommandError(f"--voxel: must be a length > 0 in the design's units, got "
                                f"{args.voxel!r}")  # fmt: skip
+    if args.tip is None:
+        _one_tip(chain)
     tip = None if args.tip is None else _integer("--tip", args.tip, 0, len(chain.Joints) - 1,
                                                  "a joint index of the design")  # fmt: skip
     cloud = workspace(chain, samples, seed=seed, voxel=voxel, tip=tip)

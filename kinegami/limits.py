@@ -32,6 +32,7 @@ __all__ = [
     "MAX_SAMPLES",
     "MAX_SAMPLED_STATES",
     "MAX_WORKSPACE_SAMPLES",
+    "MAX_REACHABILITY_DIRECTIONS",
     "MAX_REPORTED_PAIRS",
     "MEMO_CAPSULE_ROWS",
     "MAX_STARTS",
@@ -95,6 +96,9 @@ MAX_SAMPLED_STATES = 10_000_000
 #: its tip: 2,000,000 samples of a 7-joint design hold about 160 MB; drawn and tested in
 #: batches of 20,000).
 MAX_WORKSPACE_SAMPLES = 2_000_000
+#: Most approach directions per voxel of a workspace's reachability index (one inverse
+#: kinematics per voxel and direction, in batches of 4,096 targets).
+MAX_REACHABILITY_DIRECTIONS = 256
 #: Most pairs of parts one clearance report lists (closest first); it counts the others
 #: (``ClearanceReport.unlisted``). A chain folded onto itself out of one-degree elbows can have
 #: 600,000 overlapping pairs of parts.

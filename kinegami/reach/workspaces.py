@@ -6,6 +6,9 @@ points of :mod:`scipy.stats.qmc`), keeps those in which the design does not pass
 occupied voxels of edge ``voxel`` and their volume, with the number of samples it rests on and
 how much it changed from half of them (a sampled volume is low until it converges), and the
 share of the volume lost to self-collision, both volumes from as many drawn configurations.
+Where asked, it also maps the voxels: Yoshikawa's manipulability of the best clear sample in
+each, and the reachability index of Zacharias et al. (the share of approach directions for which
+:func:`~kinegami.reach.solve` finds a clear, exact answer).
 """
 
 from __future__ import annotations
@@ -18,13 +21,15 @@ import numpy as np
 
 from kinegami._atomic import write_atomic
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.limits import MAX_WORKSPACE_SAMPLES
+from kinegami.limits import MAX_REACHABILITY_DIRECTIONS, MAX_WORKSPACE_SAMPLES
 from kinegami.reach.forward import kinematics
 
-__all__ = ["Workspace", "workspace"]
+__all__ = ["Workspace", "approach_directions", "workspace"]
 
 #: Configurations per batch (tip positions and clearance, one task on an executor).
 CHUNK = 20_000
+#: Targets per call of solve_many in the reachability index (progress between them).
+REACHABILITY_CHUNK = 4096
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,6 +57,20 @@ class Workspace:
     lost_share : float
         1 - V(clear) / V(all), V(all) from as many drawn configurations as there are clear
         ones (in drawing order).
+    manipulability : (v, 2) array or None
+        Per voxel (in the order of ``voxels``), the largest Yoshikawa manipulability of the
+        clear samples in it: column 0 translational (the product of the singular values of the
+        Jacobian's three rows v, design units per joint unit), column 1 full (the six rows, v in
+        units of r). Each is sqrt(det(J J^T)) when the tip has at least as many joints as rows,
+        else sqrt(det(J^T J)) (the product of the min(rows, joints) singular values). None
+        unless asked.
+    reachability : (v,) array or None
+        Per voxel, the reachability index: the share of ``directions`` approach axes (spread
+        evenly over the sphere) for which :func:`~kinegami.reach.solve` reaches the voxel's
+        representative point (its clear sample nearest the voxel's centre) with the tip's z
+        axis along the direction, exactly and clear. None unless asked.
+    directions : (d, 3) array or None
+        The approach axes of ``reachability`` (unit vectors, world frame).
     """
 
     points: np.ndarray
@@ -63,6 +82,9 @@ class Workspace:
     volume: float
     half_volume: float
     lost_share: float
+    manipulability: np.ndarray | None = None
+    reachability: np.ndarray | None = None
+    directions: np.ndarray | None = None
 
     @property
     def convergence(self) -> float:
@@ -93,10 +115,14 @@ class Workspace:
             raise InvalidParameterError(f"path must end in .npz or .ply, got {path!r}")
         if suffix == ".npz":
             buffer = io.BytesIO()
+            maps = {name: getattr(self, name) for name in
+                    ("manipulability", "reachability", "directions")
+                    if getattr(self, name) is not None}  # fmt: skip
             np.savez_compressed(
                 buffer, points=self.points, configurations=self.configurations,
                 lost=self.lost, voxels=self.voxels, samples=self.samples, voxel=self.voxel,
                 volume=self.volume, half_volume=self.half_volume, lost_share=self.lost_share,
+                **maps,
             )  # fmt: skip
             data = buffer.getvalue()
         else:
@@ -137,8 +163,8 @@ class Workspace:
 
 
 def workspace(design, samples: int = 20_000, *, seed: int = 0, voxel: float | None = None,
-              tip=None, margin=None, sampler: str = "uniform", executor=None,
-              progress=None) -> Workspace:  # fmt: skip
+              tip=None, margin=None, sampler: str = "uniform", manipulability: bool = False,
+              reachability: int = 0, executor=None, progress=None) -> Workspace:  # fmt: skip
     """The sampled workspace of ``design``'s tip.
 
     Parameters
@@ -155,6 +181,12 @@ def workspace(design, samples: int = 20_000, *, seed: int = 0, voxel: float | No
         The clearance required (default: the design's margin).
     sampler : "uniform" or "sobol"
         Uniform over the joints' ranges, or scrambled Sobol points (lower variance).
+    manipulability : bool
+        Also map each voxel's best Yoshikawa manipulability (``Workspace.manipulability``).
+    reachability : int
+        Approach directions per voxel for the reachability index (0: none; up to
+        MAX_REACHABILITY_DIRECTIONS). It costs one inverse kinematics per voxel and direction,
+        on ``executor`` when given.
     executor : concurrent.futures.Executor, optional
         Runs the batches (threads, processes, a Dask cluster's).
     progress : bool or callable, optional
@@ -172,6 +204,14 @@ def workspace(design, samples: int = 20_000, *, seed: int = 0, voxel: float | No
             f"configuration and tip are kept), got {samples}"
         )
     seed = check_int("seed", seed, minimum=0, floats=False)
+    if not isinstance(manipulability, bool):
+        raise InvalidTypeError(f"manipulability must be True or False, got {manipulability!r}")
+    reachability = check_int("reachability", reachability, minimum=0, floats=False)
+    if reachability > MAX_REACHABILITY_DIRECTIONS:
+        raise InvalidParameterError(
+            f"reachability must be an integer in [0, {MAX_REACHABILITY_DIRECTIONS}] (approach "
+            f"directions per voxel; MAX_REACHABILITY_DIRECTIONS), got {reachability}"
+        )
     if sampler not in ("uniform", "sobol"):
         raise InvalidParameterError(f"sampler must be 'uniform' or 'sobol', got {sampler!r}")
     r = float(design.r)
@@ -205,11 +245,84 @@ def workspace(design, samples: int = 20_000, *, seed: int = 0, voxel: float | No
     everything = _voxel_keys(tips[: points.shape[0]], h)  # as many drawn as there are clear
     volume = keys.shape[0] * h**3
     all_volume = everything.shape[0] * h**3
+    configurations = Q[clear]
+    which = _voxel_of(points, keys, h)
+    maps = {}
+    if manipulability:
+        maps["manipulability"] = _manipulability(compiled, configurations, which, keys.shape[0],
+                                                 r)  # fmt: skip
+    if reachability:
+        directions = approach_directions(reachability)
+        maps["directions"] = directions
+        maps["reachability"] = _reachability(design, compiled.tips[0], points, which, keys, h,
+                                             directions, margin, seed, executor, progress)
     return Workspace(
-        points=points, configurations=Q[clear], lost=tips[~clear], samples=int(samples),
+        points=points, configurations=configurations, lost=tips[~clear], samples=int(samples),
         voxel=h, voxels=keys, volume=volume, half_volume=half.shape[0] * h**3,
-        lost_share=0.0 if all_volume == 0 else 1.0 - volume / all_volume,
+        lost_share=0.0 if all_volume == 0 else 1.0 - volume / all_volume, **maps,
     )  # fmt: skip
+
+
+def approach_directions(count: int) -> np.ndarray:
+    """``count`` unit vectors spread evenly over the sphere (a Fibonacci lattice), (count, 3);
+    the first is +z."""
+    k = np.arange(count, dtype=float)
+    z = 1.0 - 2.0 * k / max(1, count - 1) if count > 1 else np.ones(1)
+    ring = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
+    angle = k * math.pi * (3.0 - math.sqrt(5.0))
+    return np.column_stack([ring * np.cos(angle), ring * np.sin(angle), z])
+
+
+def _voxel_of(points: np.ndarray, keys: np.ndarray, h: float) -> np.ndarray:
+    """The index into ``keys`` (sorted, distinct) of each point's voxel, (k,)."""
+    if points.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    _, inverse = np.unique(np.floor(points / h).astype(np.int64), axis=0, return_inverse=True)
+    return inverse.reshape(-1)
+
+
+def _manipulability(compiled, Q: np.ndarray, which: np.ndarray, voxels: int,
+                    r: float) -> np.ndarray:  # fmt: skip
+    """Per voxel, the largest translational and full manipulability of its samples, (v, 2)."""
+    out = np.zeros((voxels, 2))
+    columns = compiled.screws.moving[compiled.path(compiled.tips[0]) - 1]
+    if columns.size == 0 or Q.shape[0] == 0:
+        return out
+    scale = np.array([1.0 / r] * 3 + [1.0] * 3)
+    for a in range(0, Q.shape[0], CHUNK):
+        J = compiled.jacobians(Q[a : a + CHUNK])[0][:, 0][:, :, columns]  # (m, 6, k)
+        values = np.empty((J.shape[0], 2))
+        values[:, 0] = np.prod(np.linalg.svd(J[:, :3], compute_uv=False), axis=1)
+        values[:, 1] = np.prod(np.linalg.svd(J * scale[:, None], compute_uv=False), axis=1)
+        np.maximum.at(out, which[a : a + CHUNK], values)
+    return out
+
+
+def _reachability(design, tip: int, points, which, keys, h, directions, margin, seed, executor,
+                  progress) -> np.ndarray:  # fmt: skip
+    """Per voxel, the share of ``directions`` reached at its representative point."""
+    from kinegami.progress import Progress
+    from kinegami.reach.inverse import Target, solve_many
+
+    v = keys.shape[0]
+    if v == 0:
+        return np.zeros(0)
+    # each voxel's clear sample nearest its centre
+    gap = np.linalg.norm(points - (keys[which] + 0.5) * h, axis=1)
+    order = np.lexsort((gap, which))
+    first = order[np.r_[True, which[order][1:] != which[order][:-1]]]
+    d = directions.shape[0]
+    total = v * d
+    reached = np.zeros(total, dtype=bool)
+    with Progress(progress, total, desc="reachability", unit="target") as bar:
+        for a in range(0, total, REACHABILITY_CHUNK):
+            ks = range(a, min(a + REACHABILITY_CHUNK, total))
+            targets = [Target(points[first[k // d]], axis=directions[k % d]) for k in ks]
+            answers = solve_many(design, targets, tip=tip, seed=seed, margin=margin,
+                                 executor=executor)  # fmt: skip
+            reached[a : a + len(answers)] = [answer.ok for answer in answers]
+            bar.update(len(answers))
+    return reached.reshape(v, d).mean(axis=1)
 
 
 def _draw(low: np.ndarray, high: np.ndarray, m: int, seed: int, sampler: str) -> np.ndarray:

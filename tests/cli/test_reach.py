@@ -88,7 +88,7 @@ def test_bad_options_are_one_line():
     assert_clean_failure(run("reach", PUMA, "--target", "1,2,nan"), "--target")
     assert_clean_failure(run("reach", PUMA, "--target", "1,2,3", "--tip", "99"), "--tip", "99")
     assert_clean_failure(run("reach", PUMA, "--target", "1,2,3", "--axis", "0,0,0"), "axis")
-    assert_clean_failure(run("reach", HAND, "--target", "1,2,3"), "tip")
+    assert_clean_failure(run("reach", HAND, "--target", "1,2,3"), "give --tip J")
     assert_clean_failure(run("reach", PUMA, "--target", "1,2,3", "-o", "x.txt"), "-o", ".json")
     usage = run("reach", PUMA)
     assert usage.returncode == 2 and "--target" in usage.stderr
@@ -112,5 +112,6 @@ def test_workspace_writes_the_arrays_the_cloud_and_a_picture(tmp_path):
 def test_workspace_options_are_checked_in_one_line(tmp_path):
     assert_clean_failure(run("workspace", PUMA, "-o", tmp_path, "--samples", "0"), "--samples")
     assert_clean_failure(run("workspace", PUMA, "-o", tmp_path, "--voxel", "-1"), "--voxel")
-    assert_clean_failure(run("workspace", HAND, "-o", tmp_path, "--samples", "10"), "tip")
+    assert_clean_failure(run("workspace", HAND, "-o", tmp_path, "--samples", "10"),
+                         "give --tip J")
     assert not any(tmp_path.iterdir())

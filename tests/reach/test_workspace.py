@@ -13,7 +13,8 @@ import pytest
 
 from kinegami.design import load_design
 from kinegami.errors import InvalidParameterError, InvalidTypeError
-from kinegami.reach import kinematics, workspace
+from kinegami.reach import Target, kinematics, solve, workspace
+from kinegami.reach.workspaces import approach_directions
 
 DESIGNS = Path(__file__).resolve().parents[2] / "examples" / "designs"
 
@@ -113,9 +114,59 @@ def test_a_tree_names_its_tip():
     ({"voxel": -1.0}, InvalidParameterError, "voxel"),
     ({"sampler": "grid"}, InvalidParameterError, "sampler"),
     ({"seed": -1}, InvalidParameterError, "seed"),
+    ({"reachability": -1}, InvalidParameterError, "reachability"),
+    ({"reachability": 257}, InvalidParameterError, "MAX_REACHABILITY_DIRECTIONS"),
+    ({"reachability": 2.5}, InvalidTypeError, "reachability"),
+    ({"manipulability": "yes"}, InvalidTypeError, "manipulability"),
 ])  # fmt: skip
 def test_bad_input_is_one_line(puma, options, error, words):
     arguments = {"samples": 10, **options}
     with pytest.raises(error, match=words) as raised:
         workspace(puma, **arguments)
     assert "\n" not in str(raised.value)
+
+
+def test_manipulability_per_voxel_is_the_best_of_its_samples(puma):
+    mapped = workspace(puma, 1500, seed=7, manipulability=True)
+    assert mapped.manipulability.shape == (mapped.voxels.shape[0], 2)
+    compiled = kinematics(puma)
+    J = compiled.jacob0(mapped.configurations)[:, :, compiled.movable]  # (k, 6, 6)
+    translational = np.sqrt(np.linalg.det(J[:, :3] @ J[:, :3].transpose(0, 2, 1)))
+    scaled = J.copy()
+    scaled[:, :3] /= puma.r
+    full = np.abs(np.linalg.det(scaled))  # square: sqrt(det(J J^T)) = |det J|
+    voxel = {tuple(k): i for i, k in enumerate(mapped.voxels)}
+    best = np.zeros((mapped.voxels.shape[0], 2))
+    for point, t, f in zip(mapped.points, translational, full, strict=True):
+        i = voxel[tuple(np.floor(point / mapped.voxel).astype(int))]
+        best[i] = np.maximum(best[i], (t, f))
+    assert np.allclose(mapped.manipulability, best, rtol=1e-9, atol=0)
+    assert (mapped.manipulability > 0).all()
+    assert mapped.reachability is None and mapped.directions is None
+
+
+def test_approach_directions_cover_the_sphere():
+    d = approach_directions(64)
+    assert d.shape == (64, 3) and np.allclose(np.linalg.norm(d, axis=1), 1.0)
+    assert np.allclose(d[0], (0, 0, 1)) and np.allclose(d[-1], (0, 0, -1))
+    assert np.linalg.norm(d.mean(axis=0)) < 0.05  # evenly spread: no side favoured
+    assert np.allclose(approach_directions(1), [[0, 0, 1]])
+
+
+def test_reachability_index_counts_the_clear_answers(puma, tmp_path):
+    mapped = workspace(puma, 200, seed=3, voxel=10 * puma.r, reachability=4)
+    v = mapped.voxels.shape[0]
+    assert mapped.reachability.shape == (v,) and mapped.directions.shape == (4, 3)
+    assert np.all((mapped.reachability * 4) % 1 == 0)
+    assert 0 < mapped.reachability.mean() < 1
+    # one voxel again, by hand: its clear sample nearest the centre, each direction solved
+    i = int(np.argmax(mapped.reachability))
+    inside = np.flatnonzero((np.floor(mapped.points / mapped.voxel) == mapped.voxels[i]).all(1))
+    centre = (mapped.voxels[i] + 0.5) * mapped.voxel
+    point = mapped.points[inside[np.argmin(np.linalg.norm(mapped.points[inside] - centre,
+                                                          axis=1))]]  # fmt: skip
+    ok = [solve(puma, Target(point, axis=d), seed=0).ok for d in mapped.directions]
+    assert np.mean(ok) == mapped.reachability[i]
+    with np.load(mapped.save(tmp_path / "mapped.npz")) as data:
+        assert np.array_equal(data["reachability"], mapped.reachability)
+        assert data["directions"].shape == (4, 3)
