@@ -15,6 +15,7 @@ targets, all starts of all targets in one batch, and spreads chunks over any
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -93,8 +94,12 @@ class Target:
         if A.shape == (4, 4):
             from kinegami.chain.joints import pose_array
 
-            T = pose_array(A, "target")
-            return cls(T[:3, 3], rotation=T[:3, :3])
+            T = pose_array(A, "target")  # finite and rigid: no second check of its rotation
+            target = object.__new__(cls)
+            for name, value in (("position", T[:3, 3].copy()), ("axis", None),
+                                ("rotation", T[:3, :3].copy())):  # fmt: skip
+                object.__setattr__(target, name, value)
+            return target
         if A.shape == (3,):
             return cls(A)
         raise InvalidParameterError(
@@ -475,10 +480,31 @@ def _kernel():
 _KINDS = {"position": 0, "axis": 1, "pose": 2}
 
 
+#: Per compiled design (while it lives), what each tip's solves share: (what, tip) -> value.
+_PER_TIP: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _per_tip(compiled: Kinematics, what: str, tip: int, make):
+    """``make(compiled, tip)``, made once per compiled design and tip (a compiled design is
+    immutable, so what is derived from it stays true)."""
+    known = _PER_TIP.get(compiled)
+    if known is None:
+        known = _PER_TIP[compiled] = {}
+    key = (what, tip)
+    if key not in known:
+        known[key] = make(compiled, tip)
+    return known[key]
+
+
 def _tip_path(compiled: Kinematics, tip: int) -> tuple:
-    """What the compiled descent needs of one tip: the moving bodies from the root to it (in
-    order), their joints' columns of a configuration, revolute flags, reference states and
-    ranges, the steps between their axis frames and the tip's frame in its body's."""
+    """What the compiled descent needs of one tip (made once per compiled design and tip,
+    :func:`_per_tip`): the moving bodies from the root to it (in order), their joints'
+    columns of a configuration, revolute flags, reference states and ranges, the steps
+    between their axis frames and the tip's frame in its body's."""
+    return _per_tip(compiled, "path", tip, _make_tip_path)
+
+
+def _make_tip_path(compiled: Kinematics, tip: int) -> tuple:
     screws = compiled.screws
     tip_body = int(screws.body_of[tip])
     path = compiled.path(tip)
@@ -506,7 +532,7 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
     steps, path, revolute, reference, E, columns, low_p, high_p = _tip_path(compiled, tip)
     low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
     problem = _Problem(compiled, [goal], r)
-    rng = np.random.default_rng([seed, *_words(goal)])
+    rng = None  # the target's own random stream, made at the first restart (it costs ~70 us)
     hopeless = bool(_beyond_reach(compiled, goal))
     budget, patience = (1, 12) if hopeless else (MAX_STARTS, ITERATIONS)
     kind = _KINDS[target.kind]
@@ -518,6 +544,8 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
     q = np.clip(start, low, high)
     for started in range(budget):
         if started:
+            if rng is None:
+                rng = np.random.default_rng([seed, *_words(goal)])
             q = low + (high - low) * rng.random(low.size)
         if path.size == 0:  # nothing moves the tip: one evaluation
             exact, count, pos, ang = _still(problem, q, tol_p, tol_a, r)
@@ -681,7 +709,7 @@ def _beyond_reach(compiled: Kinematics, goal: dict) -> str:
     if screws.moving.size == 0:
         return ""
     for tip, target in goal.items():
-        radius, centre = reach_bound(compiled, tip)
+        radius, centre = _per_tip(compiled, "bound", tip, reach_bound)
         distance = float(np.linalg.norm(target.position - centre))
         if distance > radius * (1.0 + 1e-9) + 1e-9:
             return (f"beyond reach: the target is {distance:.6g} from the first moving joint's "

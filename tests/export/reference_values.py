@@ -56,9 +56,13 @@ GALLERY_FOLD_VERTICES = {"example1": 327 - 54, "puma": 1013 - 104}
 #: A face corner within this of 180 degrees (radians) counts as straight.
 STRAIGHT_ANGLE_TOLERANCE = 1e-6
 
-#: Origami Simulator in CI: these designs, FOLD and SVG, must fold with an average vertex error
-#: below the limit (percent) within the given number of solver steps.
+#: Origami Simulator in CI: these designs' FOLD files, and the SVG files of the second tuple,
+#: must fold with an average vertex error below the limit (percent) within the given number of
+#: solver steps, the SVG into the same tube as the FOLD. The PUMA's SVG (137 s in the simulator,
+#: the longest test of the suite) is left to the slow run over every gallery design
+#: (``pytest -m slow``) to keep CI within its time; its FOLD, from the same crease pattern, runs.
 SIMULATOR_CI_DESIGNS = ("example1", "puma", "cylindrical_joint")
+SIMULATOR_CI_SVG_DESIGNS = ("example1", "cylindrical_joint")
 SIMULATOR_ERROR_LIMIT = 2.0
 SIMULATOR_MAX_STEPS = 60_000
 
