@@ -3,7 +3,8 @@
 
 The PUMA (examples/designs/puma.json) in an :class:`~kinegami.editor.view.EditorView` on a viser
 server with no tab connected (so sending over the network is not counted). The target starts
-at the tip and moves along a circle of radius 2r in small steps, as a hand drags it; each step
+at the tip and moves along a circle of radius 2r (on the side towards the base, inside the
+workspace) in small steps, as a hand drags it; each step
 is :meth:`EditorView.reach_to` with ``preview=True``, what the handle's update does: inverse
 kinematics warm-started from the current states (clearance included), the preview of the found
 states and its meshes. Every few steps the drag ends (one command). Prints the median and the
@@ -35,10 +36,14 @@ def measure(steps: int = STEPS) -> dict:
         view.flush()
         r = float(view.model.chain.r)
         start = view.tip_position()
+        base = np.asarray(view.model.chain.Joints[0].pose_matrix, dtype=float)[:3, 3]
+        inward = (base - start) / np.linalg.norm(base - start)
+        side = np.cross(inward, (0.0, 0.0, 1.0))
+        side = side / np.linalg.norm(side) if np.linalg.norm(side) > 1e-9 else np.array((1, 0, 0))
         previews, ends, reached = [], [], 0
-        for k in range(steps):
+        for k in range(steps):  # a circle of radius 2r through the tip, on its inner side
             angle = 2.0 * math.pi * (k + 1) / steps
-            point = start + 2.0 * r * np.array([math.cos(angle) - 1.0, math.sin(angle), 0.0])
+            point = start + 2.0 * r * ((1.0 - math.cos(angle)) * inward + math.sin(angle) * side)
             t0 = time.perf_counter()
             answer = view.reach_to(point, preview=True)
             previews.append(time.perf_counter() - t0)

@@ -304,6 +304,9 @@ class JointAssembly:
         if ball is None:
             ball = self._ball_of(joints, links)
         self._joints, self._links, self._ball = joints, links, ball
+        home = self.__dict__.get("_home")
+        if home is not None and home[4] is joints:  # a change of states from home
+            home[3], home[4] = joints, None
 
     def recomputeBoundingBall(self) -> Ball:
         """Recompute the ball from every joint and link (docs/theory/chain.md §2) and return it."""
@@ -361,15 +364,20 @@ class JointAssembly:
                            self._parent_list(), [joint.state for joint in joints])  # fmt: skip
 
     def _configured(self, values: Sequence[float]) -> tuple[list, list]:
-        """Joint and link lists at the (checked) states ``values``, one per joint: every joint
-        and link beyond a changed state moved by the forward kinematics of
-        :meth:`joint_screws`; the others are the same objects."""
-        joints = list(self._joints)
-        links = list(self._links)
+        """Joint and link lists at the (checked) states ``values``, one per joint, moved from
+        the home lists (:meth:`_home_lists`) by the forward kinematics of their screws: every
+        joint and link beyond a state that differs from home moves, the others are the home
+        objects. Each configuration is one motion from home, never a motion from the last
+        one, so rounding does not build up over many state changes (it did: 300 random
+        setJointStates of the 9-joint spherical series had moved its tip 0.1 r)."""
+        home = self._home_lists()
+        if all(float(v) == joint.state for v, joint in zip(values, self._joints, strict=True)):
+            joints = list(self._joints)
+            home[4] = joints  # the same configuration: still made from home
+            return joints, list(self._links)
+        joints, links = list(home[0]), list(home[1])
         changed = [float(v) != joint.state for v, joint in zip(values, joints, strict=True)]
-        if not any(changed):
-            return joints, links
-        A = self.joint_screws().joint_motions(np.asarray(values, dtype=float))
+        A = home[2].joint_motions(np.asarray(values, dtype=float))
         moved = [False] * len(joints)  # whether joint k's distal side moves
         for k, p in enumerate(self._parent_list()):
             upstream = p >= 0 and moved[p]
@@ -379,7 +387,19 @@ class JointAssembly:
             if changed[k]:
                 joints[k] = joints[k].with_state(values[k])
             moved[k] = upstream or changed[k]
+        home[4] = joints  # committed, these lists are still home's (:meth:`_commit`)
         return joints, links
+
+    def _home_lists(self) -> list:
+        """[joints, links, screws, committed, candidate]: the lists as the last operation that
+        was not a change of states left them, with their screws; ``committed`` is the chain's
+        current joint list when it was made from home by states, ``candidate`` the last list
+        :meth:`_configured` made. Any other operation makes the current lists home."""
+        home = self.__dict__.get("_home")
+        if home is None or home[3] is not self._joints:
+            home = [self._joints, self._links, self.joint_screws(), self._joints, None]
+            self._home = home
+        return home
 
     def _parent_of(self, j: int) -> int:
         """The parent of joint j > 0 (a chain: j - 1)."""

@@ -369,14 +369,9 @@ class KinematicTree(JointAssembly):
         s = self._state_value(j, newState)
         if s is None:
             return False
-        joint = self._joints[j]
-        G = joint.state_transform(s - joint.state)
-        joints = list(self._joints)
-        links = list(self._links)
-        joints[j] = joint.with_state(s)
-        for k in self._subtree(j)[1:]:
-            joints[k] = joints[k].transformed(G)
-            links[k] = links[k].transformed(G)
+        values = [joint.state for joint in self._joints]
+        values[j] = s
+        joints, links = self._configured(values)  # one motion from home: no drift
         return self._accept("setJointState", joints, links)
 
     def setJointStates(self, states: Sequence[float]) -> bool:
