@@ -623,7 +623,8 @@ def run_steps(steps: list[tuple[str, Callable[[], Rows]]], stream: TextIO | None
     return rows
 
 
-def steps(seeds: int, compact_seeds: int) -> list[tuple[str, Callable[[], Rows]]]:
+def steps(seeds: int, compact_seeds: int,
+          reach_targets: int = 5000) -> list[tuple[str, Callable[[], Rows]]]:
     """The measurements of the table, in its order: (what is measured, its rows function)."""
     shared: dict[str, list[KinematicChain]] = {}
 
@@ -643,6 +644,8 @@ def steps(seeds: int, compact_seeds: int) -> list[tuple[str, Callable[[], Rows]]
         ("clearance engine and safe chains' clearance", lambda: clearance_rows(0)),
         ("clearance engine for workspaces: sweeps, one configuration, trees", engine_rows),
         ("reach: kinematics, inverse kinematics, workspaces", reach_rows),
+        ("reach in the editor: the target's drag steps, PUMA",
+         lambda: __import__("editor_reach").rows()),
     ]
     if compact_seeds > 0:
         out += [
@@ -650,6 +653,11 @@ def steps(seeds: int, compact_seeds: int) -> list[tuple[str, Callable[[], Rows]]
              lambda: compaction_rows(compact_seeds)),
             ("algorithmic hand: construction and compaction", tree_rows),
         ]  # fmt: skip
+    if reach_targets > 0:
+        out.append((f"reach: success on {reach_targets:,} clear targets per gallery chain and "
+                    f"{max(1, reach_targets // 5):,} per hand",
+                    lambda: __import__("reach_success").rows(reach_targets,
+                                                             max(1, reach_targets // 5))))
     out.append(("start-up, fresh processes", lambda: __import__("startup").rows()))
     return out
 
@@ -662,8 +670,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--only", action="append", default=[], metavar="WORD",
                         help="run only the measurements whose name (as the progress lines "
                              "show it) contains WORD (repeatable)")  # fmt: skip
+    parser.add_argument("--reach-targets", type=int, default=5000,
+                        help="clear targets per gallery chain for the success rates (a fifth "
+                             "of it per hand; 0 skips them: several minutes)")  # fmt: skip
     args = parser.parse_args(argv)
-    chosen = steps(args.seeds, args.compact_seeds)
+    chosen = steps(args.seeds, args.compact_seeds, args.reach_targets)
     if args.only:
         chosen = [s for s in chosen if any(w.lower() in s[0].lower() for w in args.only)]
         if not chosen:

@@ -12,7 +12,11 @@ chain or tree with the design loader and writes, into ``docs/images/gallery/`` (
 * for a tree, ``<name>_sheet_<k>_pattern.png``: the crease pattern of every sheet k, as
   ``kinegami build`` cuts the tree (one sheet per leaf, branch joints slid where their junction
   sockets need room), and ``<name>_<pose>.png``: the 3D view in every named configuration of
-  the entry's script (its ``POSES``: the hand's grasps).
+  the entry's script (its ``POSES``: the hand's grasps);
+* for the entries of ``WORKSPACES`` (the PUMA and the hand's middle finger),
+  ``<name>_workspace.png``: the sampled workspace of the tip (:func:`kinegami.reach.workspace`,
+  seed 0), clear tip positions in blue and those that pass through themselves in red, three
+  orthographic views in the design's ``units``.
 
 The pictures are reproducible byte for byte: a second run, or a run on another machine with the
 same versions of matplotlib and numpy, writes the same files (no version stamp in the PNGs, faces
@@ -54,6 +58,10 @@ from kinegami.design import DesignError, load_design_with_info  # noqa: E402
 
 DESIGNS = EXAMPLES / "designs"
 GALLERY = EXAMPLES.parent / "docs" / "images" / "gallery"
+#: Entries whose workspace is drawn: name -> (tip joint, None for a chain's last; samples).
+WORKSPACES = {"puma": (None, 20_000), "hand": (11, 10_000)}
+#: Resolution of the workspace pictures (15 x 5 inch figures).
+WORKSPACE_DPI = 80
 
 
 def design_names() -> list[str]:
@@ -102,7 +110,8 @@ def draw_entry(name: str, folder: Path) -> list[Path]:
         warnings.simplefilter("ignore", ClearanceWarning)  # the gallery states the clearance
         chain, info = load_design_with_info(DESIGNS / f"{name}.json")
         if isinstance(chain, KinematicTree):
-            return draw_tree_entry(chain, name, folder, info.units)
+            return draw_tree_entry(chain, name, folder, info.units) + draw_workspace(
+                chain, name, folder, info.units)  # fmt: skip
     return [
         save_figure(draw_chain(chain, units=info.units), folder / f"{name}.png", CHAIN_DPI),
         save_figure(
@@ -111,7 +120,20 @@ def draw_entry(name: str, folder: Path) -> list[Path]:
             PATTERN_DPI,
             tight=True,
         ),
+        *draw_workspace(chain, name, folder, info.units),
     ]
+
+
+def draw_workspace(design, name: str, folder: Path, units: str) -> list[Path]:
+    """``<name>_workspace.png`` for the entries of ``WORKSPACES`` (none for the others)."""
+    if name not in WORKSPACES:
+        return []
+    from kinegami.reach import workspace
+
+    tip, samples = WORKSPACES[name]
+    cloud = workspace(design, samples, seed=0, tip=tip)
+    return [save_figure(cloud.show(design, units=units), folder / f"{name}_workspace.png",
+                        WORKSPACE_DPI)]  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> int:

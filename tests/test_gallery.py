@@ -624,6 +624,7 @@ def test_the_gallery_page_shows_every_entry_and_only_existing_pictures(scripts):
     assert shown == on_disk  # every picture shown exists, and every picture is shown
     for name in ENTRIES:
         assert {f"{name}.png", f"{name}_pattern.png"} <= shown
+    assert {"puma_workspace.png", "hand_workspace.png"} <= shown
     for name, (_, leaves, _) in TREE_ENTRIES.items():
         poses = getattr(scripts(name), "POSES", {})
         assert {f"{name}.png", *(f"{name}_sheet_{k}_pattern.png" for k in range(leaves)),
@@ -777,7 +778,8 @@ def test_make_gallery_draws_a_trees_sheets_and_poses(tmp_path):
     assert result.returncode == 0, result.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         ["hand.png", *(f"hand_sheet_{k}_pattern.png" for k in range(3)),
-         *(f"hand_{grasp}.png" for grasp in ("spherical", "cylindrical", "pinch"))]
+         *(f"hand_{grasp}.png" for grasp in ("spherical", "cylindrical", "pinch")),
+         "hand_workspace.png"]
     )  # fmt: skip
     assert "1 gallery entries" in result.stdout
     assert result.stderr == ""  # no warning: the hand's overlap is the gallery's to state
