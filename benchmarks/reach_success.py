@@ -6,9 +6,9 @@ clear by the design's own clearance engine; their tip poses are the targets, sol
 :func:`kinegami.reach.solve_many` on a process pool (``--workers``, default 2). Every answer is
 checked as a user would: the design loaded again with ``requireClearance`` on takes the states
 (``setJointStates``) and its tip is on the target within 1e-9 r; the solver's own numbers are
-not trusted. For the two hands, ``--tree-targets`` (default 1,000) targets each of which is every
-fingertip's pose at one clear configuration, all solved at once. Prints, per design, the share
-reached, the failures' reasons, and the wall time per target.
+not trusted. For each tree (the hands, the quadruped, the gripper), ``--tree-targets`` (default
+1,000) targets each of which is every tip's pose at one clear configuration, all at once.
+Prints, per design, the share reached, the failures' reasons, and the wall time per target.
 """
 
 from __future__ import annotations
@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 DESIGNS = Path(__file__).resolve().parents[1] / "examples" / "designs"
-TREES = ("hand", "algorithmic_hand")
 
 
 def clear_configurations(design, compiled, count: int, seed: int) -> np.ndarray:
@@ -101,17 +100,22 @@ def rows(targets: int = 5000, tree_targets: int = 1000, workers: int = 2,
     """(figure, result, goal) rows for benchmarks/run.py."""
     import json
 
+    from kinegami.design import DesignInfo
+
+    def is_tree(name: str) -> bool:
+        data = json.loads((DESIGNS / f"{name}.json").read_text(encoding="utf-8"))
+        return DesignInfo.of(data).structure == "tree"
+
     if names is None:
-        names = sorted(p.stem for p in DESIGNS.glob("*.json")
-                       if p.stem in TREES or "parents" not in json.loads(p.read_text()))
+        names = sorted(p.stem for p in DESIGNS.glob("*.json"))
     out = []
     with ProcessPoolExecutor(workers) as executor:
         for name in names:
-            tree = name in TREES
+            tree = is_tree(name)
             found = measure(name, tree_targets if tree else targets, executor)
             share = found["reached"] / found["targets"]
             why = ", ".join(f"{k} {v}" for k, v in found["reasons"].most_common(3))
-            what = f"every fingertip ({found['tips']}) at once" if tree else "tip pose"
+            what = f"every tip ({found['tips']}) at once" if tree else "tip pose"
             out.append((
                 f"solve_many, {name}: {found['targets']:,} clear {what} targets, reached exact "
                 "and clear (checked by setJointStates)",
@@ -126,9 +130,9 @@ def rows(targets: int = 5000, tree_targets: int = 1000, workers: int = 2,
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--targets", type=int, default=5000, help="targets per gallery chain")
-    parser.add_argument("--tree-targets", type=int, default=1000, help="targets per hand")
+    parser.add_argument("--tree-targets", type=int, default=1000, help="targets per tree")
     parser.add_argument("--workers", type=int, default=2, help="processes")
-    parser.add_argument("names", nargs="*", help="gallery designs (default: every chain and hand)")
+    parser.add_argument("names", nargs="*", help="gallery designs (default: all)")
     args = parser.parse_args()
     for figure, result, goal in rows(args.targets, args.tree_targets, args.workers,
                                      args.names or None):  # fmt: skip

@@ -655,7 +655,7 @@ def steps(seeds: int, compact_seeds: int,
         ]  # fmt: skip
     if reach_targets > 0:
         out.append((f"reach: success on {reach_targets:,} clear targets per gallery chain and "
-                    f"{max(1, reach_targets // 5):,} per hand",
+                    f"{max(1, reach_targets // 5):,} per tree",
                     lambda: __import__("reach_success").rows(reach_targets,
                                                              max(1, reach_targets // 5))))
     out.append(("start-up, fresh processes", lambda: __import__("startup").rows()))

@@ -34,6 +34,9 @@ MAX_STARTS = 64
 ITERATIONS = 60
 #: Damping: first value, bounds (in units of the residual squared).
 DAMPING, DAMPING_MIN, DAMPING_MAX = 1e-3, 1e-12, 1e8
+#: Configurations of the seed table (per design, tips and seed), and how many of the nearest
+#: to a target are tried after its first start, before random ones.
+SEED_TABLE, SEEDED_STARTS = 4096, 24
 
 
 @dataclass(frozen=True, eq=False)
@@ -373,10 +376,20 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
     low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
     mov = compiled.movable
     rngs = [np.random.default_rng([seed, *_words(goal)]) for goal in goals]
+    table = _seed_table(design, compiled, tuple(problem.keys), seed)
+    kinds = tuple(problem.kinds)
+    seeds: list = [None] * G
+    used = [0] * G
 
     def fresh(g: int, first: bool) -> np.ndarray:
+        """The first start (q0), then the table's nearest configurations, then random."""
         if first:
             return np.clip(start, low, high)
+        if seeds[g] is None:
+            seeds[g] = table.nearest(goals[g], kinds, SEEDED_STARTS)
+        if used[g] < seeds[g].shape[0]:
+            used[g] += 1
+            return seeds[g][used[g] - 1].copy()
         return low + (high - low) * rngs[g].random(low.size)
 
     # rows of the batch: (goal, start); STARTS rows per goal at first
@@ -496,6 +509,69 @@ def _per_tip(compiled: Kinematics, what: str, tip: int, make):
     return known[key]
 
 
+class _SeedTable:
+    """Seeded random configurations of a design and its tips' poses there (clear ones only,
+    for a chain): the nearest to a target, by tip positions in units of the reach and
+    rotations or axes, are good starts (a KD-tree each, per target kind)."""
+
+    def __init__(self, design, compiled: Kinematics, tips: tuple, seed: int):
+        from kinegami.chain.model import KinematicChain
+
+        low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+        rng = np.random.default_rng([seed, 0x5EED])
+        Q = low + (high - low) * rng.random((SEED_TABLE, low.size))
+        if isinstance(design, KinematicChain):  # clear ones (a chain's batch: ~0.1 s)
+            from kinegami.clearance.engine import engine_for
+
+            Q = Q[~engine_for(design).colliding(Q, float(design.margin))]
+        T = compiled.tip_poses(Q)  # (m, L, 4, 4), the compiled tips
+        order = [compiled.tips.index(t) for t in tips]
+        self.Q = Q
+        self.T = T[:, order]
+        scale = max((_per_tip(compiled, "bound", t, reach_bound)[0] for t in tips),
+                    default=1.0)
+        self.scale = scale if scale > 0 else 1.0
+        self.trees: dict = {}
+
+    def features(self, T: np.ndarray, kinds: tuple) -> np.ndarray:
+        """(m, F): tip positions over the reach, and each tip's rotation (pose) or z (axis)."""
+        parts = []
+        for n, kind in enumerate(kinds):
+            parts.append(T[:, n, :3, 3] / self.scale)
+            if kind == "pose":
+                parts.append(T[:, n, :3, :3].reshape(-1, 9) / 3.0)
+            elif kind == "axis":
+                parts.append(T[:, n, :3, 2] / 2.0)
+        return np.concatenate(parts, axis=1)
+
+    def nearest(self, goal: dict, kinds: tuple, count: int) -> np.ndarray:
+        """The table's configurations nearest to ``goal`` (tip -> Target), nearest first."""
+        if self.Q.shape[0] == 0 or count <= 0:
+            return self.Q[:0]
+        tree = self.trees.get(kinds)
+        if tree is None:
+            from scipy.spatial import cKDTree
+
+            tree = self.trees[kinds] = cKDTree(self.features(self.T, kinds))
+        wanted = np.zeros((1, len(goal), 4, 4))
+        for n, key in enumerate(sorted(goal)):
+            target = goal[key]
+            wanted[0, n, :3, 3] = target.position
+            if target.rotation is not None:
+                wanted[0, n, :3, :3] = target.rotation
+            if target.axis is not None:
+                wanted[0, n, :3, 2] = target.axis
+        k = min(count, self.Q.shape[0])
+        _, index = tree.query(self.features(wanted, kinds)[0], k=k)
+        return self.Q[np.atleast_1d(index)]
+
+
+def _seed_table(design, compiled: Kinematics, tips: tuple, seed: int) -> _SeedTable:
+    """The seed table of ``compiled`` for ``tips`` and ``seed``, made once (:func:`_per_tip`)."""
+    return _per_tip(compiled, "table", (tips, seed),
+                    lambda c, key: _SeedTable(design, c, key[0], key[1]))  # fmt: skip
+
+
 def _tip_path(compiled: Kinematics, tip: int) -> tuple:
     """What the compiled descent needs of one tip (made once per compiled design and tip,
     :func:`_per_tip`): the moving bodies from the root to it (in order), their joints'
@@ -542,11 +618,18 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
     collided = ""
     iterations = escapes = 0
     q = np.clip(start, low, high)
+    seeds = None
     for started in range(budget):
         if started:
-            if rng is None:
-                rng = np.random.default_rng([seed, *_words(goal)])
-            q = low + (high - low) * rng.random(low.size)
+            if seeds is None:  # the table's configurations nearest the target, then random
+                seeds = _seed_table(design, compiled, (tip,), seed).nearest(
+                    goal, (target.kind,), SEEDED_STARTS)  # fmt: skip
+            if started <= seeds.shape[0]:
+                q = seeds[started - 1].copy()
+            else:
+                if rng is None:
+                    rng = np.random.default_rng([seed, *_words(goal)])
+                q = low + (high - low) * rng.random(low.size)
         if path.size == 0:  # nothing moves the tip: one evaluation
             exact, count, pos, ang = _still(problem, q, tol_p, tol_a, r)
             near, near_pos, near_ang = q[columns], pos, ang

@@ -107,14 +107,17 @@ def test_a_redundant_arm_moves_along_its_solutions_away_from_itself(monkeypatch)
     """The 9-joint spherical series has three joints more than a pose fixes: an exact
     solution that passes through itself is moved along the Jacobian's null space, up the
     clearance's gradient, and brought back onto the target. Target 4 of these (seed 0) is
-    reached from its second start that way; without the moves every solution found for it
-    passes through itself."""
+    reached from its random starts that way (the seed table's clear configurations, which
+    reach it directly, left out); without the moves every solution found for it passes
+    through itself."""
     import kinegami.reach.inverse as inverse
 
     path = DESIGNS / "spherical_series.json"
     design = load_design(path)
     compiled = kinematics(design)
     T = compiled.fkine(clear_configurations(design, 5, seed=0)[4])
+    check(path, solve(design, T), {compiled.tips[0]: Target.of(T)})  # with the table
+    monkeypatch.setattr(inverse, "SEEDED_STARTS", 0)
     answer = solve(design, T)
     check(path, answer, {compiled.tips[0]: Target.of(T)})
     monkeypatch.setattr(inverse, "ESCAPES", 0)
@@ -251,3 +254,30 @@ def test_a_margin_is_kept_or_refused():
         assert "passes through itself" in answer.reason
     with pytest.raises(InvalidParameterError, match="margin"):
         solve(design, compiled.fkine(q), margin=-1.0)
+
+
+def test_the_seed_table_holds_clear_configurations_nearest_first():
+    """Restarts begin with the seed table's configurations whose tip poses are nearest the
+    target's: each is in range and clear (a chain), they come nearest first by the table's
+    features, and the same seed gives the same table."""
+    import kinegami.reach.inverse as inverse
+
+    design = load_design(DESIGNS / "puma.json")
+    compiled = kinematics(design)
+    tip = compiled.tips[0]
+    table = inverse._seed_table(design, compiled, (tip,), 0)
+    assert 0 < table.Q.shape[0] <= inverse.SEED_TABLE
+    low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+    assert np.all(table.Q >= low) and np.all(table.Q <= high)
+    for q in table.Q[:20]:
+        assert design.clearance(q.tolist()).ok
+    T = compiled.fkine(clear_configurations(design, 1, seed=9)[0])
+    goal = {tip: Target.of(T)}
+    near = table.nearest(goal, ("pose",), 5)
+    wanted = table.features(T[None, None], ("pose",))[0]
+    gaps = np.linalg.norm(table.features(compiled.tip_poses(near), ("pose",)) - wanted, axis=1)
+    every = np.linalg.norm(table.features(table.T, ("pose",)) - wanted, axis=1)
+    assert np.all(np.diff(gaps) >= 0) and gaps[0] == pytest.approx(every.min())
+    assert inverse._seed_table(design, compiled, (tip,), 0) is table  # made once
+    again = inverse._SeedTable(design, compiled, (tip,), 0)
+    assert np.array_equal(again.Q, table.Q)

@@ -95,6 +95,11 @@ def test_the_incremental_test_answers_as_the_whole_tree_test(steps, margin, elbo
         assert TreeGrowth(*before, tree.r, tree.margin).clear(*after) is (expected is None)
         with mock.patch("kinegami.clearance.tree_bodies._CLEAR_CHUNK", 3):  # its first chunk
             assert TreeGrowth(*before, tree.r, tree.margin).clear(*after) is (expected is None)
+        # new rows a few at a time (the blocks whose pairs are listed and measured in turn)
+        for block in (1, 5):
+            with mock.patch("kinegami.clearance.tree_bodies._NEW_ROWS_PER_BLOCK", block):
+                assert TreeGrowth(*before, tree.r, tree.margin).clear(*after) is \
+                    (expected is None)  # fmt: skip
         checked += 1
     assert checked or len(tree.Joints) == 1
 
@@ -204,3 +209,36 @@ def test_junction_extents_are_remembered_by_the_links_not_the_joint_numbers(monk
     fresh = tree_bodies.tree_capsules(tree.Joints, links, tree.Parents, tree.r)
     assert np.array_equal(first.extent, again.extent)
     assert np.array_equal(again.extent, fresh.extent)
+
+
+def test_a_colliding_candidate_is_told_by_its_first_block_of_new_rows(monkeypatch):
+    """Issue 29 §3 (fuzz operations seed 407229): the pairs of a candidate with the tree are
+    listed a block of new rows at a time and measured before the next block's are listed,
+    so a candidate whose first rows collide lists no more than that block's pairs."""
+    import kinegami.clearance.tree_bodies as tree_bodies
+
+    tree = KinematicTree(Waypoint(4, 1, SE3()), maxAnglePerElbow=math.pi / 36)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        tree.addJoint(0, RevoluteJoint(4, 1, math.pi, SE3.Trans(0, 0, 30)), safe=False)
+    before = (tree.Joints, tree.Links, tree.Parents)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        # a second child whose link doubles back along the first's: it collides at once
+        tree.addJoint(0, RevoluteJoint(4, 1, math.pi, SE3.Trans(0, 0.5, 20) * SE3.Rx(math.pi)),
+                      safe=False)  # fmt: skip
+    after = (tree.Joints, tree.Links, tree.Parents)
+    blocks = []
+    listed = tree_bodies._near_pairs_by_block
+
+    def counted(*args, **kwargs):
+        for pair in listed(*args, **kwargs):
+            blocks.append(pair[0].size)
+            yield pair
+
+    monkeypatch.setattr(tree_bodies, "_NEW_ROWS_PER_BLOCK", 2)
+    monkeypatch.setattr(tree_bodies, "_near_pairs_by_block", counted)
+    growth = TreeGrowth(*before, tree.r, tree.margin)
+    assert growth.clear(*after) is False
+    new_rows = int((growth._extended(*after, 0).node >= len(before[0])).sum())
+    assert len(blocks) < new_rows / 2  # stopped before the last block
