@@ -456,7 +456,10 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
                 if not done[g]:
                     _keep(best, g, Q[sr[i]], now_pos[i], now_ang[i], None)
             # stalled starts (too old, or damped to nothing): a new start, within the budget
-            stalled = (age[sr] >= patience[owner[sr]]) | (damping[sr] >= DAMPING_MAX)
+            # (a start the step made exact is judged at the next iteration, never replaced)
+            now_exact = (now_pos <= tol_p * r) & (now_ang <= tol_a)
+            stalled = ((age[sr] >= patience[owner[sr]]) | (damping[sr] >= DAMPING_MAX)) \
+                & ~now_exact  # fmt: skip
             for row in sr[stalled].tolist():
                 g = owner[row]
                 if done[g] or started[g] >= budget[g]:

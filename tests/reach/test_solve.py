@@ -281,3 +281,24 @@ def test_the_seed_table_holds_clear_configurations_nearest_first():
     assert inverse._seed_table(design, compiled, (tip,), 0) is table  # made once
     again = inverse._SeedTable(design, compiled, (tip,), 0)
     assert np.array_equal(again.Q, table.Q)
+
+
+def test_a_start_made_exact_by_its_last_step_is_judged_not_replaced(monkeypatch):
+    """The batched path (several tips at once) replaces a start that has used its iterations;
+    one whose last step has just made it exact is judged first. (With one iteration per start
+    and a start a step from the answer, the answer was thrown away: the hand's fingertips
+    were then 'not attainable' at errors of 1e-12.)"""
+    import kinegami.reach.inverse as inverse
+
+    path = DESIGNS / "hand.json"
+    hand = load_design(path)
+    compiled = kinematics(hand)
+    q = clear_configurations(hand, 1, seed=5)[0]
+    poses = compiled.fkine(q)
+    goals = {tip: Target(poses[k][:3, 3]) for k, tip in enumerate(compiled.tips)}
+    near = q.copy()
+    near[compiled.movable] += 1e-6  # one damped step from the answer
+    monkeypatch.setattr(inverse, "ITERATIONS", 1)
+    monkeypatch.setattr(inverse, "MAX_STARTS", 1)
+    monkeypatch.setattr(inverse, "STARTS", 1)
+    check(path, solve(hand, goals, q0=near), goals)
