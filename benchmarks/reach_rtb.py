@@ -63,7 +63,59 @@ def _median_ms(times) -> str:
     return f"{statistics.median(times) * 1e3:.2f} ms"
 
 
-def rows(names=("puma", "spherical_series"), count: int = 40) -> list[tuple[str, str, str]]:
+def batch_rows(names=("puma", "revolute_spiral", "spherical_series"),
+               count: int = 1000) -> list[tuple[str, str, str]]:  # fmt: skip
+    """``solve_many`` on ``count`` clear pose targets against RTB's ``ik_LM`` in a loop over the
+    same targets: wall time per target and the share reached (ours exact and clear, checked
+    by the design's kinematics and clearance; RTB's at 1e-5 r, and how many of those clear)."""
+    from kinegami.design import load_design
+    from kinegami.reach import kinematics, solve_many
+
+    try:
+        import roboticstoolbox  # noqa: F401
+    except ImportError:
+        return [("RTB batched side by side", "skipped: roboticstoolbox-python is not installed "
+                 "(pip install -e .[bench])", "-")]  # fmt: skip
+    goals = {"puma": "<= 1.5x RTB ik_LM loop", "revolute_spiral": "<= RTB ik_LM loop",
+             "spherical_series": "<= RTB ik_LM loop"}  # fmt: skip
+    out = []
+    for name in names:
+        design = load_design(DESIGNS / f"{name}.json")
+        compiled = kinematics(design)
+        robot, columns, reference = rtb_robot(compiled)
+        _, targets = clear_targets(design, compiled, count, seed=1)
+        r = float(design.r)
+        t0 = time.perf_counter()
+        answers = solve_many(design, targets)
+        ours = (time.perf_counter() - t0) / count
+        reached = sum(a.ok and _reaches(design, np.array(a.states), T, 1e-9 * r)
+                      and design.clearance(list(a.states)).ok
+                      for a, T in zip(answers, targets, strict=True))  # fmt: skip
+        t0 = time.perf_counter()
+        found = [robot.ik_LM(T) for T in targets]
+        theirs = (time.perf_counter() - t0) / count
+        base = np.array([joint.state for joint in design.Joints], dtype=float)
+        rtb_ok = rtb_clear = 0
+        for answer, T in zip(found, targets, strict=True):
+            if not answer.success:
+                continue
+            q = base.copy()
+            q[columns] = reference + np.asarray(answer.q, dtype=float)
+            if _reaches(design, q, T, 1e-5 * r):
+                rtb_ok += 1
+                rtb_clear += bool(design.clearance(q.tolist()).ok)
+        out += [
+            (f"{name}: solve_many, {count} clear pose targets, per target (wall)",
+             f"{ours * 1e3:.3f} ms, {reached}/{count} exact and clear",
+             f"{goals.get(name, '-')} ({ours / theirs:.2f}x)"),
+            (f"{name}: RTB ik_LM in a loop, same targets, per target (wall)",
+             f"{theirs * 1e3:.3f} ms, {rtb_ok}/{count} at 1e-5 r, {rtb_clear} clear", "-"),
+        ]  # fmt: skip
+    return out
+
+
+def rows(names=("puma", "revolute_spiral", "spherical_series"),
+         count: int = 40) -> list[tuple[str, str, str]]:  # fmt: skip
     """The side-by-side rows (name, result, goal) for each design."""
     from kinegami.design import load_design
     from kinegami.reach import kinematics, solve
@@ -74,7 +126,8 @@ def rows(names=("puma", "spherical_series"), count: int = 40) -> list[tuple[str,
         return [("RTB side by side", "skipped: roboticstoolbox-python is not installed "
                  "(pip install -e .[bench])", "-")]  # fmt: skip
     out = []
-    goals = {"puma": ("0.25 ms", "14.5 ms"), "spherical_series": ("0.39 ms", "14.3 ms")}
+    goals = {"puma": ("0.25 ms", "14.5 ms"), "spherical_series": ("0.39 ms", "14.3 ms"),
+             "revolute_spiral": ("-", "-")}  # fmt: skip
     for name in names:
         design = load_design(DESIGNS / f"{name}.json")
         compiled = kinematics(design)
@@ -146,5 +199,5 @@ def _checked(path: Path, states, T, tolerance: float) -> bool:
 
 
 if __name__ == "__main__":
-    for row in rows():
+    for row in rows() + batch_rows():
         print(" | ".join(row))

@@ -503,7 +503,8 @@ def reach_rows() -> list[tuple[str, str, str]]:
         space.append((f"workspace, PUMA, {samples:,} samples (wall)",
                       f"{took:.1f} s; volume {cloud.volume / 1e9:.4g} dm^3, half-sample "
                       f"{cloud.convergence:.1%}, lost {cloud.lost_share:.1%}", goal))  # fmt: skip
-    side_by_side = __import__("reach_rtb").rows()  # RTB's rows, or one saying it is absent
+    rtb = __import__("reach_rtb")
+    side_by_side = rtb.rows() + rtb.batch_rows()  # RTB's rows, or ones saying it is absent
     return ik + side_by_side + space + [
         ("forward kinematics, PUMA, batches of 100,000 (wall / CPU)",
          f"{Q.shape[0] / statistics.median(walls):,.0f} / {Q.shape[0] / t:,.0f} /s",
