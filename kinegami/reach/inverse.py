@@ -689,16 +689,21 @@ def _escape(design, compiled: Kinematics, q: np.ndarray, columns: np.ndarray, de
     rows = 3 if kind == 0 else 6
     iterations = 0
     h = 1e-6
+    engine = _engine_of(design)
+    # the smallest clearance at the nudged configurations, one batch of the engine: every
+    # pair closer than the margin (and a hundredth of r more: the configurations are a
+    # nudge from one that is not clear) is measured; a report's words are not needed here
+    reach = (float(getattr(design, "margin", 0.0)) if margin is None else margin) + 0.01 * r
     for _ in range(ESCAPE_STEPS):
         base = float(verdict[0])  # _judge's clearance of this q (measured once)
-        gradient = np.zeros(columns.size)
+        nudged = np.repeat(q[None, :], columns.size, axis=0)
         for m, c in enumerate(columns.tolist()):
-            moved = q.copy()
-            moved[c] = min(moved[c] + h * (1.0 if revolute[m] else r), high_p[m])
-            if moved[c] == q[c]:
-                moved[c] = q[c] - h * (1.0 if revolute[m] else r)
-            gradient[m] = (float(design.clearance(moved.tolist(), margin).min_clearance) - base) \
-                / (moved[c] - q[c])  # fmt: skip
+            nudged[m, c] = min(q[c] + h * (1.0 if revolute[m] else r), high_p[m])
+            if nudged[m, c] == q[c]:
+                nudged[m, c] = q[c] - h * (1.0 if revolute[m] else r)
+        closest = engine.worst_arrays(nudged, reach)[0]
+        steps_taken = nudged[np.arange(columns.size), columns] - q[columns]
+        gradient = np.where(np.isfinite(closest), (closest - base) / steps_taken, 0.0)
         J = compiled.jacob0(q)[:, columns]
         J = np.vstack([J[:3] / r, J[3:]])[: rows if kind != 1 else 6]
         null = np.eye(columns.size) - np.linalg.pinv(J) @ J
@@ -720,6 +725,16 @@ def _escape(design, compiled: Kinematics, q: np.ndarray, columns: np.ndarray, de
         if verdict[2]:
             break
     return q, verdict, iterations
+
+
+def _engine_of(design):
+    """The clearance engine of a chain or a tree (what ``design.clearance`` measures with)."""
+    from kinegami.chain.model import KinematicChain
+    from kinegami.clearance.engine import TreeMotion, engine_for
+
+    if isinstance(design, KinematicChain):
+        return engine_for(design)
+    return TreeMotion(design).engine
 
 
 def _still(problem: _Problem, q: np.ndarray, tol_p: float, tol_a: float, r: float) -> tuple:
