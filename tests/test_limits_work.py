@@ -178,6 +178,37 @@ def test_the_takeoff_search_of_a_tree_of_many_branching_joints_shares_one_budget
     assert len(measured) <= 10 + 3 * 2  # the budget, and each joint's one candidate and set
 
 
+def test_a_single_branch_is_not_measured_again_as_a_set(monkeypatch):
+    """A take-off joint with one branch: its set is its best candidate, whose body was measured
+    already with the same placements (fuzz operations seed 502287 measured three such bodies
+    twice each, 3.3 s a time): every body measured is a candidate's, and the choice is the
+    one the sets' measure made."""
+    tree = KinematicTree(Waypoint(4, 1, SE3()), maxAnglePerElbow=math.pi / 60)
+    for parent, x, y in ((0, -6, 0), (0, 6, 0), (1, -9, 4), (1, -3, 4)):
+        pose = SE3.Trans(x, y, 10 if parent == 0 else 22) * SE3.Rx(2.0)
+        tree.addJoint(parent, RevoluteJoint(4, 1, math.pi, pose), safe=False)
+    from kinegami.fabrication.sheets import fabricate
+
+    combine = takeoffs._combine
+    inside = []
+
+    def counted_combine(*args, **kwargs):
+        overlap = takeoffs.takeoff_overlap
+        monkeypatch.setattr(takeoffs, "takeoff_overlap",
+                            lambda *a, **k: (inside.append(1), overlap(*a, **k))[1])
+        try:
+            return combine(*args, **kwargs)
+        finally:
+            monkeypatch.setattr(takeoffs, "takeoff_overlap", overlap)
+
+    monkeypatch.setattr(takeoffs, "_combine", counted_combine)
+    made = fabricate(tree, junction="takeoff")
+    assert inside == []
+    # the take-offs the sets' measure chose before (face, height along the trunk's tube)
+    assert [(t.junction.face, t.junction.y0) for t in made.takeoffs] == \
+        [(1, 3.6103849214667867), (0, 9.196849167737891)]  # fmt: skip
+
+
 def test_a_takeoff_candidate_is_charged_for_its_junction_extents(monkeypatch):
     """A take-off candidate costs its body's capsules and its junction's extents (the two
     tubes leaving it, each one's capsules against the other's): a tree of long one-degree-
