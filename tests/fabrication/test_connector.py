@@ -354,3 +354,21 @@ def test_random_sibling_sets_give_watertight_connectors(ends, n, parent_side, wi
     mesh = junction_connector(R, n, D, links, parent_side=parent_side, trunk=trunk, options=options)
     assert mesh.is_watertight and mesh.is_volume
     assert mesh.body_count == 1
+
+
+def test_the_same_junction_is_measured_once_and_answers_stay_separate():
+    """sibling_overlap_lengths keeps its answers for the last few sets of links (choosing a
+    tree's trunks and then building its sockets asked for the same junctions again: fuzz
+    operations seed 504290); the caller gets its own array each time."""
+    from spatialmath import SE3
+
+    import kinegami.fabrication.connector as connector
+
+    a = LinkCSC(1, SE3(), SE3.Trans(10, 6, 0))
+    b = LinkCSC(1, SE3(), SE3.Trans(10, -6, 0))
+    connector._overlap_lengths.cache_clear()
+    first = connector.sibling_overlap_lengths([a, b], 1.0)
+    first[:] = -1.0  # the caller's own copy
+    again = connector.sibling_overlap_lengths([a, b], 1.0)
+    assert again.round(3).tolist() == [2.482, 2.482]
+    assert connector._overlap_lengths.cache_info().hits == 1
