@@ -173,8 +173,7 @@ def solve(design, target, *, tip=None, tool=None, q0=None, seed: int = 0, clear:
     tool : 4x4 array or SE3, optional
         A fixed frame on the tip.
     q0 : configuration, optional
-        The first start (a warm start). Default: the seed table's configurations nearest
-        the target first, then the design's current states (docs/reach.md).
+        The first start (default: the design's current states).
     seed : int
         The other starts' random seed (the answer is the same for the same seed).
     clear : bool
@@ -213,7 +212,7 @@ def solve_many(design, targets, *, tip=None, tool=None, q0=None, seed: int = 0,
     compiled = kinematics(design, tips if tips else None, tool)
     start = compiled.configurations(
         [joint.state for joint in design.Joints] if q0 is None else q0)[0][0]
-    options = (tol_p, tol_a, int(seed), clear, margin, q0 is not None)
+    options = (tol_p, tol_a, int(seed), clear, margin)
     chunk = max(1, int(chunk))
     pieces = [list(range(a, min(a + chunk, len(goals)))) for a in range(0, len(goals), chunk)]
     if executor is None:
@@ -370,7 +369,7 @@ def _solve_chunk(design, compiled: Kinematics, goals: list, indices: list, start
 
 
 def _solve_group(design, compiled, goals, indices, start, options) -> list[Answer]:
-    tol_p, tol_a, seed, clear, margin, _ = options
+    tol_p, tol_a, seed, clear, margin = options
     r = float(design.r)
     problem = _Problem(compiled, goals, r)
     G = len(goals)
@@ -605,7 +604,7 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
     compiled descent (:func:`kinegami.reach.kernels.descend`) in turn: the first from
     ``start``, the others drawn from the target's own random stream, until one is exact and
     clear or the budget is spent."""
-    tol_p, tol_a, seed, clear, margin, warm = options
+    tol_p, tol_a, seed, clear, margin = options
     descend = _kernel()
     r = float(design.r)
     (tip, target), = goal.items()
@@ -623,19 +622,13 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
     iterations = escapes = 0
     q = np.clip(start, low, high)
     seeds = None
-    # the starts: q0 when given (a warm start), the seed table's configurations nearest the
-    # target, the design's states when no q0 was given, then random ones
-    first_table = 0 if warm or hopeless else -1  # the start before the table's
     for started in range(budget):
-        if started > first_table:
-            if seeds is None:
+        if started:
+            if seeds is None:  # the table's configurations nearest the target, then random
                 seeds = _seed_table(design, compiled, (tip,), seed).nearest(
                     goal, (target.kind,), SEEDED_STARTS)  # fmt: skip
-            k = started - first_table - 1
-            if k < seeds.shape[0]:
-                q = seeds[k].copy()
-            elif k == seeds.shape[0] and not warm:
-                q = np.clip(start, low, high)
+            if started <= seeds.shape[0]:
+                q = seeds[started - 1].copy()
             else:
                 if rng is None:
                     rng = np.random.default_rng([seed, *_words(goal)])
@@ -779,7 +772,7 @@ def _failure(design, kept, iterations, restarts, collided, options, compiled, go
              problem) -> Answer:  # fmt: skip
     """The answer when no start gave an exact, clear configuration: the nearest one, and
     why in one sentence."""
-    tol_p, tol_a, _, clear, margin, _ = options
+    tol_p, tol_a, _, clear, margin = options
     _, q, pos, ang, verdict = kept
     if verdict is None:
         verdict = _judge(design, q, clear, margin)
