@@ -31,12 +31,12 @@ STARTS = 8
 #: Most starts tried for one target before it is given up.
 MAX_STARTS = 64
 #: Iterations of one start before it counts as stalled.
-ITERATIONS = 60
+ITERATIONS = 200
 #: Damping: first value, bounds (in units of the residual squared).
 DAMPING, DAMPING_MIN, DAMPING_MAX = 1e-3, 1e-12, 1e8
 #: Configurations of the seed table (per design, tips and seed), and how many of the nearest
 #: to a target are tried after its first start, before random ones.
-SEED_TABLE, SEEDED_STARTS = 4096, 24
+SEED_TABLE, SEEDED_STARTS = 8192, 63
 
 
 @dataclass(frozen=True, eq=False)
