@@ -527,11 +527,12 @@ def _ik_rows(puma, arm) -> list[tuple[str, str, str]]:
         q = low + (high - low) * rng.random(low.size)
         if puma.clearance(q.tolist()).ok:
             targets.append(arm.fkine(q))
-    times, reached = [], 0
-    for T in targets:
+    times, answers, reached = [], [], 0
+    for T in targets:  # timed alone: the checks load other designs (and their engines)
         t0 = time.perf_counter()
-        answer = solve(puma, T)
+        answers.append(solve(puma, T))
         times.append(time.perf_counter() - t0)
+    for answer, T in zip(answers, targets, strict=True):
         if answer.ok:
             check = load_design(DESIGNS / "puma.json")
             check.requireClearance = True

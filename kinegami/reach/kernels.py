@@ -114,6 +114,40 @@ def _residual(T, kind, target_p, target_R, target_a, r, e, w):
 
 
 @njit(cache=True)
+def _solve_spd(A, b):
+    """x with A x = b for a small symmetric positive definite A (J J^T + lambda I, 3x3 or
+    6x6), by Cholesky in plain loops: no LAPACK call, so a threaded BLAS loaded by another
+    library (Robotics Toolbox's import made each solve 2x slower) costs nothing here. A
+    pivot that is not positive (A singular to rounding) falls back to LAPACK."""
+    n = A.shape[0]
+    L = np.zeros((n, n))
+    for i in range(n):
+        for j in range(i + 1):
+            total = A[i, j]
+            for k in range(j):
+                total -= L[i, k] * L[j, k]
+            if i == j:
+                if not total > 0.0:
+                    return np.linalg.solve(A, b)
+                L[i, i] = math.sqrt(total)
+            else:
+                L[i, j] = total / L[j, j]
+    y = np.empty(n)
+    for i in range(n):
+        total = b[i]
+        for k in range(i):
+            total -= L[i, k] * y[k]
+        y[i] = total / L[i, i]
+    x = np.empty(n)
+    for i in range(n - 1, -1, -1):
+        total = y[i]
+        for k in range(i + 1, n):
+            total -= L[k, i] * x[k]
+        x[i] = total / L[i, i]
+    return x
+
+
+@njit(cache=True)
 def descend(steps, path, revolute, reference, E, low, high, kind, target_p, target_R, target_a,
             r, tol_p, tol_a, q, patience, damping, damping_min, damping_max):  # fmt: skip
     """Iterate one start: ``q`` (P,) the path joints' states, changed in place to the last
@@ -158,7 +192,7 @@ def descend(steps, path, revolute, reference, E, low, high, kind, target_p, targ
         A = J @ J.T
         for i in range(size):
             A[i, i] += lam
-        step = J.T @ np.linalg.solve(A, e)
+        step = J.T @ _solve_spd(A, e)
         for m in range(P):
             trial[m] = min(max(q[m] + step[m], low[m]), high[m])
         _frames(steps, path, revolute, trial - reference, E, axes, T)
