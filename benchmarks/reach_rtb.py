@@ -91,19 +91,8 @@ def batch_rows(names=("puma", "revolute_spiral", "spherical_series"),
         reached = sum(a.ok and _reaches(design, np.array(a.states), T, 1e-9 * r)
                       and design.clearance(list(a.states)).ok
                       for a, T in zip(answers, targets, strict=True))  # fmt: skip
-        t0 = time.perf_counter()
-        found = [robot.ik_LM(T) for T in targets]
-        theirs = (time.perf_counter() - t0) / count
-        base = np.array([joint.state for joint in design.Joints], dtype=float)
-        rtb_ok = rtb_clear = 0
-        for answer, T in zip(found, targets, strict=True):
-            if not answer.success:
-                continue
-            q = base.copy()
-            q[columns] = reference + np.asarray(answer.q, dtype=float)
-            if _reaches(design, q, T, 1e-5 * r):
-                rtb_ok += 1
-                rtb_clear += bool(design.clearance(q.tolist()).ok)
+        times, rtb_ok, rtb_clear = _rtb(design, robot.ik_LM, targets, columns, reference, r)
+        theirs = sum(times) / count
         out += [
             (f"{name}: solve_many, {count} clear pose targets, per target (wall)",
              f"{ours * 1e3:.3f} ms, {reached}/{count} exact and clear",

@@ -1131,7 +1131,7 @@ def cmd_reach(args: argparse.Namespace) -> int:
     if not tips and len(targets) > 1:
         raise CommandError("--target: several targets need one --tip each")
     if not tips:
-        _one_tip(chain)
+        _one_tip(chain, per_target=True)
     goal = dict(zip(tips, targets, strict=True)) if tips else targets[0]
     answer = solve(chain, goal, seed=seed)
     length = Lengths(chain.r, info.units)
@@ -1174,15 +1174,17 @@ def cmd_reach(args: argparse.Namespace) -> int:
     return 0 if answer.ok else NOT_REACHED
 
 
-def _one_tip(design) -> None:
-    """Refuse, in the command line's words, a design with several tips and no ``--tip``."""
+def _one_tip(design, per_target: bool = False) -> None:
+    """Refuse, in the command line's words, a design with several tips and no ``--tip``
+    (``per_target``: reach's, which takes one per --target)."""
     from kinegami.reach import kinematics
 
     tips = kinematics(design).tips
     if len(tips) != 1:
         listed = ", ".join(str(t) for t in tips)
+        each = " (one --tip per --target)" if per_target else ""
         raise CommandError(f"--tip: the design has {len(tips)} tips (joints {listed}); give "
-                           "--tip J (for reach, one --tip per --target)")  # fmt: skip
+                           f"--tip J{each}")  # fmt: skip
 
 
 def cmd_workspace(args: argparse.Namespace) -> int:

@@ -742,20 +742,7 @@ def _near_pairs_by_block(caps: TreeCapsules, joints, since: int, reach: float):
     tau = caps.turning + np.where(caps.start_joint >= 0, kinks[caps.start_joint], 0.0)
     centre = 0.5 * (a + b)
     half = 0.5 * np.sqrt(((b - a) ** 2).sum(axis=1))
-    element = caps.element
-    starts = np.flatnonzero(np.r_[True, element[1:] != element[:-1]])
-    sizes = np.diff(np.r_[starts, S])
-    c = np.add.reduceat(centre, starts, axis=0) / sizes[:, None]
-    owner = np.repeat(np.arange(starts.size), sizes)
-    rho = np.maximum.reduceat(np.sqrt(((centre - c[owner]) ** 2).sum(axis=1)) + half, starts)
-    mine = np.unique(owner[new_rows])
-    keep = np.zeros(starts.size, dtype=bool)
-    keep[mine] = True
-    allowance = reach + 1e-9 * (reach + float(np.abs(c).max(initial=0.0)) + float(rho.max()))
-    for e in mine.tolist():
-        d = c[e] - c
-        keep |= np.sqrt(np.einsum("ij,ij->i", d, d)) - rho[e] - rho < allowance
-    rows = np.flatnonzero(keep[owner])  # every row a new row can be near
+    rows = _rows_near(caps.element, node >= since, centre, half, reach)
     is_new = node[rows] >= since
     for start in range(0, new_rows.size, _NEW_ROWS_PER_BLOCK):
         block = new_rows[start : start + _NEW_ROWS_PER_BLOCK]
@@ -776,6 +763,27 @@ def _near_pairs_by_block(caps: TreeCapsules, joints, since: int, reach: float):
             yield np.minimum(i, j), np.maximum(i, j)  # i < j, as every pair list has them
 
 
+def _rows_near(element, wanted, centre, half, reach: float) -> np.ndarray:
+    """The rows of the parts (``element``: each row's part, contiguous) that are wanted
+    (``wanted``: a bool per row, constant over each part) or whose balls come within
+    ``reach`` of a wanted part's, with a rounding allowance (keeping more parts changes
+    nothing): every row a wanted row can be near."""
+    S = element.size
+    starts = np.flatnonzero(np.r_[True, element[1:] != element[:-1]])
+    sizes = np.diff(np.r_[starts, S])
+    c = np.add.reduceat(centre, starts, axis=0) / sizes[:, None]
+    owner = np.repeat(np.arange(starts.size), sizes)
+    rho = np.maximum.reduceat(np.sqrt(((centre - c[owner]) ** 2).sum(axis=1)) + half, starts)
+    mine = np.flatnonzero(wanted[starts])
+    keep = np.zeros(starts.size, dtype=bool)
+    keep[mine] = True
+    allowance = reach + 1e-9 * (reach + float(np.abs(c).max(initial=0.0)) + float(rho.max()))
+    for e in mine.tolist():
+        d = c[e] - c
+        keep |= np.sqrt(np.einsum("ij,ij->i", d, d)) - rho[e] - rho < allowance
+    return np.flatnonzero(keep[owner])
+
+
 def _near_new_pairs(element, wanted, centre, half, reach: float, tau=None) -> tuple:
     """:func:`near_capsule_pairs` (i < j) with ``wanted`` (a bool per row, constant over each
     part), the same pairs in the same order, measured among the parts that can be in one:
@@ -787,21 +795,7 @@ def _near_new_pairs(element, wanted, centre, half, reach: float, tau=None) -> tu
     one path from the root), pairs of two wanted rows whose turning differs by less than pi
     (which the pair rule does not test) are not listed either, the others in the same
     order."""
-    S = element.size
-    starts = np.flatnonzero(np.r_[True, element[1:] != element[:-1]])
-    sizes = np.diff(np.r_[starts, S])
-    c = np.add.reduceat(centre, starts, axis=0) / sizes[:, None]
-    owner = np.repeat(np.arange(starts.size), sizes)
-    rho = np.maximum.reduceat(np.sqrt(((centre - c[owner]) ** 2).sum(axis=1)) + half, starts)
-    mine = np.flatnonzero(wanted[starts])
-    keep = np.zeros(starts.size, dtype=bool)
-    keep[mine] = True
-    # with a rounding allowance: keeping more parts changes nothing
-    allowance = reach + 1e-9 * (reach + float(np.abs(c).max(initial=0.0)) + float(rho.max()))
-    for e in mine:
-        d = c[e] - c
-        keep |= np.sqrt(np.einsum("ij,ij->i", d, d)) - rho[e] - rho < allowance
-    rows = np.flatnonzero(keep[owner])
+    rows = _rows_near(element, wanted, centre, half, reach)
     first = np.arange(rows.size) + 1
     new = np.flatnonzero(wanted[rows])
     if tau is not None and new.size and new[0] == rows.size - new.size:
