@@ -22,8 +22,13 @@ from kinegami import (
     RevoluteJoint,
     Waypoint,
 )
-from kinegami.chain.bodies import link_capsule_arrays, link_polyline
-from kinegami.clearance.tree_bodies import TreeGrowth, junction_extent, tree_worst_overlap
+from kinegami.chain.bodies import link_capsule_arrays, link_polyline, overlap_of_deepest_pair
+from kinegami.clearance.tree_bodies import (
+    TreeGrowth,
+    junction_extent,
+    tree_pair_distances,
+    tree_worst_overlap,
+)
 
 #: Turns and translations of siblings that leave together (their tubes share a junction).
 ALIKE = ((0.0, 0.0, math.pi / 2), (0.25, 0.0, math.pi / 2), (2.0, 0.5, math.pi / 2))
@@ -92,6 +97,21 @@ def test_the_incremental_test_answers_as_the_whole_tree_test(steps, margin, elbo
         assert growth.extends(*after)
         expected = tree_worst_overlap(*after, tree.r, since=len(before[0]), margin=tree.margin)
         assert _same(growth.overlap(*after), expected)
+        # the closest pair is found measuring nearest bounds first, a chunk at a time: the
+        # same pair as measuring every listed pair, whatever the chunk
+        for since in (len(before[0]), 0):
+            every = tree_pair_distances(*after, tree.r, since, margin=tree.margin)
+            whole = None if every is None else overlap_of_deepest_pair(
+                *every[:6], tree.Joints, None, tree.r, tree.margin)  # fmt: skip
+            if since:
+                assert _same(expected, whole)
+            for chunk in (1, 3):
+                with mock.patch("kinegami.clearance.tree_bodies._CLOSEST_CHUNK", chunk):
+                    assert _same(tree_worst_overlap(*after, tree.r, since=since,
+                                                    margin=tree.margin), whole)  # fmt: skip
+                    if since:
+                        assert _same(TreeGrowth(*before, tree.r, tree.margin).overlap(*after),
+                                     whole)  # fmt: skip
         assert TreeGrowth(*before, tree.r, tree.margin).clear(*after) is (expected is None)
         with mock.patch("kinegami.clearance.tree_bodies._CLEAR_CHUNK", 3):  # its first chunk
             assert TreeGrowth(*before, tree.r, tree.margin).clear(*after) is (expected is None)
