@@ -742,7 +742,9 @@ def _clean_mesh(mf, n, D, links, sockets, parent_side, opts, r):
     import trimesh
 
     for overlap in _OVERLAPS:
-        solid = _connector_solid(mf, n, D, links, sockets, parent_side, opts, r, overlap * r)
+        solid = _without_slivers(
+            mf, _connector_solid(mf, n, D, links, sockets, parent_side, opts, r, overlap * r), r
+        )
         mesh = _to_trimesh(solid)
         if mesh.is_watertight and mesh.is_volume:
             merged = _single_precision_safe(mesh)
@@ -754,6 +756,21 @@ def _clean_mesh(mf, n, D, links, sockets, parent_side, opts, r):
         faces=np.asarray(raw.tri_verts, dtype=np.int64),
         process=False,
     )
+
+
+#: Pieces of a boolean's result below this volume (units of r^3) are rounding, not material.
+_SLIVER_VOLUME = 1e-9
+
+
+def _without_slivers(mf, solid, r: float):
+    """``solid`` without the pieces of no volume that the boolean kernel may leave where faces
+    nearly coincide (four-vertex pieces of 1e-28 r^3 beside a child tilted by 1.2e-7 rad: the
+    connector then had three bodies)."""
+    parts = solid.decompose()
+    if len(parts) <= 1:
+        return solid
+    kept = [part for part in parts if part.volume() > _SLIVER_VOLUME * r**3]
+    return mf.Manifold.compose(kept) if kept else mf.Manifold()
 
 
 #: Vertices closer than this share one position (relative to the mesh's largest coordinate):
