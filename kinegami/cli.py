@@ -633,18 +633,27 @@ def cmd_build(args: argparse.Namespace) -> int:
         _note(args.command, f"--junctions {args.junctions} ignored: {args.design} is a chain "
                             "(junctions join the sheets of a tree)")  # fmt: skip
     formats = _parse_formats(",".join(DEFAULT_FORMATS) if args.formats is None else args.formats)
-    job = BuildJob(chain, info)
+    lines = _write_chain_build(args.command, args.design, BuildJob(chain, info), stem, out,
+                               formats)  # fmt: skip
+    print("\n".join(lines))
+    return 0
+
+
+def _write_chain_build(command: str, label: str, job: BuildJob, stem: str, out: Path, formats,
+                       extra=()) -> list[str]:  # fmt: skip
+    """Write a chain's outputs ``formats`` (and ``extra``: (file name, writer(path)) pairs)
+    into ``out`` as one transaction; the summary lines, with the files written."""
     # a large chain's pictures are drawn by a second process meanwhile (the longest output)
     pictures = BackgroundPictures(job) if BackgroundPictures.wanted(job, formats) else None
     try:
         _check_pattern(job)
-        lines = _summary(job, args.design)
+        lines = _summary(job, label)
         if not job.clearance.ok:
-            _warn(args.command, _overlap_warning(job.clearance, info, args.design))
+            _warn(command, _overlap_warning(job.clearance, job.info, label))
         # write everything into a hidden staging folder in the target, then publish it as one
         # transaction (kinegami.export.publish): a failure or an interrupt leaves the folder as
         # it was, and a build killed earlier is recovered first
-        staging = _open_staging(args.command, out)
+        staging = _open_staging(command, out)
         try:
             for fmt in formats:
                 paths = [staging.new / f"{stem}{suffix}" for suffix in fmt.suffixes]
@@ -655,12 +664,18 @@ def cmd_build(args: argparse.Namespace) -> int:
                     else:
                         fmt.write(job, paths)
                 except KinegamiError as error:
-                    raise CommandError(f"{args.design}: {fmt.name} export: {error}") from None
+                    raise CommandError(f"{label}: {fmt.name} export: {error}") from None
                 except OSError as error:
                     raise CommandError(
                         f"{fmt.name} export: cannot write {str(out)!r}: "
                         f"{error.strerror or error}"
                     ) from None
+            for name, write in extra:
+                try:
+                    write(staging.new / name)
+                except OSError as error:
+                    raise CommandError(f"cannot write {name} in {str(out)!r}: "
+                                       f"{error.strerror or error}") from None  # fmt: skip
             written = staging.publish()  # all or nothing, whatever interrupts it
         finally:
             staging.close()
@@ -669,8 +684,7 @@ def cmd_build(args: argparse.Namespace) -> int:
             pictures.stop()
     lines.append("  files written:")
     lines.extend(f"    {path}{os.sep if path.is_dir() else ''}" for path in written)
-    print("\n".join(lines))
-    return 0
+    return lines
 
 
 def cmd_show(args: argparse.Namespace) -> int:
@@ -694,6 +708,8 @@ def cmd_show(args: argparse.Namespace) -> int:
 def cmd_new(args: argparse.Namespace) -> int:
     from kinegami.design.starter import DesignFileExistsError, write_starter_design
 
+    if args.task:
+        return _new_task(args)
     try:
         path = write_starter_design(args.design, overwrite=args.force)
     except DesignFileExistsError:
@@ -709,6 +725,137 @@ def cmd_new(args: argparse.Namespace) -> int:
     print(f"  kinegami validate --build {name}")
     print(f"  kinegami build {name} -o out/")
     return 0
+
+
+def _new_task(args: argparse.Namespace) -> int:
+    """``kinegami new --task FILE``: the starter task, written atomically (kept if it exists,
+    unless --force)."""
+    import json
+
+    from kinegami._atomic import write_atomic
+    from kinegami.design.task import starter_task
+
+    path = Path(args.design)
+    if path.suffix.lower() != ".json":
+        raise CommandError(
+            f"a task file name must end in .json, got {_printable(repr(args.design))}"
+        )
+    if path.exists() and not args.force:
+        raise CommandError(
+            f"{_printable(repr(args.design))} exists already and was left as it is; "
+            "--force replaces it"
+        )
+    if path.is_dir():
+        raise CommandError(f"{_printable(repr(args.design))} is a directory, not a file name")
+    write_atomic(path, json.dumps(starter_task(), indent=2) + "\n")
+    name = _printable(str(path))
+    print(f"wrote {name}: a starter task (a four-joint arm that must touch four points above a "
+          "table; units mm). Change it, then:")  # fmt: skip
+    print(f"  kinegami design {name} -o out/")
+    return 0
+
+
+# --- design for a task --------------------------------------------------------------------------
+#: Exit code of ``design`` when no design of the budget reaches every target.
+INFEASIBLE = 3
+
+
+def cmd_design(args: argparse.Namespace) -> int:
+    import json
+
+    from kinegami.design.reader import DesignInfo
+    from kinegami.design.task import read_task
+    from kinegami.design.writer import design_to_dict, dumps_design
+    from kinegami.errors import InfeasibleTaskError
+    from kinegami.optimize import design_for
+
+    stem = _plain_stem(args.name if args.name is not None else Path(args.task).stem)
+    out = Path(args.output)
+    _check_output(out)
+    task = read_task(args.task)
+    options = task.options()
+    if args.seed is not None:
+        options["seed"] = _integer("--seed", args.seed, 0)
+    try:
+        chain, answers = design_for(list(task.targets), task.joints, return_answers=True,
+                                    progress=None, **options)  # fmt: skip
+    except InfeasibleTaskError as error:
+        kind = "infeasible" if error.proven else "no design found"
+        _fail(args.command, f"{args.task}: {kind}: {error}")
+        return INFEASIBLE
+    info = DesignInfo(name=task.name, description=task.description, units=task.units,
+                      twistPortion=0.2, file=None, structure="chain",
+                      task=task.document)  # fmt: skip
+    job = BuildJob(chain, info)
+    report = _task_report(chain, task, answers)
+    document = design_to_dict(chain, name=task.name, description=task.description,
+                              units=task.units, task=task.document)  # fmt: skip
+    extra = [
+        (f"{stem}.json", lambda path: path.write_text(dumps_design(document), "utf-8")),
+        (f"{stem}_task.txt", lambda path: path.write_text("\n".join(report[0]) + "\n", "utf-8")),
+        (f"{stem}_task.json", lambda path: path.write_text(json.dumps(report[1], indent=2) + "\n",
+                                                            "utf-8")),
+        (f"{stem}_task.png", lambda path: _task_picture(chain, answers, task, path)),
+    ]  # fmt: skip
+    formats = _parse_formats(",".join(DEFAULT_FORMATS) if args.formats is None else args.formats)
+    lines = _write_chain_build(args.command, args.task, job, stem, out, formats, extra)
+    print("\n".join([*report[0], *lines]))
+    return 0
+
+
+def _task_report(chain, task, answers) -> tuple[list[str], dict]:
+    """The report of a designed robot: per target its states, errors and clearance (lines and a
+    JSON-ready dict)."""
+    from kinegami.optimize import tube_length
+
+    units = task.units
+    lines = [f"{task.name or 'task'}: designed ({len(chain.Joints)} joints: "
+             f"{', '.join(type(j).__name__ for j in chain.Joints)}; tube "
+             f"{tube_length(chain):.6g} {units})"]  # fmt: skip
+    rows = []
+    for k, answer in enumerate(answers):
+        name = task.document["targets"][k].get("name")
+        label = f"target {k}" + (f" ({name})" if name else "")
+        lines.append(f"  {label}: reached, position error {answer.position_error:.3g} {units}, "
+                     f"angle error {answer.angle_error:.3g} rad, clearance "
+                     f"{answer.clearance:.6g} {units}")  # fmt: skip
+        lines.append("    states: " + ", ".join(f"{s:.6g}" for s in answer.states))
+        rows.append({"target": k, "name": name, "ok": bool(answer.ok),
+                     "states": list(answer.states), "position_error": answer.position_error,
+                     "angle_error": answer.angle_error, "clearance": answer.clearance})  # fmt: skip
+    summary = {"format": "kinegami-task-report", "version": 1, "name": task.name,
+               "units": units, "joints": [type(j).__name__ for j in chain.Joints],
+               "tube_length": tube_length(chain), "targets": rows}  # fmt: skip
+    return lines, summary
+
+
+def _task_picture(chain, answers, task, path: Path) -> None:
+    """One sheet of small multiples: the robot at every target (the target a red point)."""
+    import copy
+    import math
+
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    count = len(answers)
+    columns = min(4, count)
+    rows = math.ceil(count / columns)
+    fig = plt.figure(figsize=(3.2 * columns, 3.2 * rows))
+    try:
+        for k, answer in enumerate(answers):
+            ax = fig.add_subplot(rows, columns, k + 1, projection="3d")
+            posed = copy.copy(chain)
+            posed.setJointStates(list(answer.states))
+            posed.show(ax=ax, showJointPoses=False, showGlobalFrame=False, units=task.units)
+            p = task.targets[k].position
+            ax.scatter([p[0]], [p[1]], [p[2]], color="red", s=30, depthshade=False)
+            ax.set_title(f"target {k}", fontsize=9)
+        fig.tight_layout()
+        fig.savefig(path, dpi=100)
+    finally:
+        plt.close(fig)
 
 
 def cmd_edit(args: argparse.Namespace) -> int:
@@ -1340,7 +1487,32 @@ def make_parser() -> argparse.ArgumentParser:
     )
     new.add_argument("design", metavar="DESIGN", help="the design file to write (.json)")
     new.add_argument("--force", action="store_true", help="replace DESIGN if it exists")
+    new.add_argument("--task", action="store_true",
+                     help="write a starter task file instead (for 'kinegami design')")
     new.set_defaults(run=cmd_new)
+
+    design = commands.add_parser(
+        "design",
+        help="design a robot that reaches every target of a task file",
+        description="Design for a task (kinegami.optimize.design_for, docs/design-for-a-task.md): "
+        "find a chain of the task's joints whose tip reaches every target exactly, in range, "
+        "without passing through itself or entering a keep-out box, then write into DIR the "
+        "design file (with its task), the build's outputs, and a report: NAME_task.txt and "
+        ".json (per target the states, the errors and the clearance) and NAME_task.png (the "
+        "robot at every target). Exit code 0: designed; 3: infeasible (the certificate, or "
+        "that the search found no design, is printed); 1: a task or option error.",
+    )
+    design.add_argument("task", metavar="TASK", help="task file (.json; 'kinegami new --task' "
+                        "writes one)")  # fmt: skip
+    design.add_argument("-o", "--output", metavar="DIR", required=True,
+                        help="output folder (created if missing)")  # fmt: skip
+    design.add_argument("--name", metavar="STEM",
+                        help="file name stem of the outputs (default: the task file's)")
+    design.add_argument("--seed", metavar="S", default=None,
+                        help="seed of the search (default: the task's, else 0)")
+    design.add_argument("--formats", default=None, metavar="LIST",
+                        help="comma-separated build outputs, as for 'kinegami build'")
+    design.set_defaults(run=cmd_design)
 
     check = commands.add_parser(
         "check",

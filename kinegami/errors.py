@@ -14,6 +14,7 @@ inherit the matching builtin, so ``except ValueError`` keeps working (as ezdxf d
     +-- NoPathError(ValueError)              no CSC link joins two frames
     +-- IncompatibleJointError(ValueError)   another numSides or r than the chain's
     +-- CompactionError(ValueError)          compaction found no clear design
+    +-- InfeasibleTaskError(ValueError)      no design of the budget reaches every target
     +-- EditorCommandError(ValueError)       an editor command that cannot be applied
     +-- DesignError(ValueError)              a design file is unreadable or invalid
     +-- DesignFileExistsError(FileExistsError)
@@ -45,6 +46,7 @@ __all__ = [
     "NoPathError",
     "IncompatibleJointError",
     "CompactionError",
+    "InfeasibleTaskError",
     "EditorCommandError",
     "FoldedFormError",
     "UnknownModuleKindError",
@@ -105,6 +107,18 @@ class IncompatibleJointError(KinegamiError, ValueError):
 
 class CompactionError(KinegamiError, ValueError):
     """No clear design was found (the input passes through itself and no move fixed it)."""
+
+
+class InfeasibleTaskError(KinegamiError, ValueError):
+    """No design of the joint budget reaches every target of a task
+    (:func:`kinegami.optimize.design_for`). ``target`` is the index of the target the message
+    names (or None), ``proven`` whether a bound proves it (a certificate) rather than the
+    search not finding a design."""
+
+    def __init__(self, message: str, target: int | None = None, proven: bool = True):
+        super().__init__(message)
+        self.target = target
+        self.proven = proven
 
 
 class EditorCommandError(KinegamiError, ValueError):

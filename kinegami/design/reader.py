@@ -53,6 +53,7 @@ from kinegami.design.schema import (
     schema_errors,
     version_problem,
 )
+from kinegami.design.task import task_from_dict
 from kinegami.design.trees import (
     TreeSpecification,
     check_tree_fields,
@@ -106,6 +107,7 @@ class DesignInfo:
     twistPortion: float
     file: str | None
     structure: str = "chain"
+    task: dict | None = None
 
     @classmethod
     def of(cls, document: dict, file=None) -> DesignInfo:
@@ -117,6 +119,7 @@ class DesignInfo:
             twistPortion=float(document.get("twistPortion", DEFAULT_TWIST_PORTION)),
             file=None if file is None else os.fspath(file),
             structure=structure_of(document),
+            task=document.get("task"),
         )
 
 
@@ -711,6 +714,8 @@ def _check_document(document, file) -> _Plan:
     _check_values(document, file)
     check_schema(document, file)
     check_lengths(document, file)
+    if "task" in document:  # the task the design was made for (kinegami design)
+        task_from_dict(document["task"], file, where=("task",))
     names = _check_names(document, file)
     fields = check_tree_fields(document, file)
     units = document.get("angleUnits", "rad")

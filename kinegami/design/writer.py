@@ -70,6 +70,7 @@ def design_to_dict(
     description: str | None = None,
     units: str = "mm",
     twistPortion: float | None = None,
+    task: dict | None = None,
 ) -> dict:
     """The design document (a JSON-ready dict) that re-creates ``chain`` exactly.
 
@@ -80,6 +81,8 @@ def design_to_dict(
     name, description : optional texts stored in the file.
     units : the length unit of the chain ("mm", "cm", "m" or "in"); metadata for exporters.
     twistPortion : stored for the crease pattern when given (in [0, 1)).
+    task : the task document the design was made for (docs/design-for-a-task.md), kept as
+        its ``"task"`` block.
 
     Poses are those of the state-0 configuration (computed on a copy of the chain); non-zero
     states are listed in ``"states"`` (radians for revolute joints, lengths for prismatic).
@@ -171,6 +174,10 @@ def design_to_dict(
         document["joints"] = joints
     if any(states):
         document["states"] = states
+    if task is not None:  # the task the design was made for, as its task file says it
+        if not isinstance(task, dict):
+            raise InvalidTypeError(f"task must be a task document (a dict), got {task!r}")
+        document["task"] = task
     return document
 
 
@@ -203,6 +210,7 @@ def save_design(
     description: str | None = None,
     units: str = "mm",
     twistPortion: float | None = None,
+    task: dict | None = None,
 ) -> Path:
     """Write ``chain`` (a chain or a tree) to the design file ``path`` (suffix .json)
     atomically; return the path.
@@ -226,8 +234,9 @@ def save_design(
     if target.is_dir():
         raise InvalidParameterError(f"{os.fspath(path)!r} is a directory, not a file name")
     document = design_to_dict(
-        chain, name=name, description=description, units=units, twistPortion=twistPortion
-    )
+        chain, name=name, description=description, units=units, twistPortion=twistPortion,
+        task=task,
+    )  # fmt: skip
     text = dumps_design(document)
     try:
         check_document(json.loads(text))

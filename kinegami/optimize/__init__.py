@@ -4,14 +4,26 @@
 and rolls joints along their axes (the kinematics stay the same) to shorten the tube or shrink
 the design's ball, never accepting a design that passes through itself;
 :func:`shorten_by_axis_translations`, its slide-only, in-place form; :func:`tube_length`.
-Design for a task (targets in, a robot that reaches them out) will live here too.
+
+:mod:`kinegami.optimize.synthesis`: :func:`design_for`, a chain made for a task (targets in, a
+foldable robot that reaches every one of them out; docs/design-for-a-task.md), and
+:func:`compact_for_task`, compaction that keeps such a task.
 """
 
 from kinegami.optimize.compaction import (
     CompactionError,
     compact,
+    compact_for_task,
     shorten_by_axis_translations,
     tube_length,
 )
+from kinegami.optimize.synthesis import design_for
 
-__all__ = ["compact", "CompactionError", "shorten_by_axis_translations", "tube_length"]
+__all__ = [
+    "compact",
+    "compact_for_task",
+    "CompactionError",
+    "design_for",
+    "shorten_by_axis_translations",
+    "tube_length",
+]

@@ -45,7 +45,13 @@ from kinegami.validation import (
     check_starts,
 )
 
-__all__ = ["compact", "CompactionError", "shorten_by_axis_translations", "tube_length"]
+__all__ = [
+    "compact",
+    "compact_for_task",
+    "CompactionError",
+    "shorten_by_axis_translations",
+    "tube_length",
+]
 
 
 def tube_length(chain: KinematicChain) -> float:
@@ -642,6 +648,8 @@ def compact(
     samples: int = 200,
     junctions: bool = True,
     margin: float | None = None,
+    targets=None,
+    keep_out=(),
 ) -> KinematicChain | KinematicTree:
     """A shorter chain (or tree) with the same kinematics that does not pass through itself.
 
@@ -687,6 +695,11 @@ def compact(
     margin : float, optional
         The clearance required between the parts (chain units, >= 0; folded sheets have a
         thickness); default: ``chain.margin``. The result's ``margin`` is this value.
+    targets : sequence of targets, optional (chains only)
+        A task to keep (:func:`compact_for_task`): the end tip keeps its place on the last
+        movable joint's body, and a shorter design is accepted only when every target is still
+        reached exactly, in range, clear with the margin and outside ``keep_out``.
+    keep_out : boxes no part may come near at the targets' configurations (with ``targets``).
 
     Raises
     ------
@@ -707,6 +720,10 @@ def compact(
         raise InvalidTypeError(
             f"chain must be a KinematicChain or a KinematicTree, got {type(chain).__name__}"
         )
+    if targets is not None:
+        return compact_for_task(chain, targets, keep_out=keep_out, margin=margin, seed=seed,
+                                executor=executor, starts=starts, time_limit=time_limit,
+                                progress=progress)[0]  # fmt: skip
     seed = check_int("seed", seed, minimum=0, floats=False)  # numpy seeds: ints >= 0, as sweep
     motion = check_bool("motion", motion)
     if motion and isinstance(chain, KinematicTree):
@@ -756,6 +773,94 @@ def compact(
         )
     value, _, _, best = min(found, key=lambda res: (res[0], res[2]))
     return best
+
+
+def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(),
+                     margin: float | None = None, seed: int = 0, executor=None, starts: int = 4,
+                     time_limit: float | None = None, progress=None) -> tuple:  # fmt: skip
+    """``(design, answers)``: :func:`compact` that keeps a task (docs/design-for-a-task.md).
+
+    Compaction slides and rolls joints along their axes, which keeps each joint's motion but
+    would move an end tip. Here the joints up to the last movable one are compacted, and the
+    joints after it (the end tip; waypoints go) are placed again exactly where they were: on the
+    last movable joint's body, so the tip's motion is unchanged. The result is solved again for
+    every target (from the states of ``answers``, one reach answer per target, or of a first
+    solve) and accepted only when each is reached exactly, in range, clear with ``margin``
+    (default the chain's) and outside the ``keep_out`` boxes, with a tube no longer than the
+    input's; otherwise the input itself is returned.
+
+    Raises
+    ------
+    CompactionError
+        When the input itself does not reach a target so.
+    """
+    from kinegami.clearance.keep_out import Box, keep_out_violation
+    from kinegami.reach import Target, solve
+
+    if not isinstance(chain, KinematicChain):
+        raise InvalidParameterError(
+            "compaction with targets is available for chains only (got a "
+            f"{type(chain).__name__})"
+        )
+    margin = float(chain.margin) if margin is None else check_margin(margin)
+    if isinstance(targets, (str, bytes)) or not isinstance(targets, (list, tuple)):
+        raise InvalidTypeError(f"targets must be a list of targets, got {targets!r}")
+    goals = [Target.of(t) for t in targets]
+    boxes = tuple(Box.of(b, f"keep_out box {k}") for k, b in enumerate(keep_out or ()))
+
+    def reached(design, start) -> tuple[list | None, str]:
+        found = []
+        for k, goal in enumerate(goals):
+            for attempt in range(4):
+                answer = solve(design, goal, q0=None if start is None else start[k],
+                               seed=attempt, margin=margin)  # fmt: skip
+                hit = None if not answer.ok else keep_out_violation(design, answer.states,
+                                                                     boxes, margin)  # fmt: skip
+                if answer.ok and hit is None:
+                    found.append(answer)
+                    break
+            else:
+                why = answer.reason if not answer.ok else f"it enters keep-out box {hit[0]}"
+                return None, f"target {k}: {why}"
+        return found, ""
+
+    if answers is None:
+        answers, why = reached(chain, None)
+        if answers is None:
+            raise CompactionError(f"the design does not reach its task before compaction: {why}")
+    movable = [k for k, joint in enumerate(chain.Joints) if joint.stateRange() != (0.0, 0.0)]
+    if not movable:
+        return chain, answers
+    last = movable[-1]
+    tail = [joint for joint in chain.Joints[last + 1 :] if type(joint).__name__ != "Waypoint"]
+    head = copy.copy(chain)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlacementWarning)
+        warnings.simplefilter("ignore", ClearanceWarning)
+        while len(head.Joints) > last + 1:
+            if not head.delete(len(head.Joints) - 1):  # pragma: no cover - dropping the last
+                return chain, answers
+        try:
+            shorter = compact(head, seed=seed, executor=executor, starts=starts,
+                              time_limit=time_limit, progress=progress, margin=margin)  # fmt: skip
+        except CompactionError:
+            return chain, answers
+        shorter = copy.copy(shorter)
+        for joint in tail:
+            placed = shorter.append(joint, relative=False, safe=False, fixedPosition=True,
+                                    fixedOrientation=True)  # fmt: skip
+            if placed is None:
+                return chain, answers
+    new_movable = [k for k, j in enumerate(shorter.Joints) if j.stateRange() != (0.0, 0.0)]
+    starts_q = []
+    for answer in answers:
+        q = np.zeros(len(shorter.Joints))
+        q[new_movable] = np.asarray(answer.states)[movable]
+        starts_q.append(q)
+    found, _ = reached(shorter, starts_q)
+    if found is None or tube_length(shorter) > tube_length(chain):
+        return chain, answers
+    return shorter, found
 
 
 def _run_all(executor, own: bool, tasks: list, bar: Progress) -> list:

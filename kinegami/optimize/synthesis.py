@@ -1,0 +1,589 @@
+"""Design for a task (docs/design-for-a-task.md): targets in, a foldable chain that reaches every
+one of them exactly, in range and without passing through itself, out.
+
+The search works on the kinematics alone: a standard Denavit-Hartenberg table (theta, alpha, a,
+d per joint, the root joint on the base pose) and one configuration per target are fitted
+together by bounded least squares (:func:`scipy.optimize.least_squares`), from seeded random
+starts, until every target's residual is below 1e-11 r. Such a table is then built by
+kinegami's own placement (the joints slide along their axes, which keeps the kinematics; the end
+tip is placed exactly where the table puts the tip), and every target is solved again on the
+built chain by :func:`kinegami.reach.solve` with clearance, the margin and the keep-out boxes:
+only a chain that passes those checks is an answer. Compaction with the targets
+(:func:`kinegami.optimize.compact`) then shortens its tube.
+
+Before any search, bounds that prove a task impossible raise :class:`InfeasibleTaskError` (the
+certificate): a target farther from the base than the longest tube allowed; orientations that
+the joint types cannot give (no revolute joint, or one).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import itertools
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinegami.clearance.keep_out import Box, keep_out_violation
+from kinegami.errors import InfeasibleTaskError, InvalidParameterError, InvalidTypeError
+from kinegami.progress import Progress, check_progress
+from kinegami.validation import check_int, check_num_sides, check_positive, check_radius
+
+__all__ = ["MAX_TASK_JOINTS", "MAX_TASK_TARGETS", "design_for", "task_certificate"]
+
+#: The most joints a task's design may have (each joint adds four table entries and one state
+#: per target to the fit).
+MAX_TASK_JOINTS = 8
+#: The most targets one task may name (each adds a configuration to the fit).
+MAX_TASK_TARGETS = 64
+#: Largest residual of a fitted table (units of r and rad) that is built and checked.
+FIT_TOLERANCE = 1e-11
+#: Starts of the fit run together (a round): the search stops after the first round that gives
+#: a design, so the answer does not depend on the executor.
+ROUND = 8
+#: Default number of starts per joint-type string.
+STARTS = 64
+#: The default longest tube, in units of r.
+MAX_TUBE_LENGTH_R = 100.0
+
+
+# --- the task ------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class _Task:
+    """A checked task: targets (reach Targets), base pose, boxes, bounds, tube."""
+
+    targets: tuple
+    r: float
+    numSides: int
+    base: np.ndarray
+    boxes: tuple
+    max_tube_length: float
+    margin: float
+    oriented: bool  # some target fixes an orientation or an axis
+
+    @property
+    def scale(self) -> float:
+        """The largest distance of a target from the base's origin."""
+        return max(float(np.linalg.norm(t.position - self.base[:3, 3])) for t in self.targets)
+
+
+def _joint_strings(joints) -> list[str]:
+    """The joint-type strings to try, in order: the given one, or for a budget every string of
+    1 to k joints, fewest first (then fewest prismatic joints)."""
+    if isinstance(joints, str):
+        types = joints.upper()
+        if not types or set(types) - {"R", "P"}:
+            raise InvalidParameterError(
+                f"joints must be a string of 'R' (revolute) and 'P' (prismatic), got {joints!r}"
+            )
+        if len(types) > MAX_TASK_JOINTS:
+            raise InvalidParameterError(
+                f"joints {joints!r} has {len(types)} joints; at most {MAX_TASK_JOINTS} "
+                "(MAX_TASK_JOINTS: each adds a table row and a state per target to the search)"
+            )
+        return [types]
+    budget = check_int("joints", joints, minimum=1, floats=False)
+    if budget > MAX_TASK_JOINTS:
+        raise InvalidParameterError(
+            f"joints (a budget) must be at most {MAX_TASK_JOINTS} (MAX_TASK_JOINTS), got {budget}"
+        )
+    out = []
+    for k in range(1, budget + 1):
+        strings = ["".join(s) for s in itertools.product("RP", repeat=k)]
+        out += sorted(strings, key=lambda s: (s.count("P"), s))
+    return out
+
+
+def _task(targets, r, numSides, base, keep_out, max_tube_length, margin) -> _Task:
+    from kinegami.chain.bodies import check_margin
+    from kinegami.chain.joints import pose_array
+    from kinegami.reach import Target
+
+    r = check_radius(r)
+    n = check_num_sides(numSides)
+    if isinstance(targets, (str, bytes)) or not isinstance(targets, Sequence) \
+            or (np.ndim(targets) == 1 and len(targets) == 3 and not isinstance(targets[0], Sequence)
+                and np.isscalar(targets[0])):  # fmt: skip
+        raise InvalidTypeError(
+            "targets must be a list of targets (3-vectors, 4x4 poses or reach Targets), got "
+            f"{targets!r}"
+        )
+    if not 1 <= len(targets) <= MAX_TASK_TARGETS:
+        raise InvalidParameterError(
+            f"a task needs 1 to {MAX_TASK_TARGETS} targets (MAX_TASK_TARGETS), got {len(targets)}"
+        )
+    found = tuple(Target.of(t) for t in targets)
+    limit = 1e6 * r
+    for k, t in enumerate(found):
+        if np.abs(t.position).max() > limit:
+            raise InvalidParameterError(
+                f"target {k} position {t.position.tolist()} is beyond 1e6 r = {limit:g} "
+                "(the coordinate limit, docs/limits.md)"
+            )
+    B = np.eye(4) if base is None else pose_array(getattr(base, "A", base), "base")
+    boxes = tuple(Box.of(b, f"keep_out box {k}") for k, b in enumerate(keep_out or ()))
+    L = MAX_TUBE_LENGTH_R * r if max_tube_length is None \
+        else check_positive("max_tube_length", max_tube_length)  # fmt: skip
+    margin = check_margin(margin)
+    oriented = any(t.kind != "position" for t in found)
+    return _Task(found, r, n, B, boxes, float(L), margin, oriented)
+
+
+def task_certificate(task: _Task, types: str) -> tuple[int, str] | None:
+    """(target index, why) when a bound proves that no chain of the joint types ``types`` can
+    reach every target, else None (docs/design-for-a-task.md, Certificates)."""
+    origin = task.base[:3, 3]
+    L = task.max_tube_length
+    for k, t in enumerate(task.targets):
+        D = float(np.linalg.norm(t.position - origin))
+        if D > L:
+            return k, (
+                f"target {k} at {_fmt(t.position)} is {D:.6g} from the base at {_fmt(origin)}, "
+                f"farther than the longest tube allowed (max_tube_length {L:.6g}): the tip of a "
+                f"tube of length L stays within L of its base"
+            )
+    revolute = types.count("R")
+    posed = [(k, t) for k, t in enumerate(task.targets) if t.kind == "pose"]
+    axes = [(k, t) for k, t in enumerate(task.targets) if t.kind == "axis"]
+    if revolute == 0:  # the tip never turns
+        z = [(k, t.rotation[:, 2]) for k, t in posed] + [(k, t.axis) for k, t in axes]
+        for (k0, t0), (k, t) in itertools.combinations(posed, 2):
+            angle = _angle(t.rotation @ t0.rotation.T)
+            if angle > 1e-9:
+                return k, (
+                    f"target {k}'s orientation differs from target {k0}'s by {angle:.6g} rad, "
+                    f"but prismatic joints alone ({types}) never turn the tip"
+                )
+        for (k0, z0), (k, zk) in itertools.combinations(z, 2):
+            angle = math.atan2(float(np.linalg.norm(np.cross(z0, zk))), float(z0 @ zk))
+            if angle > 1e-9:
+                return k, (
+                    f"target {k}'s axis differs from target {k0}'s by {angle:.6g} rad, but "
+                    f"prismatic joints alone ({types}) never turn the tip"
+                )
+    if revolute == 1 and len(posed) >= 2:  # the tip turns about one fixed direction
+        (k0, t0) = posed[0]
+        direction = None
+        for k, t in posed[1:]:
+            w = _rotation_vector(t.rotation @ t0.rotation.T)
+            angle = float(np.linalg.norm(w))
+            if angle <= 1e-9:
+                continue
+            if angle > math.pi - 1e-9 + 1e-12:  # pragma: no cover - rotation vectors are <= pi
+                continue
+            u = w / angle
+            if direction is None:
+                direction = (k, u)
+                continue
+            cross = float(np.linalg.norm(np.cross(direction[1], u)))
+            if cross > 1e-9:
+                return k, (
+                    f"target {k} turns from target {k0} about {_fmt(u)} but target "
+                    f"{direction[0]} about {_fmt(direction[1])}: one revolute joint ({types}) "
+                    "turns the tip about one direction only"
+                )
+    return None
+
+
+def _fmt(v) -> str:
+    return "(" + ", ".join(f"{float(x):.6g}" for x in v) + ")"
+
+
+def _angle(R: np.ndarray) -> float:
+    return float(np.linalg.norm(_rotation_vector(R)))
+
+
+def _rotation_vector(R: np.ndarray) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_matrix(R).as_rotvec()
+
+
+# --- the model: a DH table with one configuration per target -------------------------------------
+def _dh(theta, alpha, a, d) -> np.ndarray:
+    """(..., 4, 4) standard DH transforms Rz(theta) Tz(d) Tx(a) Rx(alpha)."""
+    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+    theta = np.broadcast_to(theta, np.broadcast_shapes(np.shape(theta), np.shape(d)))
+    out = np.zeros(theta.shape + (4, 4))
+    out[..., 0, 0], out[..., 0, 1], out[..., 0, 2], out[..., 0, 3] = ct, -st * ca, st * sa, a * ct
+    out[..., 1, 0], out[..., 1, 1], out[..., 1, 2], out[..., 1, 3] = st, ct * ca, -ct * sa, a * st
+    out[..., 2, 1], out[..., 2, 2], out[..., 2, 3] = sa, ca, d
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def _tool(w: np.ndarray, t: np.ndarray) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    E = np.eye(4)
+    E[:3, :3] = Rotation.from_rotvec(w).as_matrix()
+    E[:3, 3] = t
+    return E
+
+
+class _Model:
+    """The fit's unknowns and residuals for one joint-type string: x = (table (n, 4) flattened,
+    the tool (rotation vector, translation) when a target is oriented, the configurations
+    (targets, n))."""
+
+    def __init__(self, task: _Task, types: str):
+        from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
+
+        self.task, self.types = task, types
+        self.n, self.T = len(types), len(task.targets)
+        self.revolute = np.array([c == "R" for c in types])
+        r = task.r
+        ranges = {"R": RevoluteJoint(task.numSides, r, math.pi, np.eye(4)).stateRange(),
+                  "P": PrismaticJoint(task.numSides, r, 3.0 * r, 3, math.pi / 4,
+                                      np.eye(4)).stateRange()}  # fmt: skip
+        self.low = np.array([ranges[c][0] for c in types])
+        self.high = np.array([ranges[c][1] for c in types])
+        self.tool_size = 6 if task.oriented else 0
+        self.size = 4 * self.n + self.tool_size + self.T * self.n
+        # lengths of the table and the tool: within half the longest tube, and a few times the
+        # task's spread
+        self.span = min(0.5 * task.max_tube_length, max(4.0 * r, 2.0 * task.scale))
+        self.position = np.array([t.position for t in task.targets])
+
+    def split(self, x: np.ndarray):
+        n, T = self.n, self.T
+        table = x[: 4 * n].reshape(n, 4)
+        tool = x[4 * n : 4 * n + self.tool_size]
+        Q = x[4 * n + self.tool_size :].reshape(T, n)
+        return table, tool, Q
+
+    def tips(self, table: np.ndarray, tool: np.ndarray, Q: np.ndarray) -> np.ndarray:
+        """(K, 4, 4) tip frames at the configurations Q (K, n)."""
+        G = np.broadcast_to(self.task.base, (Q.shape[0], 4, 4))
+        for i in range(self.n):
+            th, al, a, d = table[i]
+            q = Q[:, i]
+            G = G @ (_dh(th + q, al, a, d) if self.revolute[i] else _dh(th, al, a, d + q))
+        if self.tool_size:
+            G = G @ _tool(tool[:3], tool[3:])
+        return G
+
+    def residual(self, x: np.ndarray) -> np.ndarray:
+        table, tool, Q = self.split(x)
+        T = self.tips(table, tool, Q)
+        parts = [((self.position - T[:, :3, 3]) / self.task.r).reshape(-1)]
+        for k, t in enumerate(self.task.targets):
+            if t.kind == "pose":
+                parts.append(_rotation_vector(t.rotation @ T[k, :3, :3].T))
+            elif t.kind == "axis":
+                parts.append(t.axis - T[k, :3, 2])
+        return np.concatenate(parts)
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        n, s = self.n, self.span
+        lo = np.tile([-2 * math.pi, -2 * math.pi, -s, -s], n)
+        hi = np.tile([2 * math.pi, 2 * math.pi, s, s], n)
+        if self.tool_size:
+            lo = np.r_[lo, [-2 * math.pi] * 3, [-s] * 3]
+            hi = np.r_[hi, [2 * math.pi] * 3, [s] * 3]
+        inset = 1e-6 * (self.high - self.low)
+        lo = np.r_[lo, np.tile(self.low + inset, self.T)]
+        hi = np.r_[hi, np.tile(self.high - inset, self.T)]
+        return lo, hi
+
+    def start(self, rng: np.random.Generator) -> np.ndarray:
+        n, r = self.n, self.task.r
+        s = min(self.span, max(2.0 * r, 1.5 * self.task.scale / n))
+        table = np.column_stack([rng.uniform(-math.pi, math.pi, n),
+                                 rng.uniform(-math.pi, math.pi, n),
+                                 rng.uniform(0.0, s, n), rng.uniform(-s, s, n)])  # fmt: skip
+        parts = [table.reshape(-1)]
+        if self.tool_size:
+            parts += [rng.uniform(-math.pi, math.pi, 3) * 0.5, rng.uniform(-r, r, 3)]
+        parts.append((self.low + (self.high - self.low) * rng.random((self.T, n))).reshape(-1))
+        return np.concatenate(parts)
+
+
+def _fit(model: _Model, seed: int, start: int) -> np.ndarray | None:
+    """The fitted unknowns of start ``start`` (every residual <= FIT_TOLERANCE), or None."""
+    from scipy.optimize import least_squares
+
+    rng = np.random.default_rng([seed, start, len(model.types), *map(ord, model.types)])
+    x0 = model.start(rng)
+    lo, hi = model.bounds()
+    x0 = np.clip(x0, lo, hi)
+    scale = np.ones(model.size)
+    lengths = np.r_[np.tile([False, False, True, True], model.n),
+                    [False] * 3 + [True] * 3 if model.tool_size else [],
+                    np.tile(~model.revolute, model.T)].astype(bool)  # fmt: skip
+    scale[lengths] = model.task.r
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        fit = least_squares(model.residual, x0, bounds=(lo, hi), x_scale=scale, ftol=1e-15,
+                            xtol=1e-15, gtol=1e-15, max_nfev=60 * model.size, method="trf")
+    if not np.all(np.isfinite(fit.x)) or np.abs(model.residual(fit.x)).max() > FIT_TOLERANCE:
+        return None
+    return fit.x
+
+
+# --- building and checking a fitted table ---------------------------------------------------------
+#: Rotations of a position task's tip frame about its point that building tries in turn (the
+#: end tip's tube leaves along the frame's x axis).
+_TIP_TURNS = (np.eye(3), np.diag([-1.0, -1.0, 1.0]), np.array([[0, -1, 0], [1, 0, 0], [0, 0, 1.0]]),
+              np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1.0]]),
+              np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0.0]]),
+              np.array([[0, 0, -1], [0, 1, 0], [1, 0, 0.0]]))  # fmt: skip
+#: The end tip's frame in its Pose's: along the tube (Pose z) by half its length, x = Pose z,
+#: y = Pose x, z = Pose y (kinegami.chain.joints.EndTip, DistalDubinsFrame).
+_TIP_AXES = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+
+
+def _build(model: _Model, x: np.ndarray):
+    """The chain of the fitted unknowns ``x`` (joints slid along their axes by placement, the end
+    tip exactly at the table's tip), with its states per target (full configurations), or
+    (None, reason)."""
+    from kinegami.chain.joints import EndTip, PrismaticJoint, RevoluteJoint
+    from kinegami.chain.model import KinematicChain
+    from kinegami.errors import ClearanceWarning, NoPathError, PlacementWarning
+
+    task, r, n = model.task, model.task.r, model.n
+    table, tool, Q = model.split(x)
+    frames = [task.base]
+    for i in range(n):
+        th, al, a, d = table[i]
+        frames.append(frames[-1] @ _dh(th, al, a, d))
+    tip = frames[-1] @ (_tool(tool[:3], tool[3:]) if model.tool_size else np.eye(4))
+    joints = []
+    for i, kind in enumerate(model.types):
+        if kind == "R":
+            joint = RevoluteJoint(task.numSides, r, math.pi, np.eye(4))
+        else:
+            joint = PrismaticJoint(task.numSides, r, 3.0 * r, 3, math.pi / 4, np.eye(4))
+        joints.append(joint.with_pose(frames[i]))
+    length = 1.5 * r
+    turns = (np.eye(3),) if model.tool_size else _TIP_TURNS
+    reason = "no link reaches the end tip"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlacementWarning)
+        warnings.simplefilter("ignore", ClearanceWarning)
+        try:
+            chain = KinematicChain(joints[0])
+        except (NoPathError, InvalidParameterError) as exc:
+            return None, str(exc)
+        chain.margin = task.margin
+        for joint in joints[1:]:
+            index = chain.append(joint, relative=False, safe=False, fixedOrientation=True)
+            if index is None:
+                index = chain.append(joint, relative=False, safe=True)
+            if index is None:
+                return None, "a joint could not be placed"
+        for turn in turns:
+            F = tip.copy()
+            F[:3, :3] = tip[:3, :3] @ turn
+            P = F.copy()
+            P[:3, :3] = F[:3, :3] @ _TIP_AXES.T
+            P[:3, 3] = F[:3, 3] - 0.5 * length * P[:3, 2]
+            end = EndTip(task.numSides, r, np.eye(4), length).with_pose(P)
+            if chain.append(end, relative=False, safe=False, fixedPosition=True,
+                            fixedOrientation=True) is not None:  # fmt: skip
+                break
+        else:
+            return None, reason
+    movable = [k for k, joint in enumerate(chain.Joints) if joint.stateRange() != (0.0, 0.0)]
+    if len(movable) != n:  # pragma: no cover - placement adds waypoints and the tip only
+        return None, "placement changed the joints"
+    states = np.zeros((model.T, len(chain.Joints)))
+    states[:, movable] = Q
+    return (chain, states), ""
+
+
+def _answers(chain, states: np.ndarray, task: _Task) -> tuple[list | None, str]:
+    """One reach answer per target on the built chain, each exact, in range, clear with the
+    margin and outside every box (solved again from the fit's states, then from other seeds),
+    or (None, why)."""
+    from kinegami.reach import solve
+
+    answers = []
+    for k, target in enumerate(task.targets):
+        why = ""
+        for seed in range(4):
+            answer = solve(chain, target, q0=states[k], seed=seed, margin=task.margin)
+            if not answer.ok:
+                why = f"target {k}: {answer.reason}"
+                continue
+            hit = keep_out_violation(chain, answer.states, task.boxes, task.margin)
+            if hit is not None:
+                why = f"target {k}: the robot enters keep-out box {hit[0]}"
+                continue
+            answers.append(answer)
+            break
+        else:
+            return None, why
+    return answers, ""
+
+
+def _attempt(task: _Task, types: str, seed: int, start: int) -> tuple | None:
+    """One start: (table unknowns, tube length, smallest clearance) of a design that reaches
+    every target, or (None, why)."""
+    from kinegami.optimize.compaction import tube_length
+
+    model = _Model(task, types)
+    x = _fit(model, seed, start)
+    if x is None:
+        return None, "the fit did not reach every target"
+    built, why = _build(model, x)
+    if built is None:
+        return None, why
+    chain, states = built
+    length = tube_length(chain)
+    if length > task.max_tube_length:
+        return None, f"tube {length:.6g} longer than max_tube_length"
+    answers, why = _answers(chain, states, task)
+    if answers is None:
+        return None, why
+    return (x, length, min(a.clearance for a in answers)), ""
+
+
+# --- the search -----------------------------------------------------------------------------------
+def design_for(
+    targets,
+    joints,
+    *,
+    r: float,
+    numSides: int,
+    seed: int = 0,
+    executor: concurrent.futures.Executor | None = None,
+    base=None,
+    keep_out=(),
+    max_tube_length: float | None = None,
+    margin: float = 0.0,
+    starts: int = STARTS,
+    compact: bool = True,
+    return_answers: bool = False,
+    progress=None,
+):
+    """A :class:`~kinegami.KinematicChain` whose tip (its end tip's distal frame) reaches every
+    target exactly (1e-9 r, 1e-9 rad), in range, without passing through itself
+    (docs/design-for-a-task.md).
+
+    Parameters
+    ----------
+    targets : sequence of targets, each a position (3 numbers), a pose (4x4 or SE3) or a
+        :class:`kinegami.reach.Target` (a position with an axis); world frame, units of r.
+    joints : str or int
+        The joint types in order (``"RRRR"``, ``"RPRR"``; the end tip and any waypoints are
+        added by placement), or a budget: at most that many joints of any type, tried from the
+        fewest up.
+    r, numSides : the tube.
+    seed : the search's seed (the answer depends only on it, not on the executor).
+    executor : runs the starts of each round (any ``concurrent.futures.Executor``; default: in
+        this process).
+    base : the root joint's pose (4x4 or SE3; default the identity): the first joint turns or
+        slides along its z axis.
+    keep_out : boxes (``{"min": [x, y, z], "max": [x, y, z]}`` or :class:`Box`) that no part
+        may come within ``margin`` of at any target's configuration.
+    max_tube_length : the longest tube allowed (default 100 r).
+    margin : the clearance required between parts and from the boxes (>= 0).
+    starts : the fit's starts per joint-type string (>= 1).
+    compact : shorten the found design by compaction that keeps the task.
+    return_answers : return ``(design, answers)``: one reach answer per target.
+    progress : ``progress(done, total)`` per start (False from it cancels), True for a bar.
+
+    Among designs that reach every target: fewer joints first, then a shorter tube, then a
+    larger smallest clearance over the targets' configurations.
+
+    Raises
+    ------
+    InfeasibleTaskError
+        ``proven`` True: a bound shows no design of the budget reaches a target (which one and
+        why); ``proven`` False: the search found none in its starts (the last reason given).
+
+    Examples
+    --------
+    >>> arm = design_for([(6, 2, 3), (3, 5, 4), (-2, 4, 6)], "RRR", r=1, numSides=4)
+    >>> all(solve(arm, p).ok for p in [(6, 2, 3), (3, 5, 4), (-2, 4, 6)])
+    True
+    """
+    from kinegami.optimize.compaction import tube_length
+
+    task = _task(targets, r, numSides, base, keep_out, max_tube_length, margin)
+    strings = _joint_strings(joints)
+    seed = check_int("seed", seed, minimum=0, floats=False)
+    starts = check_int("starts", starts, minimum=1, floats=False)
+    if starts > 10_000:
+        raise InvalidParameterError(f"starts must be at most 10000, got {starts}")
+    progress = check_progress(progress)
+    if executor is not None and not isinstance(executor, concurrent.futures.Executor):
+        raise InvalidTypeError(
+            f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}"
+        )
+    certificates = [task_certificate(task, types) for types in strings]
+    if all(c is not None for c in certificates):
+        k, why = certificates[-1] if len(strings) > 1 else certificates[0]
+        raise InfeasibleTaskError(f"no design of {_budget(joints)} can reach every target: {why}",
+                                  target=k, proven=True)  # fmt: skip
+    last = ""
+    found = None
+    live = [types for types, c in zip(strings, certificates, strict=True) if c is None]
+    with Progress(progress, starts * len(live), desc="design", unit="start") as bar:
+        for types in live:
+            best = None
+            for first in range(0, starts, ROUND):
+                batch = range(first, min(starts, first + ROUND))
+                if executor is None:
+                    results = []
+                    for k in batch:
+                        results.append(_attempt(task, types, seed, k))
+                        bar.update(1)
+                else:
+                    futures = [executor.submit(_attempt, task, types, seed, k) for k in batch]
+                    results = []
+                    for future in futures:
+                        results.append(future.result())
+                        bar.update(1)
+                for result, why in results:
+                    if result is None:
+                        last = why
+                        continue
+                    key = (result[1], -result[2])
+                    if best is None or key < best[0]:
+                        best = (key, result[0])
+                if best is not None:
+                    bar.update(starts - batch.stop)
+                    break
+            if best is not None:
+                found = (types, best[1])
+                break
+    if found is None:
+        raise InfeasibleTaskError(
+            f"no design of {_budget(joints)} found that reaches every target in {starts} "
+            f"start(s) per joint string (not proven impossible; last: {last}); try more starts, "
+            "another seed, more joints or a longer max_tube_length", target=_named(last),
+            proven=False,
+        )  # fmt: skip
+    types, x = found
+    model = _Model(task, types)
+    (chain, states), _ = _build(model, x)
+    answers, why = _answers(chain, states, task)
+    if answers is None:  # pragma: no cover - the attempt checked the same chain
+        raise InfeasibleTaskError(f"the design found no longer reaches: {why}", proven=False)
+    if compact:
+        from kinegami.optimize.compaction import compact_for_task
+
+        with concurrent.futures.ThreadPoolExecutor(1) as own:
+            shorter, shorter_answers = compact_for_task(
+                chain, list(task.targets), answers, keep_out=task.boxes, margin=task.margin,
+                seed=seed, executor=executor or own)  # fmt: skip
+        if tube_length(shorter) <= tube_length(chain):
+            chain, answers = shorter, shorter_answers
+    return (chain, answers) if return_answers else chain
+
+
+def _budget(joints) -> str:
+    return f"joints {joints!r}" if isinstance(joints, str) else f"at most {joints} joint(s)"
+
+
+def _named(why: str) -> int | None:
+    if why.startswith("target "):
+        head = why.split(":")[0].split()
+        if len(head) == 2 and head[1].isdigit():
+            return int(head[1])
+    return None
