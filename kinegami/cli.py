@@ -1175,8 +1175,20 @@ def cmd_compact(args: argparse.Namespace) -> int:
     before = BuildJob(chain, info)
     if not _is_tree(chain):  # a tree's sheets are checked by build
         _check_pattern(before)
+    task = None
+    if info.task is not None and not _is_tree(chain):  # the task it was made for: kept
+        from kinegami.design.task import task_from_dict
+
+        task = task_from_dict(info.task, args.design, where=("task",))
+        if args.motion:
+            _note(args.command, "--motion ignored: the design's task is kept instead (every "
+                                "target still reached, clear)")  # fmt: skip
     try:
-        compacted = compact(chain, seed=seed, motion=args.motion, time_limit=limit)
+        if task is not None:
+            compacted = compact(chain, seed=seed, time_limit=limit, targets=list(task.targets),
+                                keep_out=task.keep_out)  # fmt: skip
+        else:
+            compacted = compact(chain, seed=seed, motion=args.motion, time_limit=limit)
     except CompactionError as error:
         _fail(args.command, f"{args.design}: {error}")
         return COMPACTION_FAILED
@@ -1186,8 +1198,9 @@ def cmd_compact(args: argparse.Namespace) -> int:
     if not _is_tree(compacted):
         _check_pattern(after)
     title = f"{_printable(info.name)} ({args.design})" if info.name else args.design
+    kept = ", task kept" if task is not None else ", motion kept" if args.motion else ""
     lines = [
-        f"{title}: compacted (seed {seed}{', motion kept' if args.motion else ''}, margin "
+        f"{title}: compacted (seed {seed}{kept}, margin "
         f"{Lengths(chain.r, info.units).exact(chain.margin)})",
         "  before:",
         *_compaction_lines(before),
@@ -1196,7 +1209,7 @@ def cmd_compact(args: argparse.Namespace) -> int:
     ]
     written = save_design(
         compacted, out, name=info.name, description=info.description, units=info.units,
-        twistPortion=info.twistPortion,
+        twistPortion=info.twistPortion, task=info.task,
     )  # fmt: skip
     lines.append(f"  written: {written}")
     print("\n".join(_printable(line) for line in lines))

@@ -145,6 +145,16 @@ def task_certificate(task: _Task, types: str) -> tuple[int, str] | None:
                 f"farther than the longest tube allowed (max_tube_length {L:.6g}): the tip of a "
                 f"tube of length L stays within L of its base"
             )
+    for k, t in enumerate(task.targets):  # the tube's centreline passes through the target
+        for j, box in enumerate(task.boxes):
+            inside = np.clip(t.position, box.min, box.max)
+            gap = float(np.linalg.norm(t.position - inside))
+            if gap < task.r + task.margin:
+                return k, (
+                    f"target {k} at {_fmt(t.position)} is {gap:.6g} from keep-out box {j}, "
+                    f"closer than the tube's radius plus the margin ({task.r + task.margin:.6g}): "
+                    "the tip's tube would enter the box"
+                )
     revolute = types.count("R")
     posed = [(k, t) for k, t in enumerate(task.targets) if t.kind == "pose"]
     axes = [(k, t) for k, t in enumerate(task.targets) if t.kind == "axis"]
@@ -420,9 +430,13 @@ def _answers(chain, states: np.ndarray, task: _Task) -> tuple[list | None, str]:
     return answers, ""
 
 
-def _attempt(task: _Task, types: str, seed: int, start: int) -> tuple | None:
-    """One start: (table unknowns, tube length, smallest clearance) of a design that reaches
-    every target, or (None, why)."""
+def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = True) -> tuple:
+    """One start: ((table unknowns, tube length, smallest clearance), "") of a design that
+    reaches every target, or (None, why). Not ``thorough``: only when the fit's own
+    configurations are clear and outside the boxes (one batch of the clearance engine, about a
+    millisecond); ``thorough``: the solver may also look for other configurations (restarts,
+    and moves along a redundant arm's solutions), about a second per design."""
+    from kinegami.clearance.engine import engine_for
     from kinegami.optimize.compaction import tube_length
 
     model = _Model(task, types)
@@ -436,6 +450,14 @@ def _attempt(task: _Task, types: str, seed: int, start: int) -> tuple | None:
     length = tube_length(chain)
     if length > task.max_tube_length:
         return None, f"tube {length:.6g} longer than max_tube_length"
+    if not thorough:
+        hit = np.flatnonzero(engine_for(chain).colliding(states, task.margin))
+        if hit.size:
+            return None, f"target {int(hit[0])}: the fitted configuration passes through itself"
+        for k in range(len(states)):
+            box = keep_out_violation(chain, states[k], task.boxes, task.margin)
+            if box is not None:
+                return None, f"target {k}: the fitted configuration enters keep-out box {box[0]}"
     answers, why = _answers(chain, states, task)
     if answers is None:
         return None, why
@@ -498,8 +520,10 @@ def design_for(
 
     Examples
     --------
-    >>> arm = design_for([(6, 2, 3), (3, 5, 4), (-2, 4, 6)], "RRR", r=1, numSides=4)
-    >>> all(solve(arm, p).ok for p in [(6, 2, 3), (3, 5, 4), (-2, 4, 6)])
+    >>> from kinegami.reach import solve
+    >>> points = [(6, 2, 3), (3, 5, 4), (-2, 4, 6)]
+    >>> arm = design_for(points, "RRR", r=1, numSides=4)
+    >>> all(solve(arm, p).ok for p in points)
     True
     """
     from kinegami.optimize.compaction import tube_length
@@ -528,17 +552,14 @@ def design_for(
             best = None
             for first in range(0, starts, ROUND):
                 batch = range(first, min(starts, first + ROUND))
-                if executor is None:
-                    results = []
-                    for k in batch:
-                        results.append(_attempt(task, types, seed, k))
-                        bar.update(1)
-                else:
-                    futures = [executor.submit(_attempt, task, types, seed, k) for k in batch]
-                    results = []
-                    for future in futures:
-                        results.append(future.result())
-                        bar.update(1)
+                # first the fits whose own configurations are clear; when none is, the solver
+                # looks for other configurations of the same fits
+                results = _run(executor, task, types, seed, batch, False)
+                if all(result is None for result, _ in results):
+                    again = [k for k, (_, why) in zip(batch, results, strict=True)
+                             if "fitted configuration" in why]  # fmt: skip
+                    results += _run(executor, task, types, seed, again, True)
+                bar.update(len(batch))
                 for result, why in results:
                     if result is None:
                         last = why
@@ -575,6 +596,14 @@ def design_for(
         if tube_length(shorter) <= tube_length(chain):
             chain, answers = shorter, shorter_answers
     return (chain, answers) if return_answers else chain
+
+
+def _run(executor, task: _Task, types: str, seed: int, starts, thorough: bool) -> list:
+    """The attempts of ``starts``, in order (on ``executor`` when given)."""
+    if executor is None:
+        return [_attempt(task, types, seed, k, thorough) for k in starts]
+    futures = [executor.submit(_attempt, task, types, seed, k, thorough) for k in starts]
+    return [future.result() for future in futures]
 
 
 def _budget(joints) -> str:

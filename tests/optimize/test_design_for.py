@@ -1,0 +1,235 @@
+"""Design for a task (issue 32): kinegami.optimize.design_for and compaction that keeps a task.
+
+Every designed robot is checked as a user would check it, not by the search's own numbers: a
+fresh kinegami.reach.solve from the design's home states, setJointStates with the answer, the
+tip's frame against the target, and the design's own clearance report."""
+
+from __future__ import annotations
+
+import concurrent.futures
+import copy
+import math
+import time
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from kinegami import KinematicChain
+from kinegami.clearance.engine import engine_for
+from kinegami.clearance.keep_out import Box, keep_out_violation, segment_box_distances
+from kinegami.errors import (
+    ClearanceWarning,
+    InfeasibleTaskError,
+    InvalidParameterError,
+    InvalidTypeError,
+    KinegamiError,
+    PlacementWarning,
+)
+from kinegami.optimize import compact, compact_for_task, design_for, tube_length
+from kinegami.reach import Target, kinematics, solve
+
+
+def hidden_targets(seed: int, n: int = 4, count: int = 4, r: float = 1.0) -> list:
+    """Tip positions of a hidden random robot at clear configurations (the benchmark's tasks:
+    n revolute joints from a DH table with theta 0, alpha in (-pi, pi], a, d in [0, 4r])."""
+    rng = np.random.default_rng(seed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlacementWarning)
+        warnings.simplefilter("ignore", ClearanceWarning)
+        while True:
+            table = [(0.0, rng.uniform(-math.pi, math.pi), rng.uniform(0, 4 * r),
+                      rng.uniform(0, 4 * r)) for _ in range(n)]  # fmt: skip
+            robot = KinematicChain.from_dh(table, 4, r, placement="safe")
+            K = kinematics(robot)
+            low, high = K.ranges[:, 0], K.ranges[:, 1]
+            Q = low + (high - low) * rng.random((200, low.size))
+            Q = Q[~engine_for(robot).colliding(Q, 0.0)]
+            if len(Q) >= count:
+                return [K.fkine(q)[:3, 3] for q in Q[:count]]
+
+
+def check_reaches(design, targets, boxes=(), margin: float = 0.0) -> None:
+    """Every target reached from scratch: exact (1e-9 r), in range, clear, outside the boxes;
+    the answer's states put the design's own tip on the target."""
+    r = float(design.r)
+    K = kinematics(design)
+    for target in targets:
+        goal = Target.of(target)
+        answer = solve(design, goal, margin=margin)
+        assert answer.ok, answer.reason
+        posed = copy.copy(design)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ClearanceWarning)
+            assert posed.setJointStates(list(answer.states))
+        tip = posed.Joints[-1].DistalDubinsFrame()
+        T = np.asarray(getattr(tip, "A", tip))
+        assert np.linalg.norm(T[:3, 3] - goal.position) <= 1e-9 * r
+        assert np.linalg.norm(K.fkine(np.array(answer.states))[:3, 3] - goal.position) <= 1e-9 * r
+        if goal.rotation is not None:
+            assert np.abs(T[:3, :3] - goal.rotation).max() <= 1e-8
+        assert design.clearance(list(answer.states), margin).ok
+        assert all(lo - 1e-12 <= s <= hi + 1e-12 for s, (lo, hi) in
+                   zip(answer.states, (j.stateRange() for j in design.Joints), strict=True))
+        assert keep_out_violation(design, answer.states, boxes, margin) is None
+
+
+@settings(max_examples=3, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 10_000))
+def test_designs_reach_the_tip_positions_of_a_hidden_robot(seed):
+    """The benchmark's task: four tip positions of a hidden 4R robot at clear configurations;
+    the designed RRRR chain reaches each one, exactly and clear."""
+    targets = hidden_targets(seed)
+    design, answers = design_for(targets, "RRRR", r=1.0, numSides=4, return_answers=True)
+    assert isinstance(design, KinematicChain)
+    assert sum(j.stateRange() != (0.0, 0.0) for j in design.Joints) == 4
+    assert len(answers) == 4 and all(a.ok for a in answers)
+    check_reaches(design, targets)
+    design.creasePattern()  # it folds from one sheet
+
+
+def test_the_result_depends_on_the_seed_only_not_on_the_executor():
+    targets = hidden_targets(3)
+    alone = design_for(targets, "RRRR", r=1.0, numSides=4, seed=5)
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        shared = design_for(targets, "RRRR", r=1.0, numSides=4, seed=5, executor=pool)
+    assert len(alone.Joints) == len(shared.Joints)
+    for a, b in zip(alone.Joints, shared.Joints, strict=True):
+        assert np.array_equal(a.pose_matrix, b.pose_matrix)
+
+
+def test_a_budget_uses_the_fewest_joints_that_reach():
+    """One point: a single joint reaches it (fewest joints first), with types tried R first."""
+    design = design_for([(3.0, 2.0, 4.0)], 3, r=1.0, numSides=4)
+    movable = [j for j in design.Joints if j.stateRange() != (0.0, 0.0)]
+    assert len(movable) == 1 and type(movable[0]).__name__ == "RevoluteJoint"
+    check_reaches(design, [(3.0, 2.0, 4.0)])
+
+
+def test_pose_targets():
+    """Full poses: two tip poses of a hidden arm, reached in position and orientation."""
+    rng = np.random.default_rng(11)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlacementWarning)
+        robot = KinematicChain.from_dh([(0.0, rng.uniform(-3, 3), rng.uniform(0, 4),
+                                         rng.uniform(0, 4)) for _ in range(6)], 4, 1.0,
+                                       placement="safe")  # fmt: skip
+    K = kinematics(robot)
+    low, high = K.ranges[:, 0], K.ranges[:, 1]
+    Q = low + (high - low) * rng.random((100, low.size))
+    Q = Q[~engine_for(robot).colliding(Q, 0.0)][:2]
+    targets = [K.fkine(q) for q in Q]
+    design = design_for(targets, "RRRRRR", r=1.0, numSides=4)
+    check_reaches(design, targets)
+
+
+def test_keep_out_boxes_are_avoided_at_every_target():
+    targets = hidden_targets(1)
+    low = min(float(t[2]) for t in targets)
+    table = Box((-100.0, -100.0, -20.0), (100.0, 100.0, -1.5))
+    assert low > 1.5
+    design, answers = design_for(targets, "RRRR", r=1.0, numSides=4, keep_out=[table],
+                                 return_answers=True)  # fmt: skip
+    for answer in answers:
+        assert keep_out_violation(design, answer.states, [table]) is None
+    check_reaches(design, targets, boxes=[table])
+
+
+def test_segment_box_distance_is_exact():
+    """Against a dense sampling of the segment and the box's exact point distance."""
+    rng = np.random.default_rng(0)
+    a, b = rng.uniform(-3, 3, (50, 3)), rng.uniform(-3, 3, (50, 3))
+    low, high = np.array([-1.0, -0.5, 0.0]), np.array([1.0, 0.5, 2.0])
+    found = segment_box_distances(a, b, low, high)
+    t = np.linspace(0, 1, 20001)
+    p = a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]
+    sampled = np.linalg.norm(p - np.clip(p, low, high), axis=2).min(axis=1)
+    assert np.all(found <= sampled + 1e-12)
+    assert np.all(sampled - found <= 1e-6)
+
+
+# --- certificates ---------------------------------------------------------------------------------
+def test_a_target_beyond_the_longest_tube_is_proven_infeasible_within_a_second():
+    t0 = time.perf_counter()
+    with pytest.raises(InfeasibleTaskError) as caught:
+        design_for([(1.0, 0.0, 0.0), (0.0, 150.0, 0.0)], "RRRR", r=1.0, numSides=4)
+    assert time.perf_counter() - t0 < 5.0  # liveness only; the benchmark times it
+    error = caught.value
+    assert isinstance(error, KinegamiError) and isinstance(error, ValueError)
+    assert error.proven and error.target == 1
+    assert "target 1" in str(error) and "150" in str(error) and "max_tube_length 100" in str(error)
+    with pytest.raises(InfeasibleTaskError):
+        design_for([(0.0, 0.0, 30.0)], 4, r=1.0, numSides=4, max_tube_length=20.0)
+
+
+def test_orientations_the_joint_types_cannot_give_are_proven_infeasible():
+    T0, T1 = np.eye(4), np.eye(4)
+    T1[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+    T0[:3, 3], T1[:3, 3] = (3, 0, 2), (0, 3, 2)
+    with pytest.raises(InfeasibleTaskError, match="prismatic joints alone") as caught:
+        design_for([T0, T1], "PPP", r=1.0, numSides=4)
+    assert caught.value.proven and caught.value.target == 1
+    T2 = np.eye(4)
+    T2[:3, :3] = [[1, 0, 0], [0, 0, -1], [0, 1, 0]]  # about x, where T1 turns about z
+    T2[:3, 3] = (2, 2, 2)
+    with pytest.raises(InfeasibleTaskError, match="one revolute joint"):
+        design_for([T0, T1, T2], "RPP", r=1.0, numSides=4)
+    with pytest.raises(InfeasibleTaskError, match="keep-out box 0"):
+        design_for([(3.0, 0.0, 0.5)], "RR", r=1.0, numSides=4,
+                   keep_out=[{"min": [-9, -9, -9], "max": [9, 9, 0]}])  # fmt: skip
+
+
+def test_bad_input_is_one_clear_error():
+    cases = [
+        (([(1, 2, 3)], "RXR"), {}, InvalidParameterError, "joints"),
+        (([(1, 2, 3)], ""), {}, InvalidParameterError, "joints"),
+        (([(1, 2, 3)], 0), {}, InvalidParameterError, "joints"),
+        (([(1, 2, 3)], "R" * 9), {}, InvalidParameterError, "MAX_TASK_JOINTS"),
+        (([], "RR"), {}, InvalidParameterError, "targets"),
+        (((1, 2, 3), "RR"), {}, InvalidTypeError, "targets"),
+        (([(1, 2)], "RR"), {}, InvalidParameterError, "target"),
+        (([(1, 2, 3)], "RR"), {"r": -1}, InvalidParameterError, "r"),
+        (([(1, 2, 3)], "RR"), {"max_tube_length": 0}, InvalidParameterError, "max_tube_length"),
+        (([(1, 2, 3)], "RR"), {"margin": -1}, InvalidParameterError, "margin"),
+        (([(1, 2, 3)], "RR"), {"keep_out": [{"min": [0, 0, 0]}]}, InvalidParameterError, "max"),
+        (([(1, 2, 3)], "RR"), {"executor": 3}, InvalidTypeError, "executor"),
+    ]
+    for (targets, joints), extra, kind, word in cases:
+        options = {"r": 1.0, "numSides": 4, **extra}
+        with pytest.raises(kind, match=word):
+            design_for(targets, joints, **options)
+
+
+# --- compaction keeps the task --------------------------------------------------------------------
+def test_compaction_with_targets_keeps_every_target_and_never_lengthens():
+    """An uncompacted design for a task: compact(design, targets=...) returns a design no longer
+    than it whose tip still reaches every target (the end tip is not slid, so the kinematics
+    of the tip are the same: equal fkine at the mapped configurations)."""
+    targets = hidden_targets(4)
+    design, answers = design_for(targets, "RRRR", r=1.0, numSides=4, compact=False,
+                                 return_answers=True)  # fmt: skip
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        shorter, again = compact_for_task(design, targets, answers, executor=pool)
+        plain = compact(design, executor=pool, targets=targets)
+    assert tube_length(shorter) <= tube_length(design) + 1e-9
+    assert tube_length(plain) == tube_length(shorter)
+    check_reaches(shorter, targets)
+    K0, K1 = kinematics(design), kinematics(shorter)
+    m0 = [k for k, j in enumerate(design.Joints) if j.stateRange() != (0.0, 0.0)]
+    m1 = [k for k, j in enumerate(shorter.Joints) if j.stateRange() != (0.0, 0.0)]
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        q = rng.uniform(-1.2, 1.2, len(m0))
+        q0, q1 = np.zeros(len(design.Joints)), np.zeros(len(shorter.Joints))
+        q0[m0], q1[m1] = q, q
+        assert np.abs(K0.fkine(q0) - K1.fkine(q1)).max() <= 1e-9
+
+
+def test_compaction_with_targets_refuses_a_design_that_misses_its_task():
+    design = design_for([(3.0, 2.0, 4.0)], "R", r=1.0, numSides=4)
+    from kinegami.optimize import CompactionError
+
+    with pytest.raises(CompactionError, match="does not reach its task"):
+        compact_for_task(design, [(30.0, 20.0, 40.0)])
