@@ -61,6 +61,7 @@ HIERARCHY = {
     "NoPathError": (ValueError,),
     "IncompatibleJointError": (ValueError,),
     "CompactionError": (ValueError,),
+    "InfeasibleTaskError": (ValueError,),
     "EditorCommandError": (ValueError,),
     "FoldedFormError": (ValueError,),
     "UnknownModuleKindError": (ValueError, KeyError),
