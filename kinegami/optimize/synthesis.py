@@ -104,9 +104,11 @@ def _task(targets, r, numSides, base, keep_out, max_tube_length, margin) -> _Tas
 
     r = check_radius(r)
     n = check_num_sides(numSides)
+    if isinstance(targets, np.ndarray) and targets.ndim >= 2:
+        targets = list(targets)
     if isinstance(targets, (str, bytes)) or not isinstance(targets, Sequence) \
-            or (np.ndim(targets) == 1 and len(targets) == 3 and not isinstance(targets[0], Sequence)
-                and np.isscalar(targets[0])):  # fmt: skip
+            or (len(targets) and all(isinstance(v, (int, float, np.number)) for v in targets)):
+        # one position given alone is not a list of targets
         raise InvalidTypeError(
             "targets must be a list of targets (3-vectors, 4x4 poses or reach Targets), got "
             f"{targets!r}"
@@ -225,19 +227,51 @@ def _dh(theta, alpha, a, d) -> np.ndarray:
     return out
 
 
-def _tool(w: np.ndarray, t: np.ndarray) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
+def _elementary(kind: str, axis: int, value) -> np.ndarray:
+    """(..., 4, 4): a turn ("R") about or a slide ("P") along coordinate axis 0, 1 or 2."""
+    value = np.asarray(value, dtype=float)
+    out = np.zeros(value.shape + (4, 4))
+    out[..., 0, 0] = out[..., 1, 1] = out[..., 2, 2] = out[..., 3, 3] = 1.0
+    if kind == "P":
+        out[..., axis, 3] = value
+        return out
+    i, j = (axis + 1) % 3, (axis + 2) % 3
+    c, s = np.cos(value), np.sin(value)
+    out[..., i, i], out[..., i, j], out[..., j, i], out[..., j, j] = c, -s, s, c
+    return out
 
+
+def _tool(tool: np.ndarray) -> np.ndarray:
+    """The tool frame on the last DH frame: Trans(tx, ty, tz) Rz(c) Ry(b) Rx(a) of
+    ``tool`` = (tx, ty, tz, c, b, a)."""
     E = np.eye(4)
-    E[:3, :3] = Rotation.from_rotvec(w).as_matrix()
-    E[:3, 3] = t
+    for kind, axis, value in _TOOL_STEPS:
+        E = E @ _elementary(kind, axis, tool[value])
     return E
+
+
+def _cross(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
+    """The cross product of a and b (broadcast) along ``axis`` (numpy's cross, without its
+    overhead on small arrays)."""
+    a, b = np.moveaxis(a, axis, 0), np.moveaxis(b, axis, 0)
+    out = np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                    a[0] * b[1] - a[1] * b[0]])  # fmt: skip
+    return np.moveaxis(out, 0, axis)
+
+
+#: The elementary steps of one DH row: Rz(theta) Tz(d) Tx(a) Rx(alpha), as (kind, axis, column
+#: of the row (theta, alpha, a, d)).
+_ROW_STEPS = (("R", 2, 0), ("P", 2, 3), ("P", 0, 2), ("R", 0, 1))
+#: The tool's steps, as (kind, axis, index in the tool's six numbers).
+_TOOL_STEPS = (("P", 0, 0), ("P", 1, 1), ("P", 2, 2), ("R", 2, 3), ("R", 1, 4), ("R", 0, 5))
+_UNIT = np.eye(3)
 
 
 class _Model:
     """The fit's unknowns and residuals for one joint-type string: x = (table (n, 4) flattened,
-    the tool (rotation vector, translation) when a target is oriented, the configurations
-    (targets, n))."""
+    the tool (translation, ZYX angles) when a target is oriented, the configurations
+    (targets, n)). The tip is a product of elementary turns and slides, so the residual's
+    Jacobian is exact: a step's unit twist, moved to the world by the product before it."""
 
     def __init__(self, task: _Task, types: str):
         from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
@@ -253,10 +287,33 @@ class _Model:
         self.high = np.array([ranges[c][1] for c in types])
         self.tool_size = 6 if task.oriented else 0
         self.size = 4 * self.n + self.tool_size + self.T * self.n
-        # lengths of the table and the tool: within half the longest tube, and a few times the
+        # lengths of the table and the tool: within half the longest tube, and about the
         # task's spread
-        self.span = min(0.5 * task.max_tube_length, max(4.0 * r, 2.0 * task.scale))
+        self.span = min(0.5 * task.max_tube_length, max(4.0 * r, 1.5 * task.scale))
         self.position = np.array([t.position for t in task.targets])
+        self.kinds = [t.kind for t in task.targets]
+        self.rotation = np.array([t.rotation if t.rotation is not None else np.eye(3)
+                                  for t in task.targets])  # fmt: skip
+        self.axis = np.array([t.axis if t.axis is not None else np.zeros(3)
+                              for t in task.targets])  # fmt: skip
+        # columns of x: per step of the product, the table's or the tool's entry, and the
+        # configuration's entry that adds to it (-1: none)
+        steps, columns, joint_of = [], [], []
+        for i in range(self.n):
+            for kind, axis, c in _ROW_STEPS:
+                steps.append((kind, axis))
+                columns.append(4 * i + c)
+                moves = (c == 0 and self.revolute[i]) or (c == 3 and not self.revolute[i])
+                joint_of.append(i if moves else -1)
+        for kind, axis, c in _TOOL_STEPS[: len(_TOOL_STEPS) if self.tool_size else 0]:
+            steps.append((kind, axis))
+            columns.append(4 * self.n + c)
+            joint_of.append(-1)
+        self.steps, self.columns, self.joint_of = steps, np.array(columns), np.array(joint_of)
+        rows = [3 + (9 if k == "pose" else 3 if k == "axis" else 0) for k in self.kinds]
+        self.row_start = np.r_[0, np.cumsum(rows)[:-1]].astype(int)
+        self.rows = int(sum(rows))
+        self.penalty = 0.0  # weight of the lengths' rows (a first, short-tube stage)
 
     def split(self, x: np.ndarray):
         n, T = self.n, self.T
@@ -264,6 +321,24 @@ class _Model:
         tool = x[4 * n : 4 * n + self.tool_size]
         Q = x[4 * n + self.tool_size :].reshape(T, n)
         return table, tool, Q
+
+    def _values(self, x: np.ndarray) -> np.ndarray:
+        """(T, steps): every step's value for every target."""
+        table, tool, Q = self.split(x)
+        values = np.broadcast_to(x[self.columns], (self.T, len(self.steps))).copy()
+        moving = np.flatnonzero(self.joint_of >= 0)
+        values[:, moving] += Q[:, self.joint_of[moving]]
+        return values
+
+    def _products(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(T, steps, 4, 4) the product before each step, and (T, 4, 4) the tips."""
+        values = self._values(x)
+        G = np.broadcast_to(self.task.base, (self.T, 4, 4)).copy()
+        before = np.empty((self.T, len(self.steps), 4, 4))
+        for k, (kind, axis) in enumerate(self.steps):
+            before[:, k] = G
+            G = G @ _elementary(kind, axis, values[:, k])
+        return before, G
 
     def tips(self, table: np.ndarray, tool: np.ndarray, Q: np.ndarray) -> np.ndarray:
         """(K, 4, 4) tip frames at the configurations Q (K, n)."""
@@ -273,27 +348,70 @@ class _Model:
             q = Q[:, i]
             G = G @ (_dh(th + q, al, a, d) if self.revolute[i] else _dh(th, al, a, d + q))
         if self.tool_size:
-            G = G @ _tool(tool[:3], tool[3:])
+            G = G @ _tool(tool)
         return G
 
-    def residual(self, x: np.ndarray) -> np.ndarray:
-        table, tool, Q = self.split(x)
-        T = self.tips(table, tool, Q)
-        parts = [((self.position - T[:, :3, 3]) / self.task.r).reshape(-1)]
-        for k, t in enumerate(self.task.targets):
-            if t.kind == "pose":
-                parts.append(_rotation_vector(t.rotation @ T[k, :3, :3].T))
-            elif t.kind == "axis":
-                parts.append(t.axis - T[k, :3, 2])
+    def errors(self, tips: np.ndarray) -> np.ndarray:
+        """The targets' residuals (units of r for positions; rotation matrix entries, or the
+        tip's z minus the axis)."""
+        parts = []
+        for k, kind in enumerate(self.kinds):
+            parts.append((tips[k, :3, 3] - self.position[k]) / self.task.r)
+            if kind == "pose":
+                parts.append((tips[k, :3, :3] - self.rotation[k]).reshape(9))
+            elif kind == "axis":
+                parts.append(tips[k, :3, 2] - self.axis[k])
         return np.concatenate(parts)
+
+    def residual(self, x: np.ndarray) -> np.ndarray:
+        _, tips = self._products(x)
+        e = self.errors(tips)
+        if self.penalty:
+            e = np.r_[e, self.penalty * self._lengths(x)]
+        return e
+
+    def _lengths(self, x: np.ndarray) -> np.ndarray:
+        return np.r_[x[2 : 4 * self.n : 4], x[3 : 4 * self.n : 4]] / self.task.r
+
+    def jacobian(self, x: np.ndarray) -> np.ndarray:
+        before, tips = self._products(x)
+        S = len(self.steps)
+        axes = np.array([axis for _, axis in self.steps])
+        turns = np.array([kind == "R" for kind, _ in self.steps])
+        columns = before[:, :, :3, :3].transpose(1, 3, 0, 2)  # (S, column, T, 3)
+        U = columns[np.arange(S), axes].transpose(1, 0, 2)  # (T, S, 3): the steps' axes
+        lever = tips[:, None, :3, 3] - before[:, :, :3, 3]
+        dp = np.where(turns[None, :, None], _cross(U, lever), U)  # (T, S, 3)
+        R = tips[:, None, :3, :3]  # (T, 1, 3, 3)
+        dR = _cross(U[..., None], R, axis=2) * turns[None, :, None, None]  # u x each column
+        J = np.zeros((self.rows, self.size))
+        moving = np.flatnonzero(self.joint_of >= 0)
+        first_q = 4 * self.n + self.tool_size
+        for t, kind in enumerate(self.kinds):
+            parts = [dp[t] / self.task.r]
+            if kind == "pose":
+                parts.append(dR[t].reshape(S, 9))
+            elif kind == "axis":
+                parts.append(dR[t][:, :, 2])
+            block = np.concatenate(parts, axis=1).T  # (rows of t, S)
+            a = self.row_start[t]
+            J[a : a + block.shape[0], self.columns] = block  # one column per step
+            J[a : a + block.shape[0], first_q + t * self.n + self.joint_of[moving]] = \
+                block[:, moving]  # the configuration moves this target's tip only  # fmt: skip
+        if self.penalty:
+            L = np.zeros((2 * self.n, self.size))
+            L[np.arange(self.n), 4 * np.arange(self.n) + 2] = self.penalty / self.task.r
+            L[self.n + np.arange(self.n), 4 * np.arange(self.n) + 3] = self.penalty / self.task.r
+            J = np.vstack([J, L])
+        return J
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         n, s = self.n, self.span
         lo = np.tile([-2 * math.pi, -2 * math.pi, -s, -s], n)
         hi = np.tile([2 * math.pi, 2 * math.pi, s, s], n)
         if self.tool_size:
-            lo = np.r_[lo, [-2 * math.pi] * 3, [-s] * 3]
-            hi = np.r_[hi, [2 * math.pi] * 3, [s] * 3]
+            lo = np.r_[lo, [-s] * 3, [-2 * math.pi] * 3]
+            hi = np.r_[hi, [s] * 3, [2 * math.pi] * 3]
         inset = 1e-6 * (self.high - self.low)
         lo = np.r_[lo, np.tile(self.low + inset, self.T)]
         hi = np.r_[hi, np.tile(self.high - inset, self.T)]
@@ -307,31 +425,42 @@ class _Model:
                                  rng.uniform(0.0, s, n), rng.uniform(-s, s, n)])  # fmt: skip
         parts = [table.reshape(-1)]
         if self.tool_size:
-            parts += [rng.uniform(-math.pi, math.pi, 3) * 0.5, rng.uniform(-r, r, 3)]
+            parts += [rng.uniform(-r, r, 3), rng.uniform(-math.pi, math.pi, 3) * 0.5]
         parts.append((self.low + (self.high - self.low) * rng.random((self.T, n))).reshape(-1))
         return np.concatenate(parts)
 
 
+#: Weight of the table's lengths (over r) in the fit's first stage: it keeps the tube short; the
+#: second stage, without it, makes the residual exact.
+LENGTH_PENALTY = 1e-2
+
+
 def _fit(model: _Model, seed: int, start: int) -> np.ndarray | None:
-    """The fitted unknowns of start ``start`` (every residual <= FIT_TOLERANCE), or None."""
+    """The fitted unknowns of start ``start`` (every residual <= FIT_TOLERANCE), or None: a
+    first stage that also keeps the table's lengths small, then the exact fit from there."""
     from scipy.optimize import least_squares
 
     rng = np.random.default_rng([seed, start, len(model.types), *map(ord, model.types)])
-    x0 = model.start(rng)
+    x = model.start(rng)
     lo, hi = model.bounds()
-    x0 = np.clip(x0, lo, hi)
+    x = np.clip(x, lo, hi)
     scale = np.ones(model.size)
     lengths = np.r_[np.tile([False, False, True, True], model.n),
-                    [False] * 3 + [True] * 3 if model.tool_size else [],
+                    [True] * 3 + [False] * 3 if model.tool_size else [],
                     np.tile(~model.revolute, model.T)].astype(bool)  # fmt: skip
     scale[lengths] = model.task.r
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        fit = least_squares(model.residual, x0, bounds=(lo, hi), x_scale=scale, ftol=1e-15,
-                            xtol=1e-15, gtol=1e-15, max_nfev=60 * model.size, method="trf")
-    if not np.all(np.isfinite(fit.x)) or np.abs(model.residual(fit.x)).max() > FIT_TOLERANCE:
+        for penalty, tol, budget in ((LENGTH_PENALTY, 1e-8, 200), (0.0, 1e-15, 50 * model.size)):
+            model.penalty = penalty
+            fit = least_squares(model.residual, x, jac=model.jacobian, bounds=(lo, hi),
+                                x_scale=scale, ftol=tol, xtol=tol, gtol=tol, max_nfev=budget,
+                                method="trf")  # fmt: skip
+            x = np.clip(fit.x, lo, hi)
+    model.penalty = 0.0
+    if not np.all(np.isfinite(x)) or np.abs(model.residual(x)).max() > FIT_TOLERANCE:
         return None
-    return fit.x
+    return x
 
 
 # --- building and checking a fitted table ---------------------------------------------------------
@@ -360,7 +489,7 @@ def _build(model: _Model, x: np.ndarray):
     for i in range(n):
         th, al, a, d = table[i]
         frames.append(frames[-1] @ _dh(th, al, a, d))
-    tip = frames[-1] @ (_tool(tool[:3], tool[3:]) if model.tool_size else np.eye(4))
+    tip = frames[-1] @ (_tool(tool) if model.tool_size else np.eye(4))
     joints = []
     for i, kind in enumerate(model.types):
         if kind == "R":

@@ -109,19 +109,20 @@ def test_a_budget_uses_the_fewest_joints_that_reach():
 
 
 def test_pose_targets():
-    """Full poses: two tip poses of a hidden arm, reached in position and orientation."""
+    """Full poses: three tip poses of a hidden 3R arm, reached in position and orientation by
+    a designed RRR chain (a fitted tool frame on its last frame)."""
     rng = np.random.default_rng(11)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PlacementWarning)
         robot = KinematicChain.from_dh([(0.0, rng.uniform(-3, 3), rng.uniform(0, 4),
-                                         rng.uniform(0, 4)) for _ in range(6)], 4, 1.0,
+                                         rng.uniform(0, 4)) for _ in range(3)], 4, 1.0,
                                        placement="safe")  # fmt: skip
     K = kinematics(robot)
     low, high = K.ranges[:, 0], K.ranges[:, 1]
     Q = low + (high - low) * rng.random((100, low.size))
-    Q = Q[~engine_for(robot).colliding(Q, 0.0)][:2]
+    Q = Q[~engine_for(robot).colliding(Q, 0.0)][:3]
     targets = [K.fkine(q) for q in Q]
-    design = design_for(targets, "RRRRRR", r=1.0, numSides=4)
+    design = design_for(targets, "RRR", r=1.0, numSides=4)
     check_reaches(design, targets)
 
 
@@ -233,3 +234,39 @@ def test_compaction_with_targets_refuses_a_design_that_misses_its_task():
 
     with pytest.raises(CompactionError, match="does not reach its task"):
         compact_for_task(design, [(30.0, 20.0, 40.0)])
+
+
+@settings(max_examples=20, deadline=None)
+@given(types=st.text("RP", min_size=1, max_size=6), seed=st.integers(0, 2**31),
+       kinds=st.lists(st.sampled_from(["position", "pose", "axis"]), min_size=1, max_size=4))
+def test_the_fit_jacobian_is_exact(types, seed, kinds):
+    """The fit's Jacobian (elementary twists moved to the world) against central differences,
+    for every target form and joint type, with the length rows of the first stage."""
+    from kinegami.optimize import synthesis
+
+    rng = np.random.default_rng(seed)
+    targets = []
+    for kind in kinds:
+        p = rng.uniform(-3, 3, 3)
+        if kind == "pose":
+            T = np.eye(4)
+            T[:3, :3] = np.linalg.qr(rng.normal(size=(3, 3)))[0] * np.array([1, 1, 1])
+            if np.linalg.det(T[:3, :3]) < 0:
+                T[:3, 0] *= -1
+            T[:3, 3] = p
+            targets.append(T)
+        elif kind == "axis":
+            targets.append(Target(p, axis=rng.normal(size=3)))
+        else:
+            targets.append(p)
+    model = synthesis._Model(synthesis._task(targets, 1.0, 4, None, (), None, 0.0), types)
+    x = model.start(rng)
+    for penalty in (0.0, 0.5):
+        model.penalty = penalty
+        J = model.jacobian(x)
+        h = 1e-6
+        F = np.array([(model.residual(x + h * e) - model.residual(x - h * e)) / (2 * h)
+                      for e in np.eye(model.size)]).T  # fmt: skip
+        assert np.abs(J - F).max() <= 1e-6
+    table, tool, Q = model.split(x)
+    assert np.abs(model._products(x)[1] - model.tips(table, tool, Q)).max() <= 1e-12

@@ -1,0 +1,161 @@
+"""Design for a task (issue 32): ``python benchmarks/design_task.py [--full] [--workers W]``.
+
+Position tasks: 4 targets, each the tip position of a hidden random robot at a clear
+configuration (4 revolute joints from a DH table with theta 0, alpha uniform in (-pi, pi], a and
+d uniform in [0, 4r]; base at the identity; the same tube, r = 1, square); ``design_for`` is
+given ``"RRRR"``. Pose tasks: 2 to 6 full tip poses of a hidden random 6R robot, given
+``"RRRRRR"``. Every designed robot is checked as a user would: each target solved again from the
+design's home states by :func:`kinegami.reach.solve` (exact, in range, clear by the design's
+own clearance), its crease pattern built, its tube measured against the same kinematics
+compacted without the task (:func:`kinegami.optimize.compact`: the end tip may slide there).
+Infeasible tasks: a target beyond any reach of the budget, timed to the certificate. Compaction
+with targets: the PUMA and 5 of its clear tip poses.
+
+20 tasks of each kind by default, 100 with ``--full``; ``--workers`` runs tasks in parallel
+(each task's time is its own wall time in its process).
+"""
+
+from __future__ import annotations
+
+import argparse
+import concurrent.futures
+import math
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+DESIGNS = Path(__file__).resolve().parents[1] / "examples" / "designs"
+
+
+def hidden_task(seed: int, joints: int, count: int, poses: bool, r: float = 1.0) -> list:
+    """Targets: tip positions (or poses) of a hidden random revolute robot at ``count`` clear
+    configurations."""
+    from kinegami import KinematicChain
+    from kinegami.clearance.engine import engine_for
+    from kinegami.errors import ClearanceWarning, PlacementWarning
+    from kinegami.reach import kinematics
+
+    rng = np.random.default_rng([seed, joints, count])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlacementWarning)
+        warnings.simplefilter("ignore", ClearanceWarning)
+        while True:
+            table = [(0.0, rng.uniform(-math.pi, math.pi), rng.uniform(0, 4 * r),
+                      rng.uniform(0, 4 * r)) for _ in range(joints)]  # fmt: skip
+            robot = KinematicChain.from_dh(table, 4, r, placement="safe")
+            K = kinematics(robot)
+            low, high = K.ranges[:, 0], K.ranges[:, 1]
+            Q = low + (high - low) * rng.random((50 * count, low.size))
+            Q = Q[~engine_for(robot).colliding(Q, 0.0)]
+            if len(Q) >= count:
+                T = [K.fkine(q) for q in Q[:count]]
+                return T if poses else [t[:3, 3] for t in T]
+
+
+def one_task(kind: str, seed: int) -> dict:
+    """Design one task and check the result; a dict of what was measured."""
+    from kinegami.errors import InfeasibleTaskError
+    from kinegami.optimize import compact, design_for, tube_length
+    from kinegami.reach import solve
+
+    warnings.simplefilter("ignore")
+    if kind == "position":
+        targets, joints = hidden_task(seed, 4, 4, False), "RRRR"
+    elif kind == "pose":
+        count = 2 + seed % 5  # 2 to 6 poses
+        targets, joints = hidden_task(seed, 6, count, True), "RRRRRR"
+    else:  # infeasible: one target 150 r away, beyond the 100 r tube
+        targets = hidden_task(seed, 4, 3, False) + [np.array([150.0, 0.0, 0.0])]
+        joints = "RRRR"
+    t0 = time.perf_counter()
+    try:
+        design = design_for(targets, joints, r=1.0, numSides=4, seed=0)
+    except InfeasibleTaskError as error:
+        return {"ok": False, "seconds": time.perf_counter() - t0, "proven": error.proven,
+                "why": str(error)}  # fmt: skip
+    seconds = time.perf_counter() - t0
+    reached = all(solve(design, t).ok for t in targets)
+    design.creasePattern()
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        plain = tube_length(compact(design, executor=pool, seed=0))
+    return {"ok": reached, "seconds": seconds, "tube": tube_length(design), "plain": plain,
+            "proven": False, "why": ""}  # fmt: skip
+
+
+def puma_compaction() -> tuple[str, str, str]:
+    """The PUMA compacted with 5 of its clear tip poses as targets."""
+    from kinegami.clearance.engine import engine_for
+    from kinegami.design import load_design
+    from kinegami.optimize import compact_for_task, tube_length
+    from kinegami.reach import kinematics, solve
+
+    design = load_design(DESIGNS / "puma.json")
+    K = kinematics(design)
+    rng = np.random.default_rng(5)
+    low, high = K.ranges[:, 0], K.ranges[:, 1]
+    Q = low + (high - low) * rng.random((100, low.size))
+    Q = Q[~engine_for(design).colliding(Q, float(design.margin))][:5]
+    targets = [K.fkine(q) for q in Q]
+    t0 = time.perf_counter()
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        shorter, _ = compact_for_task(design, targets, executor=pool)
+    seconds = time.perf_counter() - t0
+    reached = sum(solve(shorter, t).ok for t in targets)
+    before, after = tube_length(design), tube_length(shorter)
+    return ("PUMA compacted with 5 clear pose targets",
+            f"{reached}/5 reached clear, tube {after:.1f} (before {before:.1f}), {seconds:.0f} s",
+            "every target clear, tube no longer")  # fmt: skip
+
+
+def rows(count: int = 20, workers: int = 1) -> list[tuple[str, str, str]]:
+    """The benchmark's rows (what, result, goal)."""
+    out = []
+    goals = {"position": ("95%", 60.0), "pose": ("90%", 300.0), "infeasible": ("-", 1.0)}
+    for kind in ("position", "pose", "infeasible"):
+        jobs = [(kind, seed) for seed in range(count)]
+        if workers > 1:
+            with concurrent.futures.ProcessPoolExecutor(workers) as pool:
+                results = list(pool.map(one_task, *zip(*jobs, strict=True)))
+        else:
+            results = [one_task(*job) for job in jobs]
+        seconds = [r["seconds"] for r in results]
+        if kind == "infeasible":
+            proven = sum(r["proven"] for r in results)
+            out.append((f"design_for: {count} infeasible tasks (a target 150 r away), "
+                        "certificate", f"{proven}/{count} proven, max {max(seconds) * 1e3:.1f} ms",
+                        "<= 1 s each"))  # fmt: skip
+            continue
+        ok = [r for r in results if r["ok"]]
+        ratio = [r["tube"] / r["plain"] for r in ok if r["plain"] > 0]
+        share, limit = goals[kind]
+        what = "4 positions of a hidden 4R robot, RRRR" if kind == "position" \
+            else "2-6 poses of a hidden 6R robot, RRRRRR"  # fmt: skip
+        out += [
+            (f"design_for: {count} {kind} tasks ({what}), designed and checked",
+             f"{len(ok)}/{count} = {100 * len(ok) / count:.0f}%", f">= {share}"),
+            (f"design_for: {kind} tasks, seconds per task (median, max)",
+             f"{np.median(seconds):.1f} s, {max(seconds):.1f} s", f"<= {limit:.0f} s each"),
+            (f"design_for: {kind} tasks, tube / the same kinematics compacted (max)",
+             f"{max(ratio):.2f}" if ratio else "-", "<= 1.2"),
+        ]  # fmt: skip
+    out.append(puma_compaction())
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--full", action="store_true", help="100 tasks of each kind (not 20)")
+    parser.add_argument("--tasks", type=int, default=None, help="tasks of each kind")
+    parser.add_argument("--workers", type=int, default=1, help="tasks run in parallel")
+    args = parser.parse_args()
+    count = args.tasks if args.tasks is not None else 100 if args.full else 20
+    table = rows(count, args.workers)
+    width = max(len(r[0]) for r in table)
+    for name, value, goal in table:
+        print(f"{name:<{width}}  {value:>36}  {goal}")
+
+
+if __name__ == "__main__":
+    main()
