@@ -579,18 +579,89 @@ def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = Tr
     length = tube_length(chain)
     if length > task.max_tube_length:
         return None, f"tube {length:.6g} longer than max_tube_length"
-    if not thorough:
-        hit = np.flatnonzero(engine_for(chain).colliding(states, task.margin))
-        if hit.size:
-            return None, f"target {int(hit[0])}: the fitted configuration passes through itself"
-        for k in range(len(states)):
-            box = keep_out_violation(chain, states[k], task.boxes, task.margin)
-            if box is not None:
-                return None, f"target {k}: the fitted configuration enters keep-out box {box[0]}"
+    engine = engine_for(chain)
+    bad = _blocked(engine, chain, states, task)
+    if bad and not thorough:
+        k, why = bad[0]
+        return None, f"target {k}: the fitted configuration {why}"
+    if bad:  # other configurations of the same table for those targets, a batch at a time
+        movable = [m for m, joint in enumerate(chain.Joints) if joint.stateRange() != (0.0, 0.0)]
+        rng = np.random.default_rng([seed, start, 0x0C0F])
+        first_q = 4 * model.n + model.tool_size
+        for k, _ in bad:
+            found = _other_configurations(model, x, k, OTHER_CONFIGURATIONS, rng)
+            if not found:
+                continue
+            trial = np.zeros((len(found), states.shape[1]))
+            trial[:, movable] = found
+            for m in np.flatnonzero(~engine.colliding(trial, task.margin)):
+                if keep_out_violation(chain, trial[m], task.boxes, task.margin) is None:
+                    states[k] = trial[m]
+                    x = x.copy()
+                    x[first_q + k * model.n : first_q + (k + 1) * model.n] = found[m]
+                    break
+        still = _blocked(engine, chain, states, task)
+        dof = {"position": 3, "axis": 5, "pose": 6}
+        for k, why in still:  # the solver's moves along the solutions need a redundant arm
+            if model.n <= dof[model.kinds[k]]:
+                return None, f"target {k}: every configuration found {why}"
     answers, why = _answers(chain, states, task)
     if answers is None:
         return None, why
     return (x, length, min(a.clearance for a in answers)), ""
+
+
+#: Starts of the fit of one target's configuration alone (the table kept) when the fitted one
+#: passes through itself or enters a box: a 6R arm has up to 16 configurations per pose.
+OTHER_CONFIGURATIONS = 24
+
+
+def _blocked(engine, chain, states: np.ndarray, task: _Task) -> list[tuple[int, str]]:
+    """The targets whose configuration passes through itself or enters a box, and why."""
+    out = [(int(k), "passes through itself")
+           for k in np.flatnonzero(engine.colliding(states, task.margin))]  # fmt: skip
+    colliding = {k for k, _ in out}
+    for k in range(len(states)):
+        if k not in colliding:
+            box = keep_out_violation(chain, states[k], task.boxes, task.margin)
+            if box is not None:
+                out.append((k, f"enters keep-out box {box[0]}"))
+    return sorted(out)
+
+
+def _other_configurations(model: _Model, x: np.ndarray, k: int, count: int,
+                          rng: np.random.Generator) -> list[np.ndarray]:  # fmt: skip
+    """Configurations (movable joints) of the fitted table that put the tip exactly on target
+    ``k``, from ``count`` random starts (duplicates dropped)."""
+    from scipy.optimize import least_squares
+
+    n = model.n
+    first = 4 * n + model.tool_size + k * n
+    a = model.row_start[k]
+    rows = slice(a, a + 3 + (9 if model.kinds[k] == "pose" else 3 if model.kinds[k] == "axis"
+                             else 0))  # fmt: skip
+    inset = 1e-6 * (model.high - model.low)
+    lo, hi = model.low + inset, model.high - inset
+
+    def placed(q):
+        y = x.copy()
+        y[first : first + n] = q
+        return y
+
+    found: list[np.ndarray] = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for _ in range(count):
+            q0 = lo + (hi - lo) * rng.random(n)
+            fit = least_squares(lambda q: model.residual(placed(q))[rows], q0,
+                                jac=lambda q: model.jacobian(placed(q))[rows, first : first + n],
+                                bounds=(lo, hi), ftol=1e-15, xtol=1e-15, gtol=1e-15,
+                                max_nfev=100, method="trf")  # fmt: skip
+            q = np.clip(fit.x, lo, hi)
+            if np.abs(model.residual(placed(q))[rows]).max() <= FIT_TOLERANCE and \
+                    all(np.abs(q - other).max() > 1e-6 for other in found):  # fmt: skip
+                found.append(q)
+    return found
 
 
 # --- the search -----------------------------------------------------------------------------------
