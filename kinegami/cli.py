@@ -777,17 +777,19 @@ def cmd_design(args: argparse.Namespace) -> int:
     if args.seed is not None:
         options["seed"] = _integer("--seed", args.seed, 0)
     try:
-        chain, answers = design_for(list(task.targets), task.joints, return_answers=True,
-                                    progress=None, **options)  # fmt: skip
+        found = design_for(list(task.targets), task.joints, return_answers=True,
+                           progress=None, **options)  # fmt: skip
     except InfeasibleTaskError as error:
         kind = "infeasible" if error.proven else "no design found"
         _fail(args.command, f"{args.task}: {kind}: {error}")
         return INFEASIBLE
+    chain, answers = found[0], found[1]
+    paths = found[2] if len(found) > 2 else None
     info = DesignInfo(name=task.name, description=task.description, units=task.units,
                       twistPortion=0.2, file=None, structure="chain",
                       task=task.document)  # fmt: skip
     job = BuildJob(chain, info)
-    report = _task_report(chain, task, answers)
+    report = _task_report(chain, task, answers, paths)
     document = design_to_dict(chain, name=task.name, description=task.description,
                               units=task.units, task=task.document)  # fmt: skip
     extra = [
@@ -803,7 +805,7 @@ def cmd_design(args: argparse.Namespace) -> int:
     return 0
 
 
-def _task_report(chain, task, answers) -> tuple[list[str], dict]:
+def _task_report(chain, task, answers, paths=None) -> tuple[list[str], dict]:
     """The report of a designed robot: per target its states, errors and clearance (lines and a
     JSON-ready dict)."""
     from kinegami.optimize import tube_length
@@ -826,6 +828,13 @@ def _task_report(chain, task, answers) -> tuple[list[str], dict]:
     summary = {"format": "kinegami-task-report", "version": 1, "name": task.name,
                "units": units, "joints": [type(j).__name__ for j in chain.Joints],
                "tube_length": tube_length(chain), "targets": rows}  # fmt: skip
+    if paths is not None:
+        summary["moves"] = []
+        for k, configurations in enumerate(paths):
+            lines.append(f"  move {k} -> {k + 1}: clear along the way (certified; "
+                         f"{len(configurations)} configurations measured)")  # fmt: skip
+            summary["moves"].append({"from": k, "to": k + 1, "clear": True,
+                                     "configurations": configurations.tolist()})  # fmt: skip
     return lines, summary
 
 

@@ -58,6 +58,7 @@ class Task:
     seed: int
     starts: int | None
     document: dict
+    path: bool = False
 
     def options(self) -> dict:
         """Keyword arguments of ``design_for(targets, joints, **options)``."""
@@ -66,6 +67,8 @@ class Task:
                "margin": self.margin, "seed": self.seed}  # fmt: skip
         if self.starts is not None:
             out["starts"] = self.starts
+        if self.path:
+            out["path"] = True
         return out
 
 
@@ -140,6 +143,7 @@ def task_from_dict(document, file=None, where: tuple = ()) -> Task:
         base=base, keep_out=tuple(boxes), max_tube_length=document.get("maxTubeLength"),
         margin=float(document.get("margin", 0.0)), seed=int(document.get("seed", 0)),
         starts=document.get("starts"), document=copy.deepcopy(dict(document)),
+        path=bool(document.get("path", False)),
     )  # fmt: skip
 
 

@@ -23,7 +23,7 @@ import itertools
 import math
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -63,6 +63,7 @@ class _Task:
     max_tube_length: float
     margin: float
     oriented: bool  # some target fixes an orientation or an axis
+    path: bool = False  # the moves from each target to the next must be clear too
 
     @property
     def scale(self) -> float:
@@ -608,7 +609,26 @@ def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = Tr
     answers, why = _answers(chain, states, task)
     if answers is None:
         return None, why
+    if task.path:
+        paths, why = _paths(chain, answers, task)
+        if paths is None:
+            return None, why
     return (x, length, min(a.clearance for a in answers)), ""
+
+
+def _paths(chain, answers, task: _Task) -> tuple[list | None, str]:
+    """The certified straight joint-space moves from each target's answer to the next
+    (:func:`kinegami.clearance.paths.check_path`), as their measured configurations, or
+    (None, why)."""
+    from kinegami.clearance.paths import check_path
+
+    out = []
+    for k in range(len(answers) - 1):
+        found = check_path(chain, answers[k].states, answers[k + 1].states, task.margin)
+        if not found.ok:
+            return None, f"the move from target {k} to target {k + 1}: {found.reason}"
+        out.append(found.configurations)
+    return out, ""
 
 
 #: Starts of the fit of one target's configuration alone (the table kept) when the fitted one
@@ -679,6 +699,7 @@ def design_for(
     margin: float = 0.0,
     starts: int = STARTS,
     compact: bool = True,
+    path: bool = False,
     return_answers: bool = False,
     progress=None,
 ):
@@ -706,7 +727,12 @@ def design_for(
     margin : the clearance required between parts and from the boxes (>= 0).
     starts : the fit's starts per joint-type string (>= 1).
     compact : shorten the found design by compaction that keeps the task.
-    return_answers : return ``(design, answers)``: one reach answer per target.
+    path : also require that the robot moves from each target's configuration to the next along
+        the straight line in joint space without passing through itself (certified by
+        :func:`kinegami.clearance.paths.check_path`).
+    return_answers : return ``(design, answers)``: one reach answer per target; with ``path``,
+        ``(design, answers, paths)``, each path the configurations (m, joints) measured along a
+        move, from one target's states to the next's.
     progress : ``progress(done, total)`` per start (False from it cancels), True for a bar.
 
     Among designs that reach every target: fewer joints first, then a shorter tube, then a
@@ -729,6 +755,9 @@ def design_for(
     from kinegami.optimize.compaction import tube_length
 
     task = _task(targets, r, numSides, base, keep_out, max_tube_length, margin)
+    if not isinstance(path, bool):
+        raise InvalidTypeError(f"path must be True or False, got {path!r}")
+    task = replace(task, path=path)
     strings = _joint_strings(joints)
     seed = check_int("seed", seed, minimum=0, floats=False)
     starts = check_int("starts", starts, minimum=1, floats=False)
@@ -793,9 +822,14 @@ def design_for(
             shorter, shorter_answers = compact_for_task(
                 chain, list(task.targets), answers, keep_out=task.boxes, margin=task.margin,
                 seed=seed, executor=executor or own)  # fmt: skip
-        if tube_length(shorter) <= tube_length(chain):
+        if tube_length(shorter) <= tube_length(chain) and \
+                (not path or _paths(shorter, shorter_answers, task)[0] is not None):  # fmt: skip
             chain, answers = shorter, shorter_answers
-    return (chain, answers) if return_answers else chain
+    if not return_answers:
+        return chain
+    if path:
+        return chain, answers, _paths(chain, answers, task)[0]
+    return chain, answers
 
 
 def _run(executor, task: _Task, types: str, seed: int, starts, thorough: bool) -> list:

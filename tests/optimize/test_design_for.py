@@ -270,3 +270,24 @@ def test_the_fit_jacobian_is_exact(types, seed, kinds):
         assert np.abs(J - F).max() <= 1e-6
     table, tool, Q = model.split(x)
     assert np.abs(model._products(x)[1] - model.tips(table, tool, Q)).max() <= 1e-12
+
+
+def test_path_true_certifies_every_move_between_targets():
+    """With path=True the moves from each target's configuration to the next are certified
+    clear (check_path), and dense sampling of each move finds no collision."""
+    from kinegami.clearance.paths import check_path
+
+    targets = hidden_targets(2, count=3)
+    design, answers, paths = design_for(targets, "RRRR", r=1.0, numSides=4, path=True,
+                                        return_answers=True)  # fmt: skip
+    assert len(paths) == 2
+    engine = engine_for(design)
+    u = np.linspace(0.0, 1.0, 2001)
+    for k, measured in enumerate(paths):
+        a, b = np.array(answers[k].states), np.array(answers[k + 1].states)
+        assert np.allclose(measured[0], a) and np.allclose(measured[-1], b)
+        assert check_path(design, a, b).ok
+        assert not engine.colliding(a + u[:, None] * (b - a), 0.0).any()
+    check_reaches(design, targets)
+    with pytest.raises(InvalidTypeError, match="path"):
+        design_for(targets, "RRRR", r=1.0, numSides=4, path="yes")
