@@ -111,11 +111,11 @@ def puma_compaction() -> tuple[str, str, str]:
             "every target clear, tube no longer")  # fmt: skip
 
 
-def rows(count: int = 20, workers: int = 1, pose_count: int | None = None
-         ) -> list[tuple[str, str, str]]:  # fmt: skip
+def rows(count: int = 20, workers: int = 1, pose_count: int | None = None,
+         print_rows: bool = False) -> list[tuple[str, str, str]]:  # fmt: skip
     """The benchmark's rows (what, result, goal); ``pose_count`` pose tasks (default
-    ``count``: each may take minutes)."""
-    out = []
+    ``count``: each may take minutes); ``print_rows``: each row printed as it is measured."""
+    out = _Rows(print_rows)
     goals = {"position": ("95%", 60.0), "pose": ("90%", 300.0), "infeasible": ("-", 1.0)}
     for kind in ("position", "pose", "infeasible"):
         number = pose_count if kind == "pose" and pose_count is not None else count
@@ -148,7 +148,25 @@ def rows(count: int = 20, workers: int = 1, pose_count: int | None = None
              f"{max(ratio):.2f}" if ratio else "-", "<= 1.2"),
         ]  # fmt: skip
     out.append(puma_compaction())
-    return out
+    return list(out)
+
+
+class _Rows(list):
+    """A list of rows that prints each row added (when asked)."""
+
+    def __init__(self, show: bool):
+        super().__init__()
+        self.show = show
+
+    def append(self, row) -> None:
+        super().append(row)
+        if self.show:
+            print(f"{row[0]}  |  {row[1]}  |  {row[2]}", flush=True)
+
+    def __iadd__(self, rows):
+        for row in rows:
+            self.append(row)
+        return self
 
 
 def main() -> None:
@@ -160,10 +178,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=1, help="tasks run in parallel")
     args = parser.parse_args()
     count = args.tasks if args.tasks is not None else 100 if args.full else 20
-    table = rows(count, args.workers, args.pose_tasks)
-    width = max(len(r[0]) for r in table)
-    for name, value, goal in table:
-        print(f"{name:<{width}}  {value:>36}  {goal}")
+    rows(count, args.workers, args.pose_tasks, print_rows=True)
 
 
 if __name__ == "__main__":
