@@ -185,9 +185,7 @@ def task_certificate(task: _Task, types: str) -> tuple[int, str] | None:
             angle = float(np.linalg.norm(w))
             if angle <= 1e-9:
                 continue
-            if angle > math.pi - 1e-9 + 1e-12:  # pragma: no cover - rotation vectors are <= pi
-                continue
-            u = w / angle
+            u = w / angle  # (at pi its sign is arbitrary: the cross product below ignores it)
             if direction is None:
                 direction = (k, u)
                 continue
