@@ -672,18 +672,31 @@ def _tested_pairs(caps: TreeCapsules, joints, since: int, reach: float,
                   measured: list | None = None) -> tuple | None:  # fmt: skip
     """:func:`tree_pair_distances` of the tree whose capsules are ``caps``; ``measured``,
     when given, gets the number of pairs measured appended (what the test cost)."""
-    found = _near_pairs(caps, joints, since, reach)
-    if measured is not None:
-        measured.append(0 if found is None else int(found[0].size))
+    found = _listed_pairs(caps, joints, since, reach, measured)
     if found is None:
         return None
     i, j = found
+    return i, j, *_pair_distances(caps, i, j), caps.rows, caps.starts, caps.ends
+
+
+def _listed_pairs(caps: TreeCapsules, joints, since: int, reach: float,
+                  measured: list | None) -> tuple | None:  # fmt: skip
+    """:func:`_near_pairs`, with their number appended to ``measured`` (when given)."""
+    found = _near_pairs(caps, joints, since, reach)
+    if measured is not None:
+        measured.append(0 if found is None else int(found[0].size))
+    return found
+
+
+def _pair_distances(caps: TreeCapsules, i: np.ndarray, j: np.ndarray) -> tuple:
+    """``(dist, s, t)`` of the row pairs (i, j) by the pair rule: junction pairs beyond their
+    junction (:meth:`TreeCapsules.beyond_junction`), the others whole."""
     a, b = caps.starts, caps.ends
     dist, s, t = segment_distances(a[i], b[i], a[j], b[j])
     q = np.flatnonzero(caps.junction_pairs(i, j))
-    if q.size:
+    if q.size:  # beyond the junction: parts of the rows, never nearer than the rows
         dist[q], s[q], t[q] = caps.beyond_junction(i[q], j[q])
-    return i, j, dist, s, t, caps.rows, a, b
+    return dist, s, t
 
 
 def _near_pairs(caps: TreeCapsules, joints, since: int, reach: float) -> tuple | None:
@@ -845,9 +858,7 @@ def _closest_tested_pairs(caps: TreeCapsules, joints, since: int, reach: float,
     folded onto itself lists millions of near pairs but the closest is among its first few
     thousand (fuzz operations seed 407416). ``measured`` gets the number of pairs listed
     appended, as :func:`_tested_pairs` counts them."""
-    found = _near_pairs(caps, joints, since, reach)
-    if measured is not None:
-        measured.append(0 if found is None else int(found[0].size))
+    found = _listed_pairs(caps, joints, since, reach, measured)
     if found is None:
         return None
     i, j = found
@@ -867,11 +878,7 @@ def _closest_tested_pairs(caps: TreeCapsules, joints, since: int, reach: float,
         if start and bound[start] > best + slack:
             break
         k = order[start : start + _CLOSEST_CHUNK]
-        ki, kj = i[k], j[k]
-        dist, s, t = segment_distances(a[ki], b[ki], a[kj], b[kj])
-        q = np.flatnonzero(caps.junction_pairs(ki, kj))
-        if q.size:  # beyond the junction: parts of the rows, never nearer than the rows
-            dist[q], s[q], t[q] = caps.beyond_junction(ki[q], kj[q])
+        dist, s, t = _pair_distances(caps, i[k], j[k])
         best = min(best, float(dist.min()))
         taken.append((k, dist, s, t))
     k = np.concatenate([x[0] for x in taken])
