@@ -13,7 +13,7 @@ import abc
 import math
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -58,6 +58,7 @@ __all__ = [
     "SetJointState",
     "SetJointStates",
     "Compact",
+    "DesignForTask",
     "SetOptions",
     "FitJunctions",
     "ReplaceDocument",
@@ -915,9 +916,15 @@ class LongCommand(Command):
     def finish(self, document: Document, computed: tuple[Any, tuple[str, ...]]) -> Outcome:
         """The outcome for ``document`` of :meth:`compute`'s result for its chain."""
 
+    def prepared(self, document: Document) -> LongCommand:
+        """This command with what its heavy part needs of ``document`` besides the chain (e.g.
+        the task Compact keeps), to run elsewhere; by default itself."""
+        return self
+
     def apply(self, document: Document) -> Outcome:
-        self.check(document)
-        return self.finish(document, self.compute(document.chain))
+        command = self.prepared(document)
+        command.check(document)
+        return command.finish(document, command.compute(document.chain))
 
 
 @dataclass(frozen=True, eq=False)
@@ -948,7 +955,15 @@ class Computed(Command):
 class Compact(LongCommand):
     """Replace the chain (or tree) by a shorter one with the same kinematics and no collisions
     (:func:`kinegami.optimize.compact`, docs/clearance.md; a tree's sockets fit afterwards);
-    names follow their joints. ``motion`` is for chains only."""
+    names follow their joints. ``motion`` is for chains only.
+
+    A chain with a task keeps it (``keep_task``, as ``kinegami compact`` does): a shorter design
+    is accepted only when every target is still reached exactly, in range, clear with the
+    larger of the chain's and the task's margins and outside the keep-out boxes
+    (:func:`kinegami.optimize.compact_for_task`; ``motion`` and ``objective`` are then not
+    used), else the command is refused. ``task`` is the task document to keep (default: the
+    document's) and ``units`` the design's length units; :meth:`prepared` fills both in.
+    """
 
     seed: int = 0
     motion: bool = False
@@ -956,15 +971,41 @@ class Compact(LongCommand):
     starts: int = 4
     time_limit: float | None = None
     executor: Any = None
+    keep_task: bool = True
+    task: Any = None
+    units: str = "mm"
 
     label: ClassVar[str] = "compact"
+
+    def prepared(self, document: Document) -> Compact:
+        task = self.task
+        if task is None and self.keep_task and not document.is_tree:
+            task = document.task
+        if task is None:
+            return self
+        return replace(self, task=task, units=document.units)
 
     def _compute(self, chain, progress):
         from kinegami.optimize import compact
 
-        return compact(chain, seed=self.seed, motion=self.motion, executor=self.executor,
-                       time_limit=self.time_limit, progress=progress, objective=self.objective,
-                       starts=self.starts)  # fmt: skip
+        if self.task is None:
+            return compact(chain, seed=self.seed, motion=self.motion, executor=self.executor,
+                           time_limit=self.time_limit, progress=progress,
+                           objective=self.objective, starts=self.starts)  # fmt: skip
+        from kinegami.editor.tasks import task_goals
+
+        goals = task_goals(self.task, self.units)
+        margin = max(float(chain.margin), goals.margin)
+        found = compact(chain, seed=self.seed, executor=self.executor, time_limit=self.time_limit,
+                        progress=progress, starts=self.starts, targets=list(goals.targets),
+                        keep_out=goals.keep_out, margin=margin)  # fmt: skip
+        if found is chain:
+            _fail("compact: no shorter design keeps the task (every target reached exactly, in "
+                  "range, clear and outside the keep-out boxes); the design is unchanged")
+        if found.margin != chain.margin:  # checked with the larger margin; the design keeps its own
+            found = fork_chain(found)
+            found.margin = chain.margin
+        return found
 
     def finish(self, document: Document, computed) -> Outcome:
         new, warned = computed
@@ -979,8 +1020,68 @@ class Compact(LongCommand):
         for i, k in zip(new_kept, old_kept, strict=True):
             names[i], sources[i] = document.names[k], k
         clear = tuple(warned) if warned and not new.clearance().ok else ()
+        if self.task is not None and self.motion:
+            clear += ("motion was not checked: the design's task is kept instead (every target "
+                      "still reached, clear)",)  # fmt: skip
         return Outcome(document.replaced(chain=new, names=tuple(names)), None, clear,
                        tuple(sources))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class DesignForTask(LongCommand):
+    """Replace the chain by one designed for the document's task
+    (:func:`kinegami.optimize.design_for`, docs/design-for-a-task.md): its tip reaches every
+    target exactly, in range, clear of itself and outside the keep-out boxes, as
+    ``kinegami design`` makes it. The task stays in the document; the design's length units
+    become the task's (the designed chain is in them), its name and description stay (a
+    design without a name takes the task's). ``seed`` and ``starts`` default to the task's.
+    Refused (the design unchanged) when the search finds no design, with its reason
+    (:class:`~kinegami.errors.InfeasibleTaskError`). ``task`` is filled in by
+    :meth:`prepared` from the document.
+    """
+
+    seed: int | None = None
+    starts: int | None = None
+    executor: Any = None
+    task: Any = None
+
+    label: ClassVar[str] = "design for task"
+
+    def prepared(self, document: Document) -> DesignForTask:
+        if self.task is not None or document.task is None:
+            return self
+        return replace(self, task=document.task)
+
+    def check(self, document: Document) -> None:
+        if document.is_tree:
+            _fail("design for task: tasks are for chains for now, and this design is a tree")
+        if self.task is None:
+            _fail("design for task: this design has no task (a design file made by kinegami "
+                  "design carries one in its \"task\" block; docs/design-for-a-task.md)")
+
+    def _compute(self, chain, progress):
+        from kinegami.design.task import task_from_dict
+        from kinegami.optimize import design_for
+
+        task = task_from_dict(self.task, where=("task",))
+        options = task.options()
+        if self.seed is not None:
+            options["seed"] = self.seed
+        if self.starts is not None:
+            options["starts"] = self.starts
+        # a search, run as kinegami design runs it (numpy's default floating-point handling)
+        with np.errstate(over="warn", invalid="warn", divide="warn", under="ignore"):
+            return design_for(list(task.targets), task.joints, executor=self.executor,
+                              progress=progress, **options)  # fmt: skip
+
+    def finish(self, document: Document, computed) -> Outcome:
+        new, warned = computed
+        task = self.task
+        name = document.name if document.name is not None else task.get("name")
+        designed = Document(new, (None,) * len(new.Joints), name, document.description,
+                            task.get("units", "mm"), document.twistPortion, task)  # fmt: skip
+        clear = tuple(warned) if warned and not new.clearance().ok else ()
+        return Outcome(designed, None, clear, (None,) * len(new.Joints))
 
 
 @dataclass(frozen=True)

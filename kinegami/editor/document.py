@@ -1,5 +1,5 @@
-"""The editor's document: a design (chain or tree, joint names, options, file metadata) as a
-value.
+"""The editor's document: a design (chain or tree, joint names, options, file metadata, the task
+it is made for) as a value.
 
 A :class:`Document` never changes once made: commands build a new one (see
 :mod:`kinegami.editor.commands`), so undo keeps the old one and gives it back bit for bit. Its
@@ -38,7 +38,7 @@ from kinegami.design.reader import (
 from kinegami.errors import ClearanceWarning, InvalidParameterError, InvalidTypeError
 from kinegami.tree import KinematicTree
 
-__all__ = ["Document", "JointRow", "joint_parameters", "fork_chain"]
+__all__ = ["Document", "JointRow", "joint_parameters", "fork_chain", "plain_task"]
 
 
 def fork_chain(chain: KinematicChain | KinematicTree) -> KinematicChain | KinematicTree:
@@ -49,6 +49,17 @@ def fork_chain(chain: KinematicChain | KinematicTree) -> KinematicChain | Kinema
     safely (and costs microseconds).
     """
     return copy.copy(chain)
+
+
+def plain_task(task) -> dict | None:
+    """A private copy of a task document made of plain JSON values (dicts, lists, numbers,
+    strings), or None for None."""
+    if task is None:
+        return None
+    if not isinstance(task, dict):
+        raise InvalidTypeError(f"task must be a task document (a dict) or None, got "
+                               f"{type(task).__name__}")  # fmt: skip
+    return json.loads(json.dumps(task, allow_nan=False))
 
 
 def joint_parameters(joint: Joint) -> dict:
@@ -109,6 +120,9 @@ class Document:
     units : the length unit ("mm", "cm", "m" or "in").
     twistPortion : share of each link's straight part given to its twist (None: the default
         0.2, not written to the file).
+    task : the task the design is made for (its ``"task"`` block, a task document as
+        docs/design-for-a-task.md describes; None: none). Plain JSON values, never changed:
+        commands keep it, :meth:`save` writes it back.
 
     ``chain.requireClearance`` and ``chain.maxAnglePerElbow`` are the design's chain options;
     the joints' states are the chain's.
@@ -120,6 +134,7 @@ class Document:
     description: str | None = None
     units: str = "mm"
     twistPortion: float | None = None
+    task: dict | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.chain, KinematicChain | KinematicTree):
@@ -135,6 +150,9 @@ class Document:
         object.__setattr__(self, "names", names)
         _check_text("name", self.name)
         _check_text("description", self.description)
+        if self.task is not None and not isinstance(self.task, dict):
+            raise InvalidTypeError(f"task must be a task document (a dict) or None, got "
+                                   f"{type(self.task).__name__}")  # fmt: skip
         if self.units not in UNITS:
             raise InvalidParameterError(
                 f"units must be one of {', '.join(map(repr, UNITS))}, got {self.units!r}"
@@ -151,9 +169,10 @@ class Document:
         description: str | None = None,
         units: str = "mm",
         twistPortion: float | None = None,
+        task: dict | None = None,
     ) -> Document:
         """A document holding a copy of ``chain``, a chain or a tree (later edits of ``chain``
-        do not reach it).
+        do not reach it), and a copy of ``task`` (a task document, or None).
 
         ``names`` defaults to the joint names the design loader remembers for ``chain``.
         """
@@ -164,7 +183,8 @@ class Document:
         if names is None:
             origin = origin_of(chain)
             names = origin.names if origin is not None else (None,) * len(chain.Joints)
-        return cls(fork_chain(chain), tuple(names), name, description, units, twistPortion)
+        return cls(fork_chain(chain), tuple(names), name, description, units, twistPortion,
+                   plain_task(task))  # fmt: skip
 
     @classmethod
     def _from_parsed(cls, document, file) -> Document:
@@ -178,6 +198,7 @@ class Document:
             info.description,
             info.units,
             document.get("twistPortion"),
+            plain_task(info.task),
         )
 
     @classmethod
@@ -201,6 +222,7 @@ class Document:
             "description": self.description,
             "units": self.units,
             "twistPortion": self.twistPortion,
+            "task": self.task,
         }
         values.update(changes)
         return Document(**values)
@@ -267,6 +289,7 @@ class Document:
                 description=self.description,
                 units=self.units,
                 twistPortion=self.twistPortion,
+                task=self.task,
             )
         entries = document["joints"]
         offset = len(entries) - len(self.names)  # 1 when the root is an EndTip (see writer)

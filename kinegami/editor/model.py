@@ -48,7 +48,7 @@ class Change:
     removed : indices (in the old document) of the joints that are gone.
     structure : the number of joints changed (joints were added or deleted).
     names : the joint names changed.
-    options : the chain options or the design's texts changed.
+    options : the chain options, the design's texts or its task changed.
     selected : the selected joint after the change (None: nothing selected).
     dirty : the document differs from the saved one.
     """
@@ -139,7 +139,7 @@ def _flatten(values):
 def _options(document: Document) -> tuple:
     c = document.chain
     return (document.name, document.description, document.units, document.twistPortion,
-            c.requireClearance, c.maxAnglePerElbow)  # fmt: skip
+            c.requireClearance, c.maxAnglePerElbow, document.task)  # fmt: skip
 
 
 def compare(old: Document, new: Document, kind: str, sources=None) -> Change:
@@ -669,11 +669,21 @@ class EditorModel:
         return self.apply(cmd.SetJointStates(states))
 
     def compact(self, **options) -> CommandResult:
-        """Compact the chain (options of :class:`~kinegami.editor.commands.Compact`)."""
+        """Compact the chain (options of :class:`~kinegami.editor.commands.Compact`; a chain
+        with a task keeps it)."""
         try:
             command = cmd.Compact(**options)
         except TypeError as error:
             return CommandResult(False, "compact", f"compact: {error}")
+        return self.apply(command)
+
+    def design_for_task(self, **options) -> CommandResult:
+        """Replace the chain by one designed for the document's task (options of
+        :class:`~kinegami.editor.commands.DesignForTask`); one undoable step, the task kept."""
+        try:
+            command = cmd.DesignForTask(**options)
+        except TypeError as error:
+            return CommandResult(False, "design for task", f"design for task: {error}")
         return self.apply(command)
 
     def set_options(self, **options) -> CommandResult:

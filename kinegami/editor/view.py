@@ -32,6 +32,7 @@ from kinegami.editor.commands import (
     JOINT_TYPES,
     Compact,
     Computed,
+    DesignForTask,
     FitJunctions,
     LongCommand,
     ReplaceDocument,
@@ -51,6 +52,7 @@ from kinegami.editor.jobs import (
 from kinegami.editor.keys import keys_script, shortcuts_markdown
 from kinegami.editor.model import Change, CommandResult, EditorModel
 from kinegami.editor.page_script import run_javascript, unsaved_changes_script
+from kinegami.editor.tasks import TargetCheck, check_targets, task_goals
 from kinegami.editor.units import (
     DEGREE,
     angle_text,
@@ -107,6 +109,12 @@ ANIMATION_FPS = 20.0
 DEFAULT_FOV = math.radians(75.0)
 #: Seconds each start of the Compact button's compaction may search.
 COMPACT_TIME_LIMIT = 30.0
+#: Seconds without a change before the targets of the design's task are checked again.
+TASK_DELAY = 0.3
+#: The colours of a task's targets: reached clear, not reached, not checked (yet).
+REACHED_COLOR = (40, 160, 80)
+MISSED_COLOR = COLLIDING_COLOR
+UNCHECKED_COLOR = (150, 150, 150)
 
 
 def gallery(folder: Path = GALLERY_DIR) -> dict[str, Path]:
@@ -232,6 +240,11 @@ def _wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
     return tuple(v / n for v in q)
 
 
+def _target_colour(reached: bool | None) -> tuple[int, int, int]:
+    """A task target's colour: green reached, red not, grey not checked (None)."""
+    return UNCHECKED_COLOR if reached is None else REACHED_COLOR if reached else MISSED_COLOR
+
+
 def _matrix(wxyz) -> np.ndarray:
     from scipy.spatial.transform import Rotation
 
@@ -334,6 +347,16 @@ class EditorView:
         self._pattern_redraw = Debounced(self.redraw_pattern, pattern_delay,
                                          name="kinegami-pattern")  # fmt: skip
         self._jobs = JobProcess() if background else None
+        self._task_check = Debounced(self.check_task, TASK_DELAY, name="kinegami-task")
+        self._task_handles: list = []  # the scene nodes of the task's targets
+        self._task_key: Any = None  # (task, units, states shown) the nodes were drawn for
+        self._task_goals: Any = None  # ((task, units), TaskGoals or the error)
+        #: The targets' checks shown (one TargetCheck each; an exception when the task could
+        #: not be checked; None: not checked) and the document they are of.
+        self.task_checks: tuple[TargetCheck, ...] | Exception | None = None
+        self.task_checked: Document | None = None
+        #: How many times the targets' checks were shown (tests read it).
+        self.task_draws = 0
         self._target_handle = None  # the reach target's handle (made when first shown)
         self._target_marker = None
         self._reach_point: np.ndarray | None = None
@@ -371,6 +394,7 @@ class EditorView:
         self._size_scene()
         self.frame_camera()
         self._pattern_redraw.trigger()
+        self._task_check.trigger()
         self._recovery_modal = None
         self._sync_unsaved()
         if recovery is not None:
@@ -398,6 +422,7 @@ class EditorView:
         self._size_scene()
         self.frame_camera()
         self._pattern_redraw.trigger()
+        self._task_check.trigger()
         self._sync_unsaved()
 
     def frame_camera(self) -> Framing:
@@ -450,6 +475,9 @@ class EditorView:
                 continue
             M = np.asarray(node.matrix, dtype=float)
             points.append(box_corners(node.lo, node.hi) @ M[:3, :3].T + M[:3, 3])
+        targets = self.task_positions()
+        if points and len(targets):  # the task's targets are drawn beside the design
+            points += [targets - self._r, targets + self._r]
         if not points:  # nothing drawn: the joints' origins, a tube radius around them
             origins = np.array([j.pose_matrix[:3, 3] for j in self.model.chain.Joints])
             return origins.min(0) - self._r, origins.max(0) + self._r
@@ -492,12 +520,15 @@ class EditorView:
         if self._jobs is not None:
             self._jobs.close()
         self._pattern_redraw.close()
+        self._task_check.close()
         if self.autosave is not None:
             self.autosave.flush()
 
     def flush(self) -> None:
-        """Do now what waits for a pause: draw the crease-pattern panel if it is due."""
+        """Do now what waits for a pause: draw the crease-pattern panel and check the task's
+        targets if they are due."""
         self._pattern_redraw.flush()
+        self._task_check.flush()
 
     def act(self, action) -> CommandResult:
         """Run ``action()`` (a model call returning a CommandResult) under the view's lock and
@@ -523,6 +554,8 @@ class EditorView:
 
     def _on_change(self, change: Change) -> None:
         self._pattern_redraw.trigger()
+        if change.kind != "select":
+            self._task_check.trigger()
         atomic = getattr(self.target, "atomic", None)
         # one batch: the tab applies the step at once, and the server wakes its sender once
         with atomic() if atomic is not None else contextlib.nullcontext():
@@ -533,6 +566,7 @@ class EditorView:
                 return
             self._update_scene(change)
             self._update_panel(structure=change.structure)
+            self._update_task()
         if self.autosave is not None:
             if change.kind == "save":
                 self.autosave.discard()
@@ -577,6 +611,7 @@ class EditorView:
         self._recolour()
         self._update_gizmo()
         self._update_panel(structure=True)
+        self._update_task()
 
     def _joint_node(self, joint, i: int) -> _Node:
         from kinegami.clearance.solids import joint_parts
@@ -911,8 +946,9 @@ class EditorView:
         with gui.add_folder("Clearance"):
             self._clearance = gui.add_markdown("")
             compact = gui.add_button(
-                "Compact", hint="a shorter design with the same kinematics, clear of itself "
-                "(runs in the background: Cancel stops it, Undo takes it back)",
+                "Compact", hint="a shorter design with the same kinematics, clear of itself; "
+                "a design with a task still reaches every target (runs in the background: "
+                "Cancel stops it, Undo takes it back)",
             )  # fmt: skip
             compact.on_click(lambda _: self.compact())
             check = gui.add_button(
@@ -927,6 +963,16 @@ class EditorView:
                 "as kinegami build does (the kinematics stay)",
             )  # fmt: skip
             self._fit.on_click(lambda _: self.fit_junctions())
+        # the task the design is made for: its targets and the design search (docs/editor.md)
+        self._task_folder = gui.add_folder("Task", visible=self.model.document.task is not None)
+        with self._task_folder:
+            self._task_html = gui.add_html("")
+            self._design_button = gui.add_button(
+                "Design for task", hint="search a design whose tip reaches every target "
+                "exactly, clear of itself, as kinegami design does (runs in the background: "
+                "Cancel stops it, Undo takes it back)",
+            )  # fmt: skip
+            self._design_button.on_click(lambda _: self.design_for_task())
         with gui.add_folder("Reach"):
             units = self.model.document.units
             self._reach_target = gui.add_vector3(
@@ -979,6 +1025,191 @@ class EditorView:
             open_example.on_click(lambda _: self.open_example(str(self._example.value)))
             upload = gui.add_upload_button("Upload design", mime_type="application/json")
             upload.on_upload(lambda e: self.upload(e.target.value.name, e.target.value.content))
+
+    # --- task ---------------------------------------------------------------------------------
+    def _goals(self, document: Document):
+        """The TaskGoals of ``document``'s task in its units (an exception when the task cannot
+        be read so; None without a task), computed once per task and units."""
+        if document.task is None:
+            return None
+        cached = self._task_goals
+        if cached is not None and cached[0][0] is document.task and \
+                cached[0][1] == document.units:  # fmt: skip
+            return cached[1]
+        try:
+            goals = task_goals(document.task, document.units)
+        except (KinegamiError, ValueError) as error:
+            goals = error
+        self._task_goals = ((document.task, document.units), goals)
+        return goals
+
+    def task_positions(self) -> np.ndarray:
+        """Where the targets of the shown design's task are ((n, 3), world frame, design
+        units; empty without a task)."""
+        goals = self._goals(self.model.document)
+        if goals is None or isinstance(goals, Exception):
+            return np.zeros((0, 3))
+        return np.array([t.position for t in goals.targets], dtype=float).reshape(-1, 3)
+
+    def _checks_of(self, document: Document):
+        """The targets' checks of ``document`` (computed once per document, in the worker
+        process when the view has one): a tuple of TargetCheck, or the exception that stopped
+        the check."""
+        cached = document.__dict__.get("_task_checks")
+        if cached is not None:
+            return cached
+        args = (document.chain, document.task, document.units)
+        checks = None
+        if self._worker is not None:
+            try:
+                checks = self._worker.run(check_targets, *args)
+            except (KinegamiError, ValueError) as error:
+                checks = error
+            except Exception:  # noqa: BLE001, S110 - the worker process failed: check here instead
+                pass
+        if checks is None:
+            try:
+                checks = check_targets(*args)
+            except (KinegamiError, ValueError) as error:
+                checks = error
+        document.__dict__["_task_checks"] = checks
+        return checks
+
+    def check_task(self) -> bool:
+        """Check every target of the shown design's task (the view calls it after a pause;
+        see :meth:`flush`): reached exactly, in range, clear and outside the keep-out boxes,
+        or why not (:func:`~kinegami.editor.tasks.check_targets`), drawn green or red in the
+        scene and listed in the Task panel. Returns whether a new result was shown (nothing
+        is shown when another document has replaced the one checked meanwhile)."""
+        with self.lock:
+            if self._closed:
+                return False
+            model, document = self.model, self.model.document
+            if document.task is None or document.is_tree:
+                return False
+        checks = self._checks_of(document)
+        with self.lock:
+            if self._closed or self.model is not model or model.document is not document:
+                return False  # a later change has triggered another check
+            self.task_checks, self.task_checked = checks, document
+            self._update_task()
+            self.task_draws += 1
+            return True
+
+    def _update_task(self) -> None:
+        """The Task panel and the targets in the scene, for the shown design and the latest
+        checks (of it, or of the design before it until the new ones come)."""
+        document = self.model.document
+        if self._task_folder.visible != (document.task is not None):
+            self._task_folder.visible = document.task is not None
+        chain_task = document.task is not None and not document.is_tree
+        if self._design_button.visible != chain_task:
+            self._design_button.visible = chain_task
+        checks = self.task_checks if chain_task else None
+        if checks is not None and self.task_checked is not None and \
+                self.task_checked.task is not document.task:  # fmt: skip
+            checks = None  # of another task
+        self._draw_targets(document, checks)
+        html_text = self.task_html(document, checks)
+        if self._task_html.content != html_text:
+            self._task_html.content = html_text
+
+    def target_colours(self) -> tuple[tuple[int, int, int], ...]:
+        """The colour each target of the task is drawn in (green reached, red not, grey not
+        checked)."""
+        key = self._task_key
+        return () if key is None else tuple(_target_colour(state) for state in key[2])
+
+    def _draw_targets(self, document: Document, checks) -> None:
+        """The targets in the scene: a ball at each (a frame for a pose target, an arrow along
+        an axis target's axis) in the colour of its check, and its name; drawn again only
+        when the task, the units or a colour changed."""
+        goals = self._goals(document)
+        if goals is None or isinstance(goals, Exception):
+            key = None
+        else:
+            states = tuple(None if not isinstance(checks, tuple) else checks[k].reached
+                           for k in range(len(goals.targets)))  # fmt: skip
+            key = (document.task, document.units, states)
+        old = self._task_key
+        if key is not None and old is not None and key[0] is old[0] and key[1:] == old[1:]:
+            return
+        for handle in self._task_handles:
+            handle.remove()
+        self._task_handles = []
+        self._task_key = key
+        if key is None:
+            return
+        size = self._r
+        for k, (target, state) in enumerate(zip(goals.targets, key[2], strict=True)):
+            colour = _target_colour(state)
+            position = tuple(float(v) for v in target.position)
+            name = f"/task/target{k}"
+            self._task_handles.append(self.scene.add_icosphere(
+                name, radius=0.5 * size, color=colour, position=position))  # fmt: skip
+            if target.rotation is not None:
+                self._task_handles.append(self.scene.add_frame(
+                    f"{name}_frame", axes_length=2.5 * size, axes_radius=0.08 * size,
+                    wxyz=_wxyz(target.rotation), position=position))  # fmt: skip
+            elif target.axis is not None:
+                tip = np.asarray(target.position) + 2.5 * size * np.asarray(target.axis)
+                self._task_handles.append(self.scene.add_arrows(
+                    f"{name}_axis", points=np.array([[target.position, tip]], dtype=np.float32),
+                    colors=colour, shaft_radius=0.1 * size, head_radius=0.25 * size,
+                    head_length=0.6 * size))  # fmt: skip
+            label = document.task["targets"][k].get("name") or f"target {k}"
+            self._task_handles.append(self.scene.add_label(
+                f"{name}_label", str(label), position=position))  # fmt: skip
+
+    def task_html(self, document: Document, checks) -> str:
+        """The Task panel: the task's name and joints, then one line per target, its colour
+        and whether the design reaches it (or why not)."""
+        from html import escape
+
+        task = document.task
+        if task is None:
+            return ""
+        title = escape(str(task.get("name") or "task"))
+        count = len(task.get("targets", ()))
+        head = (f"<b>{title}</b>: {count} target{'s' if count != 1 else ''}, joints "
+                f"{escape(str(task.get('joints')))}")  # fmt: skip
+        if document.is_tree:
+            return (f"<div>{head}.<br><b>Tasks are for chains for now</b>: this design is a tree, "
+                    "so its targets are not checked and it cannot be designed for its task "
+                    "here (the task is kept when the design is saved).</div>")  # fmt: skip
+        goals = self._goals(document)
+        if isinstance(goals, Exception):
+            return f"<div>{head}.<br><b>The task cannot be read:</b> {escape(str(goals))}</div>"
+        if isinstance(checks, Exception):
+            return (f"<div>{head}.<br><b>The targets could not be checked:</b> "
+                    f"{escape(str(checks))}</div>")  # fmt: skip
+        units = document.units
+        if checks is None:
+            summary = "checking the targets..."
+        else:
+            reached = sum(1 for c in checks if c.reached)
+            summary = f"{reached} of {len(checks)} reached"
+            if self.task_checked is not document:
+                summary += " (checking the design as changed...)"
+        rows = []
+        for k in range(count):
+            spec = task["targets"][k]
+            label = escape(f"target {k}" + (f" '{spec['name']}'" if spec.get("name") else ""))
+            if checks is None:
+                state, text, colour = "unchecked", "not checked yet", UNCHECKED_COLOR
+            elif checks[k].reached:
+                state, colour = "reached", REACHED_COLOR
+                text = (f"reached, exactly and clear (clearance "
+                        f"{length_text(checks[k].clearance, units)})")  # fmt: skip
+            else:
+                state, colour = "missed", MISSED_COLOR
+                text = f"<b>not reached</b>: {escape(checks[k].reason)}"
+            dot = "#{:02x}{:02x}{:02x}".format(*colour)
+            rows.append(f'<li data-target="{k}" data-state="{state}" style="margin:0.2em 0">'
+                        f'<span style="color:{dot}">&#9679;</span> {label}: {text}'
+                        '</li>')  # fmt: skip
+        return (f"<div>{head}; {summary}.<ul style=\"list-style:none;padding-left:0;"
+                f"margin:0.3em 0\">{''.join(rows)}</ul></div>")  # fmt: skip
 
     # --- reach --------------------------------------------------------------------------------
     def reach_tip(self) -> int:
@@ -1501,7 +1732,30 @@ class EditorView:
         except TypeError as error:
             self._say(f"**Refused:** compact: {error}")
             return None
-        return self.run_command_job(command, "Compacting", "starts")
+        document = self.model.base_document
+        keeps = command.keep_task and document.task is not None and not document.is_tree
+        return self.run_command_job(command, "Compacting (keeping the task)" if keeps
+                                    else "Compacting", "starts")  # fmt: skip
+
+    def design_for_task(self, **options) -> Job | None:
+        """Design for the document's task in the background (the Design for task button;
+        ``options`` of :class:`~kinegami.editor.commands.DesignForTask`): the designed chain
+        replaces the design as one command, the task kept; a search that finds none shows its
+        reason and changes nothing."""
+        try:
+            command = DesignForTask(**options)
+        except TypeError as error:
+            self._say(f"**Refused:** design for task: {error}")
+            return None
+        return self.run_command_job(command, "Designing for the task", "starts",
+                                    then=self._designed)  # fmt: skip
+
+    def _designed(self, result: CommandResult) -> None:
+        """After Design for task: another design, maybe of another size (grid and camera
+        follow)."""
+        if result.ok:
+            self._size_scene()
+            self.frame_camera()
 
     def fit_junctions(self) -> Job | None:
         """Fit a tree's junction sockets in the background (the Fit junctions button)."""
@@ -1527,13 +1781,17 @@ class EditorView:
                               motion_check, (document.chain, document.names, int(samples)),
                               finish)  # fmt: skip
 
-    def run_command_job(self, command: LongCommand, title: str, unit: str) -> Job | None:
+    def run_command_job(self, command: LongCommand, title: str, unit: str,
+                        then: Callable[[CommandResult], Any] | None = None,
+                        ) -> Job | None:  # fmt: skip
         """Run a long command's heavy part in the background; its result is applied as one
         command (:class:`~kinegami.editor.commands.Computed`) when the design is still the
-        one it started from, else the tab asks first (:meth:`resolve_result`)."""
+        one it started from (then ``then(result)``), else the tab asks first
+        (:meth:`resolve_result`)."""
         with self.lock:
             self.stop_animation()
             document = self.model.base_document
+            command = command.prepared(document)
             try:
                 command.check(document)
             except KinegamiError as error:
@@ -1543,7 +1801,9 @@ class EditorView:
         def finish(job: Job, computed) -> None:
             result = Computed(command, job.source, computed)
             if self.model.base_document is job.source:
-                self.act(lambda: self.model.apply(result))
+                applied = self.act(lambda: self.model.apply(result))
+                if then is not None:
+                    then(applied)
             else:
                 self._ask_result(job, result)
 
