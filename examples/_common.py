@@ -114,6 +114,37 @@ def draw_tree(tree, units: str | None = None):
     return draw_chain(tree, zoom=TREE_ZOOM, units=units)
 
 
+def draw_task(chain, positions, answers, units: str | None = None):
+    """The robot at each target of a task, side by side (the gallery's camera): ``answers``
+    one reach answer per target (its states), ``positions`` the targets' points, drawn red;
+    returns the figure."""
+    import copy
+
+    import matplotlib.pyplot as plt
+
+    count = len(answers)
+    fig = plt.figure(figsize=(4.0 * count, 3.2))
+    axes = []
+    for k, (point, answer) in enumerate(zip(positions, answers, strict=True)):
+        ax = fig.add_axes((k / count, 0.0, 1.0 / count, 0.92), projection="3d")
+        posed = copy.copy(chain)
+        posed.setJointStates(list(answer.states))
+        posed.show(ax=ax, showJointPoses=False, showGlobalFrame=False, units=units)
+        ax.scatter(*np.reshape(point, (3, 1)), color="red", s=30, depthshade=False)
+        ax.view_init(**VIEW)
+        ax.set_title(f"target {k}", fontsize=9)
+        axes.append(ax)
+    # one scale for every panel: the box around all of them
+    limits = [(min(getattr(ax, f"get_{c}lim3d")()[0] for ax in axes),
+               max(getattr(ax, f"get_{c}lim3d")()[1] for ax in axes)) for c in "xyz"]  # fmt: skip
+    for ax in axes:
+        ax.set_xlim3d(*limits[0])
+        ax.set_ylim3d(*limits[1])
+        ax.set_zlim3d(*limits[2])
+        ax.set_box_aspect([hi - lo for lo, hi in limits], zoom=1.15)
+    return fig
+
+
 def draw_pattern(pattern, units: str | None = None):
     """The crease pattern drawing (valley folds red, mountain folds blue, a scale bar in
     ``units``); returns the figure.

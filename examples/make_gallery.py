@@ -8,7 +8,8 @@ chain or tree with the design loader and writes, into ``docs/images/gallery/`` (
 * ``<name>.png``: the 3D view, 640 x 560 pixels, the same camera for every entry, with a scale
   bar in the design's ``units``;
 * for a chain, ``<name>_pattern.png``: its crease pattern (valley folds red, mountain folds
-  blue), axes and scale bar in the design's ``units``;
+  blue), axes and scale bar in the design's ``units``; for a chain designed for a task (a
+  ``task`` block), ``<name>_task.png``: the robot at each of its targets;
 * for a tree, ``<name>_sheet_<k>_pattern.png``: the crease pattern of every sheet k, as
   ``kinegami build`` cuts the tree (one sheet per leaf, branch joints slid where their junction
   sockets need room), and ``<name>_<pose>.png``: the 3D view in every named configuration of
@@ -48,6 +49,7 @@ from _common import (  # noqa: E402
     PATTERN_DPI,
     draw_chain,
     draw_pattern,
+    draw_task,
     draw_tree,
     save_figure,
     tree_sheets,
@@ -113,6 +115,7 @@ def draw_entry(name: str, folder: Path) -> list[Path]:
             return draw_tree_entry(chain, name, folder, info.units) + draw_workspace(
                 chain, name, folder, info.units)  # fmt: skip
     return [
+        *draw_task_entry(chain, info, name, folder),
         save_figure(draw_chain(chain, units=info.units), folder / f"{name}.png", CHAIN_DPI),
         save_figure(
             draw_pattern(chain.creasePattern(), info.units),
@@ -122,6 +125,25 @@ def draw_entry(name: str, folder: Path) -> list[Path]:
         ),
         *draw_workspace(chain, name, folder, info.units),
     ]
+
+
+def draw_task_entry(chain, info, name: str, folder: Path) -> list[Path]:
+    """``<name>_task.png`` for a chain designed for a task (its design file's ``task``): the
+    robot at each target, as :func:`kinegami.reach.solve` (seed 0) reaches it; none without."""
+    if info.task is None:
+        return []
+    from kinegami.design.task import task_from_dict
+    from kinegami.reach import solve
+
+    task = task_from_dict(info.task, DESIGNS / f"{name}.json", where=("task",))
+    answers = [solve(chain, target, margin=task.margin) for target in task.targets]
+    missed = [k for k, answer in enumerate(answers) if not answer.ok]
+    if missed:
+        raise DesignError(f"target {missed[0]} of the task is not reached: "
+                          f"{answers[missed[0]].reason}", field="task",
+                          file=DESIGNS / f"{name}.json")  # fmt: skip
+    picture = draw_task(chain, [t.position for t in task.targets], answers, info.units)
+    return [save_figure(picture, folder / f"{name}_task.png", CHAIN_DPI)]
 
 
 def draw_workspace(design, name: str, folder: Path, units: str) -> list[Path]:
