@@ -115,6 +115,8 @@ TASK_DELAY = 0.3
 REACHED_COLOR = (40, 160, 80)
 MISSED_COLOR = COLLIDING_COLOR
 UNCHECKED_COLOR = (150, 150, 150)
+#: The Task panel's text: as the panel's Markdown is set.
+TASK_STYLE = "padding:0 0.6em;font-size:0.875rem;line-height:1.45"
 
 
 def gallery(folder: Path = GALLERY_DIR) -> dict[str, Path]:
@@ -238,6 +240,11 @@ def _wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
         q = ((m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s)
     n = math.sqrt(sum(v * v for v in q))
     return tuple(v / n for v in q)
+
+
+def _task_box(content: str) -> str:
+    """The Task panel's HTML around ``content`` (escaped already)."""
+    return f'<div style="{TASK_STYLE}">{content}</div>'
 
 
 def _target_colour(reached: bool | None) -> tuple[int, int, int]:
@@ -880,6 +887,16 @@ class EditorView:
         self._job_cancel = gui.add_button("Cancel", color="red", visible=False,
                                           hint="stop the running job; nothing changes")  # fmt: skip
         self._job_cancel.on_click(lambda _: self.cancel_job())
+        # the task the design is made for: its targets and the design search (docs/editor.md)
+        self._task_folder = gui.add_folder("Task", visible=self.model.document.task is not None)
+        with self._task_folder:
+            self._task_html = gui.add_html("")
+            self._design_button = gui.add_button(
+                "Design for task", hint="search a design whose tip reaches every target "
+                "exactly, clear of itself, as kinegami design does (runs in the background: "
+                "Cancel stops it, Undo takes it back)",
+            )  # fmt: skip
+            self._design_button.on_click(lambda _: self.design_for_task())
         with gui.add_folder("View"):
             self._frame_button = gui.add_button("Frame all", hint="F: the whole design in view")
             self._frame_button.on_click(lambda _: self.frame_all())
@@ -963,16 +980,6 @@ class EditorView:
                 "as kinegami build does (the kinematics stay)",
             )  # fmt: skip
             self._fit.on_click(lambda _: self.fit_junctions())
-        # the task the design is made for: its targets and the design search (docs/editor.md)
-        self._task_folder = gui.add_folder("Task", visible=self.model.document.task is not None)
-        with self._task_folder:
-            self._task_html = gui.add_html("")
-            self._design_button = gui.add_button(
-                "Design for task", hint="search a design whose tip reaches every target "
-                "exactly, clear of itself, as kinegami design does (runs in the background: "
-                "Cancel stops it, Undo takes it back)",
-            )  # fmt: skip
-            self._design_button.on_click(lambda _: self.design_for_task())
         with gui.add_folder("Reach"):
             units = self.model.document.units
             self._reach_target = gui.add_vector3(
@@ -1174,15 +1181,16 @@ class EditorView:
         head = (f"<b>{title}</b>: {count} target{'s' if count != 1 else ''}, joints "
                 f"{escape(str(task.get('joints')))}")  # fmt: skip
         if document.is_tree:
-            return (f"<div>{head}.<br><b>Tasks are for chains for now</b>: this design is a tree, "
-                    "so its targets are not checked and it cannot be designed for its task "
-                    "here (the task is kept when the design is saved).</div>")  # fmt: skip
+            return _task_box(f"{head}.<br><b>Tasks are for chains for now</b>: this design is a "
+                             "tree, so its targets are not checked and it cannot be designed "
+                             "for its task here (the task is kept when the design is "
+                             "saved).")  # fmt: skip
         goals = self._goals(document)
         if isinstance(goals, Exception):
-            return f"<div>{head}.<br><b>The task cannot be read:</b> {escape(str(goals))}</div>"
+            return _task_box(f"{head}.<br><b>The task cannot be read:</b> {escape(str(goals))}")
         if isinstance(checks, Exception):
-            return (f"<div>{head}.<br><b>The targets could not be checked:</b> "
-                    f"{escape(str(checks))}</div>")  # fmt: skip
+            return _task_box(f"{head}.<br><b>The targets could not be checked:</b> "
+                             f"{escape(str(checks))}")  # fmt: skip
         units = document.units
         if checks is None:
             summary = "checking the targets..."
@@ -1203,13 +1211,14 @@ class EditorView:
                         f"{length_text(checks[k].clearance, units)})")  # fmt: skip
             else:
                 state, colour = "missed", MISSED_COLOR
-                text = f"<b>not reached</b>: {escape(checks[k].reason)}"
+                reason = checks[k].reason.removeprefix("not reached").removeprefix(": ")
+                text = f"<b>not reached</b>: {escape(reason)}"
             dot = "#{:02x}{:02x}{:02x}".format(*colour)
             rows.append(f'<li data-target="{k}" data-state="{state}" style="margin:0.2em 0">'
                         f'<span style="color:{dot}">&#9679;</span> {label}: {text}'
                         '</li>')  # fmt: skip
-        return (f"<div>{head}; {summary}.<ul style=\"list-style:none;padding-left:0;"
-                f"margin:0.3em 0\">{''.join(rows)}</ul></div>")  # fmt: skip
+        return _task_box(f"{head}; {summary}.<ul style=\"list-style:none;padding-left:0;"
+                         f"margin:0.3em 0\">{''.join(rows)}</ul>")  # fmt: skip
 
     # --- reach --------------------------------------------------------------------------------
     def reach_tip(self) -> int:
