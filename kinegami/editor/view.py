@@ -561,7 +561,7 @@ class EditorView:
 
     def _on_change(self, change: Change) -> None:
         self._pattern_redraw.trigger()
-        if change.kind != "select":
+        if change.kind != "select" and self.model.document.task is not None:
             self._task_check.trigger()
         atomic = getattr(self.target, "atomic", None)
         # one batch: the tab applies the step at once, and the server wakes its sender once
