@@ -170,6 +170,22 @@ def test_the_view_draws_each_target_green_or_red_and_lists_why(view):
     assert view.target_colours() == (REACHED_COLOR, REACHED_COLOR, MISSED_COLOR)
 
 
+def test_axis_and_pose_targets_are_drawn_with_their_direction(view):
+    task = copy.deepcopy(view.model.document.task)
+    task["targets"][1]["axis"] = [0.0, 0.0, 1.0]
+    task["targets"][2] = {"name": "C", "pose": [{"Trans": DESIGNED_C}, {"Rx": 180}]}
+    view.set_model(EditorModel(view.model.document.replaced(task=task)))
+    view.flush()
+    assert [c.kind for c in view.task_checks] == ["position", "axis", "pose"]
+    names = sorted(handle.name for handle in view._task_handles)
+    assert names == ["/task/target0", "/task/target0_label", "/task/target1",
+                     "/task/target1_axis", "/task/target1_label", "/task/target2",
+                     "/task/target2_frame", "/task/target2_label"]  # fmt: skip
+    np.testing.assert_allclose(np.asarray(view.task_checks[2].rotation)[:, 2], [0, 0, -1],
+                               atol=1e-12)  # fmt: skip
+    assert len(view.target_colours()) == 3
+
+
 def test_a_tree_with_a_task_says_tasks_are_for_chains(view):
     tree = Document.load(GRIPPER).replaced(task=view.model.document.task)
     view.set_model(EditorModel(tree))
