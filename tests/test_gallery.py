@@ -401,7 +401,7 @@ def test_pick_and_place_reaches_its_task(designs):
         assert posed.clearance().ok
         assert keep_out_violation(arm, answer.states, task.keep_out) is None
         answers.append(answer)
-    for a, b in zip(answers, answers[1:]):
+    for a, b in zip(answers, answers[1:], strict=False):
         assert check_path(arm, a.states, b.states).ok
 
 

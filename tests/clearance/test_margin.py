@@ -65,20 +65,34 @@ def _numbers(report: ClearanceReport) -> tuple:
     return (report.ok, "inf" if math.isinf(value) else value.hex(), len(report.pairs))
 
 
+def _same_numbers(now: tuple, before: tuple) -> bool:
+    """The same verdict and pair count, and the same smallest clearance up to the last bits
+    that numpy's vector kernels round differently on another processor (1e-12 relative: the
+    algorithmic hand's tree distances differ in their last 12 bits between two machines)."""
+    if now[0] != before[0] or now[2] != before[2] or ("inf" in (now[1], before[1])):
+        return now == before
+    a, b = float.fromhex(now[1]), float.fromhex(before[1])
+    return abs(a - b) <= 1e-12 * max(abs(a), abs(b))
+
+
 def serial():
     return concurrent.futures.ThreadPoolExecutor(max_workers=1)
 
 
 # --- margin 0 changes nothing ------------------------------------------------------------------
+#: Gallery designs added after the margin existed (nothing to compare them with).
+ADDED_LATER = {"pick_and_place.json"}
+
+
 def test_every_gallery_design_is_judged_as_before_at_margin_0():
-    assert sorted(p.name for p in DESIGNS.glob("*.json")) == sorted(BEFORE)
+    assert sorted(p.name for p in DESIGNS.glob("*.json")) == sorted({*BEFORE, *ADDED_LATER})
     for name, before in BEFORE.items():
         chain = _load(DESIGNS / name)
         assert chain.margin == 0.0
         report = chain.clearance()
-        assert _numbers(report) == before, name
+        assert _same_numbers(_numbers(report), before), name
         assert report.margin == 0.0
-        assert _numbers(chain.clearance(margin=0)) == before, name
+        assert _same_numbers(_numbers(chain.clearance(margin=0)), before), name
     assert _numbers(_load(PAPERS_HAND).clearance()) == PAPERS_HAND_BEFORE
 
 
