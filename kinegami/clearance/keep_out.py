@@ -61,11 +61,12 @@ def keep_out_violation(design, states, boxes, margin: float = 0.0) -> tuple[int,
     """(box index, depth) of the first keep-out box that a part of ``design`` at ``states``
     comes within ``margin`` of (its tube of radius r), or None. Depth: how far inside the allowed
     distance (design units)."""
-    from kinegami.clearance.engine import engine_for
+    from kinegami.chain.model import KinematicChain
+    from kinegami.clearance.engine import engine_for, tree_engine
 
     if not boxes:
         return None
-    engine = engine_for(design)
+    engine = engine_for(design) if isinstance(design, KinematicChain) else tree_engine(design)
     a, b = engine.segments(np.asarray(states, dtype=float)[None, :])
     a, b = a[0], b[0]
     r = float(design.r)

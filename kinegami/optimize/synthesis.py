@@ -28,7 +28,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from kinegami.clearance.keep_out import Box, keep_out_violation
-from kinegami.errors import InfeasibleTaskError, InvalidParameterError, InvalidTypeError
+from kinegami.errors import (
+    InfeasibleTaskError,
+    InvalidParameterError,
+    InvalidTypeError,
+    KinegamiError,
+)
 from kinegami.progress import Progress, check_progress
 from kinegami.validation import check_int, check_num_sides, check_positive, check_radius
 
@@ -474,18 +479,32 @@ _TIP_TURNS = (np.eye(3), np.diag([-1.0, -1.0, 1.0]), np.array([[0, -1, 0], [1, 0
 _TIP_AXES = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 
 
-def _build(model: _Model, x: np.ndarray):
-    """The chain of the fitted unknowns ``x`` (joints slid along their axes by placement, the end
-    tip exactly at the table's tip), with its states per target (full configurations), or
-    (None, reason)."""
-    from kinegami.chain.joints import EndTip, PrismaticJoint, RevoluteJoint
-    from kinegami.chain.model import KinematicChain
-    from kinegami.errors import ClearanceWarning, NoPathError, PlacementWarning
+def _end_tips(model: _Model, tip: np.ndarray) -> list:
+    """End tips (length 1.5 r) whose distal frame is ``tip`` (4x4), to try in turn: a position
+    task's tip frame may also turn about its point (:data:`_TIP_TURNS`)."""
+    from kinegami.chain.joints import EndTip
 
-    task, r, n = model.task, model.task.r, model.n
-    table, tool, Q = model.split(x)
+    length = 1.5 * model.task.r
+    out = []
+    for turn in (np.eye(3),) if model.tool_size else _TIP_TURNS:
+        F = tip.copy()
+        F[:3, :3] = tip[:3, :3] @ turn
+        P = F.copy()
+        P[:3, :3] = F[:3, :3] @ _TIP_AXES.T
+        P[:3, 3] = F[:3, 3] - 0.5 * length * P[:3, 2]
+        out.append(EndTip(model.task.numSides, model.task.r, np.eye(4), length).with_pose(P))
+    return out
+
+
+def _model_joints(model: _Model, x: np.ndarray) -> tuple[list, np.ndarray]:
+    """The joints of the fitted unknowns ``x`` on their DH axes (world frame), and the tip frame
+    (4x4) the table and the tool put the tip on."""
+    from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
+
+    task, r = model.task, model.task.r
+    table, tool, _ = model.split(x)
     frames = [task.base]
-    for i in range(n):
+    for i in range(model.n):
         th, al, a, d = table[i]
         frames.append(frames[-1] @ _dh(th, al, a, d))
     tip = frames[-1] @ (_tool(tool) if model.tool_size else np.eye(4))
@@ -496,8 +515,19 @@ def _build(model: _Model, x: np.ndarray):
         else:
             joint = PrismaticJoint(task.numSides, r, 3.0 * r, 3, math.pi / 4, np.eye(4))
         joints.append(joint.with_pose(frames[i]))
-    length = 1.5 * r
-    turns = (np.eye(3),) if model.tool_size else _TIP_TURNS
+    return joints, tip
+
+
+def _build(model: _Model, x: np.ndarray):
+    """The chain of the fitted unknowns ``x`` (joints slid along their axes by placement, the end
+    tip exactly at the table's tip), with its states per target (full configurations), or
+    (None, reason)."""
+    from kinegami.chain.model import KinematicChain
+    from kinegami.errors import ClearanceWarning, NoPathError, PlacementWarning
+
+    task, n = model.task, model.n
+    _, _, Q = model.split(x)
+    joints, tip = _model_joints(model, x)
     reason = "no link reaches the end tip"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PlacementWarning)
@@ -513,13 +543,7 @@ def _build(model: _Model, x: np.ndarray):
                 index = chain.append(joint, relative=False, safe=True)
             if index is None:
                 return None, "a joint could not be placed"
-        for turn in turns:
-            F = tip.copy()
-            F[:3, :3] = tip[:3, :3] @ turn
-            P = F.copy()
-            P[:3, :3] = F[:3, :3] @ _TIP_AXES.T
-            P[:3, 3] = F[:3, 3] - 0.5 * length * P[:3, 2]
-            end = EndTip(task.numSides, r, np.eye(4), length).with_pose(P)
+        for end in _end_tips(model, tip):
             if chain.append(end, relative=False, safe=False, fixedPosition=True,
                             fixedOrientation=True) is not None:  # fmt: skip
                 break
@@ -712,7 +736,11 @@ def design_for(
     joints : str or int
         The joint types in order (``"RRRR"``, ``"RPRR"``; the end tip and any waypoints are
         added by placement), or a budget: at most that many joints of any type, tried from the
-        fewest up.
+        fewest up. A list of strings, one per leaf, designs a
+        :class:`~kinegami.KinematicTree` instead: ``targets`` is then one list of targets per
+        leaf, all of the same length, and the k-th targets of every leaf are reached at once
+        (a grasp); the root is a start tip at ``base`` and each leaf's first joint sits on a
+        ring 4 r above it (docs/design-for-a-task.md, Trees).
     r, numSides : the tube.
     seed : the search's seed (the answer depends only on it, not on the executor).
     executor : runs the starts of each round (any ``concurrent.futures.Executor``; default: in
@@ -724,11 +752,13 @@ def design_for(
     max_tube_length : the longest tube allowed (default 100 r).
     margin : the clearance required between parts and from the boxes (>= 0).
     starts : the fit's starts per joint-type string (>= 1).
-    compact : shorten the found design by compaction that keeps the task.
-    path : also require that the robot moves from each target's configuration to the next along
-        the straight line in joint space without passing through itself (certified by
-        :func:`kinegami.clearance.paths.check_path`).
-    return_answers : return ``(design, answers)``: one reach answer per target; with ``path``,
+    compact : shorten the found design by compaction that keeps the task (chains; a tree is
+        the shortest of the leaves' designs tried, its junctions fitted).
+    path : (chains) also require that the robot moves from each target's configuration to the
+        next along the straight line in joint space without passing through itself (certified
+        by :func:`kinegami.clearance.paths.check_path`).
+    return_answers : return ``(design, answers)``: one reach answer per target (a tree: per
+        target index, every leaf at once); with ``path``,
         ``(design, answers, paths)``, each path the configurations (m, joints) measured along a
         move, from one target's states to the next's.
     progress : ``progress(done, total)`` per start (False from it cancels), True for a bar.
@@ -752,11 +782,8 @@ def design_for(
     """
     from kinegami.optimize.compaction import tube_length
 
-    task = _task(targets, r, numSides, base, keep_out, max_tube_length, margin)
     if not isinstance(path, bool):
         raise InvalidTypeError(f"path must be True or False, got {path!r}")
-    task = replace(task, path=path)
-    strings = _joint_strings(joints)
     seed = check_int("seed", seed, minimum=0, floats=False)
     starts = check_int("starts", starts, minimum=1, floats=False)
     if starts > 10_000:
@@ -766,6 +793,16 @@ def design_for(
         raise InvalidTypeError(
             f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}"
         )
+    if isinstance(joints, (list, tuple)):  # a tree: one joint string and target list per leaf
+        if path:
+            raise InvalidParameterError("path=True is for chains; a tree task gives poses only")
+        leaves, rooted, strings = _tree_tasks(targets, joints, r, numSides, base, keep_out,
+                                              max_tube_length, margin)  # fmt: skip
+        return _design_tree(leaves, rooted, strings, seed, starts, executor, progress,
+                            return_answers)  # fmt: skip
+    task = _task(targets, r, numSides, base, keep_out, max_tube_length, margin)
+    task = replace(task, path=path)
+    strings = _joint_strings(joints)
     certificates = [task_certificate(task, types) for types in strings]
     if all(c is not None for c in certificates):
         k, why = certificates[-1] if len(strings) > 1 else certificates[0]
@@ -848,3 +885,226 @@ def _named(why: str) -> int | None:
         if len(head) == 2 and head[1].isdigit():
             return int(head[1])
     return None
+
+
+# --- trees: one target set per leaf ---------------------------------------------------------------
+#: A tree task's leaves start on a ring around the root's z axis: each leaf's first joint sits
+#: this many r above the root, at least LEAF_RING_R r from the axis (farther for many leaves, so
+#: that neighbours stay 4 r apart); its axis is the root's z.
+LEAF_HEIGHT_R = 4.0
+LEAF_RING_R = 3.0
+#: Combinations of the leaves' fits built and checked per round (shortest first).
+TREE_COMBINATIONS = 16
+
+
+def _leaf_bases(base: np.ndarray, centres: np.ndarray, r: float) -> list[np.ndarray]:
+    """The frame (4x4, world) of each leaf's first joint: on the ring above the root, the leaves
+    in the order of the directions (about the root's z) of their targets' centres (``centres``
+    (leaves, 3), world), the first leaf's slot towards its centre."""
+    count = len(centres)
+    ring = 0.0 if count == 1 else max(LEAF_RING_R, 2.0 / math.sin(math.pi / count)) * r
+    local = (centres - base[:3, 3]) @ base[:3, :3]  # in the root's frame
+    directions = np.arctan2(local[:, 1], local[:, 0])
+    order = np.argsort(directions, kind="stable")
+    out = [None] * count
+    for slot, i in enumerate(order):
+        angle = float(directions[order[0]]) + 2.0 * math.pi * slot / count
+        M = np.eye(4)
+        M[:3, 3] = [ring * math.cos(angle), ring * math.sin(angle), LEAF_HEIGHT_R * r]
+        out[i] = base @ M
+    return out
+
+
+def _tree_tasks(targets, joints, r, numSides, base, keep_out, max_tube_length, margin):
+    """(leaf tasks with their ring bases, leaf tasks with the root's base (for certificates),
+    joint strings): one per leaf, each leaf's targets in order; the k-th targets of all leaves
+    are reached at once."""
+    strings = []
+    for i, types in enumerate(joints):
+        if not isinstance(types, str):
+            raise InvalidTypeError(
+                f"joints[{i}] must be a string of 'R' and 'P' (a tree task gives one joint "
+                f"string per leaf), got {types!r}"
+            )
+        strings.append(_joint_strings(types)[0])
+    if not strings:
+        raise InvalidParameterError("a tree task needs at least one leaf: joints is empty")
+    if isinstance(targets, (str, bytes)) or not isinstance(targets, Sequence) \
+            or len(targets) != len(strings):  # fmt: skip
+        raise InvalidParameterError(
+            f"a tree task (joints given per leaf: {len(strings)} leaves) needs one list of "
+            f"targets per leaf, got {targets!r}"
+        )
+    counts = {len(leaf) if isinstance(leaf, Sequence) else -1 for leaf in targets}
+    if len(counts) != 1:
+        raise InvalidParameterError(
+            "every leaf of a tree task needs the same number of targets (the k-th target of "
+            f"every leaf is reached at once), got {[len(leaf) for leaf in targets]}"
+        )
+    root = _task(targets[0], r, numSides, base, keep_out, max_tube_length, margin)
+    if sum(len(leaf) for leaf in targets) > MAX_TASK_TARGETS:
+        raise InvalidParameterError(
+            f"a task may name at most {MAX_TASK_TARGETS} targets (MAX_TASK_TARGETS), got "
+            f"{sum(len(leaf) for leaf in targets)}"
+        )
+    rooted = [_task(leaf, r, numSides, root.base, keep_out, max_tube_length, margin)
+              for leaf in targets]  # fmt: skip
+    centres = np.array([np.mean([t.position for t in task.targets], axis=0) for task in rooted])
+    bases = _leaf_bases(root.base, centres, root.r)
+    placed = [replace(task, base=bases[i]) for i, task in enumerate(rooted)]
+    return placed, rooted, strings
+
+
+def _tree_search(leaves: list, strings: list[str], root: np.ndarray, seed: int, starts: int,
+                 executor, bar) -> tuple:  # fmt: skip
+    """((tree, answers, states), "") of the shortest tree found in the first round that gives
+    one, or (None, last reason)."""
+    last = "the fit did not reach every target"
+    models = [_Model(task, types) for task, types in zip(leaves, strings, strict=True)]
+    found = [[] for _ in models]  # per leaf: (unknowns, tube length) of clear leaf chains
+    tried: set[tuple] = set()  # combinations of the leaves' designs already checked
+    for first in range(0, starts, ROUND):
+        batch = range(first, min(starts, first + ROUND))
+        for i, (task, types) in enumerate(zip(leaves, strings, strict=True)):
+            # each leaf alone, as a chain from its ring frame: first the fits whose own
+            # configurations are clear, then other configurations of the same fits
+            results = _run(executor, task, types, seed + 7919 * i, batch, False)
+            if all(result is None for result, _ in results):
+                again = [k for k, (_, why) in zip(batch, results, strict=True)
+                         if "fitted configuration" in why]  # fmt: skip
+                results += _run(executor, task, types, seed + 7919 * i, again, True)
+            for result, why in results:
+                if result is None:
+                    last = f"leaf {i}: {why}"
+                else:
+                    found[i].append(result[:2])
+        bar.update(len(batch))
+        if not all(found):
+            continue
+        sizes = [[length for _, length in leaf] for leaf in found]
+        found_x = [[x for x, _ in leaf] for leaf in found]
+        combos = sorted(itertools.product(*[range(len(f)) for f in found]),
+                        key=lambda c: (sum(sizes[i][j] for i, j in enumerate(c)), c))  # fmt: skip
+        best = None
+        for combo in [c for c in combos if c not in tried][:TREE_COMBINATIONS]:
+            tried.add(combo)
+            xs = [found_x[i][j] for i, j in enumerate(combo)]
+            result, why = _check_tree(models, xs, root)
+            if result is None:
+                last = why
+                continue
+            from kinegami.optimize.compaction import tube_length
+
+            key = (tube_length(result[0]), -min(a.clearance for a in result[1]))
+            if best is None or key < best[0]:
+                best = (key, result)
+        if best is not None:
+            return best[1], ""
+    return None, last
+
+
+def _check_tree(models: list, xs: list, root: np.ndarray) -> tuple:
+    """The tree of the leaves' fitted unknowns ``xs`` and one reach answer per target index
+    (every leaf at its k-th target at once, exact, in range, clear, outside the boxes), or
+    (None, why). ``root``: the root start tip's pose (the task's base)."""
+    from kinegami.chain.joints import StartTip
+    from kinegami.errors import ClearanceWarning, NoPathError, PlacementWarning
+    from kinegami.fabrication.sheets import fit_junctions
+    from kinegami.optimize.compaction import tube_length
+    from kinegami.reach import solve
+    from kinegami.tree.model import KinematicTree
+
+    task = models[0].task
+    r, margin = task.r, task.margin
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlacementWarning)
+        warnings.simplefilter("ignore", ClearanceWarning)
+        try:
+            tree = KinematicTree(StartTip(task.numSides, r, np.eye(4), r).with_pose(root))
+        except (NoPathError, InvalidParameterError) as exc:
+            return None, str(exc)
+        tree.margin = margin
+        tips = []
+        for model, x in zip(models, xs, strict=True):
+            joints, tip = _model_joints(model, x)
+            parent = 0
+            for joint in joints:  # exactly on the fit's frame when a link reaches it
+                index = tree.addJoint(parent, joint, relative=False, safe=False,
+                                      fixedPosition=True, fixedOrientation=True)  # fmt: skip
+                if index is None:
+                    index = tree.addJoint(parent, joint, relative=False, safe=False,
+                                          fixedOrientation=True)  # fmt: skip
+                if index is None:
+                    index = tree.addJoint(parent, joint, relative=False, safe=True)
+                if index is None:
+                    return None, "a joint could not be placed"
+                parent = index
+            for end in _end_tips(model, tip):
+                index = tree.addJoint(parent, end, relative=False, safe=False,
+                                      fixedPosition=True, fixedOrientation=True)  # fmt: skip
+                if index is not None:
+                    break
+            else:
+                return None, "no link reaches a leaf's end tip"
+            tips.append(index)
+    # the junctions' sockets need room on their links: the slides kinegami build would make
+    # (along the joints' own axes: the kinematics stay) are made here, so the tree returned is
+    # the one that is cut
+    try:
+        fitted, slides = fit_junctions(tree)
+    except KinegamiError as exc:
+        return None, f"a junction does not fit: {exc}"
+    if slides:
+        tree = fitted
+    if tube_length(tree) > task.max_tube_length:
+        return None, f"tube {tube_length(tree):.6g} longer than max_tube_length"
+    parents = tree.Parents
+    Q = np.zeros((models[0].T, len(tree.Joints)))
+    for model, x, tip in zip(models, xs, tips, strict=True):
+        path, joint = [], tip
+        while joint != 0:  # the leaf's movable joints, root to tip
+            joint = parents[joint]
+            if tree.Joints[joint].stateRange() != (0.0, 0.0):
+                path.append(joint)
+        Q[:, path[::-1]] = model.split(x)[2]
+    answers = []
+    for k in range(models[0].T):
+        mapping = {tip: model.task.targets[k] for model, tip in zip(models, tips, strict=True)}
+        why = ""
+        for seed in range(2):
+            answer = solve(tree, mapping, q0=Q[k], seed=seed, margin=margin)
+            if not answer.ok:
+                why = f"target {k}: {answer.reason}"
+                continue
+            hit = keep_out_violation(tree, answer.states, task.boxes, margin)
+            if hit is not None:
+                why = f"target {k}: the robot enters keep-out box {hit[0]}"
+                continue
+            answers.append(answer)
+            break
+        else:
+            return None, why
+    return (tree, answers, Q), ""
+
+
+def _design_tree(leaves: list, rooted: list, strings: list[str], seed: int, starts: int,
+                 executor, progress, return_answers: bool):  # fmt: skip
+    """:func:`design_for` of a tree task (checked leaf tasks)."""
+    for i, (task, types) in enumerate(zip(rooted, strings, strict=True)):
+        certificate = task_certificate(task, types)
+        if certificate is not None:
+            k, why = certificate
+            raise InfeasibleTaskError(
+                f"no design with joints {types!r} on leaf {i} can reach every target of that "
+                f"leaf: {why}", target=k, proven=True,
+            )  # fmt: skip
+    with Progress(progress, starts, desc="design", unit="start") as bar:
+        found, last = _tree_search(leaves, strings, rooted[0].base, seed, starts, executor, bar)
+    if found is None:
+        raise InfeasibleTaskError(
+            f"no tree with joints {strings!r} found that reaches every leaf's targets in "
+            f"{starts} start(s) (not proven impossible; last: {last}); try more starts, another "
+            "seed, more joints or a longer max_tube_length", target=_named(last), proven=False,
+        )  # fmt: skip
+    tree, answers, _ = found
+    return (tree, answers) if return_answers else tree
