@@ -27,6 +27,7 @@ import sys
 import warnings
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from kinegami import __version__, _startup
 from kinegami._record import Record
@@ -34,6 +35,9 @@ from kinegami._startup import INTERRUPTED
 from kinegami.errors import KinegamiError
 from kinegami.limits import MAX_INTEGER_DIGITS, MAX_SAMPLES
 from kinegami.validation import UNITS_IN_MM, shown, shown_path
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class CommandError(Exception):
@@ -552,27 +556,40 @@ def _takeoff_summary(fabrication, info) -> list[str]:
 def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> int:
     """``kinegami build`` of a tree: a sheet per leaf, the junction connectors and the whole
     tree (kinegami.export.tree_build), published as one transaction."""
+    lines = _write_tree_build(args.command, args.design, tree, info, stem, out, args.formats,
+                              args.junctions)  # fmt: skip
+    print("\n".join(lines))
+    return 0
+
+
+def _write_tree_build(command: str, label: str, tree, info, stem: str, out: Path,
+                      formats_text: str | None, junctions: str | None,
+                      extra=()) -> list[str]:  # fmt: skip
+    """Write a tree's outputs (``formats_text``: ``--formats``; ``junctions``: ``--junctions``)
+    and ``extra`` ((file name, writer(path)) pairs) into ``out`` as one transaction: a sheet per
+    leaf, the junction connectors and the whole tree (kinegami.export.tree_build). The summary
+    lines, with the files written."""
     from kinegami.design.reader import carry_origin
     from kinegami.errors import InvalidParameterError
     from kinegami.export.tree_build import FORMAT_LIBRARIES, write_tree_files
     from kinegami.fabrication.sheets import fabricate, fit_junctions
     from kinegami.fabrication.takeoffs import JUNCTION_KINDS
 
-    kind = "connector" if args.junctions is None else args.junctions
+    kind = "connector" if junctions is None else junctions
     if kind not in JUNCTION_KINDS:
         raise CommandError(f"--junctions: unknown kind {shown(kind)}; known: "
                            f"{', '.join(JUNCTION_KINDS)}")  # fmt: skip
-    formats = _parse_tree_formats(args.formats)
-    if args.formats is None:  # the defaults: leave out what a missing optional library stops
+    formats = _parse_tree_formats(formats_text)
+    if formats_text is None:  # the defaults: leave out what a missing optional library stops
         needs = dict(FORMAT_LIBRARIES)
         if kind == "takeoff":  # folded take-offs print no connector
             del needs["junctions"]
-        for fmt, (modules, extra) in needs.items():
+        for fmt, (modules, extra_name) in needs.items():
             missing = [m for m in modules if fmt in formats and not _importable(m)]
             if missing:
                 formats.remove(fmt)
-                _note(args.command, f"{fmt} not written: it needs {missing[0]} "
-                                    f"(pip install 'kinegami[{extra}]')")  # fmt: skip
+                _note(command, f"{fmt} not written: it needs {missing[0]} "
+                               f"(pip install 'kinegami[{extra_name}]')")  # fmt: skip
     try:
         fitted, moves, fabrication = tree, [], None
         if kind != "connector":  # take-offs need no room for sockets: try the tree as it is
@@ -586,14 +603,14 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
             carry_origin(tree, fitted)  # the joint names
             fabrication = fabricate(fitted, twistPortion=info.twistPortion, junction=kind)
     except KinegamiError as error:
-        raise CommandError(f"{args.design}: {error}") from None
+        raise CommandError(f"{label}: {error}") from None
     written = _clearance(tree) if moves else None
-    lines = _tree_summary(fitted, info, args.design, fabrication, moves, written)
+    lines = _tree_summary(fitted, info, label, fabrication, moves, written)
     lines += _takeoff_summary(fabrication, info)
     report = _clearance(fitted)
     if not report.ok:
-        _warn(args.command, _overlap_warning(report, info, args.design))
-    staging = _open_staging(args.command, out)
+        _warn(command, _overlap_warning(report, info, label))
+    staging = _open_staging(command, out)
     try:
         try:
             data = [f for f in formats if f != "png"]
@@ -608,8 +625,10 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
             )
             if "png" in formats:
                 _write_tree_pictures(fabrication, staging.new, stem, info.units)
+            for name, write in extra:
+                write(staging.new / name)
         except KinegamiError as error:
-            raise CommandError(f"{args.design}: {error}") from None
+            raise CommandError(f"{label}: {error}") from None
         except OSError as error:
             raise CommandError(f"cannot write {str(out)!r}: {error.strerror or error}") from None
         written = staging.publish()
@@ -617,8 +636,7 @@ def _build_tree(args: argparse.Namespace, tree, info, stem: str, out: Path) -> i
         staging.close()
     lines.append("  files written:")
     lines.extend(f"    {path}{os.sep if path.is_dir() else ''}" for path in written)
-    print("\n".join(lines))
-    return 0
+    return lines
 
 
 def cmd_build(args: argparse.Namespace) -> int:
@@ -710,6 +728,9 @@ def cmd_new(args: argparse.Namespace) -> int:
 
     if args.task:
         return _new_task(args)
+    if args.tree:
+        raise CommandError("--tree goes with --task: 'kinegami new --task --tree FILE' writes a "
+                           "starter tree task (there is no starter tree design)")  # fmt: skip
     try:
         path = write_starter_design(args.design, overwrite=args.force)
     except DesignFileExistsError:
@@ -728,8 +749,8 @@ def cmd_new(args: argparse.Namespace) -> int:
 
 
 def _new_task(args: argparse.Namespace) -> int:
-    """``kinegami new --task FILE``: the starter task, written atomically (kept if it exists,
-    unless --force)."""
+    """``kinegami new --task [--tree] FILE``: the starter task (a chain's, or with --tree a
+    tree's), written atomically (kept if it exists, unless --force)."""
     import json
 
     from kinegami._atomic import write_atomic
@@ -747,10 +768,15 @@ def _new_task(args: argparse.Namespace) -> int:
         )
     if path.is_dir():
         raise CommandError(f"{_printable(repr(args.design))} is a directory, not a file name")
-    write_atomic(path, json.dumps(starter_task(), indent=2) + "\n")
+    write_atomic(path, json.dumps(starter_task(tree=args.tree), indent=2) + "\n")
     name = _printable(str(path))
-    print(f"wrote {name}: a starter task (a four-joint arm that must touch four points above a "
-          "table; units mm). Change it, then:")  # fmt: skip
+    if args.tree:
+        print(f"wrote {name}: a starter tree task (a hand of two three-joint fingers, each "
+              "touching two points, the k-th points of both at once; units mm). Change it, "
+              "then:")  # fmt: skip
+    else:
+        print(f"wrote {name}: a starter task (a four-joint arm that must touch four points "
+              "above a table; units mm). Change it, then:")  # fmt: skip
     print(f"  kinegami design {name} -o out/")
     return 0
 
@@ -776,13 +802,17 @@ def cmd_design(args: argparse.Namespace) -> int:
     options = task.options()
     if args.seed is not None:
         options["seed"] = _integer("--seed", args.seed, 0)
+    targets, joints = list(task.targets), task.joints
+    if task.is_tree:  # one list of targets and one joint string per leaf
+        targets, joints = [list(leaf) for leaf in task.targets], list(task.joints)
     try:
-        found = design_for(list(task.targets), task.joints, return_answers=True,
-                           progress=None, **options)  # fmt: skip
+        found = design_for(targets, joints, return_answers=True, progress=None, **options)
     except InfeasibleTaskError as error:
         kind = "infeasible" if error.proven else "no design found"
         _fail(args.command, f"{args.task}: {kind}: {error}")
         return INFEASIBLE
+    if task.is_tree:
+        return _write_tree_design(args, task, found[0], found[1], stem, out)
     chain, answers = found[0], found[1]
     paths = found[2] if len(found) > 2 else None
     info = DesignInfo(name=task.name, description=task.description, units=task.units,
@@ -803,6 +833,129 @@ def cmd_design(args: argparse.Namespace) -> int:
     lines = _write_chain_build(args.command, args.task, job, stem, out, formats, extra)
     print("\n".join([*report[0], *lines]))
     return 0
+
+
+def _write_tree_design(args: argparse.Namespace, task, tree, answers, stem: str, out: Path
+                       ) -> int:  # fmt: skip
+    """``kinegami design`` of a tree task: the tree's design file (with its task), its build
+    (as ``kinegami build`` writes a tree) and the report, published as one transaction."""
+    import json
+
+    from kinegami.design.reader import DesignInfo
+    from kinegami.design.writer import design_to_dict, dumps_design
+
+    info = DesignInfo(name=task.name, description=task.description, units=task.units,
+                      twistPortion=0.2, file=None, structure="tree",
+                      task=task.document)  # fmt: skip
+    tips = _leaf_tips(tree, task, answers)
+    report = _tree_task_report(tree, task, answers, tips)
+    document = design_to_dict(tree, name=task.name, description=task.description,
+                              units=task.units, task=task.document)  # fmt: skip
+    extra = [
+        (f"{stem}.json", lambda path: path.write_text(dumps_design(document), "utf-8")),
+        (f"{stem}_task.txt", lambda path: path.write_text("\n".join(report[0]) + "\n", "utf-8")),
+        (f"{stem}_task.json", lambda path: path.write_text(json.dumps(report[1], indent=2) + "\n",
+                                                            "utf-8")),
+        (f"{stem}_task.png", lambda path: _task_picture(tree, answers, task, path)),
+    ]  # fmt: skip
+    lines = _write_tree_build(args.command, args.task, tree, info, stem, out, args.formats,
+                              None, extra)  # fmt: skip
+    print("\n".join([*report[0], *lines]))
+    return 0
+
+
+def _leaf_tips(tree, task, answers) -> list[int]:
+    """The tip joint of each leaf of a tree task (the task's order): the leaf tips of ``tree``
+    matched to the task's leaves by where they are at the answers' states (world frame)."""
+    import numpy as np
+    from scipy.optimize import linear_sum_assignment
+
+    from kinegami.reach import kinematics
+
+    compiled = kinematics(tree)  # every leaf tip, in joint-index order
+    Q, _ = compiled.configurations([list(answer.states) for answer in answers])
+    places = compiled.tip_poses(Q)[..., :3, 3]  # (grasps, tips, 3)
+    wanted = np.array([[target.position for target in leaf] for leaf in task.targets])
+    if places.shape[1] != wanted.shape[0]:
+        raise CommandError(f"{task.name or 'task'}: the designed tree has {places.shape[1]} "
+                           f"leaves, the task {wanted.shape[0]}")  # fmt: skip
+    cost = np.linalg.norm(places.transpose(1, 0, 2)[None] - wanted[:, None], axis=-1).sum(-1)
+    _, columns = linear_sum_assignment(cost)
+    return [compiled.tips[j] for j in columns]
+
+
+def _target_errors(pose: np.ndarray, target) -> tuple[float, float]:
+    """(position error, angle error in rad) of a tip at ``pose`` (4x4, world) for a
+    :class:`kinegami.reach.Target`: the distance, and the angle between the tip's z and an axis
+    target's axis or between the tip's and a pose target's orientations (0 for a position)."""
+    import numpy as np
+
+    position = float(np.linalg.norm(pose[:3, 3] - target.position))
+    if target.axis is not None:
+        z = pose[:3, 2]
+        return position, float(np.arctan2(np.linalg.norm(np.cross(z, target.axis)),
+                                          np.dot(z, target.axis)))  # fmt: skip
+    if target.rotation is not None:
+        E = pose[:3, :3].T @ target.rotation
+        vee = np.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
+        return position, float(np.arctan2(np.linalg.norm(vee) / 2, (np.trace(E) - 1) / 2))
+    return position, 0.0
+
+
+def _target_json(target, name) -> dict:
+    """A target of a task report: its name, kind, position and axis or rotation (world)."""
+    out = {"name": name, "kind": target.kind, "position": target.position.tolist()}
+    if target.axis is not None:
+        out["axis"] = target.axis.tolist()
+    if target.rotation is not None:
+        out["rotation"] = target.rotation.tolist()
+    return out
+
+
+def _tree_task_report(tree, task, answers, tips: list[int]) -> tuple[list[str], dict]:
+    """The report of a tree designed for a task: its leaves (joint strings, tip joints), then
+    per grasp its states and clearance and, per leaf, the target and the tip's errors there
+    (lines and a JSON-ready dict)."""
+    from kinegami.optimize import tube_length
+    from kinegami.reach import kinematics
+
+    units = task.units
+    compiled = kinematics(tree, tip=tips)  # the tips in joint-index order
+    order = [compiled.tips.index(t) for t in tips]
+    Q, _ = compiled.configurations([list(answer.states) for answer in answers])
+    poses = compiled.tip_poses(Q)[:, order]  # (grasps, leaves, 4, 4), the task's leaf order
+    lines = [f"{task.name or 'task'}: designed (a tree of {task.leaves} leaves, "
+             f"{len(tree.Joints)} joints: {', '.join(type(j).__name__ for j in tree.Joints)}; "
+             f"tube {tube_length(tree):.6g} {units})"]  # fmt: skip
+    leaves = []
+    for i, (types, tip) in enumerate(zip(task.joints, tips, strict=True)):
+        lines.append(f"  leaf {i}: joints {types}, tip joint {tip}")
+        leaves.append({"leaf": i, "joints": types, "tip": int(tip)})
+    grasps = []
+    for k, answer in enumerate(answers):
+        state = "reached" if answer.ok else f"not reached: {answer.reason}"
+        lines.append(f"  grasp {k}: {state}, clearance {answer.clearance:.6g} {units}")
+        rows = []
+        for i, leaf in enumerate(task.targets):
+            name = task.document["targets"][i][k].get("name")
+            target = leaf[k]
+            position, angle = _target_errors(poses[k, i], target)
+            where = ", ".join(f"{v:.6g}" for v in target.position)
+            label = f"target ({name}) " if name else "target "
+            lines.append(f"    leaf {i}: {label}[{where}], position error {position:.3g} "
+                         f"{units}, angle error {angle:.3g} rad")  # fmt: skip
+            rows.append({"leaf": i, "tip": int(tips[i]), "target": _target_json(target, name),
+                         "position_error": position, "angle_error": angle})  # fmt: skip
+        lines.append("    states: " + ", ".join(f"{s:.6g}" for s in answer.states))
+        grasps.append({"grasp": k, "ok": bool(answer.ok), "reason": answer.reason,
+                       "states": list(answer.states), "clearance": answer.clearance,
+                       "position_error": answer.position_error,
+                       "angle_error": answer.angle_error, "leaves": rows})  # fmt: skip
+    summary = {"format": "kinegami-task-report", "version": 1, "name": task.name,
+               "units": units, "structure": "tree",
+               "joints": [type(j).__name__ for j in tree.Joints],
+               "tube_length": tube_length(tree), "leaves": leaves, "grasps": grasps}  # fmt: skip
+    return lines, summary
 
 
 def _task_report(chain, task, answers, paths=None) -> tuple[list[str], dict]:
@@ -839,11 +992,13 @@ def _task_report(chain, task, answers, paths=None) -> tuple[list[str], dict]:
 
 
 def _task_picture(chain, answers, task, path: Path) -> None:
-    """One sheet of small multiples: the robot at every target (the target a red point)."""
+    """One sheet of small multiples: the robot at every target (the target a red point); a
+    tree at every grasp (every leaf's target a red point)."""
     import copy
     import math
 
     import matplotlib
+    import numpy as np
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
@@ -858,9 +1013,10 @@ def _task_picture(chain, answers, task, path: Path) -> None:
             posed = copy.copy(chain)
             posed.setJointStates(list(answer.states))
             posed.show(ax=ax, showJointPoses=False, showGlobalFrame=False, units=task.units)
-            p = task.targets[k].position
-            ax.scatter([p[0]], [p[1]], [p[2]], color="red", s=30, depthshade=False)
-            ax.set_title(f"target {k}", fontsize=9)
+            leaves = task.targets if task.is_tree else [task.targets]
+            p = np.array([leaf[k].position for leaf in leaves])
+            ax.scatter(p[:, 0], p[:, 1], p[:, 2], color="red", s=30, depthshade=False)
+            ax.set_title(f"{'grasp' if task.is_tree else 'target'} {k}", fontsize=9)
         fig.tight_layout()
         fig.savefig(path, dpi=100)
     finally:
@@ -1181,6 +1337,10 @@ def cmd_compact(args: argparse.Namespace) -> int:
     _check_design_output(out, args.design, args.force)
     chain, info = _load(args.design)
     _margin(args, chain)
+    if info.task is not None and _is_tree(chain):
+        _note(args.command, "the design's task is not checked: compaction keeps a task for "
+                            "chains only, so the compacted tree may no longer reach its "
+                            "targets (the task is written as it was)")  # fmt: skip
     before = BuildJob(chain, info)
     if not _is_tree(chain):  # a tree's sheets are checked by build
         _check_pattern(before)
@@ -1511,6 +1671,9 @@ def make_parser() -> argparse.ArgumentParser:
     new.add_argument("--force", action="store_true", help="replace DESIGN if it exists")
     new.add_argument("--task", action="store_true",
                      help="write a starter task file instead (for 'kinegami design')")
+    new.add_argument("--tree", action="store_true",
+                     help="with --task: a starter tree task (two fingers, one target list "
+                     "each)")  # fmt: skip
     new.set_defaults(run=cmd_new)
 
     design = commands.add_parser(
@@ -1521,8 +1684,11 @@ def make_parser() -> argparse.ArgumentParser:
         "without passing through itself or entering a keep-out box, then write into DIR the "
         "design file (with its task), the build's outputs, and a report: NAME_task.txt and "
         ".json (per target the states, the errors and the clearance) and NAME_task.png (the "
-        "robot at every target). Exit code 0: designed; 3: infeasible (the certificate, or "
-        "that the search found no design, is printed); 1: a task or option error.",
+        "robot at every target). A tree task (joints given per leaf, one target list per "
+        "leaf) designs a tree whose leaves reach their k-th targets at once (grasp k), built "
+        "as 'kinegami build' builds a tree, and reports per grasp and leaf. Exit code 0: "
+        "designed; 3: infeasible (the certificate, or that the search found no design, is "
+        "printed); 1: a task or option error.",
     )
     design.add_argument("task", metavar="TASK", help="task file (.json; 'kinegami new --task' "
                         "writes one)")  # fmt: skip

@@ -715,7 +715,10 @@ def _check_document(document, file) -> _Plan:
     check_schema(document, file)
     check_lengths(document, file)
     if "task" in document:  # the task the design was made for (kinegami design)
-        task_from_dict(document["task"], file, where=("task",))
+        task = task_from_dict(document["task"], file, where=("task",))
+        if task.is_tree and structure_of(document) != "tree":
+            raise DesignError("a tree task (joints given per leaf) is for a tree design; this "
+                              "design is a chain", field="task.joints", file=file)  # fmt: skip
     names = _check_names(document, file)
     fields = check_tree_fields(document, file)
     units = document.get("angleUnits", "rad")

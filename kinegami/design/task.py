@@ -10,6 +10,11 @@ along the axis) or ``{"pose": POSE}`` with a pose spelled as in design files. Va
 JSON Schema (``task_schema.json``, which borrows the design format's pose definitions); every
 error is one :class:`~kinegami.errors.DesignError` line naming the field.
 
+A tree task (a hand: docs/design-for-a-task.md, Trees) gives ``joints`` as an array of joint
+strings, one per leaf, and ``targets`` as one array of targets per leaf, all of the same length:
+the k-th target of every leaf is reached at once (a grasp). Then :attr:`Task.joints` is a tuple
+of strings and :attr:`Task.targets` a tuple of per-leaf tuples.
+
 A design written by ``kinegami design`` carries its task in an optional ``"task"`` block (the
 same object), which ``kinegami compact`` keeps.
 """
@@ -41,15 +46,21 @@ MAX_TASK_BYTES = 1_000_000
 
 @dataclass(frozen=True)
 class Task:
-    """A checked task file: :meth:`options` are :func:`kinegami.optimize.design_for`'s
-    arguments; ``document`` the task as read (what a design's ``"task"`` block holds)."""
+    """A checked task file: ``design_for(list(task.targets), task.joints, **task.options())``
+    designs it (:func:`kinegami.optimize.design_for`); ``document`` is the task as read (what a
+    design's ``"task"`` block holds).
+
+    ``joints`` is a joint string or a budget (a chain), or a tuple of joint strings, one per
+    leaf (a tree, :attr:`is_tree`). ``targets`` holds :class:`~kinegami.reach.Target` s (world
+    frame, ``units``): a chain's in order; a tree's as one tuple per leaf, all of the same
+    length (the k-th of every leaf reached at once)."""
 
     name: str | None
     description: str | None
     units: str
     r: float
     numSides: int
-    joints: str | int
+    joints: str | int | tuple[str, ...]
     targets: tuple
     base: np.ndarray
     keep_out: tuple
@@ -59,6 +70,22 @@ class Task:
     starts: int | None
     document: dict
     path: bool = False
+
+    @property
+    def is_tree(self) -> bool:
+        """Whether the task is for a tree (joints given per leaf)."""
+        return isinstance(self.joints, tuple)
+
+    @property
+    def leaves(self) -> int:
+        """The leaves of the robot the task is for (1 for a chain)."""
+        return len(self.joints) if isinstance(self.joints, tuple) else 1
+
+    @property
+    def grasps(self) -> int:
+        """How many configurations the task asks for: a chain's targets, a tree's targets per
+        leaf (the k-th of every leaf reached at once)."""
+        return len(self.targets[0]) if self.is_tree else len(self.targets)
 
     def options(self) -> dict:
         """Keyword arguments of ``design_for(targets, joints, **options)``."""
@@ -95,7 +122,6 @@ def task_from_dict(document, file=None, where: tuple = ()) -> Task:
     document, for messages); DesignError (one line, naming the field) when it is invalid."""
     from kinegami.clearance.keep_out import Box
     from kinegami.design.schema import translate
-    from kinegami.reach import Target
 
     if not isinstance(document, dict):
         raise DesignError('a task must be a JSON object {...} with "format": "kinegami-task"',
@@ -107,27 +133,26 @@ def task_from_dict(document, file=None, where: tuple = ()) -> Task:
     errors = sorted(_validator().iter_errors(document),
                     key=lambda e: (list(map(str, e.absolute_path)), len(e.absolute_schema_path)))
     if errors:
-        error = translate(errors[0], document, file)
-        field = json_path((*where, *errors[0].absolute_path))
+        first = _target_branch_error(errors[0])
+        error = translate(first, document, file)
+        field = json_path((*where, *first.absolute_path))
+        reason = _task_reason(first, document) or error.reason
         if error.has_value:
-            raise DesignError(error.reason, field=field, value=error.value, file=file)
-        raise DesignError(error.reason, field=field, file=file)
+            raise DesignError(reason, field=field, value=error.value, file=file)
+        raise DesignError(reason, field=field, file=file)
+    tree = isinstance(document["joints"], list)
+    if tree:
+        _check_tree_shape(document, file, where)
     units = document.get("units", "mm")
     angle_units = document.get("angleUnits", "rad")
     r = float(document["r"])
-    targets = []
-    for k, spec in enumerate(document["targets"]):
-        path = (*where, "targets", k)
-        try:
-            if "pose" in spec:
-                targets.append(Target.of(pose_from_json(spec["pose"], (*path, "pose"),
-                                                        angle_units)))  # fmt: skip
-            else:
-                targets.append(Target(spec["position"], axis=spec.get("axis")))
-        except DesignError:
-            raise
-        except ValueError as exc:  # a zero axis, a pose that is not rigid
-            raise DesignError(str(exc), field=json_path(path), file=file) from None
+    if tree:
+        targets = tuple(_targets(leaf, (*where, "targets", i), angle_units, file)
+                        for i, leaf in enumerate(document["targets"]))  # fmt: skip
+        joints = tuple(document["joints"])
+    else:
+        targets = _targets(document["targets"], (*where, "targets"), angle_units, file)
+        joints = document["joints"]
     base = np.eye(4) if "base" not in document else \
         pose_from_json(document["base"], (*where, "base"), angle_units)  # fmt: skip
     boxes = []
@@ -139,12 +164,106 @@ def task_from_dict(document, file=None, where: tuple = ()) -> Task:
                               file=file) from None  # fmt: skip
     return Task(
         name=document.get("name"), description=document.get("description"), units=units, r=r,
-        numSides=int(document["numSides"]), joints=document["joints"], targets=tuple(targets),
+        numSides=int(document["numSides"]), joints=joints, targets=targets,
         base=base, keep_out=tuple(boxes), max_tube_length=document.get("maxTubeLength"),
         margin=float(document.get("margin", 0.0)), seed=int(document.get("seed", 0)),
         starts=document.get("starts"), document=copy.deepcopy(dict(document)),
         path=bool(document.get("path", False)),
     )  # fmt: skip
+
+
+def _targets(specs: list, where: tuple, angle_units: str, file) -> tuple:
+    """The :class:`~kinegami.reach.Target` s of a checked list of target objects at JSON path
+    ``where``."""
+    from kinegami.reach import Target
+
+    targets = []
+    for k, spec in enumerate(specs):
+        path = (*where, k)
+        try:
+            if "pose" in spec:
+                targets.append(Target.of(pose_from_json(spec["pose"], (*path, "pose"),
+                                                        angle_units)))  # fmt: skip
+            else:
+                targets.append(Target(spec["position"], axis=spec.get("axis")))
+        except DesignError:
+            raise
+        except ValueError as exc:  # a zero axis, a pose that is not rigid
+            raise DesignError(str(exc), field=json_path(path), file=file) from None
+    return tuple(targets)
+
+
+def _target_branch_error(error: jsonschema.ValidationError) -> jsonschema.ValidationError:
+    """For a target object that fits neither form, the first error of the form it was meant as
+    (a pose when it has ``"pose"``, else a position); any other error as it is."""
+    path = list(error.absolute_path)
+    if error.validator != "oneOf" or not path or path[0] != "targets" or \
+            not isinstance(error.instance, dict) or not error.context:  # fmt: skip
+        return error
+    form = 1 if "pose" in error.instance else 0
+    meant = [e for e in error.context if e.relative_schema_path and
+             e.relative_schema_path[0] == form]  # fmt: skip
+    if not meant:
+        return error
+    return min(meant, key=lambda e: (list(map(str, e.absolute_path)),
+                                     len(e.absolute_schema_path)))  # fmt: skip
+
+
+def _task_reason(error: jsonschema.ValidationError, document: dict) -> str | None:
+    """A clearer reason than the design format's for a schema error of a task's own fields
+    (None: the design format's reason is clear)."""
+    path = list(error.absolute_path)
+    tree = isinstance(document.get("joints"), list)
+    if path and path[0] == "joints" and error.validator == "pattern":
+        return "must be a string of the letters R and P, 1 to 8 of them (e.g. \"RRR\")"
+    if path[:1] == ["joints"] and len(path) == 2 and error.validator == "type":
+        return ("must be a joint string such as \"RRR\" (a tree task gives one joint string "
+                "per leaf)")
+    if path == ["joints"] and error.validator == "oneOf":
+        return ("must be a joint string such as \"RRRR\", a budget (an integer, 1 to 8) or, "
+                "for a tree, an array of joint strings, one per leaf")
+    if path == ["path"] and error.validator == "const" and tree:
+        return ("\"path\": true is for chains; a tree task (joints given per leaf) asks for "
+                "grasps only")
+    if len(path) == 2 and path[0] == "targets" and error.validator == "type":
+        if tree:
+            return (f"must be an array of targets: a tree task (joints given per leaf) gives "
+                    f"one array of targets per leaf ({len(document['joints'])} leaves)")
+        if isinstance(error.instance, list):
+            return ("must be a target object; one array of targets per leaf is a tree task, "
+                    "whose \"joints\" is an array of joint strings, one per leaf")
+    if path == ["targets"] and error.validator == "maxItems" and tree:
+        return (f"a tree task has at most {error.validator_value} leaves (one array of targets "
+                f"per leaf); it has {len(error.instance)}")
+    return None
+
+
+#: The most targets a task names (a tree's over all its leaves), as design_for takes.
+MAX_TASK_TARGETS = 64
+
+
+def _check_tree_shape(document: dict, file, where: tuple) -> None:
+    """The checks of a tree task that its schema cannot state: one target array per leaf, all
+    of the same length, at most :data:`MAX_TASK_TARGETS` targets in all."""
+    joints, targets = document["joints"], document["targets"]
+    if len(targets) != len(joints):
+        raise DesignError(
+            f"a tree task needs one array of targets per leaf: \"joints\" names {len(joints)} "
+            f"leaves, \"targets\" has {len(targets)} arrays",
+            field=json_path((*where, "targets")), file=file,
+        )  # fmt: skip
+    for i, leaf in enumerate(targets[1:], start=1):
+        if len(leaf) != len(targets[0]):
+            raise DesignError(
+                f"every leaf needs the same number of targets (the k-th target of every leaf "
+                f"is reached at once): targets[0] has {len(targets[0])}, targets[{i}] has "
+                f"{len(leaf)}", field=json_path((*where, "targets", i)), file=file,
+            )  # fmt: skip
+    total = sum(len(leaf) for leaf in targets)
+    if total > MAX_TASK_TARGETS:
+        raise DesignError(f"a task names at most {MAX_TASK_TARGETS} targets in all; this tree "
+                          f"task names {total}", field=json_path((*where, "targets")),
+                          file=file)  # fmt: skip
 
 
 def read_task(path) -> Task:
@@ -185,9 +304,11 @@ def _no_constant(name: str):
     raise ValueError(f"{name} is not a number a task may hold (JSON has no {name})")
 
 
-def starter_task() -> dict:
+def starter_task(tree: bool = False) -> dict:
     """A small task that ``kinegami design`` solves in seconds (what ``kinegami new --task``
     writes): a four-joint arm on a square tube of radius 10 mm that touches four points above a
-    table it must stay clear of."""
-    text = resources.files("kinegami.design").joinpath("starter_task.json").read_text("utf-8")
-    return json.loads(text)
+    table it must stay clear of. With ``tree``, a tree task (``kinegami new --task --tree``;
+    designed in about 20 s): two three-joint fingers on that tube, each touching two points,
+    the k-th points of both at once."""
+    name = "starter_tree_task.json" if tree else "starter_task.json"
+    return json.loads(resources.files("kinegami.design").joinpath(name).read_text("utf-8"))

@@ -979,7 +979,8 @@ class Compact(LongCommand):
 
     def prepared(self, document: Document) -> Compact:
         task = self.task
-        if task is None and self.keep_task and not document.is_tree:
+        if task is None and self.keep_task and not document.is_tree and \
+                not _is_tree_task(document.task):  # fmt: skip
             task = document.task
         if task is None:
             return self
@@ -1027,6 +1028,11 @@ class Compact(LongCommand):
                        tuple(sources))  # fmt: skip
 
 
+def _is_tree_task(task) -> bool:
+    """Whether a task document is a tree's (its joints given per leaf)."""
+    return isinstance(task, dict) and isinstance(task.get("joints"), list)
+
+
 @dataclass(frozen=True)
 class DesignForTask(LongCommand):
     """Replace the chain by one designed for the document's task
@@ -1053,8 +1059,9 @@ class DesignForTask(LongCommand):
         return replace(self, task=document.task)
 
     def check(self, document: Document) -> None:
-        if document.is_tree:
-            _fail("design for task: tasks are for chains for now, and this design is a tree")
+        if document.is_tree or _is_tree_task(self.task):
+            _fail("design for task: tasks are for chains for now, and this design or its task "
+                  "is a tree's")
         if self.task is None:
             _fail("design for task: this design has no task (a design file made by kinegami "
                   "design carries one in its \"task\" block; docs/design-for-a-task.md)")

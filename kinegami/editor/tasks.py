@@ -15,7 +15,8 @@ import numpy as np
 
 from kinegami.errors import InvalidTypeError
 
-__all__ = ["ATTEMPTS", "TargetCheck", "TaskGoals", "check_targets", "task_goals"]
+__all__ = ["ATTEMPTS", "TargetCheck", "TaskGoals", "check_targets", "labelled_targets",
+           "task_goals"]
 
 #: Solves per target before it counts as not reached (seeds 0, 1, ...; the first starts from
 #: the design's states), as compaction with a task tries.
@@ -29,7 +30,8 @@ class TaskGoals:
     Attributes
     ----------
     task : the :class:`~kinegami.design.task.Task` as read (its own units).
-    targets : one :class:`~kinegami.reach.Target` per task target (world frame, design units).
+    targets : one :class:`~kinegami.reach.Target` per task target (world frame, design units);
+        a tree task's as one tuple per leaf, as the task holds them.
     keep_out : the keep-out :class:`~kinegami.clearance.keep_out.Box` es (design units).
     margin : the clearance required (design units).
     scale : design units per task unit (1 when both are the same).
@@ -55,12 +57,32 @@ def task_goals(task_document: dict, units: str) -> TaskGoals:
     scale = UNITS_IN_MM[task.units] / UNITS_IN_MM[units]
     if scale == 1.0:
         return TaskGoals(task, task.targets, task.keep_out, task.margin, 1.0)
-    targets = tuple(Target(t.position * scale, axis=t.axis, rotation=t.rotation)
-                    for t in task.targets)  # fmt: skip
+
+    def scaled(targets) -> tuple:
+        return tuple(Target(t.position * scale, axis=t.axis, rotation=t.rotation)
+                     for t in targets)  # fmt: skip
+
+    targets = tuple(scaled(leaf) for leaf in task.targets) if task.is_tree \
+        else scaled(task.targets)  # fmt: skip
     boxes = tuple(Box(tuple(np.multiply(box.min, scale).tolist()),
                       tuple(np.multiply(box.max, scale).tolist()))
                   for box in task.keep_out)  # fmt: skip
     return TaskGoals(task, targets, boxes, task.margin * scale, scale)
+
+
+def labelled_targets(goals: TaskGoals) -> tuple[tuple[str, object], ...]:
+    """Every target of ``goals`` with its label, in the task's order: ``target 2 'C'`` (the
+    name when the task gives one); a tree task's leaf by leaf, ``leaf 1, target 0 'A'``."""
+    specs = goals.task.document["targets"]
+
+    def label(k: int, spec: dict) -> str:
+        return f"target {k}" + (f" '{spec['name']}'" if spec.get("name") else "")
+
+    if not goals.task.is_tree:
+        return tuple((label(k, specs[k]), t) for k, t in enumerate(goals.targets))
+    return tuple((f"leaf {i}, {label(k, specs[i][k])}", t)
+                 for i, leaf in enumerate(goals.targets)
+                 for k, t in enumerate(leaf))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -127,6 +149,9 @@ def check_targets(chain, task_document: dict, units: str,
         raise InvalidTypeError(f"a task is checked on a chain (tasks are for chains for now), "
                                f"got a {type(chain).__name__}")  # fmt: skip
     goals = task_goals(task_document, units)
+    if goals.task.is_tree:
+        raise InvalidTypeError("a tree task (joints given per leaf) is for a tree, and this "
+                               "design is a chain")  # fmt: skip
     specs = task_document["targets"]
     checks = []
     for k, target in enumerate(goals.targets):

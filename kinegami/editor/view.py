@@ -52,7 +52,7 @@ from kinegami.editor.jobs import (
 from kinegami.editor.keys import keys_script, shortcuts_markdown
 from kinegami.editor.model import Change, CommandResult, EditorModel
 from kinegami.editor.page_script import run_javascript, unsaved_changes_script
-from kinegami.editor.tasks import TargetCheck, check_targets, task_goals
+from kinegami.editor.tasks import TargetCheck, check_targets, labelled_targets, task_goals
 from kinegami.editor.units import (
     DEGREE,
     angle_text,
@@ -1056,7 +1056,8 @@ class EditorView:
         goals = self._goals(self.model.document)
         if goals is None or isinstance(goals, Exception):
             return np.zeros((0, 3))
-        return np.array([t.position for t in goals.targets], dtype=float).reshape(-1, 3)
+        return np.array([t.position for _, t in labelled_targets(goals)],
+                        dtype=float).reshape(-1, 3)  # fmt: skip
 
     def _checks_of(self, document: Document):
         """The targets' checks of ``document`` (computed once per document, in the worker
@@ -1133,10 +1134,11 @@ class EditorView:
         when the task, the units or a colour changed."""
         goals = self._goals(document)
         if goals is None or isinstance(goals, Exception):
-            key = None
+            key, targets = None, ()
         else:
+            targets = labelled_targets(goals)
             states = tuple(None if not isinstance(checks, tuple) else checks[k].reached
-                           for k in range(len(goals.targets)))  # fmt: skip
+                           for k in range(len(targets)))  # fmt: skip
             key = (document.task, document.units, states)
         old = self._task_key
         if key is not None and old is not None and key[0] is old[0] and key[1:] == old[1:]:
@@ -1148,7 +1150,7 @@ class EditorView:
         if key is None:
             return
         size = self._r
-        for k, (target, state) in enumerate(zip(goals.targets, key[2], strict=True)):
+        for k, ((label, target), state) in enumerate(zip(targets, key[2], strict=True)):
             colour = _target_colour(state)
             position = tuple(float(v) for v in target.position)
             name = f"/task/target{k}"
@@ -1164,9 +1166,8 @@ class EditorView:
                     f"{name}_axis", points=np.array([[target.position, tip]], dtype=np.float32),
                     colors=colour, shaft_radius=0.1 * size, head_radius=0.25 * size,
                     head_length=0.6 * size))  # fmt: skip
-            label = document.task["targets"][k].get("name") or f"target {k}"
             self._task_handles.append(self.scene.add_label(
-                f"{name}_label", str(label), position=position))  # fmt: skip
+                f"{name}_label", label, position=position))  # fmt: skip
 
     def task_html(self, document: Document, checks) -> str:
         """The Task panel: the task's name and joints, then one line per target, its colour
@@ -1178,8 +1179,15 @@ class EditorView:
             return ""
         title = escape(str(task.get("name") or "task"))
         count = len(task.get("targets", ()))
-        head = (f"<b>{title}</b>: {count} target{'s' if count != 1 else ''}, joints "
-                f"{escape(str(task.get('joints')))}")  # fmt: skip
+        joints = task.get("joints")
+        if isinstance(joints, list):  # a tree task: one joint string and target list per leaf
+            grasps = len(task["targets"][0]) if task.get("targets") else 0
+            head = (f"<b>{title}</b>: {len(joints)} leaves, {grasps} "
+                    f"grasp{'s' if grasps != 1 else ''}, joints "
+                    f"{escape(', '.join(map(str, joints)))}")  # fmt: skip
+        else:
+            head = (f"<b>{title}</b>: {count} target{'s' if count != 1 else ''}, joints "
+                    f"{escape(str(joints))}")  # fmt: skip
         if document.is_tree:
             return _task_box(f"{head}.<br><b>Tasks are for chains for now</b>: this design is a "
                              "tree, so its targets are not checked and it cannot be designed "
