@@ -8,6 +8,8 @@ inherit the matching builtin, so ``except ValueError`` keeps working (as ezdxf d
     +-- InvalidParameterError(ValueError)    a value outside its valid range
     |   +-- FoldedFormError                  a pattern that cannot be folded
     |   +-- UnknownModuleKindError(KeyError) no catalog entry for a module kind
+    |   +-- SplitError                       a sheet cannot be cut into short enough pieces
+    |       +-- BedTooSmallError             ... nor into pieces that fit the laser bed
     +-- InvalidTypeError(TypeError)          a value of the wrong type, an unknown option
     +-- ReadOnlyError(AttributeError)        assignment to a joint's or link's attribute
     +-- JointIndexError(IndexError)          no joint with that index
@@ -47,6 +49,8 @@ __all__ = [
     "IncompatibleJointError",
     "CompactionError",
     "InfeasibleTaskError",
+    "SplitError",
+    "BedTooSmallError",
     "EditorCommandError",
     "FoldedFormError",
     "UnknownModuleKindError",
@@ -119,6 +123,32 @@ class InfeasibleTaskError(KinegamiError, ValueError):
         super().__init__(message)
         self.target = target
         self.proven = proven
+
+
+class SplitError(InvalidParameterError):
+    """A sheet cannot be cut into pieces no longer than asked: a stretch without plain tube to
+    cut across is too long (kinegami.pattern.pieces). ``stretch`` says which (a
+    ``kinegami.pattern.pieces.Stretch``, or None), ``needed`` the shortest piece length that
+    would work (pattern units)."""
+
+    def __init__(self, message: str, stretch=None, needed: float = float("nan")):
+        super().__init__(message)
+        self.stretch = stretch
+        self.needed = needed
+
+
+class BedTooSmallError(SplitError):
+    """A sheet does not fit the laser bed and cannot be cut into pieces that do (a stretch
+    without plain tube to cut across is too long, or the strip is wider than the bed).
+
+    ``smallest`` is the smallest bed that would work, (long side, short side) in mm; the message
+    names the stretch and that bed (docs/fabrication.md, "Laser bed").
+    """
+
+    def __init__(self, message: str, smallest: tuple[float, float] = (0.0, 0.0), stretch=None,
+                 needed: float = float("nan")):  # fmt: skip
+        super().__init__(message, stretch, needed)
+        self.smallest = smallest
 
 
 class EditorCommandError(KinegamiError, ValueError):

@@ -62,6 +62,8 @@ HIERARCHY = {
     "IncompatibleJointError": (ValueError,),
     "CompactionError": (ValueError,),
     "InfeasibleTaskError": (ValueError,),
+    "SplitError": (ValueError,),
+    "BedTooSmallError": (ValueError,),
     "EditorCommandError": (ValueError,),
     "FoldedFormError": (ValueError,),
     "UnknownModuleKindError": (ValueError, KeyError),
