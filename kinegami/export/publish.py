@@ -38,7 +38,10 @@ itself cut short again leaves a prefix of the plan.
 * A crash of the whole machine is not covered: nothing is flushed to disk (no ``fsync``), so
   the file system may not keep the order of the moves.
 
-Entries of ``OUT`` that the new build does not write are never touched, and a folder of
+Entries of ``OUT`` that the new build does not write are never touched, except those it names
+to remove (``publish(remove=...)``: files an earlier build wrote that this one replaces by
+others, such as ``arm_bed_3.dxf`` when the new build needs two beds): they are moved aside like
+the replaced entries, in the same transaction, and come back on a rollback. A folder of
 ``OUT`` with anything in it is replaced only by a folder of the same name (a URDF's meshes):
 where the build would put a file in its place, publishing is refused before anything moves (an
 empty folder in the way is replaced: nothing is lost).
@@ -59,7 +62,7 @@ import signal
 import tempfile
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -201,17 +204,23 @@ def _move(src: Path, dst: Path) -> None:
     os.replace(src, dst)
 
 
-def _plan_steps(entries: list[tuple[str, bool]]) -> list[tuple[str, str]]:
+#: A journal entry: the name, whether ``OUT`` holds an entry of that name (moved aside), and
+#: whether the build writes one (moved in; False for a file the build removes).
+Entry = tuple[str, bool, bool]
+
+
+def _plan_steps(entries: list[Entry]) -> list[tuple[str, str]]:
     """The moves of a journal, in order: ("aside", name) and ("in", name)."""
     steps = []
-    for name, old in entries:
+    for name, old, new in entries:
         if old:
             steps.append(("aside", name))
-        steps.append(("in", name))
+        if new:
+            steps.append(("in", name))
     return steps
 
 
-def _rollback(out: Path, staging: Path, entries: list[tuple[str, bool]]) -> tuple[list, list]:
+def _rollback(out: Path, staging: Path, entries: list[Entry]) -> tuple[list, list]:
     """Undo the done moves of ``entries`` in reverse order; return (withdrawn, restored)
     names. Which moves were done is read from where the files are."""
     new, old = staging / "new", staging / "old"
@@ -227,7 +236,7 @@ def _rollback(out: Path, staging: Path, entries: list[tuple[str, bool]]) -> tupl
     return withdrawn, restored
 
 
-def _read_journal(staging: Path) -> list[tuple[str, bool]] | None:
+def _read_journal(staging: Path) -> list[Entry] | None:
     """The plan in ``staging``'s journal, or None if there is no journal."""
     try:
         text = (staging / JOURNAL).read_text(encoding="utf-8")
@@ -235,13 +244,14 @@ def _read_journal(staging: Path) -> list[tuple[str, bool]] | None:
         return None
     try:
         data = json.loads(text)
-        entries = [(str(item["name"]), bool(item["old"])) for item in data["entries"]]
+        entries = [(str(item["name"]), bool(item["old"]), bool(item.get("new", True)))
+                   for item in data["entries"]]  # fmt: skip
     except (ValueError, KeyError, TypeError) as exc:
         raise PublishError(
             f"cannot read the journal of an interrupted build in {str(staging)!r} ({exc}); "
             "move its old/ entries back by hand, then delete the folder"
         ) from None
-    for name, _ in entries:
+    for name, _, _ in entries:
         if not name or name in (".", "..") or "/" in name or (os.sep in name):
             raise PublishError(f"the journal in {str(staging)!r} names {name!r}: not a file name")
     return entries
@@ -382,8 +392,15 @@ class Staging:
         self._keep = False  # a rollback was cut short: the backups must stay
         self._created: list[Path] = []  # folders open_staging created, innermost first
 
-    def publish(self) -> list[Path]:
+    def publish(self, remove: Iterable[str] = ()) -> list[Path]:
         """Move every entry of :attr:`new` into :attr:`out`, all or nothing.
+
+        Parameters
+        ----------
+        remove : iterable of str, optional
+            Names of files in :attr:`out` to remove in the same transaction (files of an
+            earlier build that this one does not write again); names the build writes, and
+            names not in :attr:`out`, are skipped. Folders are never removed.
 
         Returns
         -------
@@ -401,6 +418,11 @@ class Staging:
             raise PublishError(f"{str(self.path)!r} is already published")
         out, staging = self.out, self.path
         names = sorted(os.listdir(self.new))
+        removed = sorted(set(remove) - set(names))
+        for name in removed:
+            if not isinstance(name, str) or not name or name in (".", "..") or "/" in name or (
+                    os.sep in name):  # fmt: skip
+                raise PublishError(f"cannot remove {name!r} from {str(out)!r}: not a file name")
         with _folder_lock(out), deferred_signals() as received:
             for name in names:  # a file of the build never replaces a folder of the user's
                 if _holds_files(out / name) and not _is_folder(self.new / name):
@@ -409,14 +431,17 @@ class Staging:
                         f"replace it with a file of the same name; move or rename the folder "
                         f"(nothing was written, {str(out)!r} is as before)"
                     )
-            entries = [(name, os.path.lexists(out / name)) for name in names]
+            entries = [(name, os.path.lexists(out / name), True) for name in names]
+            entries += [(name, True, False) for name in removed
+                        if os.path.lexists(out / name) and not _is_folder(out / name)]
             steps = _plan_steps(entries)
             try:
                 self._step(0, received)
                 journal = {
                     "format": "kinegami-build-journal",
                     "version": 1,
-                    "entries": [{"name": name, "old": old} for name, old in entries],
+                    "entries": [{"name": name, "old": old, "new": new}
+                                for name, old, new in entries],  # fmt: skip
                 }
                 (staging / "journal.tmp").write_text(json.dumps(journal), encoding="utf-8")
                 _move(staging / "journal.tmp", staging / JOURNAL)
@@ -454,7 +479,7 @@ class Staging:
         if received:
             raise _Interrupted(received[0])
 
-    def _undo(self, entries: list[tuple[str, bool]]) -> None:
+    def _undo(self, entries: list[Entry]) -> None:
         """Roll back, then retire the journal (so that removing the folder, even cut short,
         cannot leave a journal that no longer matches the files)."""
         try:

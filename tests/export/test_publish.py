@@ -96,11 +96,11 @@ def leftovers(folder: Path) -> list[str]:
     return sorted(p.name for p in folder.iterdir() if p.name.startswith(PREFIX))
 
 
-def build(out: Path) -> list[Path]:
-    """A whole build: stage NEW, publish, close."""
+def build(out: Path, remove=()) -> list[Path]:
+    """A whole build: stage NEW, publish (removing ``remove``), close."""
     with staging_folder(out) as staging:
         write_files(staging.new, NEW)
-        return staging.publish()
+        return staging.publish(remove=remove)
 
 
 class Moves:
@@ -267,7 +267,7 @@ def test_a_signal_during_the_rollback_lets_it_finish(out, monkeypatch, index, na
 
 
 # --- real signals at every step (forked processes, the test hook) -------------------------------
-def _child(out: Path, step: int, write_end: int) -> None:
+def _child(out: Path, step: int, write_end: int, remove=()) -> None:
     """In a forked process: build NEW into ``out``, paused before ``step``; never returns."""
     code = 0
     try:
@@ -275,7 +275,7 @@ def _child(out: Path, step: int, write_end: int) -> None:
         os.environ[PAUSE_HOOK] = str(step)
         signal.signal(signal.SIGINT, signal.default_int_handler)
         signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
-        build(out)
+        build(out, remove)
     except KeyboardInterrupt:
         code = 130
     except SystemExit as stop:
@@ -286,13 +286,13 @@ def _child(out: Path, step: int, write_end: int) -> None:
         os._exit(code)
 
 
-def run_paused(out: Path, step: int, signum: int) -> int:
+def run_paused(out: Path, step: int, signum: int, remove=()) -> int:
     """Fork a build paused before ``step``, send ``signum`` and return its wait status."""
     read_end, write_end = os.pipe()
     pid = os.fork()
     if pid == 0:  # pragma: no cover - the child
         os.close(read_end)
-        _child(out, step, write_end)
+        _child(out, step, write_end, remove)
     os.close(write_end)
     try:
         ready, _, _ = select.select([read_end], [], [], 60)
@@ -504,3 +504,64 @@ def test_a_folder_replaces_a_folder(out):
     """As the URDF's meshes folder replaces the last build's: m/ is replaced whole."""
     build(out)
     assert not (out / "m" / "sub").exists() and (out / "m" / "z.bin").read_bytes() == b"new z"
+
+
+# --- files of an earlier build removed in the same transaction -----------------------------------
+#: A file an earlier build wrote that the new one replaces by others (arm_bed_3.dxf when the new
+#: build needs two beds); the build also names a file it writes, a missing one and a folder.
+STALE = {"arm_bed_3.dxf": b"old bed 3"}
+REMOVE = ["arm_bed_3.dxf", "a.txt", "missing.txt", "m"]
+#: The journal, a.txt aside and in, m aside and in, n.txt in, arm_bed_3.dxf aside, the commit.
+REMOVE_STEPS = STEPS + 1
+
+
+@pytest.fixture
+def stale_out(out) -> Path:
+    write_files(out, STALE)
+    return out
+
+
+def test_publish_removes_the_files_it_is_told_to(stale_out, monkeypatch):
+    moves = Moves({})
+    monkeypatch.setattr(publish, "_move", moves)
+    written = build(stale_out, REMOVE)
+    assert [p.name for p in written] == ["a.txt", "m", "n.txt"]
+    assert snapshot(stale_out) == new_state()  # the stale file gone; the folder m is the new one
+    assert moves.calls == REMOVE_STEPS
+
+
+@pytest.mark.parametrize("index", range(REMOVE_STEPS))
+def test_an_error_at_any_move_keeps_the_file_to_remove(stale_out, monkeypatch, index):
+    error = PermissionError(errno.EACCES, "Permission denied", "x")
+    monkeypatch.setattr(publish, "_move", Moves({index: error}))
+    with pytest.raises(PublishError):
+        build(stale_out, REMOVE)
+    assert snapshot(stale_out) == tree({**OLD, **STALE})
+
+
+@pytest.mark.parametrize("step", range(REMOVE_STEPS))
+def test_sigkill_while_removing_is_recovered(stale_out, step):
+    status = run_paused(stale_out, step, signal.SIGKILL, REMOVE)
+    assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGKILL
+    assert recover(stale_out) is not None
+    assert snapshot(stale_out) == tree({**OLD, **STALE})
+
+
+def test_a_journal_of_an_earlier_version_is_still_recovered(out):
+    """Journals written before removals existed have no "new" key: every entry was written."""
+    staging = out / f"{PREFIX}1-old"
+    (staging / "new").mkdir(parents=True)
+    (staging / "old").mkdir()
+    os.replace(out / "a.txt", staging / "old" / "a.txt")
+    (out / "a.txt").write_bytes(b"half-published a")
+    (staging / "journal.json").write_text(
+        '{"format": "kinegami-build-journal", "version": 1, '
+        '"entries": [{"name": "a.txt", "old": true}]}', encoding="utf-8")
+    assert "put back the earlier a.txt" in recover(out)
+    assert snapshot(out) == old_state()
+
+
+def test_a_name_with_a_folder_is_not_removed(out):
+    with pytest.raises(PublishError, match="not a file name"):
+        build(out, ["m/x.bin"])
+    assert snapshot(out) == old_state()
