@@ -5,7 +5,8 @@ Commands::
     kinegami build DESIGN -o DIR [--formats dxf,svg,png] [--name STEM]
     kinegami show DESIGN [--pattern]
     kinegami validate DESIGN
-    kinegami new DESIGN [--force]
+    kinegami new DESIGN [--force] [--task [--tree]]
+    kinegami design TASK -o DIR [--seed S] [--name STEM] [--formats LIST]
     kinegami check DESIGN [--motion N] [--seed S] [--json]
     kinegami compact DESIGN -o OUT.json [--seed S] [--motion] [--time-limit T] [--force]
 

@@ -20,11 +20,13 @@ import pytest
 
 pytest.importorskip("viser")
 
+from kinegami.design.task import starter_task  # noqa: E402
 from kinegami.editor import Document, EditorModel  # noqa: E402
 from kinegami.editor.commands import DesignForTask, ReplaceDocument  # noqa: E402
 from kinegami.editor.server import EditorServer  # noqa: E402
 from kinegami.editor.tasks import check_targets, task_goals  # noqa: E402
 from kinegami.editor.view import MISSED_COLOR, REACHED_COLOR  # noqa: E402
+from kinegami.errors import InvalidTypeError  # noqa: E402
 from kinegami.optimize import tube_length  # noqa: E402
 from kinegami.reach import solve  # noqa: E402
 
@@ -193,6 +195,27 @@ def test_a_tree_with_a_task_says_tasks_are_for_chains(view):
     assert view._task_folder.visible and not view._design_button.visible
     assert "Tasks are for chains for now" in view._task_html.content
     assert view.design_for_task() is None and "tasks are for chains for now" in view.message
+
+
+def test_a_tree_with_a_tree_task_draws_every_leaf_target_and_says_tasks_are_for_chains(view):
+    tree = Document.load(GRIPPER).replaced(task=starter_task(tree=True))
+    view.set_model(EditorModel(tree))
+    view.flush()
+    assert "2 leaves, 2 grasps, joints RRR, RRR" in view._task_html.content
+    assert "Tasks are for chains for now" in view._task_html.content
+    np.testing.assert_allclose(view.task_positions(), [[-60, 20, 120], [-40, 30, 130],
+                                                       [60, -20, 120], [40, -30, 130]])
+    labels = sorted(h.name for h in view._task_handles if h.name.endswith("_label"))
+    assert len(labels) == 4 and len(view.target_colours()) == 4
+    assert view.design_for_task() is None and "tasks are for chains for now" in view.message
+
+
+def test_a_tree_task_is_not_checked_on_a_chain():
+    document = Document.load(TASK_ARM)
+    with pytest.raises(InvalidTypeError, match="a tree task"):
+        check_targets(document.chain, starter_task(tree=True), document.units)
+    result = EditorModel(document.replaced(task=starter_task(tree=True))).design_for_task()
+    assert not result.ok and "tasks are for chains for now" in result.reason
 
 
 def test_design_for_task_is_one_undo_step_that_keeps_the_task(view):
