@@ -1,5 +1,5 @@
 """Design files: a kinematic chain or tree as a JSON document (format "kinegami-design",
-versions 1 and 2).
+versions 1 to 4).
 
 A design file lists the tube (``numSides``, ``r``), the joints as they would be appended in
 Python (or a DH table), optional edits and joint states; see docs/design-format.md and the JSON

@@ -26,6 +26,7 @@ import stat
 import warnings
 import weakref
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from kinegami.chain.joints import (
     JOINT_KINDS,
@@ -64,11 +65,15 @@ from kinegami.design.trees import (
 from kinegami.errors import ClearanceWarning, JointIndexError, KinegamiError, PlacementWarning
 from kinegami.geometry.screws import REVOLUTE
 from kinegami.tree import KinematicTree
-from kinegami.validation import LENGTH_UNITS, shorten, shown
+from kinegami.validation import LENGTH_UNITS, UNITS_IN_MM, shorten, shown
+
+if TYPE_CHECKING:  # pragma: no cover
+    from kinegami.fabrication.beds import Bed, Material
 
 __all__ = [
     "DesignInfo",
     "FORMAT",
+    "fabrication_fields",
     "VERSIONS",
     "UNITS",
     "parse_design_text",
@@ -99,6 +104,12 @@ class DesignInfo:
     file : the design file (None for a design given as text or a dict).
     structure : ``"chain"`` or ``"tree"``: whether the design loads as a KinematicChain or a
         KinematicTree (version 2).
+    task : the task block (kinegami design), or None.
+    material : the sheet material (version 4, a :class:`~kinegami.fabrication.beds.Material`),
+        or None.
+    bed : the laser bed (version 4, a :class:`~kinegami.fabrication.beds.Bed`), or None.
+    margin : the file's own ``"margin"`` (design units), None without one (then the chain's
+        margin is the material's thickness, or 0).
     """
 
     name: str | None
@@ -108,10 +119,14 @@ class DesignInfo:
     file: str | None
     structure: str = "chain"
     task: dict | None = None
+    material: Material | None = None
+    bed: Bed | None = None
+    margin: float | None = None
 
     @classmethod
     def of(cls, document: dict, file=None) -> DesignInfo:
         """The info of a checked design document."""
+        material, bed = fabrication_fields(document)
         return cls(
             name=document.get("name"),
             description=document.get("description"),
@@ -120,7 +135,49 @@ class DesignInfo:
             file=None if file is None else os.fspath(file),
             structure=structure_of(document),
             task=document.get("task"),
+            material=material,
+            bed=bed,
+            margin=float(document["margin"]) if "margin" in document else None,
         )
+
+
+def fabrication_fields(document: dict, file=None) -> tuple[Material | None, Bed | None]:
+    """The ``"material"`` and ``"bed"`` of a schema-valid design (version 4), checked: a
+    known material's usual thickness when none is given (another needs one), a bed margin
+    less than half the bed's shorter side. A DesignError names the field."""
+    material = bed = None
+    if "material" not in document and "bed" not in document:
+        return None, None
+    from kinegami.fabrication.beds import Bed, check_material
+
+    if "material" in document:
+        fields = document["material"]
+        try:
+            material = check_material(fields.get("name"), fields.get("thickness"))
+        except KinegamiError as error:
+            reason = str(error).removeprefix("thickness: ")
+            where = "thickness" if "thickness" in str(error).split(" ")[0] else "name"
+            raise DesignError(reason, field=f"material.{where}", file=file) from None
+    if "bed" in document:
+        fields = document["bed"]
+        try:
+            bed = Bed.of(fields.get("width"), fields.get("height"), fields.get("margin"),
+                         fields.get("tab"))  # fmt: skip
+        except KinegamiError as error:
+            words = str(error).split(" ")
+            where = "bed." + (words[1] if words[0] == "bed" else words[0])
+            raise DesignError(str(error), field=where, file=file) from None
+    return material, bed
+
+
+def _margin_of(document: dict, material) -> float:
+    """The chain's margin: the file's ``"margin"``, else the material's thickness in the
+    design's units, else 0."""
+    if "margin" in document:
+        return float(document["margin"])
+    if material is None:
+        return 0.0
+    return material.thickness / UNITS_IN_MM[document.get("units", "mm")]
 
 
 # --- parsing ---------------------------------------------------------------------------------
@@ -517,7 +574,7 @@ class _Plan:
     states: list | None
     names: tuple = ()  # the "name" of every entry of "joints" (None where it has none)
     require_clearance: bool = False  # the design's "requireClearance"
-    margin: float = 0.0  # the design's "margin" (version 3; design units)
+    margin: float = 0.0  # the design's "margin" (version 3), else its material's thickness
     tree: bool = False  # build a KinematicTree (version 2)
     parents: tuple = ()  # per entry of "joints", the entry it is added to (-1: the root)
     specification: TreeSpecification | None = None  # a joint specification to construct
@@ -714,6 +771,7 @@ def _check_document(document, file) -> _Plan:
     _check_values(document, file)
     check_schema(document, file)
     check_lengths(document, file)
+    material, _ = fabrication_fields(document, file)
     if "task" in document:  # the task the design was made for (kinegami design)
         task = task_from_dict(document["task"], file, where=("task",))
         if task.is_tree and structure_of(document) != "tree":
@@ -753,7 +811,7 @@ def _check_document(document, file) -> _Plan:
     return _Plan(
         numSides, r, units, chain_options, joints, dh, edits, states, names,
         require_clearance=document.get("requireClearance", False),
-        margin=float(document.get("margin", 0.0)),
+        margin=_margin_of(document, material),
         tree=fields.tree, parents=fields.parents, specification=specification,
     )  # fmt: skip
 
@@ -831,6 +889,7 @@ def _audit_semantics(document: dict, file, attempt) -> None:
     units = document.get("angleUnits", "rad")
     numSides, r = int(document["numSides"]), float(document["r"])
     attempt("lengths", check_lengths, document, file)
+    attempt("fabrication", fabrication_fields, document, file)
     attempt("names", _check_names, document, file)
     ok, fields = attempt("tree", check_tree_fields, document, file)
     if "joints" in document:

@@ -114,8 +114,9 @@ _PARENT_TEXT = (
 )
 
 
-#: The versions of the format this kinegami reads (3 adds ``"margin"``).
-VERSIONS = (1, 2, 3)
+#: The versions of the format this kinegami reads (3 adds ``"margin"``, 4 ``"material"`` and
+#: ``"bed"``).
+VERSIONS = (1, 2, 3, 4)
 
 
 def version_problem(version) -> str:
@@ -361,8 +362,11 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
         if name == "op":
             known = ", ".join(EDIT_OPS)
             return fail(f"unknown edit op {shown(value)}; known: {known}", value=value)
-        if path == ["version"] and error.validator_value == [2, 3]:  # a field of version 2
-            return fail(f"{_version_2_field(document)} needs \"version\": 2 (or 3)",
+        if path == ["version"] and error.validator_value == [2, 3, 4]:  # a version-2 field
+            return fail(f"{_version_2_field(document)} needs \"version\": 2 (or 3 or 4)",
+                        value=value)  # fmt: skip
+        if path == ["version"] and error.validator_value == [3, 4]:  # a field of version 3
+            return fail("'margin' (a field of version 3) needs \"version\": 3 (or 4)",
                         value=value)  # fmt: skip
         if path == ["version"]:
             return fail(version_problem(value), value=value)
@@ -370,8 +374,9 @@ def translate(error: jsonschema.ValidationError, document, file=None) -> DesignE
     if keyword == "const":
         if path == ["format"]:
             return fail("not a kinegami design: format must be 'kinegami-design'", value=value)
-        if path == ["version"] and error.validator_value == 3:  # a field of version 3
-            return fail("'margin' (a field of version 3) needs \"version\": 3", value=value)
+        if path == ["version"] and error.validator_value == 4:  # a field of version 4
+            key = next((k for k in ("material", "bed") if k in document), "material")
+            return fail(f"'{key}' (a field of version 4) needs \"version\": 4", value=value)
         if path == ["placement", "method"]:
             return fail(f"unknown placement method {shown(value)}; known: wafr2024", value=value)
         return fail(f"must be {format_value(expected)}", value=value)

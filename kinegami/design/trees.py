@@ -29,6 +29,7 @@ from kinegami.validation import shorten
 __all__ = [
     "VERSION_2_FIELDS",
     "VERSION_3_FIELDS",
+    "VERSION_4_FIELDS",
     "SPECIFICATION_METHODS",
     "TreeFields",
     "TreeSpecification",
@@ -43,6 +44,8 @@ __all__ = [
 VERSION_2_FIELDS = ("structure", "placement")
 #: Top-level fields that need version 3 (which has every field of version 2).
 VERSION_3_FIELDS = ("margin",)
+#: Top-level fields that need version 4 (which has every field of version 3).
+VERSION_4_FIELDS = ("material", "bed")
 #: Methods of ``"placement"``: the tree constructions a joint specification can ask for.
 SPECIFICATION_METHODS = ("wafr2024",)
 #: Joint keys that a joint specification does not have (the construction places the joints).
@@ -52,11 +55,20 @@ _PLACED_BY_CONSTRUCTION = ("safe", "fixedPosition", "fixedOrientation")
 def check_version_features(document: dict, file=None) -> None:
     """A DesignError for the first version-2 field of a design that says ``"version": 1``.
 
-    Also the first version-3 field (``"margin"``) of a design that says 1 or 2. Runs on the
+    Also the first version-3 field (``"margin"``) of a design that says 1 or 2, and the first
+    version-4 field (``"material"``, ``"bed"``) of one that says 1, 2 or 3. Runs on the
     top-level shape only (``joints`` a list); cheap. The JSON Schema says the same for other
     validators.
     """
     version = document.get("version")
+    for key in VERSION_4_FIELDS:
+        if key in document and version in (1, 2, 3):
+            raise DesignError(
+                f"'{key}' is a field of version 4 of the format: write \"version\": 4 "
+                f"(version {version} has no {key})",
+                field=key,
+                file=file,
+            )
     for key in VERSION_3_FIELDS:
         if key in document and version in (1, 2):
             raise DesignError(

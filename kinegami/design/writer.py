@@ -11,7 +11,8 @@ written with ``"requireClearance": true``. A chain is written as version 1, exac
 trees existed; a :class:`~kinegami.tree.KinematicTree` as version 2 with ``"structure": "tree"``
 and every non-root joint's ``"parent"`` (its name when it has one, else its index), so that
 loading gives a tree again, whatever its shape. A chain or tree whose ``margin`` is not 0 is
-written as version 3 with its ``"margin"``; every other one exactly as before.
+written as version 3 with its ``"margin"``; one saved with a sheet ``material`` or a laser
+``bed`` as version 4 with them; every other one exactly as before.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from kinegami.design.errors import DesignError
 from kinegami.design.reader import FORMAT, UNITS, check_document, origin_of
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.tree import KinematicTree
-from kinegami.validation import check_twist_portion
+from kinegami.validation import UNITS_IN_MM, check_twist_portion
 
 __all__ = ["design_to_dict", "dumps_design", "save_design"]
 
@@ -71,6 +72,8 @@ def design_to_dict(
     units: str = "mm",
     twistPortion: float | None = None,
     task: dict | None = None,
+    material=None,
+    bed=None,
 ) -> dict:
     """The design document (a JSON-ready dict) that re-creates ``chain`` exactly.
 
@@ -83,6 +86,11 @@ def design_to_dict(
     twistPortion : stored for the crease pattern when given (in [0, 1)).
     task : the task document the design was made for (docs/design-for-a-task.md), kept as
         its ``"task"`` block.
+    material : the sheet material (a :class:`~kinegami.fabrication.beds.Material`), kept as
+        ``"material"`` (version 4); the chain's margin is then written only when it is not
+        the material's thickness (the default a loaded file gets).
+    bed : the laser bed (a :class:`~kinegami.fabrication.beds.Bed`), kept as ``"bed"``
+        (version 4).
 
     Poses are those of the state-0 configuration (computed on a copy of the chain); non-zero
     states are listed in ``"states"`` (radians for revolute joints, lengths for prismatic).
@@ -126,8 +134,12 @@ def design_to_dict(
                     "to False or move it clear"
                 )
     margin = float(chain.margin)
-    # version 3 only when it says something older readers do not know: the margin
-    document = {"format": FORMAT, "version": 3 if margin else 2 if tree else 1}
+    fabrication = _fabrication_fields(material, bed)
+    if material is not None and margin == material.thickness / UNITS_IN_MM[units]:
+        margin = 0.0  # the material's thickness is the margin a loaded file gets
+    # a newer version only when it says something older readers do not know
+    version = 4 if fabrication else 3 if margin else 2 if tree else 1
+    document = {"format": FORMAT, "version": version}
     if name is not None:
         document["name"] = name
     if description is not None:
@@ -143,6 +155,7 @@ def design_to_dict(
         document["requireClearance"] = True
     if margin:
         document["margin"] = margin
+    document.update(fabrication)
     if twistPortion is not None:
         document["twistPortion"] = check_twist_portion(twistPortion)
     if tree:
@@ -181,6 +194,23 @@ def design_to_dict(
     return document
 
 
+def _fabrication_fields(material, bed) -> dict:
+    """The ``"material"`` and ``"bed"`` fields of the given records (none for None)."""
+    from kinegami.fabrication.beds import Bed, Material
+
+    fields = {}
+    if material is not None:
+        if not isinstance(material, Material):
+            raise InvalidTypeError(f"material must be a Material or None, got {material!r}")
+        fields["material"] = {"name": material.name, "thickness": float(material.thickness)}
+    if bed is not None:
+        if not isinstance(bed, Bed):
+            raise InvalidTypeError(f"bed must be a Bed or None, got {bed!r}")
+        fields["bed"] = {"width": float(bed.width), "height": float(bed.height),
+                         "margin": float(bed.margin), "tab": float(bed.tab)}  # fmt: skip
+    return fields
+
+
 def _dumps(value, indent: str) -> str:
     """JSON with lists of plain values (matrix rows, vectors) on one line."""
     inner = indent + "  "
@@ -211,6 +241,8 @@ def save_design(
     units: str = "mm",
     twistPortion: float | None = None,
     task: dict | None = None,
+    material=None,
+    bed=None,
 ) -> Path:
     """Write ``chain`` (a chain or a tree) to the design file ``path`` (suffix .json)
     atomically; return the path.
@@ -235,7 +267,7 @@ def save_design(
         raise InvalidParameterError(f"{os.fspath(path)!r} is a directory, not a file name")
     document = design_to_dict(
         chain, name=name, description=description, units=units, twistPortion=twistPortion,
-        task=task,
+        task=task, material=material, bed=bed,
     )  # fmt: skip
     text = dumps_design(document)
     try:

@@ -43,7 +43,7 @@ def test_schema_and_loader_agree_on_names():
     assert set(top) == {
         "format", "version", "name", "description", "units", "angleUnits", "numSides", "r",
         "maxAnglePerElbow", "twistPortion", "joints", "dh", "edits", "states", "requireClearance",
-        "structure", "placement", "margin", "task",
+        "structure", "placement", "margin", "task", "material", "bed",
     }  # fmt: skip
     assert top["version"]["enum"] == list(design.VERSIONS)
     assert top["units"]["enum"] == list(design.UNITS)
@@ -75,7 +75,8 @@ def test_public_functions():
         assert str(inspect.signature(getattr(design, name))) == signature, name
     save = inspect.signature(design.save_design)
     assert list(save.parameters) == [
-        "chain", "path", "name", "description", "units", "twistPortion", "task"
+        "chain", "path", "name", "description", "units", "twistPortion", "task", "material",
+        "bed",
     ]  # fmt: skip
     assert save.parameters["units"].default == "mm"
     assert save.parameters["name"].kind is inspect.Parameter.KEYWORD_ONLY

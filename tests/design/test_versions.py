@@ -267,4 +267,4 @@ def test_a_newer_version_is_refused_in_one_line():
         chain_from_dict(document, "arm.json")
     text = str(info.value)
     assert "\n" not in text and info.value.field == "version"
-    assert "version 9 is newer than this kinegami" in text and "(versions 1, 2, 3)" in text
+    assert "version 9 is newer than this kinegami" in text and "(versions 1, 2, 3, 4)" in text
