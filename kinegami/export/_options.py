@@ -14,6 +14,7 @@ from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.validation import UNITS_IN_MM, check_bool, check_options, check_positive
 
 __all__ = [
+    "BedText",
     "LABEL_HEIGHT",
     "check_label",
     "UNITS_IN_MM",
@@ -24,6 +25,8 @@ __all__ = [
     "resolve_sheet_options",
     "dash_segments",
     "format_numbers",
+    "sheet_lines",
+    "bed_lines",
 ]
 
 #: Default perforation: cut length and bridge length along fold lines, millimetres.
@@ -216,3 +219,70 @@ def sheet_lines(
         kinds = np.concatenate([kinds[folds][source], kinds[~folds]])
     bounds = tuple(float(v) * opts.factor for v in sheet.bounds)
     return segments, kinds, bounds
+
+
+class BedText(Record):
+    """One line of text on a bed sheet: lower left corner (x, y), height and angle
+    (degrees, counter-clockwise), mm."""
+
+    text: str
+    x: float
+    y: float
+    height: float
+    angle: float
+
+
+def _placed(points: np.ndarray, placement) -> np.ndarray:
+    """Points (..., 2) in mm from a piece's lower left corner, where ``placement`` puts them
+    on the bed (a quarter turn counter-clockwise when it is ``rotated``)."""
+    if not placement.rotated:
+        return points + [placement.x, placement.y]
+    out = np.empty_like(points)
+    out[..., 0] = placement.x + placement.width - points[..., 1]
+    out[..., 1] = placement.y + points[..., 0]
+    return out
+
+
+def bed_lines(
+    layout, index: int, opts: SheetOptions
+) -> tuple[np.ndarray, np.ndarray, list[BedText], tuple[float, float, float, float]]:
+    """The lines of bed sheet ``index`` (from 0) of a :class:`~kinegami.fabrication.beds.
+    BedLayout`, in mm on the bed: every piece's sheet where the layout puts it, its marks on
+    the Boundary layer (``"B"``: guides to etch), and its labels.
+
+    ``opts.factor`` is not used: the layout says how many mm a pattern unit is.
+
+    Returns
+    -------
+    segments : numpy.ndarray, shape (K, 2, 2)
+        Creases (or their dashes) first, then boundary, marks and cut lines.
+    kinds : numpy.ndarray of str, shape (K,)
+    texts : list of BedText
+    bounds : tuple of float
+        The bed, (0, 0, width, height).
+    """
+    from kinegami.pattern.sheet import flatten
+
+    unit = layout.unit
+    segments, kinds, texts = [], [], []
+    for k in layout.on_bed(index):
+        piece, placement = layout.pieces[k], layout.placements[k]
+        corner = np.array(layout.bounds[k][:2])
+        sheet = flatten(piece.pattern, skip_creases_on_cut=opts.skip_creases_on_cut)
+        lines = np.concatenate([sheet.segments, piece.marks])
+        segments.append(_placed((lines - corner) * unit, placement))
+        kinds.append(np.concatenate([sheet.kinds, np.full(piece.marks.shape[0], "B")]))
+        for label in piece.labels:
+            x, y = _placed((np.array([label.x, label.y]) - corner) * unit, placement).tolist()
+            texts.append(BedText(label.text, x, y, label.height * unit,
+                                 90.0 if placement.rotated else 0.0))  # fmt: skip
+    segments = np.concatenate(segments) if segments else np.zeros((0, 2, 2))
+    kinds = np.concatenate(kinds).astype("<U1") if kinds else np.zeros(0, dtype="<U1")
+    if opts.perforate:
+        folds = np.isin(kinds, ("M", "V"))
+        dashes, source = dash_segments(segments[folds], opts.dash, opts.gap)
+        segments = np.concatenate([dashes, segments[~folds]])
+        kinds = np.concatenate([kinds[folds][source], kinds[~folds]])
+    rank = {"M": 0, "V": 1, "B": 2, "C": 3}
+    order = np.argsort([rank[k] for k in kinds.tolist()], kind="stable")
+    return segments[order], kinds[order], texts, (0.0, 0.0, layout.bed.width, layout.bed.height)

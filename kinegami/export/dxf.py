@@ -43,9 +43,10 @@ from typing import TYPE_CHECKING, Any, NamedTuple, TextIO
 
 import numpy as np
 
-from kinegami.errors import KinegamiError
+from kinegami.errors import InvalidParameterError, KinegamiError
 from kinegami.export._options import (
     LABEL_HEIGHT,
+    bed_lines,
     check_label,
     format_numbers,
     resolve_sheet_options,
@@ -59,8 +60,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from kinegami.pattern.tubular import TubularPattern
 
-__all__ = ["LAYERS", "DXF_VERSION", "dxf_data", "write_dxf", "dxf_document", "dxf_skeleton",
-           "make_skeleton", "DxfSkeleton"]
+__all__ = ["LAYERS", "DXF_VERSION", "dxf_data", "bed_dxf_data", "write_dxf", "dxf_document",
+           "dxf_skeleton", "make_skeleton", "DxfSkeleton"]
 
 #: Layer name and ACI colour for each kind of line.
 LAYERS = {"M": ("Mountain", 5), "V": ("Valley", 1), "B": ("Boundary", 2), "C": ("Cut", 3)}
@@ -168,17 +169,72 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
     >>> dxf_data(TubeFittingPattern(4, 10.0, 30.0)).split()[:2]
     ['0', 'SECTION']
     """
-    template = dxf_skeleton()
     opts = resolve_sheet_options(options, {"label": None}, "DXF")
     label = check_label(opts.extra["label"])
     segments, kinds, bounds = sheet_lines(pattern, opts)
+    texts = []
+    if label:  # one TEXT entity on layer 0, below the sheet, after the lines
+        texts.append(_Text(label, *_label_point(bounds), LABEL_HEIGHT, 0.0, "0", None))
+    return _document(segments, kinds, bounds, texts, repr((bounds, label)).encode())
+
+
+def bed_dxf_data(layout, index: int, **options: Any) -> str:
+    """Bed sheet ``index`` (from 0) of a :class:`~kinegami.fabrication.beds.BedLayout` as DXF
+    R2013 text (mm, the bed's corner at the origin): every piece on it where the layout puts
+    it, with its marks (join line and alignment ticks) on the Boundary layer and its labels as
+    TEXT on the Boundary layer, turned with the piece (docs/fabrication.md, "Laser bed").
+
+    Parameters
+    ----------
+    layout : BedLayout
+    index : int
+    perforate, dash, gap, skip_creases_on_cut
+        As for :func:`dxf_data` (the layout fixes the units).
+
+    Raises
+    ------
+    InvalidTypeError, InvalidParameterError
+        For an unknown option or a bad value.
+    """
+    opts = resolve_sheet_options(options, {}, "DXF bed sheet")
+    if "units" in options or "scale" in options:
+        raise InvalidParameterError("units and scale are the layout's (lay_out(..., unit=)); "
+                                    "a bed sheet takes neither")  # fmt: skip
+    segments, kinds, texts, bounds = bed_lines(layout, index, opts)
+    name, color = LAYERS["B"]
+    placed = [_Text(t.text, t.x, t.y, t.height, t.angle, name, color) for t in texts]
+    return _document(segments, kinds, bounds, placed, repr((bounds, placed)).encode())
+
+
+class _Text(NamedTuple):
+    text: str
+    x: float
+    y: float
+    height: float
+    angle: float  # degrees, counter-clockwise
+    layer: str
+    color: int | None
+
+
+def _text_entity(text: _Text, handle: int, owner: str) -> str:
+    """One TEXT entity, group codes as ezdxf writes them."""
+    x, y, height = (repr(float(v)) for v in (text.x, text.y, text.height))
+    color = "" if text.color is None else f" 62\n{text.color}\n"
+    angle = "" if not text.angle else f" 50\n{float(text.angle)!r}\n"
+    return (f"  0\nTEXT\n  5\n{handle:X}\n330\n{owner}\n100\nAcDbEntity\n  8\n{text.layer}\n"
+            f"{color}100\nAcDbText\n 10\n{x}\n 20\n{y}\n 30\n0.0\n 40\n{height}\n"
+            f"  1\n{text.text}\n{angle}100\nAcDbText\n")  # fmt: skip
+
+
+def _document(segments: np.ndarray, kinds: np.ndarray, bounds: tuple, texts: list[_Text],
+              fingerprint: bytes) -> str:  # fmt: skip
+    """The DXF text of lines and texts in the skeleton; ``fingerprint`` (with the lines) makes
+    the GUIDs under SOURCE_DATE_EPOCH."""
+    template = dxf_skeleton()
     count = segments.shape[0]
     entities = _line_entities(segments, kinds, template.first_handle, template.owner, bounds)
-    if label:  # one TEXT entity, after the lines, as ezdxf writes it
-        x, y = (repr(float(v)) for v in _label_point(bounds))
-        entities += (f"  0\nTEXT\n  5\n{template.first_handle + count:X}\n330\n{template.owner}\n"
-                     f"100\nAcDbEntity\n  8\n0\n100\nAcDbText\n 10\n{x}\n 20\n{y}\n 30\n0.0\n"
-                     f" 40\n{LABEL_HEIGHT!r}\n  1\n{label}\n100\nAcDbText\n")  # fmt: skip
+    for text in texts:  # after the lines, as ezdxf writes them
+        entities += _text_entity(text, template.first_handle + count, template.owner)
         count += 1
     xmin, ymin, xmax, ymax = (repr(float(v)) for v in bounds)
     epoch = source_date_epoch()
@@ -187,7 +243,7 @@ def dxf_data(pattern: TubularPattern, **options: Any) -> str:
         fingerprint, version = _guid(), _guid()
     else:  # SOURCE_DATE_EPOCH: that time, and GUIDs made from the drawing
         seconds = float(epoch)
-        drawing = b"".join((segments.tobytes(), kinds.tobytes(), repr((bounds, label)).encode()))
+        drawing = b"".join((segments.tobytes(), kinds.tobytes(), fingerprint))
         fingerprint, version = (f"{{{content_uuid(drawing, tag).upper()}}}"
                                 for tag in ("FINGERPRINTGUID", "VERSIONGUID"))  # fmt: skip
     now = datetime.datetime.fromtimestamp(seconds, datetime.UTC)

@@ -83,6 +83,11 @@ __all__ = [
 #: given.
 ACCEPTS = ("pattern", "chain", "any")
 
+#: The formats that ``bed=`` writes one file per laser bed sheet of, and the function that
+#: does (kinegami.export.beds.save_on_beds, imported when used).
+BED_FORMATS = (".dxf", ".svg")
+BED_WRITER = "kinegami.export.beds:save_on_beds"
+
 #: The same writer as :func:`kinegami._atomic.write_atomic` (bytes or text), by its old name.
 write_atomic_bytes = write_atomic
 
@@ -375,10 +380,19 @@ def _subject(obj: Any, fmt: ExportFormat, options: dict[str, Any]) -> Any:
     return obj
 
 
-def _write(obj: Any, target: Path, options: dict[str, Any]) -> Path:
+def _write(obj: Any, target: Path, options: dict[str, Any]) -> Path | list[Path]:
     fmt = FORMATS[target.suffix.lower()]
     options = dict(options)
     subject = _subject(obj, fmt, options)
+    if options.get("bed") is not None:  # one file per bed sheet (docs/fabrication.md)
+        if fmt.suffix not in BED_FORMATS:
+            raise InvalidParameterError(
+                f"bed applies to {' and '.join(BED_FORMATS)} files (one per bed sheet), not "
+                f"{fmt.suffix}"
+            )
+        module, _, name = BED_WRITER.partition(":")  # by name, as the formats' exporters
+        return getattr(importlib.import_module(module), name)(subject, target, **options)
+    options.pop("bed", None)
     data = fmt.render(subject, target, **options)
     if fmt.kind == "files":
         write_atomic_files(target, data)
@@ -387,7 +401,7 @@ def _write(obj: Any, target: Path, options: dict[str, Any]) -> Path:
     return target
 
 
-def export(obj: Any, path: str | os.PathLike, **options: Any) -> Path:
+def export(obj: Any, path: str | os.PathLike, **options: Any) -> Path | list[Path]:
     """Write ``obj`` (a KinematicChain, KinematicTree or TubularPattern) to ``path`` in the
     suffix's format.
 
@@ -401,19 +415,25 @@ def export(obj: Any, path: str | os.PathLike, **options: Any) -> Path:
         Target file; missing parent folders are created and an existing file is replaced.
     **options
         Passed to the exporter (see :func:`known_formats` and each exporter's docstring);
-        ``twistPortion`` (default 0.2) is used to make a chain's crease pattern.
+        ``twistPortion`` (default 0.2) is used to make a chain's crease pattern. ``bed``
+        (``.dxf`` and ``.svg``: ``"600x400"``, mm) cuts the sheet into pieces that fit that
+        laser bed and writes one file per bed sheet, ``<stem>_bed_<m>.dxf``, with
+        ``bed_margin`` (mm, default 5), ``tab`` (mm, default 10) and ``name`` (the pieces'
+        labels; default the stem): :func:`kinegami.export.beds.save_on_beds`.
 
     Returns
     -------
-    pathlib.Path
+    pathlib.Path or list of pathlib.Path
         The path written (for ``.urdf`` the URDF itself; its meshes are in
-        ``<stem>_meshes/`` beside it).
+        ``<stem>_meshes/`` beside it); with ``bed``, every bed sheet's path.
 
     Raises
     ------
     InvalidParameterError
         For a missing or bad file name, an unknown suffix (the message lists the known ones)
         or a bad option value.
+    BedTooSmallError
+        With ``bed``: the sheet cannot be cut into pieces that fit (nothing is written).
     InvalidTypeError
         For an object the format cannot take, or an unknown option.
     ExporterUnavailableError
@@ -432,7 +452,9 @@ def export(obj: Any, path: str | os.PathLike, **options: Any) -> Path:
     return _write(obj, _target(path), options)
 
 
-def save_pattern(pattern: Any, dxfName: str | os.PathLike | None, **options: Any) -> Path:
+def save_pattern(
+    pattern: Any, dxfName: str | os.PathLike | None, **options: Any
+) -> Path | list[Path]:
     """Save a crease pattern in the format of the file suffix (what ``pattern.save`` calls).
 
     Parameters
@@ -444,13 +466,14 @@ def save_pattern(pattern: Any, dxfName: str | os.PathLike | None, **options: Any
         ``.dxf``, ``.svg``, ``.fold``, ``.pdf``, ...). Missing parent folders are created; an
         existing file is replaced.
     **options
-        Passed to the exporter, e.g. ``units``, ``scale``, ``perforate`` for the sheet formats;
-        see docs/fabrication.md and docs/exports.md.
+        Passed to the exporter, e.g. ``units``, ``scale``, ``perforate`` for the sheet formats,
+        or ``bed="600x400"`` for one file per laser bed sheet (as for :func:`export`); see
+        docs/fabrication.md and docs/exports.md.
 
     Returns
     -------
-    pathlib.Path
-        The path written.
+    pathlib.Path or list of pathlib.Path
+        The path written (with ``bed``: every bed sheet's).
 
     Raises
     ------

@@ -39,6 +39,7 @@ import numpy as np
 from kinegami.errors import InvalidParameterError, InvalidTypeError
 from kinegami.export._options import (
     LABEL_HEIGHT,
+    bed_lines,
     check_label,
     format_numbers,
     resolve_sheet_options,
@@ -60,6 +61,7 @@ __all__ = [
     "SIMULATOR_MERGE_TOLERANCE",
     "simulator_unit",
     "svg_data",
+    "bed_svg_data",
     "write_svg",
 ]
 
@@ -197,6 +199,21 @@ def _write_laser(pattern, stream: TextIO, options: dict[str, Any]) -> None:
         f'height="{height}mm" viewBox="{left} {top} {width} {height}">\n',
         f"<title>{_title('kinegami tubular crease pattern (laser cutting)', label)}</title>\n",
     ]
+    out += _line_groups(flipped, kinds, colors, stroke, extent)
+    if label:  # below the sheet's lower edge, inside the drawing's width
+        size = format_numbers(np.array([LABEL_HEIGHT]), 1.0)[0]
+        x, y = format_numbers(np.array([xmin, -text_y]), extent)
+        out.append(f'<text id="label" x="{x}" y="{y}" font-family="sans-serif" '
+                   f'font-size="{size}" fill="black" stroke="none">{escape(label)}</text>\n')
+    out.append("</svg>\n")
+    stream.write("".join(out))
+
+
+def _line_groups(flipped: np.ndarray, kinds: np.ndarray, colors: dict[str, str], stroke: str,
+                 extent: float) -> list[str]:  # fmt: skip
+    """The laser flavour's lines (y already flipped): one group per kind, each line with its
+    own stroke."""
+    out = []
     for kind in SHEET_KINDS:
         color = quoteattr(colors[kind])
         selected = flipped[kinds == kind]
@@ -208,13 +225,69 @@ def _write_laser(pattern, stream: TextIO, options: dict[str, Any]) -> None:
             x1, y1, x2, y2 = numbers[4 * i : 4 * i + 4]
             out.append(f'<line x1="{x1}" y1="{y1}" x2="{x2}" y2="{y2}" stroke={color}/>\n')
         out.append("</g>\n")
-    if label:  # below the sheet's lower edge, inside the drawing's width
-        size = format_numbers(np.array([LABEL_HEIGHT]), 1.0)[0]
-        x, y = format_numbers(np.array([xmin, -text_y]), extent)
-        out.append(f'<text id="label" x="{x}" y="{y}" font-family="sans-serif" '
-                   f'font-size="{size}" fill="black" stroke="none">{escape(label)}</text>\n')
-    out.append("</svg>\n")
-    stream.write("".join(out))
+    return out
+
+
+def bed_svg_data(layout, index: int, **options: Any) -> str:
+    """Bed sheet ``index`` (from 0) of a :class:`~kinegami.fabrication.beds.BedLayout` as a
+    laser flavour SVG (the bed's size in mm, one user unit = 1 mm): every piece where the
+    layout puts it, its marks (join line, alignment ticks) with the Boundary lines, and its
+    labels as text in the Boundary colour, turned with the piece.
+
+    Parameters
+    ----------
+    layout : BedLayout
+    index : int
+    perforate, dash, gap, skip_creases_on_cut, colors, stroke_width
+        As for the laser flavour of :func:`write_svg` (the layout fixes the units);
+        ``flavour`` may only be ``'laser'`` (a bed sheet is for cutting).
+    title : str, optional
+        The document's title (default "kinegami bed sheet k of m").
+
+    Raises
+    ------
+    InvalidTypeError, InvalidParameterError
+        For an unknown option or a bad value.
+    """
+    options = dict(options)
+    flavour = options.pop("flavour", "laser")
+    if flavour != "laser":
+        raise InvalidParameterError(
+            f"flavour must be 'laser' for a bed sheet (it is for cutting; Origami Simulator "
+            f"takes a piece's own pattern), got {flavour!r}"
+        )
+    if "units" in options or "scale" in options:
+        raise InvalidParameterError("units and scale are the layout's (lay_out(..., unit=)); "
+                                    "a bed sheet takes neither")  # fmt: skip
+    title = options.pop("title", None)
+    opts = resolve_sheet_options(
+        options, {"colors": None, "stroke_width": _DEFAULT_STROKE_WIDTH}, "SVG bed sheet"
+    )
+    colors = _check_colors(opts.extra["colors"])
+    stroke = format_numbers(np.array([_stroke_width(opts.extra["stroke_width"])]), 1.0)[0]
+    segments, kinds, texts, bounds = bed_lines(layout, index, opts)
+    title = check_label(title) or f"kinegami bed sheet {index + 1} of {layout.count}"
+    _, _, width_mm, height_mm = bounds
+    extent = max(width_mm, height_mm) or 1.0
+    flipped = segments.copy()
+    flipped[:, :, 1] *= -1.0
+    width, height = format_numbers(np.array([width_mm, height_mm]), extent)
+    (top,) = format_numbers(np.array([-height_mm]), extent)
+    out = [
+        '<?xml version="1.0" encoding="UTF-8" standalone="no"?>\n',
+        f'<svg xmlns="http://www.w3.org/2000/svg" version="1.1" width="{width}mm" '
+        f'height="{height}mm" viewBox="0 {top} {width} {height}">\n',
+        f"<title>{_title(title + ' (laser cutting)', None)}</title>\n",
+    ]
+    out += _line_groups(flipped, kinds, colors, stroke, extent)
+    color = quoteattr(colors["B"])
+    out.append(f'<g id="Labels" font-family="sans-serif" fill={color} stroke="none">\n')
+    for text in texts:
+        x, y, size = format_numbers(np.array([text.x, -text.y, text.height]), extent)
+        turn = f' transform="rotate({-text.angle!r} {x} {y})"' if text.angle else ""
+        out.append(f'<text x="{x}" y="{y}" font-size="{size}"{turn}>{escape(text.text)}</text>\n')
+    out.append("</g>\n</svg>\n")
+    return "".join(out)
 
 
 # --- simulator flavour -----------------------------------------------------------------------
