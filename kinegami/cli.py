@@ -280,6 +280,7 @@ def _summary(job: BuildJob, design: str) -> list[str]:
         f"  sheet: {_sheet_size(job)}",
         f"  total tube length: {tube * factor:.1f} mm "
         f"(links {links_length * factor:.1f} mm, joints {joints_length * factor:.1f} mm)",
+        *_material_lines(chain, info),
         _verdict_line(job.clearance, info),
     ]
 
@@ -341,6 +342,137 @@ def _margin(args: argparse.Namespace, chain) -> None:
             f"design's units), got {shorten(text)!r}"
         )
     chain.margin = value
+
+
+def _millimetres(option: str, text: str | None) -> float | None:
+    """A finite number of mm given to ``option`` (checked further by the library), or None."""
+    if text is None:
+        return None
+    import math
+
+    from kinegami.validation import shorten
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise CommandError(f"{option}: must be a number of millimetres, got {shorten(text)!r}")
+    return value
+
+
+def _fabrication(args: argparse.Namespace, chain, info):
+    """The design's info with ``--material``/``--thickness`` and (build) ``--bed``,
+    ``--bed-margin``, ``--tab`` applied; a new material's thickness becomes the chain's margin
+    unless ``--margin`` or the design's own "margin" says otherwise (docs/fabrication.md)."""
+    import dataclasses
+
+    from kinegami.fabrication.beds import Bed, check_material, parse_bed
+
+    name, thickness = getattr(args, "material", None), getattr(args, "thickness", None)
+    material = info.material
+    if name is not None or thickness is not None:
+        thickness = _millimetres("--thickness", thickness)
+        if name is None:
+            if info.material is None:
+                raise CommandError("--thickness: give the material too (--material NAME); the "
+                                   "design names none")  # fmt: skip
+            name = info.material.name
+        try:
+            material = check_material(name, thickness)
+        except KinegamiError as error:
+            option = "--thickness" if str(error).startswith("thickness") else "--material"
+            raise CommandError(f"{option}: {str(error).removeprefix('thickness: ')}") from None
+        if getattr(args, "margin", None) is None and info.margin is None:
+            chain.margin = material.thickness / UNITS_IN_MM[info.units]
+    bed = info.bed
+    text = getattr(args, "bed", None)
+    margin = _millimetres("--bed-margin", getattr(args, "bed_margin", None))
+    tab = _millimetres("--tab", getattr(args, "tab", None))
+    try:
+        if text is not None and text.strip().lower() == "none":
+            bed = None
+        elif text is not None:
+            width, height = parse_bed(text)
+            bed = Bed.of(width, height, margin if margin is not None else
+                         None if info.bed is None else info.bed.margin,
+                         tab if tab is not None else None if info.bed is None else info.bed.tab)
+        elif margin is not None or tab is not None:
+            if info.bed is None:
+                option = "--bed-margin" if margin is not None else "--tab"
+                raise CommandError(f"{option}: give the bed too (--bed WxH, mm); the design "
+                                   "names none")  # fmt: skip
+            bed = Bed.of(info.bed.width, info.bed.height,
+                         info.bed.margin if margin is None else margin,
+                         info.bed.tab if tab is None else tab)  # fmt: skip
+    except KinegamiError as error:
+        words = str(error).split(" ")
+        option = {"tab": "--tab", "margin": "--bed-margin"}.get(words[1] if words[0] == "bed"
+                                                                  else words[0], "--bed")
+        raise CommandError(f"{option}: {error}") from None
+    return dataclasses.replace(info, material=material, bed=bed)
+
+
+def _material_lines(chain, info) -> list[str]:
+    """The summary's material line ("  material: PET, 0.25 mm thick, the clearance margin"),
+    none without a material."""
+    if info.material is None:
+        return []
+    thickness = info.material.thickness
+    margin = chain.margin * UNITS_IN_MM[info.units]
+    if abs(margin - thickness) <= 1e-9 * max(thickness, 1.0):
+        return [f"  material: {_printable(info.material.describe())}, the clearance margin"]
+    return [f"  material: {_printable(info.material.describe())} (the clearance margin is "
+            f"{margin:g} mm)"]  # fmt: skip
+
+
+def _square_metres(area: float) -> str:
+    return f"{area / 1e6:.2f} square metres"
+
+
+def _counted(count: int, one: str, many: str) -> str:
+    return f"{count} {one if count == 1 else many}"
+
+
+def _bed_summary(layouts, info, sheets=None) -> list[str]:
+    """The summary's laser bed lines: the bed, then each piece (or, for a tree's sheets, each
+    sheet's pieces and beds)."""
+    bed = info.bed
+    count = sum(layout.count for layout in layouts)
+    pieces_area = sum(layout.pieces_area for layout in layouts)
+    material = info.material.name if info.material is not None else "material"
+    head = (f"  laser bed: {bed.describe()} (margin {bed.margin:g} mm), tab {bed.tab:g} mm (a "
+            f"cut needs {bed.minimum_tube:g} mm of plain tube): "
+            f"{_counted(sum(len(layout.pieces) for layout in layouts), 'piece', 'pieces')} on "
+            f"{_counted(count, 'bed sheet', 'bed sheets')}, "
+            f"{_square_metres(count * bed.width * bed.height)} of "
+            f"{_printable(material)} (the pieces {_square_metres(pieces_area)})")  # fmt: skip
+    lines = [head]
+    for k, layout in enumerate(layouts):
+        prefix = "    " if sheets is None else "      "
+        if sheets is not None:
+            lines.append(f"    sheet {sheets[k]}: "
+                         f"{_counted(len(layout.pieces), 'piece', 'pieces')} on "
+                         f"{_counted(layout.count, 'bed sheet', 'bed sheets')}")  # fmt: skip
+        if len(layout.pieces) == 1:
+            lines.append(f"{prefix}the sheet fits whole")
+            continue
+        start = layout.pieces[0].start
+        for piece, place in zip(layout.pieces, layout.placements, strict=True):
+            long_side, short_side = sorted((place.width, place.height), reverse=True)
+            lines.append(
+                f"{prefix}piece {piece.index}: {(piece.start - start) * layout.unit:,.0f} to "
+                f"{(piece.end - start) * layout.unit:,.0f} mm along the strip"
+                + (f", {piece.tab * layout.unit:g} mm tab" if piece.tab else "")
+                + f" ({long_side:.0f} x {short_side:.0f} mm), bed sheet {place.bin + 1}"
+            )
+    return lines
+
+
+def _bed_failure(label: str, error) -> CommandError:
+    """The one line of a sheet that cannot be cut to fit the bed, with the --bed that works."""
+    width, height = error.smallest
+    return CommandError(f"{label}: {error} (--bed {width:g}x{height:g})")
 
 
 # --- commands ----------------------------------------------------------------------------------
@@ -449,6 +581,14 @@ def _write_tree_pictures(fabrication, folder: Path, stem: str, units: str | None
     return written
 
 
+def _stale_bed_files(out: Path, stem: str, fmt: str, new: Path) -> list[str]:
+    """The ``<stem>_bed_<m>.<fmt>`` files in ``out`` that the build in ``new`` does not write
+    again: what an earlier build with more beds (or with a bed) left."""
+    from kinegami.export.beds import stale_bed_files
+
+    return stale_bed_files(out, stem, f".{fmt}", set(os.listdir(new)))
+
+
 def _tree_summary(tree, info, design: str, fabrication, moves, written=None) -> list[str]:
     """The summary of a tree's build; ``written``: the clearance report of the design file as
     written, when the build slid joints (then it is not the tree built)."""
@@ -471,6 +611,7 @@ def _tree_summary(tree, info, design: str, fabrication, moves, written=None) -> 
         f"  tube: {tree.numSides} sides, r = {tree.r * factor:g} mm",
         f"  total tube length: {(links_length + joints_length) * factor:.1f} mm "
         f"(links {links_length * factor:.1f} mm, joints {joints_length * factor:.1f} mm)",
+        *_material_lines(tree, info),
         _verdict_line(report, info),
         f"  sheets: {len(fabrication.sheets)} (one per leaf)",
     ]  # fmt: skip
@@ -608,6 +749,16 @@ def _write_tree_build(command: str, label: str, tree, info, stem: str, out: Path
     written = _clearance(tree) if moves else None
     lines = _tree_summary(fitted, info, label, fabrication, moves, written)
     lines += _takeoff_summary(fabrication, info)
+    layouts = None
+    if info.bed is not None:
+        from kinegami.errors import BedTooSmallError
+        from kinegami.export.tree_build import sheet_layouts
+
+        try:
+            layouts = sheet_layouts(fabrication, info.bed, info.units, info.name or stem)
+        except BedTooSmallError as error:
+            raise _bed_failure(label, error) from None
+        lines += _bed_summary(layouts, info, [sheet.index for sheet in fabrication.sheets])
     report = _clearance(fitted)
     if not report.ok:
         _warn(command, _overlap_warning(report, info, label))
@@ -623,6 +774,7 @@ def _write_tree_build(command: str, label: str, tree, info, stem: str, out: Path
                 units=info.units,
                 twistPortion=info.twistPortion,
                 names=_joint_names(fitted),
+                layouts=layouts,
             )
             if "png" in formats:
                 _write_tree_pictures(fabrication, staging.new, stem, info.units)
@@ -632,7 +784,11 @@ def _write_tree_build(command: str, label: str, tree, info, stem: str, out: Path
             raise CommandError(f"{label}: {error}") from None
         except OSError as error:
             raise CommandError(f"cannot write {str(out)!r}: {error.strerror or error}") from None
-        written = staging.publish()
+        stale = [name for fmt in ("dxf", "svg") if fmt in formats
+                 for sheet in fabrication.sheets
+                 for name in _stale_bed_files(out, f"{stem}_sheet_{sheet.index}", fmt,
+                                              staging.new)]  # fmt: skip
+        written = staging.publish(remove=stale)
     finally:
         staging.close()
     lines.append("  files written:")
@@ -646,6 +802,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     _check_output(out)
     chain, info = _load(args.design)
     _margin(args, chain)
+    info = _fabrication(args, chain, info)
     if _is_tree(chain):
         return _build_tree(args, chain, info, stem, out)
     if args.junctions is not None:
@@ -667,6 +824,17 @@ def _write_chain_build(command: str, label: str, job: BuildJob, stem: str, out: 
     try:
         _check_pattern(job)
         lines = _summary(job, label)
+        layout = None
+        if job.info.bed is not None:
+            from kinegami.errors import BedTooSmallError
+            from kinegami.fabrication.beds import lay_out
+
+            try:
+                layout = lay_out(job.pattern, job.info.bed, unit=UNITS_IN_MM[job.info.units],
+                                 name=job.info.name or stem)  # fmt: skip
+            except BedTooSmallError as error:
+                raise _bed_failure(label, error) from None
+            lines += _bed_summary([layout], job.info)
         if not job.clearance.ok:
             _warn(command, _overlap_warning(job.clearance, job.info, label))
         # write everything into a hidden staging folder in the target, then publish it as one
@@ -680,6 +848,11 @@ def _write_chain_build(command: str, label: str, job: BuildJob, stem: str, out: 
                     if pictures is not None and fmt.name == "png":
                         for path, data in zip(paths, pictures.result(), strict=True):
                             path.write_bytes(data)
+                    elif layout is not None and fmt.name in ("dxf", "svg"):
+                        from kinegami.export.beds import bed_files
+
+                        for name, text in bed_files(layout, stem, f".{fmt.name}").items():
+                            (staging.new / name).write_text(text, encoding="utf-8")
                     else:
                         fmt.write(job, paths)
                 except KinegamiError as error:
@@ -695,7 +868,9 @@ def _write_chain_build(command: str, label: str, job: BuildJob, stem: str, out: 
                 except OSError as error:
                     raise CommandError(f"cannot write {name} in {str(out)!r}: "
                                        f"{error.strerror or error}") from None  # fmt: skip
-            written = staging.publish()  # all or nothing, whatever interrupts it
+            stale = [name for fmt in formats if fmt.name in ("dxf", "svg")
+                     for name in _stale_bed_files(out, stem, fmt.name, staging.new)]
+            written = staging.publish(remove=stale)  # all or nothing, whatever interrupts it
         finally:
             staging.close()
     finally:
@@ -1161,6 +1336,8 @@ def _check_json(chain, info, design, report, motion, seed) -> dict:
         "r": chain.r,
         "ok": report.ok,
         "margin": report.margin,
+        "material": None if info.material is None else {
+            "name": info.material.name, "thickness": info.material.thickness},
         "verdict": report.verdict(info.units),
         "min_clearance": report.min_clearance if report.closest is not None else None,
         "closest": None if report.closest is None else _pair_json(report.closest),
@@ -1200,6 +1377,7 @@ def _check_lines(chain, info, design, report, motion, seed) -> list[str]:
     LISTED_PAIRS pairs) and the sweep's (SweepReport.summary)."""
     title = f"{_printable(info.name)} ({design})" if info.name else design
     lines = report.summary(info.units, title=title, listed=LISTED_PAIRS)
+    lines[1:1] = _material_lines(chain, info)
     if not report.ok and report.pair_count > LISTED_PAIRS:  # the last line: "... and N more"
         lines[-1] += " (--json lists them all)" if not report.unlisted else \
             f" (--json lists the closest {len(report.pairs):,})"  # fmt: skip
@@ -1224,6 +1402,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
         samples = check_samples("--motion", samples, len(chain.Joints))
     _margin(args, chain)
+    info = _fabrication(args, chain, info)
     names = _joint_names(chain)
     report = _clearance(chain)
     motion = None if samples is None else sweep(chain, samples, seed, names=names)
@@ -1338,6 +1517,7 @@ def cmd_compact(args: argparse.Namespace) -> int:
     _check_design_output(out, args.design, args.force)
     chain, info = _load(args.design)
     _margin(args, chain)
+    info = _fabrication(args, chain, info)
     if info.task is not None and _is_tree(chain):
         _note(args.command, "the design's task is not checked: compaction keeps a task for "
                             "chains only, so the compacted tree may no longer reach its "
@@ -1372,6 +1552,7 @@ def cmd_compact(args: argparse.Namespace) -> int:
     lines = [
         f"{title}: compacted (seed {seed}{kept}, margin "
         f"{Lengths(chain.r, info.units).exact(chain.margin)})",
+        *_material_lines(chain, info),
         "  before:",
         *_compaction_lines(before),
         "  after:",
@@ -1379,7 +1560,7 @@ def cmd_compact(args: argparse.Namespace) -> int:
     ]
     written = save_design(
         compacted, out, name=info.name, description=info.description, units=info.units,
-        twistPortion=info.twistPortion, task=info.task,
+        twistPortion=info.twistPortion, task=info.task, material=info.material, bed=info.bed,
     )  # fmt: skip
     lines.append(f"  written: {written}")
     print("\n".join(_printable(line) for line in lines))
@@ -1592,6 +1773,21 @@ def _add_margin_option(command: argparse.ArgumentParser, more: str = "") -> None
     )  # fmt: skip
 
 
+def _add_material_options(command: argparse.ArgumentParser) -> None:
+    """``--material NAME`` and ``--thickness MM`` (read by :func:`_fabrication`)."""
+    command.add_argument(
+        "--material", metavar="NAME", default=None,
+        help="the sheet material, e.g. PET, paper, cardstock (default: the design's "
+        "\"material\"); its thickness is the clearance margin unless --margin or the design's "
+        "\"margin\" says otherwise, and every report names it",
+    )  # fmt: skip
+    command.add_argument(
+        "--thickness", metavar="MM", default=None,
+        help="the material's thickness in mm (default: the design's, or the usual thickness "
+        "of a known material: PET 0.25, paper 0.1, cardstock 0.3, polypropylene 0.3)",
+    )  # fmt: skip
+
+
 def make_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="kinegami",
@@ -1636,6 +1832,22 @@ def make_parser() -> argparse.ArgumentParser:
         "connectors elsewhere)",
     )  # fmt: skip
     _add_margin_option(build)
+    _add_material_options(build)
+    build.add_argument(
+        "--bed", metavar="WxH", default=None,
+        help="the laser cutter's bed in mm whatever the design's units, e.g. 600x400 (default: "
+        "the design's \"bed\"; none: the whole sheet): the sheet is cut across plain tube into "
+        "pieces that fit, each with an overlap tab, alignment marks and a label, nested onto "
+        "bed sheets; dxf and svg write one file per bed sheet, <name>_bed_<m>.dxf "
+        "(<name>_sheet_<k>_bed_<m>.dxf for a tree), and files of an earlier build with more "
+        "beds are removed; exit code 1 when a stretch without plain tube is longer than the bed "
+        "(the message names it and the smallest bed that works)",
+    )  # fmt: skip
+    build.add_argument("--bed-margin", metavar="MM", default=None,
+                       help="distance kept from the bed's edges and between pieces (default 5)")
+    build.add_argument("--tab", metavar="MM", default=None,
+                       help="height of the overlap tab of the pieces (default 10; a cut needs "
+                       "1.5 times this much plain tube)")  # fmt: skip
     build.set_defaults(run=cmd_build)
 
     show = commands.add_parser(
@@ -1727,6 +1939,7 @@ def make_parser() -> argparse.ArgumentParser:
         "--json", action="store_true", help="print one JSON object instead (see docs/cli.md)"
     )
     _add_margin_option(check)
+    _add_material_options(check)
     check.set_defaults(run=cmd_check)
 
     reach = commands.add_parser(
@@ -1819,6 +2032,7 @@ def make_parser() -> argparse.ArgumentParser:
     )
     _add_margin_option(compact, "; the compacted design keeps its closest parts at least this "
                        "far apart and is written with it")  # fmt: skip
+    _add_material_options(compact)
     compact.set_defaults(run=cmd_compact)
 
     edit = commands.add_parser(

@@ -4,7 +4,9 @@ the whole tree.
 ``kinegami build TREE.json`` writes, for the stem ``hand``:
 
 * ``hand_sheet_<k>.dxf``, ``.svg``, ``.fold``: every sheet's crease pattern, labelled (which
-  sheet, its joints, the junction it starts in);
+  sheet, its joints, the junction it starts in); with a laser bed, ``hand_sheet_<k>_bed_<m>.dxf``
+  and ``.svg`` instead: every sheet cut into pieces that fit the bed and nested onto bed sheets
+  of its own (:func:`sheet_layouts`, docs/fabrication.md "Laser bed");
 * ``hand.pdf``: every sheet at 1:1, one after the other, each titled with its label;
 * ``hand_junction_<k>.stl`` and ``.3mf``: the printed connector of every junction (mm);
 * ``hand.stl``, ``hand.obj``, ``hand.urdf`` (with ``hand_meshes/``): the whole tree.
@@ -29,6 +31,7 @@ __all__ = [
     "FORMAT_LIBRARIES",
     "write_tree_files",
     "sheet_labels",
+    "sheet_layouts",
 ]
 
 #: ``--formats`` names for trees and what each writes.
@@ -64,6 +67,30 @@ def sheet_labels(fabrication, names: Sequence[str | None] | None = None,
     return [sheet.label(fabrication.tree, names, length) for sheet in fabrication.sheets]
 
 
+def sheet_layouts(fabrication, bed, units: str = "mm", name: str | None = None) -> list:
+    """Every sheet of a tree laid out on ``bed`` (a :class:`~kinegami.fabrication.beds.Bed`),
+    one :class:`~kinegami.fabrication.beds.BedLayout` per sheet, in order; the pieces' labels
+    say "NAME, sheet k, piece i of n ...".
+
+    Raises
+    ------
+    BedTooSmallError
+        For the first sheet that cannot be cut into pieces that fit (the message names it).
+    """
+    from kinegami.errors import BedTooSmallError
+    from kinegami.fabrication.beds import lay_out
+
+    layouts = []
+    for sheet in fabrication.sheets:
+        label = f"sheet {sheet.index}" if not name else f"{name}, sheet {sheet.index}"
+        try:
+            layouts.append(lay_out(sheet.pattern, bed, unit=UNITS_IN_MM[units], name=label))
+        except BedTooSmallError as error:
+            raise BedTooSmallError(f"sheet {sheet.index}: {error}", error.smallest,
+                                   error.stretch, error.needed) from None  # fmt: skip
+    return layouts
+
+
 def write_tree_files(
     fabrication,
     folder: str | Path,
@@ -73,9 +100,13 @@ def write_tree_files(
     units: str = "mm",
     twistPortion: float = 0.2,
     names: Sequence[str | None] | None = None,
+    layouts: Sequence | None = None,
 ) -> list[Path]:
     """Write the files of ``formats`` for a :class:`~kinegami.fabrication.sheets.TreeFabrication`
     into ``folder`` and return their paths (in the order written).
+
+    ``layouts`` (:func:`sheet_layouts`, one per sheet): the DXF and SVG go one file per bed
+    sheet, ``<stem>_sheet_<k>_bed_<m>.dxf`` (the SVG in the laser flavour).
 
     Raises
     ------
@@ -102,7 +133,14 @@ def write_tree_files(
     folded = fabrication.folded_tree()
     written: list[Path] = []
     for fmt in formats:
-        if fmt in ("dxf", "svg", "fold"):
+        if fmt in ("dxf", "svg") and layouts is not None:
+            from kinegami.export.beds import bed_files
+
+            for sheet, layout in zip(fabrication.sheets, layouts, strict=True):
+                files = bed_files(layout, f"{stem}_sheet_{sheet.index}", f".{fmt}")
+                for file_name, text in files.items():
+                    written.append(write_atomic(folder / file_name, text))
+        elif fmt in ("dxf", "svg", "fold"):
             for sheet, label in zip(fabrication.sheets, labels, strict=True):
                 path = folder / f"{stem}_sheet_{sheet.index}.{fmt}"
                 extra = {} if fmt == "fold" else {"label": label}

@@ -30,7 +30,7 @@ FOLD_BACK_PAIRS = [
     ("link 1, straight tube", "link 3, straight tube"),
     ("link 1, straight tube", "link 3, second elbow"),
 ]
-JSON_KEYS = {"design", "name", "units", "r", "ok", "margin", "verdict", "min_clearance",
+JSON_KEYS = {"design", "name", "units", "r", "ok", "margin", "material", "verdict", "min_clearance",
              "closest", "pairs", "unlisted", "states", "motion"}  # fmt: skip
 MOTION_KEYS = {"samples", "seed", "colliding", "colliding_fraction", "worst_pairs",
                "free_intervals"}  # fmt: skip
