@@ -17,6 +17,7 @@ import warnings
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -37,6 +38,9 @@ from kinegami.design.reader import (
 )
 from kinegami.errors import ClearanceWarning, InvalidParameterError, InvalidTypeError
 from kinegami.tree import KinematicTree
+
+if TYPE_CHECKING:  # pragma: no cover
+    from kinegami.fabrication.beds import Bed, Material
 
 __all__ = ["Document", "JointRow", "joint_parameters", "fork_chain", "plain_task"]
 
@@ -123,6 +127,8 @@ class Document:
     task : the task the design is made for (its ``"task"`` block, a task document as
         docs/design-for-a-task.md describes; None: none). Plain JSON values, never changed:
         commands keep it, :meth:`save` writes it back.
+    material, bed : the design's sheet material and laser bed (version 4,
+        kinegami.fabrication.beds.Material and Bed; None: none), kept and written back.
 
     ``chain.requireClearance`` and ``chain.maxAnglePerElbow`` are the design's chain options;
     the joints' states are the chain's.
@@ -135,6 +141,8 @@ class Document:
     units: str = "mm"
     twistPortion: float | None = None
     task: dict | None = None
+    material: Material | None = None
+    bed: Bed | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.chain, KinematicChain | KinematicTree):
@@ -199,6 +207,8 @@ class Document:
             info.units,
             document.get("twistPortion"),
             plain_task(info.task),
+            info.material,
+            info.bed,
         )
 
     @classmethod
@@ -223,6 +233,8 @@ class Document:
             "units": self.units,
             "twistPortion": self.twistPortion,
             "task": self.task,
+            "material": self.material,
+            "bed": self.bed,
         }
         values.update(changes)
         return Document(**values)
@@ -290,6 +302,8 @@ class Document:
                 units=self.units,
                 twistPortion=self.twistPortion,
                 task=self.task,
+                material=self.material,
+                bed=self.bed,
             )
         entries = document["joints"]
         offset = len(entries) - len(self.names)  # 1 when the root is an EndTip (see writer)
