@@ -21,7 +21,7 @@ from kinegami.errors import BedTooSmallError, InvalidParameterError
 from kinegami.export.beds import bed_files, stale_bed_files
 from kinegami.fabrication.beds import Bed, lay_out
 from kinegami.pattern.sheet import flatten
-from tests.gallery_designs import DESIGN_DIR
+from tests.gallery_designs import DESIGN_DIR, is_tree
 
 SVG = "{http://www.w3.org/2000/svg}"
 
@@ -136,3 +136,36 @@ def test_bed_files_are_reproducible(monkeypatch):
     first = bed_files(layout, "puma", ".dxf")
     assert first == bed_files(layout, "puma", ".dxf")
     assert list(first) == ["puma_bed_1.dxf", "puma_bed_2.dxf", "puma_bed_3.dxf"]
+
+
+@pytest.mark.parametrize("path", sorted(DESIGN_DIR.glob("*.json")), ids=lambda p: p.stem)
+def test_every_gallery_design_draws_inside_a_600_by_400_bed(path):
+    """What the bed files of every gallery design hold (every sheet of a tree): every line,
+    and every label's estimated extent, inside the bed less its 5 mm margin."""
+    from kinegami.design import load_design_with_info
+    from kinegami.export._options import bed_lines, resolve_sheet_options
+    from kinegami.pattern.pieces import CHARACTER_WIDTH
+    from kinegami.validation import UNITS_IN_MM
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        chain, info = load_design_with_info(path)
+    if is_tree(path):
+        from kinegami.fabrication.sheets import fabricate
+
+        sheets = [s.pattern for s in fabricate(chain, twistPortion=info.twistPortion).sheets]
+    else:
+        sheets = [chain.creasePattern(twistPortion=info.twistPortion)]
+    opts = resolve_sheet_options({}, {}, "test")
+    tol = 1e-6
+    for sheet in sheets:
+        layout = lay_out(sheet, Bed.of(600, 400), unit=UNITS_IN_MM[info.units], name=info.name)
+        for m in range(layout.count):
+            segments, _, texts, _ = bed_lines(layout, m, opts)
+            assert segments[:, :, 0].min() >= 5 - tol and segments[:, :, 0].max() <= 595 + tol
+            assert segments[:, :, 1].min() >= 5 - tol and segments[:, :, 1].max() <= 395 + tol
+            for text in texts:
+                length = CHARACTER_WIDTH * text.height * len(text.text)
+                x1, y1 = (text.x, text.y + length) if text.angle else (text.x + length, text.y)
+                assert 5 - tol <= min(text.x, x1) and max(text.x, x1) <= 595 + tol
+                assert 5 - tol <= min(text.y, y1) and max(text.y, y1) <= 395 + tol
