@@ -365,6 +365,9 @@ def _fabrication(args: argparse.Namespace, chain, info):
     """The design's info with ``--material``/``--thickness`` and (build) ``--bed``,
     ``--bed-margin``, ``--tab`` applied; a new material's thickness becomes the chain's margin
     unless ``--margin`` or the design's own "margin" says otherwise (docs/fabrication.md)."""
+    options = ("material", "thickness", "bed", "bed_margin", "tab")
+    if all(getattr(args, option, None) is None for option in options):
+        return info  # the design's (no import of the bed code: check stays quick)
     import dataclasses
 
     from kinegami.fabrication.beds import Bed, check_material, parse_bed
