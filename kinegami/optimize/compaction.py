@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinegami.chain.bodies import check_margin, worst_overlap
+from kinegami.chain.joints import EndTip
 from kinegami.chain.model import KinematicChain
 from kinegami.clearance.tree_bodies import tree_worst_overlap
 from kinegami.errors import (
@@ -750,6 +751,14 @@ def compact(
         movable_states = _motion_configurations(chain, samples, seed)
         motion_task = (movable_states, _colliding_fraction(chain, movable_states))
     junctions = isinstance(chain, KinematicTree) and check_bool("junctions", junctions)
+    return _search(chain, seed, executor, time_limit, progress, objective, starts, motion_task,
+                   junctions)  # fmt: skip
+
+
+def _search(chain, seed: int, executor, time_limit, progress, objective: str, starts: int,
+            motion_task, junctions: bool):  # fmt: skip
+    """:func:`compact`'s search of checked arguments; ``motion_task``: (movable joints' states
+    (S, m), the largest colliding fraction allowed) or None."""
     tasks = [(chain, k, seed, objective, time_limit, motion_task, junctions)
              for k in range(starts)]  # fmt: skip
     own = executor is None
@@ -775,6 +784,32 @@ def compact(
     return best
 
 
+#: Rotations of a position target's tip frame about its point (the end tip's tube leaves
+#: along the frame's x axis): the identity first, then the other five directions of x.
+TIP_TURNS = (np.eye(3), np.diag([-1.0, -1.0, 1.0]), np.array([[0, -1, 0], [1, 0, 0], [0, 0, 1.0]]),
+             np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1.0]]),
+             np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0.0]]),
+             np.array([[0, 0, -1], [0, 1, 0], [1, 0, 0.0]]))  # fmt: skip
+#: The end tip's distal frame in its Pose's axes: x = Pose z (along the tube), y = Pose x,
+#: z = Pose y; its origin half the tip's length along Pose z (kinegami.chain.joints.EndTip).
+TIP_AXES = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+
+
+def end_tips_at(frame: np.ndarray, numSides: int, r: float, length: float,
+                turns=TIP_TURNS) -> list[EndTip]:  # fmt: skip
+    """End tips of ``length`` whose distal frame is ``frame`` (4x4, world) turned by each of
+    ``turns`` (3x3, in the frame's axes) about its origin, in order."""
+    out = []
+    for turn in turns:
+        F = np.array(frame, dtype=float)
+        F[:3, :3] = F[:3, :3] @ turn
+        P = F.copy()
+        P[:3, :3] = F[:3, :3] @ TIP_AXES.T
+        P[:3, 3] = F[:3, 3] - 0.5 * length * P[:3, 2]
+        out.append(EndTip(numSides, r, np.eye(4), length).with_pose(P))
+    return out
+
+
 def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(),
                      margin: float | None = None, seed: int = 0, executor=None, starts: int = 4,
                      time_limit: float | None = None, progress=None) -> tuple:  # fmt: skip
@@ -783,11 +818,14 @@ def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(
     Compaction slides and rolls joints along their axes, which keeps each joint's motion but
     would move an end tip. Here the joints up to the last movable one are compacted, and the
     joints after it (the end tip; waypoints go) are placed again exactly where they were: on the
-    last movable joint's body, so the tip's motion is unchanged. The result is solved again for
-    every target (from the states of ``answers``, one reach answer per target, or of a first
-    solve) and accepted only when each is reached exactly, in range, clear with ``margin``
-    (default the chain's) and outside the ``keep_out`` boxes, with a tube no longer than the
-    input's; otherwise the input itself is returned.
+    last movable joint's body, so the tip's motion is unchanged (when every target is a point,
+    the end tip may leave its point along any of the six axis directions: the shortest that
+    keeps the task wins). The search bans choices whose joints collide at a target's
+    configuration. The result is solved again for every target (from the states of
+    ``answers``, one reach answer per target, or of a first solve) and accepted only when each
+    is reached exactly, in range, clear with ``margin`` (default the chain's) and outside the
+    ``keep_out`` boxes, with a tube no longer than the input's; otherwise the input itself is
+    returned.
 
     Raises
     ------
@@ -840,27 +878,47 @@ def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(
         while len(head.Joints) > last + 1:
             if not head.delete(len(head.Joints) - 1):  # pragma: no cover - dropping the last
                 return chain, answers
+        head.margin = margin
+        # the search bans the choices whose head collides at a target's configuration (as
+        # compact(motion=True) does with sampled ones), so the task's configurations stay clear
+        at_targets = np.array([np.asarray(answer.states)[movable] for answer in answers])
+        _check_executor(executor)
         try:
-            shorter = compact(head, seed=seed, executor=executor, starts=starts,
-                              time_limit=time_limit, progress=progress, margin=margin)  # fmt: skip
+            shorter = _search(head, check_int("seed", seed, minimum=0, floats=False), executor,
+                              None if time_limit is None else check_positive("time_limit",
+                                                                             time_limit),
+                              check_progress(progress), "length", check_starts(starts),
+                              (at_targets, 0.0), False)  # fmt: skip
         except CompactionError:
             return chain, answers
-        shorter = copy.copy(shorter)
-        for joint in tail:
-            placed = shorter.append(joint, relative=False, safe=False, fixedPosition=True,
-                                    fixedOrientation=True)  # fmt: skip
-            if placed is None:
-                return chain, answers
-    new_movable = [k for k, j in enumerate(shorter.Joints) if j.stateRange() != (0.0, 0.0)]
-    starts_q = []
-    for answer in answers:
-        q = np.zeros(len(shorter.Joints))
-        q[new_movable] = np.asarray(answer.states)[movable]
-        starts_q.append(q)
-    found, _ = reached(shorter, starts_q)
-    if found is None or tube_length(shorter) > tube_length(chain):
-        return chain, answers
-    return shorter, found
+        tails = [tail]
+        if len(tail) == 1 and isinstance(tail[0], EndTip) and \
+                all(goal.kind == "position" for goal in goals):  # fmt: skip
+            # a point's tip frame may turn about it: the end tip may leave in any direction
+            frame = np.asarray(getattr(tail[0].DistalDubinsFrame(), "A",
+                                       tail[0].DistalDubinsFrame()))  # fmt: skip
+            tails = [[end] for end in end_tips_at(frame, chain.numSides, chain.r,
+                                                  tail[0].neutralLength)]  # fmt: skip
+        candidates = []
+        for joints in tails:
+            trial = copy.copy(shorter)
+            placed = (trial.append(joint, relative=False, safe=False, fixedPosition=True,
+                                   fixedOrientation=True) for joint in joints)  # fmt: skip
+            if all(index is not None for index in placed):
+                candidates.append(trial)
+    for trial in sorted(candidates, key=tube_length):  # the shortest that keeps the task
+        if tube_length(trial) > tube_length(chain):
+            break
+        new_movable = [k for k, j in enumerate(trial.Joints) if j.stateRange() != (0.0, 0.0)]
+        starts_q = []
+        for answer in answers:
+            q = np.zeros(len(trial.Joints))
+            q[new_movable] = np.asarray(answer.states)[movable]
+            starts_q.append(q)
+        found, _ = reached(trial, starts_q)
+        if found is not None:
+            return trial, found
+    return chain, answers
 
 
 def _run_all(executor, own: bool, tasks: list, bar: Progress) -> list:

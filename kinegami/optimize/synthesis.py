@@ -471,32 +471,13 @@ def _fit(model: _Model, seed: int, start: int) -> np.ndarray | None:
 
 
 # --- building and checking a fitted table ---------------------------------------------------------
-#: Rotations of a position task's tip frame about its point that building tries in turn (the
-#: end tip's tube leaves along the frame's x axis).
-_TIP_TURNS = (np.eye(3), np.diag([-1.0, -1.0, 1.0]), np.array([[0, -1, 0], [1, 0, 0], [0, 0, 1.0]]),
-              np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1.0]]),
-              np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0.0]]),
-              np.array([[0, 0, -1], [0, 1, 0], [1, 0, 0.0]]))  # fmt: skip
-#: The end tip's frame in its Pose's: along the tube (Pose z) by half its length, x = Pose z,
-#: y = Pose x, z = Pose y (kinegami.chain.joints.EndTip, DistalDubinsFrame).
-_TIP_AXES = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
-
-
 def _end_tips(model: _Model, tip: np.ndarray) -> list:
     """End tips (length 1.5 r) whose distal frame is ``tip`` (4x4), to try in turn: a position
-    task's tip frame may also turn about its point (:data:`_TIP_TURNS`)."""
-    from kinegami.chain.joints import EndTip
+    task's tip frame may also turn about its point (:data:`TIP_TURNS`)."""
+    from kinegami.optimize.compaction import TIP_TURNS, end_tips_at
 
-    length = 1.5 * model.task.r
-    out = []
-    for turn in (np.eye(3),) if model.tool_size else _TIP_TURNS:
-        F = tip.copy()
-        F[:3, :3] = tip[:3, :3] @ turn
-        P = F.copy()
-        P[:3, :3] = F[:3, :3] @ _TIP_AXES.T
-        P[:3, 3] = F[:3, 3] - 0.5 * length * P[:3, 2]
-        out.append(EndTip(model.task.numSides, model.task.r, np.eye(4), length).with_pose(P))
-    return out
+    turns = (np.eye(3),) if model.tool_size else TIP_TURNS
+    return end_tips_at(tip, model.task.numSides, model.task.r, 1.5 * model.task.r, turns)
 
 
 def _model_joints(model: _Model, x: np.ndarray) -> tuple[list, np.ndarray]:
