@@ -1662,7 +1662,7 @@ def cmd_reach(args: argparse.Namespace) -> int:
     else:
         title = f"{_printable(info.name)} ({args.design})" if info.name else args.design
         verdict = "reached" if answer.ok else f"not reached: {answer.reason}"
-        lines = [f"{title}: {verdict}", "  states:"]
+        lines = [f"{title}: {verdict}", *_material_lines(chain, info), "  states:"]
         for k, (joint, state) in enumerate(zip(chain.Joints, answer.states, strict=True)):
             if joint.stateRange() == (0.0, 0.0):
                 continue
@@ -1680,7 +1680,8 @@ def cmd_reach(args: argparse.Namespace) -> int:
         chain.requireClearance = False  # judged above, with the design's margin
         chain.setJointStates(list(answer.states))
         written = save_design(chain, out, name=info.name, description=info.description,
-                              units=info.units, twistPortion=info.twistPortion)  # fmt: skip
+                              units=info.units, twistPortion=info.twistPortion,
+                              material=info.material, bed=info.bed)  # fmt: skip
         if not args.json:
             print(f"  written: {written}")
     elif out is not None:
@@ -1751,8 +1752,8 @@ def cmd_workspace(args: argparse.Namespace) -> int:
             "lost_share": cloud.lost_share, "seed": seed, "files": [str(f) for f in written],
         }, indent=2, allow_nan=False))  # fmt: skip
     else:
-        print("\n".join([f"{title}: workspace", f"  {summary}", "  files written:",
-                         *(f"    {f}" for f in written)]))  # fmt: skip
+        print("\n".join([f"{title}: workspace", *_material_lines(chain, info), f"  {summary}",
+                         "  files written:", *(f"    {f}" for f in written)]))  # fmt: skip
     return 0
 
 
