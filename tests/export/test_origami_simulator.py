@@ -241,10 +241,12 @@ def test_simulator_folds_every_gallery_design(fold_run, design):
 
 
 @pytest.mark.browser
-@pytest.mark.parametrize("suffix", [".fold", ".svg"])
-def test_simulator_folds_a_piece_of_a_sheet_cut_for_a_laser_bed(simulator, outputs, suffix):
-    """A piece of Example 1 cut to fit a 300 x 200 mm bed (docs/fabrication.md "Laser bed"):
-    the middle one, which starts at a cut and ends with its tab, folds as any sheet does."""
+@pytest.mark.parametrize("index, suffix", [(1, ".fold"), (2, ".fold"), (2, ".svg"), (3, ".fold")])
+def test_simulator_folds_each_piece_of_a_sheet_cut_for_a_laser_bed(simulator, outputs, index,
+                                                                    suffix):  # fmt: skip
+    """Example 1 cut to fit a 300 x 200 mm bed (docs/fabrication.md "Laser bed") is three
+    pieces: the first (its start tip, a tab), the middle one (from a cut to its tab) and the
+    last (from a cut to the end tip). Each folds as any sheet does."""
     from kinegami.fabrication.beds import Bed, lay_out
     from kinegami.validation import UNITS_IN_MM
 
@@ -253,14 +255,15 @@ def test_simulator_folds_a_piece_of_a_sheet_cut_for_a_laser_bed(simulator, outpu
     layout = lay_out(chain.creasePattern(twistPortion=info.twistPortion), Bed.of(300, 200),
                      unit=UNITS_IN_MM[info.units])  # fmt: skip
     assert len(layout.pieces) == 3
-    piece = layout.pieces[1]
-    assert piece.tab > 0 and piece.start > 0
+    piece = layout.pieces[index - 1]
+    assert (piece.tab > 0) == (index < 3) and (piece.start > 0) == (index > 1)
+    stem = f"example1_piece_{index}"
     for kind in (".fold", suffix):
-        export(piece.pattern, folder / f"example1_piece_2{kind}", units=info.units)
-    result = simulator.fold(folder / f"example1_piece_2{suffix}", below=SIMULATOR_ERROR_LIMIT,
+        export(piece.pattern, folder / f"{stem}{kind}", units=info.units)
+    result = simulator.fold(folder / f"{stem}{suffix}", below=SIMULATOR_ERROR_LIMIT,
                             within=math.inf, max_steps=SIMULATOR_MAX_STEPS,
-                            screenshot=shots / f"example1_piece_2{suffix.replace('.', '_')}.png")
-    data = json.loads((folder / "example1_piece_2.fold").read_text())
+                            screenshot=shots / f"{stem}{suffix.replace('.', '_')}.png")
+    data = json.loads((folder / f"{stem}.fold").read_text())
     with open(shots / "results.txt", "a") as log:
         log.write(f"{summary(result, data)}\n")
     check_folds(result, data)
