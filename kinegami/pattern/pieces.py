@@ -33,6 +33,8 @@ length that allows one).
 
 from __future__ import annotations
 
+import bisect
+
 import numpy as np
 
 from kinegami._record import Record
@@ -209,14 +211,14 @@ def needed_length(sheet, tab: float, mark: float | None = None) -> tuple[float, 
         cases.append((lo + tab - hi, hi + tab, lo - mark))
     cases.append((end - intervals[-1][1], intervals[-1][1] + tab, end))
     need, y0, y1 = max(cases, key=lambda case: case[0])
-    if _cuts(sheet, need, tab, mark) is None:
+    if _cuts(sheet, need, tab, mark, intervals) is None:
         low, high = need, need + tab + mark
-        while _cuts(sheet, high, tab, mark) is None:
+        while _cuts(sheet, high, tab, mark, intervals) is None:
             high += tab + mark
         while high - low > 1e-9 * pattern.r:
             middle = 0.5 * (low + high)
-            low, high = (low, middle) if _cuts(sheet, middle, tab, mark) is not None else (
-                middle, high)  # fmt: skip
+            low, high = (low, middle) if _cuts(sheet, middle, tab, mark, intervals) is not None \
+                else (middle, high)  # fmt: skip
         need = high
     return need, _stretch(sheet, y0, y1, tab, mark)
 
@@ -236,24 +238,28 @@ def _stretch(sheet, y0: float, y1: float, tab: float, mark: float) -> Stretch:
 # --- splitting --------------------------------------------------------------------------------
 
 
-def _cuts(sheet, max_length: float, tab: float, mark: float) -> list[float] | None:
+def _cuts(sheet, max_length: float, tab: float, mark: float,
+          intervals: list[tuple[float, float]] | None = None) -> list[float] | None:
     """The greedy cuts: each as far along as a piece of ``max_length`` (tab included) allows,
     and at least ``tab + mark`` after the previous one (room for its label and ticks); None
     when a piece cannot reach an allowed cut."""
     pattern, _ = _parts(sheet)
     start, end = _sheet_range(pattern)
-    intervals = cut_intervals(sheet, tab, mark)
+    if intervals is None:
+        intervals = cut_intervals(sheet, tab, mark)
     tol = 1e-9 * pattern.r
+    starts = [lo for lo, _ in intervals]  # sorted, and so are the ends (disjoint tubes)
     cuts: list[float] = []
     s = start
     while end - s > max_length + tol:
         low = s + tab + mark if cuts else s
         high = s + max_length - tab
-        best = None
-        for lo, hi in intervals:
-            if lo <= high + tol and hi >= low - tol:
-                best = min(hi, high)  # the last allowed cut within reach
-        if best is None or best <= s + tol:
+        # the last interval starting within reach; no earlier one ends later
+        k = bisect.bisect_right(starts, high + tol) - 1
+        if k < 0 or intervals[k][1] < low - tol:
+            return None
+        best = min(intervals[k][1], high)  # the last allowed cut within reach
+        if best <= s + tol or best < low - tol:
             return None
         cuts.append(best)
         s = best
