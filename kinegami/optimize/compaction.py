@@ -428,14 +428,15 @@ def _motion_collision(chain: KinematicChain, motion) -> tuple[int, int] | None:
 
 
 def _coarse_options(
-    joints: list, r: float, rng: np.random.Generator | None, parents=None
+    joints: list, r: float, rng: np.random.Generator | None, parents=None, keep_last=False
 ) -> list:
     """Per joint, the first candidate set: slides around the feet of the common normals with
     its neighbours' axes (and the point itself), times four rolls when rolling matters. With
-    ``rng``, the offsets are scaled and the rolls turned at random."""
+    ``rng``, the offsets are scaled and the rolls turned at random. ``keep_last``: the last
+    joint stays where it is (a task's end tip)."""
     options = []
     for j in range(len(joints)):
-        if not joints[j].has_body and j > 0:  # kept where it is
+        if (not joints[j].has_body and j > 0) or (keep_last and j == len(joints) - 1):
             options.append(np.zeros((1, 2)))
             continue
         T = joints[j].pose_matrix
@@ -465,14 +466,14 @@ def _coarse_options(
     return options
 
 
-def _fine_options(layers: _Layers, choice: list[int], level: int) -> list:
+def _fine_options(layers: _Layers, choice: list[int], level: int, keep_last=False) -> list:
     """Candidates around the chosen ones: slides of 0, +-h, +-2h and rolls of 0, +-delta."""
     h = _FINE_SLIDES[level] * layers.r
     delta = _FINE_ROLLS[level]
     options = []
     for j in range(len(choice)):
         t, th = layers.options[j][choice[j]]
-        if not layers.base[j].has_body and j > 0:
+        if (not layers.base[j].has_body and j > 0) or (keep_last and j == len(choice) - 1):
             options.append(np.array([(t, th)]))
             continue
         rolls = [th] if layers.base[j].pathIndex() == 2 else [th, th - delta, th + delta]
@@ -481,11 +482,12 @@ def _fine_options(layers: _Layers, choice: list[int], level: int) -> list:
     return options
 
 
-def _dp_search(chain, rng: np.random.Generator | None, motion, deadline, junctions=False):
+def _dp_search(chain, rng: np.random.Generator | None, motion, deadline, junctions=False,
+               keep_last=False):  # fmt: skip
     """The shortest clear chain the layered search finds from ``chain``'s joints, or None.
 
     The waypoints are dropped; when no clear chain is found without them, they are tried
-    where they are.
+    where they are. ``keep_last`` (chains): the last joint stays where it is.
     """
     if isinstance(chain, KinematicTree):
         kept, parents = _without_waypoints(chain)
@@ -496,9 +498,10 @@ def _dp_search(chain, rng: np.random.Generator | None, motion, deadline, junctio
                                       list(chain.Parents), junctions)  # fmt: skip
         return found
     joints = [j for i, j in enumerate(chain.Joints) if i == 0 or j.has_body]
-    found = _dp_search_joints(chain, joints, rng, motion, deadline)
+    found = _dp_search_joints(chain, joints, rng, motion, deadline, keep_last=keep_last)
     if found is None and len(joints) < len(chain.Joints):
-        found = _dp_search_joints(chain, list(chain.Joints), rng, motion, deadline)
+        found = _dp_search_joints(chain, list(chain.Joints), rng, motion, deadline,
+                                  keep_last=keep_last)  # fmt: skip
     return found
 
 
@@ -519,11 +522,11 @@ def _without_waypoints(tree: KinematicTree) -> tuple[list[int], list[int]]:
 
 
 def _dp_search_joints(chain, joints: list, rng, motion, deadline, parents=None,
-                      junctions=False):  # fmt: skip
+                      junctions=False, keep_last=False):  # fmt: skip
     if len(joints) < 2:
         return None
     require = chain.requireClearance
-    layers = _Layers(chain, joints, _coarse_options(joints, chain.r, rng, parents),
+    layers = _Layers(chain, joints, _coarse_options(joints, chain.r, rng, parents, keep_last),
                      restarts=False, parents=parents)  # fmt: skip
     layers.junctions = junctions
     found = _clear_choice(layers, motion, require, deadline)
@@ -533,8 +536,8 @@ def _dp_search_joints(chain, joints: list, rng, motion, deadline, parents=None,
     for level in range(len(_FINE_SLIDES)):
         if deadline is not None and time.monotonic() > deadline:
             break
-        fine = _Layers(chain, joints, _fine_options(layers, choice, level), restarts=False,
-                       parents=parents)  # fmt: skip
+        fine = _Layers(chain, joints, _fine_options(layers, choice, level, keep_last),
+                       restarts=False, parents=parents)  # fmt: skip
         fine.junctions = junctions
         keep = [0] * len(choice)  # candidate 0 of every layer is the current one
         found = _clear_choice(fine, motion, require, deadline, keep=keep)
@@ -568,7 +571,7 @@ def _colliding_fraction(chain: KinematicChain, movable_states: np.ndarray) -> fl
 def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
     """One start of :func:`compact` (a top-level function, so any executor can run it):
     (objective, overlap, start, chain), chain None when the start found no clear design."""
-    chain, k, seed, kind, deadline_seconds, motion, junctions = task
+    chain, k, seed, kind, deadline_seconds, motion, junctions, keep_last = task
     deadline = None if deadline_seconds is None else time.monotonic() + deadline_seconds
     rng = np.random.default_rng([seed, k])
     # trial builds and edits that fail or collide warn; nobody wants thousands of those. Not a
@@ -576,9 +579,11 @@ def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
     # restores the caller's filters around the whole search; worker processes keep these).
     warnings.filterwarnings("ignore", category=PlacementWarning)
     warnings.filterwarnings("ignore", category=ClearanceWarning)
-    found = _dp_search(chain, None if k == 0 else rng, motion, deadline, junctions)
+    found = _dp_search(chain, None if k == 0 else rng, motion, deadline, junctions, keep_last)
     if kind == "length" and found is not None:
         return tube_length(found), 0.0, k, found
+    if keep_last:  # the descent below may slide any joint
+        return math.inf, math.inf, k, None
     # the ball (or no clear design found): greedy descent from the shortest design (or the
     # input)
     start = found if found is not None else copy.copy(chain)
@@ -756,10 +761,11 @@ def compact(
 
 
 def _search(chain, seed: int, executor, time_limit, progress, objective: str, starts: int,
-            motion_task, junctions: bool):  # fmt: skip
+            motion_task, junctions: bool, keep_last: bool = False):  # fmt: skip
     """:func:`compact`'s search of checked arguments; ``motion_task``: (movable joints' states
-    (S, m), the largest colliding fraction allowed) or None."""
-    tasks = [(chain, k, seed, objective, time_limit, motion_task, junctions)
+    (S, m), the largest colliding fraction allowed) or None; ``keep_last``: the chain's last
+    joint stays where it is."""
+    tasks = [(chain, k, seed, objective, time_limit, motion_task, junctions, keep_last)
              for k in range(starts)]  # fmt: skip
     own = executor is None
     if own:
@@ -883,23 +889,30 @@ def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(
         # compact(motion=True) does with sampled ones), so the task's configurations stay clear
         at_targets = np.array([np.asarray(answer.states)[movable] for answer in answers])
         _check_executor(executor)
+        search = (check_int("seed", seed, minimum=0, floats=False), executor,
+                  None if time_limit is None else check_positive("time_limit", time_limit),
+                  check_progress(progress), "length", check_starts(starts), (at_targets, 0.0),
+                  False)  # fmt: skip
+        candidates = []
+        if len(tail) == 1:  # the whole chain, its end tip kept: the last link counts too
+            whole = copy.copy(chain)
+            whole.margin = margin
+            try:
+                candidates.append(_search(whole, *search, keep_last=True))
+            except CompactionError:
+                pass
         try:
-            shorter = _search(head, check_int("seed", seed, minimum=0, floats=False), executor,
-                              None if time_limit is None else check_positive("time_limit",
-                                                                             time_limit),
-                              check_progress(progress), "length", check_starts(starts),
-                              (at_targets, 0.0), False)  # fmt: skip
+            shorter = _search(head, *search)
         except CompactionError:
-            return chain, answers
-        tails = [tail]
+            shorter = None
+        tails = [tail] if shorter is not None else []
         if len(tail) == 1 and isinstance(tail[0], EndTip) and \
                 all(goal.kind == "position" for goal in goals):  # fmt: skip
             # a point's tip frame may turn about it: the end tip may leave in any direction
             frame = np.asarray(getattr(tail[0].DistalDubinsFrame(), "A",
                                        tail[0].DistalDubinsFrame()))  # fmt: skip
             tails = [[end] for end in end_tips_at(frame, chain.numSides, chain.r,
-                                                  tail[0].neutralLength)]  # fmt: skip
-        candidates = []
+                                                  tail[0].neutralLength)] if tails else []
         for joints in tails:
             trial = copy.copy(shorter)
             placed = (trial.append(joint, relative=False, safe=False, fixedPosition=True,
