@@ -70,6 +70,7 @@ class Task:
     starts: int | None
     document: dict
     path: bool = False
+    base_region: object | None = None  # a keep-out Box where the base's origin may be
 
     @property
     def is_tree(self) -> bool:
@@ -96,6 +97,8 @@ class Task:
             out["starts"] = self.starts
         if self.path:
             out["path"] = True
+        if self.base_region is not None:
+            out["base_region"] = self.base_region
         return out
 
 
@@ -135,8 +138,9 @@ def task_from_dict(document, file=None, where: tuple = ()) -> Task:
     if errors:
         first = _target_branch_error(errors[0])
         error = translate(first, document, file)
-        field = json_path((*where, *first.absolute_path))
         reason = _task_reason(first, document) or error.reason
+        at = ["baseRegion"] if reason.startswith("is for chains") else first.absolute_path
+        field = json_path((*where, *at))
         if error.has_value:
             raise DesignError(reason, field=field, value=error.value, file=file)
         raise DesignError(reason, field=field, file=file)
@@ -162,13 +166,20 @@ def task_from_dict(document, file=None, where: tuple = ()) -> Task:
         except ValueError as exc:
             raise DesignError(str(exc), field=json_path((*where, "keepOut", k)),
                               file=file) from None  # fmt: skip
+    region = None
+    if "baseRegion" in document:
+        try:
+            region = Box.of(document["baseRegion"], "baseRegion")
+        except ValueError as exc:
+            raise DesignError(str(exc), field=json_path((*where, "baseRegion")),
+                              file=file) from None  # fmt: skip
     return Task(
         name=document.get("name"), description=document.get("description"), units=units, r=r,
         numSides=int(document["numSides"]), joints=joints, targets=targets,
         base=base, keep_out=tuple(boxes), max_tube_length=document.get("maxTubeLength"),
         margin=float(document.get("margin", 0.0)), seed=int(document.get("seed", 0)),
         starts=document.get("starts"), document=copy.deepcopy(dict(document)),
-        path=bool(document.get("path", False)),
+        path=bool(document.get("path", False)), base_region=region,
     )  # fmt: skip
 
 
@@ -225,6 +236,10 @@ def _task_reason(error: jsonschema.ValidationError, document: dict) -> str | Non
     if path == ["path"] and error.validator == "const" and tree:
         return ("\"path\": true is for chains; a tree task (joints given per leaf) asks for "
                 "grasps only")
+    if tree and "baseRegion" in document and error.validator is None and \
+            error.instance == document["baseRegion"]:  # fmt: skip
+        return ("is for chains; a tree task's root is at \"base\" (its leaves start on a ring "
+                "around it)")
     if len(path) == 2 and path[0] == "targets" and error.validator == "type":
         if tree:
             return (f"must be an array of targets: a tree task (joints given per leaf) gives "

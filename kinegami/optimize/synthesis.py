@@ -69,11 +69,25 @@ class _Task:
     margin: float
     oriented: bool  # some target fixes an orientation or an axis
     path: bool = False  # the moves from each target to the next must be clear too
+    region: Box | None = None  # where the base's origin may be (world); None: at base
+
+    @property
+    def origin(self) -> np.ndarray:
+        """The base's origin, or the centre of its region."""
+        if self.region is None:
+            return self.base[:3, 3]
+        return 0.5 * (np.asarray(self.region.min) + np.asarray(self.region.max))
 
     @property
     def scale(self) -> float:
-        """The largest distance of a target from the base's origin."""
-        return max(float(np.linalg.norm(t.position - self.base[:3, 3])) for t in self.targets)
+        """The largest distance of a target from the base's origin (its region's centre)."""
+        return max(float(np.linalg.norm(t.position - self.origin)) for t in self.targets)
+
+    def base_distance(self, point: np.ndarray) -> float:
+        """The distance of ``point`` from the base's origin (from its region, when given)."""
+        if self.region is None:
+            return float(np.linalg.norm(point - self.base[:3, 3]))
+        return float(np.linalg.norm(point - np.clip(point, self.region.min, self.region.max)))
 
 
 def _joint_strings(joints) -> list[str]:
@@ -103,7 +117,8 @@ def _joint_strings(joints) -> list[str]:
     return out
 
 
-def _task(targets, r, numSides, base, keep_out, max_tube_length, margin) -> _Task:
+def _task(targets, r, numSides, base, keep_out, max_tube_length, margin,
+          base_region=None) -> _Task:  # fmt: skip
     from kinegami.chain.bodies import check_margin
     from kinegami.chain.joints import pose_array
     from kinegami.reach import Target
@@ -137,19 +152,30 @@ def _task(targets, r, numSides, base, keep_out, max_tube_length, margin) -> _Tas
         else check_positive("max_tube_length", max_tube_length)  # fmt: skip
     margin = check_margin(margin)
     oriented = any(t.kind != "position" for t in found)
-    return _Task(found, r, n, B, boxes, float(L), margin, oriented)
+    region = None
+    if base_region is not None:
+        region = Box.of(base_region, "base_region")
+        if np.any(np.abs(np.r_[region.min, region.max]) > limit):
+            raise InvalidParameterError(
+                f"base_region {_fmt(region.min)} to {_fmt(region.max)} reaches beyond 1e6 r = "
+                f"{limit:g} (the coordinate limit, docs/limits.md)"
+            )
+        B = B.copy()
+        B[:3, 3] = 0.0  # the origin is an unknown of the fit, within the region
+    return _Task(found, r, n, B, boxes, float(L), margin, oriented, region=region)
 
 
 def task_certificate(task: _Task, types: str) -> tuple[int, str] | None:
     """(target index, why) when a bound proves that no chain of the joint types ``types`` can
     reach every target, else None (docs/design-for-a-task.md, Certificates)."""
-    origin = task.base[:3, 3]
     L = task.max_tube_length
+    where = f"at {_fmt(task.origin)}" if task.region is None else \
+        f"region {_fmt(task.region.min)} to {_fmt(task.region.max)}"  # fmt: skip
     for k, t in enumerate(task.targets):
-        D = float(np.linalg.norm(t.position - origin))
+        D = task.base_distance(t.position)
         if D > L:
             return k, (
-                f"target {k} at {_fmt(t.position)} is {D:.6g} from the base at {_fmt(origin)}, "
+                f"target {k} at {_fmt(t.position)} is {D:.6g} from the base {where}, "
                 f"farther than the longest tube allowed (max_tube_length {L:.6g}): the tip of a "
                 f"tube of length L stays within L of its base"
             )
@@ -290,7 +316,9 @@ class _Model:
         self.low = np.array([ranges[c][0] for c in types])
         self.high = np.array([ranges[c][1] for c in types])
         self.tool_size = 6 if task.oriented else 0
-        self.size = 4 * self.n + self.tool_size + self.T * self.n
+        self.base_size = 0 if task.region is None else 3  # the base's origin, when free
+        self.first_q = 4 * self.n + self.tool_size + self.base_size
+        self.size = self.first_q + self.T * self.n
         # lengths of the table and the tool: within half the longest tube, and about the
         # task's spread
         self.span = min(0.5 * task.max_tube_length, max(4.0 * r, 1.5 * task.scale))
@@ -303,6 +331,10 @@ class _Model:
         # columns of x: per step of the product, the table's or the tool's entry, and the
         # configuration's entry that adds to it (-1: none)
         steps, columns, joint_of = [], [], []
+        for axis in range(self.base_size):  # the base's origin: slides along the world's axes
+            steps.append(("P", axis))
+            columns.append(4 * self.n + self.tool_size + axis)
+            joint_of.append(-1)
         for i in range(self.n):
             for kind, axis, c in _ROW_STEPS:
                 steps.append((kind, axis))
@@ -323,8 +355,16 @@ class _Model:
         n, T = self.n, self.T
         table = x[: 4 * n].reshape(n, 4)
         tool = x[4 * n : 4 * n + self.tool_size]
-        Q = x[4 * n + self.tool_size :].reshape(T, n)
+        Q = x[self.first_q :].reshape(T, n)
         return table, tool, Q
+
+    def base_pose(self, x: np.ndarray) -> np.ndarray:
+        """The base pose (4x4, world) of the unknowns ``x``: its origin in the region, when
+        the task gives one."""
+        B = self.task.base.copy()
+        if self.base_size:
+            B[:3, 3] = x[4 * self.n + self.tool_size : self.first_q]
+        return B
 
     def _values(self, x: np.ndarray) -> np.ndarray:
         """(T, steps): every step's value for every target."""
@@ -337,16 +377,23 @@ class _Model:
     def _products(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(T, steps, 4, 4) the product before each step, and (T, 4, 4) the tips."""
         values = self._values(x)
-        G = np.broadcast_to(self.task.base, (self.T, 4, 4)).copy()
+        # with a region, the base's origin is the first steps (along the world's axes), then
+        # comes its rotation
+        G = np.broadcast_to(np.eye(4) if self.base_size else self.task.base,
+                            (self.T, 4, 4)).copy()  # fmt: skip
         before = np.empty((self.T, len(self.steps), 4, 4))
         for k, (kind, axis) in enumerate(self.steps):
+            if self.base_size and k == self.base_size:
+                G = G @ self.task.base  # its rotation (its translation is the steps')
             before[:, k] = G
             G = G @ _elementary(kind, axis, values[:, k])
         return before, G
 
-    def tips(self, table: np.ndarray, tool: np.ndarray, Q: np.ndarray) -> np.ndarray:
-        """(K, 4, 4) tip frames at the configurations Q (K, n)."""
-        G = np.broadcast_to(self.task.base, (Q.shape[0], 4, 4))
+    def tips(self, table: np.ndarray, tool: np.ndarray, Q: np.ndarray,
+             base: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+        """(K, 4, 4) tip frames at the configurations Q (K, n), from ``base`` (4x4; default
+        the task's)."""
+        G = np.broadcast_to(self.task.base if base is None else base, (Q.shape[0], 4, 4))
         for i in range(self.n):
             th, al, a, d = table[i]
             q = Q[:, i]
@@ -390,7 +437,7 @@ class _Model:
         dR = _cross(U[..., None], R, axis=2) * turns[None, :, None, None]  # u x each column
         J = np.zeros((self.rows, self.size))
         moving = np.flatnonzero(self.joint_of >= 0)
-        first_q = 4 * self.n + self.tool_size
+        first_q = self.first_q
         for t, kind in enumerate(self.kinds):
             parts = [dp[t] / self.task.r]
             if kind == "pose":
@@ -416,6 +463,9 @@ class _Model:
         if self.tool_size:
             lo = np.r_[lo, [-s] * 3, [-2 * math.pi] * 3]
             hi = np.r_[hi, [s] * 3, [2 * math.pi] * 3]
+        if self.base_size:
+            region = self.task.region
+            lo, hi = np.r_[lo, region.min], np.r_[hi, region.max]
         inset = 1e-6 * (self.high - self.low)
         lo = np.r_[lo, np.tile(self.low + inset, self.T)]
         hi = np.r_[hi, np.tile(self.high - inset, self.T)]
@@ -430,6 +480,8 @@ class _Model:
         parts = [table.reshape(-1)]
         if self.tool_size:
             parts += [rng.uniform(-r, r, 3), rng.uniform(-math.pi, math.pi, 3) * 0.5]
+        if self.base_size:
+            parts.append(rng.uniform(self.task.region.min, self.task.region.max))
         parts.append((self.low + (self.high - self.low) * rng.random((self.T, n))).reshape(-1))
         return np.concatenate(parts)
 
@@ -451,6 +503,7 @@ def _fit(model: _Model, seed: int, start: int) -> np.ndarray | None:
     scale = np.ones(model.size)
     lengths = np.r_[np.tile([False, False, True, True], model.n),
                     [True] * 3 + [False] * 3 if model.tool_size else [],
+                    [True] * model.base_size,
                     np.tile(~model.revolute, model.T)].astype(bool)  # fmt: skip
     scale[lengths] = model.task.r
     with warnings.catch_warnings():
@@ -487,7 +540,7 @@ def _model_joints(model: _Model, x: np.ndarray) -> tuple[list, np.ndarray]:
 
     task, r = model.task, model.task.r
     table, tool, _ = model.split(x)
-    frames = [task.base]
+    frames = [model.base_pose(x)]
     for i in range(model.n):
         th, al, a, d = table[i]
         frames.append(frames[-1] @ _dh(th, al, a, d))
@@ -597,7 +650,7 @@ def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = Tr
     if bad:  # other configurations of the same table for those targets, a batch at a time
         movable = [m for m, joint in enumerate(chain.Joints) if joint.stateRange() != (0.0, 0.0)]
         rng = np.random.default_rng([seed, start, 0x0C0F])
-        first_q = 4 * model.n + model.tool_size
+        first_q = model.first_q
         for k, _ in bad:
             for count in OTHER_CONFIGURATIONS:  # more starts only when none is clear
                 found = _other_configurations(model, x, k, count, rng)
@@ -666,11 +719,11 @@ def _other_configurations(model: _Model, x: np.ndarray, k: int, count: int,
     damping adapted on its own, steps projected into the joints' ranges."""
     n = model.n
     sub = _Model(replace(model.task, targets=(model.task.targets[k],) * count), model.types)
-    fixed = x[: 4 * n + model.tool_size]
+    fixed = x[: model.first_q]
     rows = sub.rows // count
     inset = 1e-6 * (model.high - model.low)
     lo, hi = model.low + inset, model.high - inset
-    columns = 4 * n + model.tool_size + np.arange(count)[:, None] * n + np.arange(n)[None, :]
+    columns = model.first_q + np.arange(count)[:, None] * n + np.arange(n)[None, :]
     starts, lines = np.arange(count)[:, None, None], np.arange(rows)[None, :, None]
 
     def errors(Q: np.ndarray) -> np.ndarray:
@@ -720,6 +773,7 @@ def design_for(
     seed: int = 0,
     executor: concurrent.futures.Executor | None = None,
     base=None,
+    base_region=None,
     keep_out=(),
     max_tube_length: float | None = None,
     margin: float = 0.0,
@@ -751,6 +805,10 @@ def design_for(
         this process).
     base : the root joint's pose (4x4 or SE3; default the identity): the first joint turns or
         slides along its z axis.
+    base_region : a box (``{"min": [x, y, z], "max": [x, y, z]}`` or :class:`Box`, world)
+        where the base's origin may be instead (chains): its position is fitted too, its
+        orientation is ``base``'s. (Placement may then slide the root joint along that axis,
+        as for a fixed base.)
     keep_out : boxes (``{"min": [x, y, z], "max": [x, y, z]}`` or :class:`Box`) that no part
         may come within ``margin`` of at any target's configuration.
     max_tube_length : the longest tube allowed (default 100 r).
@@ -800,11 +858,13 @@ def design_for(
     if isinstance(joints, (list, tuple)):  # a tree: one joint string and target list per leaf
         if path:
             raise InvalidParameterError("path=True is for chains; a tree task gives poses only")
+        if base_region is not None:
+            raise InvalidParameterError("base_region is for chains; a tree's root is at base")
         leaves, rooted, strings = _tree_tasks(targets, joints, r, numSides, base, keep_out,
                                               max_tube_length, margin)  # fmt: skip
         return _design_tree(leaves, rooted, strings, seed, starts, executor, progress,
                             return_answers)  # fmt: skip
-    task = _task(targets, r, numSides, base, keep_out, max_tube_length, margin)
+    task = _task(targets, r, numSides, base, keep_out, max_tube_length, margin, base_region)
     task = replace(task, path=path)
     strings = _joint_strings(joints)
     certificates = [task_certificate(task, types) for types in strings]

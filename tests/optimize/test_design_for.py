@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
 
 from kinegami import KinematicChain
 from kinegami.clearance.engine import engine_for
@@ -238,10 +239,12 @@ def test_compaction_with_targets_refuses_a_design_that_misses_its_task():
 
 @settings(max_examples=20, deadline=None)
 @given(types=st.text("RP", min_size=1, max_size=6), seed=st.integers(0, 2**31),
-       kinds=st.lists(st.sampled_from(["position", "pose", "axis"]), min_size=1, max_size=4))
-def test_the_fit_jacobian_is_exact(types, seed, kinds):
+       kinds=st.lists(st.sampled_from(["position", "pose", "axis"]), min_size=1, max_size=4),
+       region=st.booleans())  # fmt: skip
+def test_the_fit_jacobian_is_exact(types, seed, kinds, region):
     """The fit's Jacobian (elementary twists moved to the world) against central differences,
-    for every target form and joint type, with the length rows of the first stage."""
+    for every target form and joint type, with the length rows of the first stage; with a
+    base region, on a turned base whose origin is three more unknowns."""
     from kinegami.optimize import synthesis
 
     rng = np.random.default_rng(seed)
@@ -259,7 +262,14 @@ def test_the_fit_jacobian_is_exact(types, seed, kinds):
             targets.append(Target(p, axis=rng.normal(size=3)))
         else:
             targets.append(p)
-    model = synthesis._Model(synthesis._task(targets, 1.0, 4, None, (), None, 0.0), types)
+    base, box = None, None
+    if region:
+        base = np.eye(4)
+        base[:3, :3] = Rotation.from_rotvec(rng.normal(size=3)).as_matrix()
+        base[:3, 3] = rng.uniform(-2, 2, 3)  # ignored: the origin is in the box
+        box = {"min": [-1.0, -2.0, 0.0], "max": [1.0, 0.0, 0.5]}
+    task = synthesis._task(targets, 1.0, 4, base, (), None, 0.0, base_region=box)
+    model = synthesis._Model(task, types)
     x = model.start(rng)
     for penalty in (0.0, 0.5):
         model.penalty = penalty
@@ -269,7 +279,11 @@ def test_the_fit_jacobian_is_exact(types, seed, kinds):
                       for e in np.eye(model.size)]).T  # fmt: skip
         assert np.abs(J - F).max() <= 1e-6
     table, tool, Q = model.split(x)
-    assert np.abs(model._products(x)[1] - model.tips(table, tool, Q)).max() <= 1e-12
+    B = model.base_pose(x)
+    assert np.abs(model._products(x)[1] - model.tips(table, tool, Q, B)).max() <= 1e-12
+    if region:
+        assert np.all(B[:3, 3] >= box["min"]) and np.all(B[:3, 3] <= box["max"])
+        np.testing.assert_allclose(B[:3, :3], base[:3, :3], atol=1e-15)
 
 
 def test_path_true_certifies_every_move_between_targets():
@@ -291,3 +305,27 @@ def test_path_true_certifies_every_move_between_targets():
     check_reaches(design, targets)
     with pytest.raises(InvalidTypeError, match="path"):
         design_for(targets, "RRRR", r=1.0, numSides=4, path="yes")
+
+
+def test_a_base_region_lets_the_search_place_the_base():
+    """Points 70 r away from the origin: a base fixed there is proven too far for a 60 r tube;
+    with a region around them, the base's origin is fitted inside it and every point is
+    reached (checked from scratch), the root joint's axis through the region."""
+    points = [(76.0, 2.0, 3.0), (73.0, 5.0, 4.0), (68.0, 4.0, 6.0)]
+    box = {"min": [60.0, -5.0, 0.0], "max": [80.0, 5.0, 1.0]}
+    with pytest.raises(InfeasibleTaskError, match="from the base at"):
+        design_for(points, "RRR", r=1, numSides=4, max_tube_length=60)
+    arm = design_for(points, "RRR", r=1, numSides=4, max_tube_length=60, base_region=box)
+    check_reaches(arm, points)
+    P = arm.Joints[0].pose_matrix  # the axis (z) meets the region's box
+    assert abs(P[2, 2]) > 0.5
+    t = (0.5 - P[2, 3]) / P[2, 2]  # where the axis crosses the region's middle height
+    foot = P[:3, 3] + t * P[:3, 2]
+    low, high = np.array(box["min"]), np.array(box["max"])
+    assert np.all(foot >= low - 1e-9) and np.all(foot <= high + 1e-9)
+    far = {"min": [200.0, -5.0, 0.0], "max": [210.0, 5.0, 1.0]}
+    with pytest.raises(InfeasibleTaskError, match="from the base region") as caught:
+        design_for(points, "RRR", r=1, numSides=4, max_tube_length=60, base_region=far)
+    assert caught.value.proven
+    with pytest.raises(InvalidParameterError, match="base_region is for chains"):
+        design_for([points[:2], points[1:]], ["RR", "RR"], r=1, numSides=4, base_region=box)
