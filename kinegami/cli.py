@@ -167,6 +167,35 @@ def _send_png_data(job: BuildJob, send) -> None:
         send.close()
 
 
+def _write_guide(job: BuildJob, paths: list[Path], layout=None, bom=None) -> None:
+    """The folding guide of a chain (kinegami.viz.guide), with its layout on a laser bed."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    from kinegami.viz.guide import chain_guide_data
+
+    if bom is None:
+        bom = _chain_bom(job, layout)
+    paths[0].write_bytes(chain_guide_data(
+        job.chain, bom=bom, pattern=job.pattern, layout=layout,
+        title=job.info.name or paths[0].name.removesuffix("_guide.pdf"), units=job.info.units,
+        names=_joint_names(job.chain), twistPortion=job.info.twistPortion))  # fmt: skip
+
+
+def _chain_bom(job: BuildJob, layout=None):
+    """The bill of materials of a chain's build (kinegami.fabrication.bom)."""
+    from kinegami.fabrication.bom import bill_of_materials
+
+    return bill_of_materials([job.pattern], UNITS_IN_MM[job.info.units],
+                             material=job.info.material,
+                             layouts=None if layout is None else [layout])  # fmt: skip
+
+
+def _bom_lines(bom) -> list[str]:
+    """The summary's bill of materials."""
+    return ["  bill of materials:", *(f"    {_printable(line)}" for line in bom.lines())]
+
+
 def _registry_writer(suffix: str) -> Callable[..., None]:
     """A writer through the exporter registry (:func:`kinegami.export`): pattern formats get
     the design's pattern, the others the chain (with the design's twistPortion); all get the
@@ -193,11 +222,16 @@ def output_formats() -> dict[str, OutputFormat]:
     known = known_formats()
     png = OutputFormat("png", "pictures of the 3D chain and of the pattern",
                        ("_3d.png", "_pattern.png"), _write_pngs)  # fmt: skip
-    order = [".dxf", ".svg", "png"] + [s for s in known if s not in (".dxf", ".svg")]
+    guide = OutputFormat("guide", "folding guide PDF: a cover with the robot and the bill of "
+                         "materials, one step per module in folding order",
+                         ("_guide.pdf",), _write_guide)  # fmt: skip
+    order = [".dxf", ".svg", "png"] + [s for s in known if s not in (".dxf", ".svg")] + ["guide"]
     formats = {}
     for suffix in order:
         if suffix == "png":
             formats["png"] = png
+        elif suffix == "guide":
+            formats["guide"] = guide
         elif suffix in known:
             name = suffix.lstrip(".")
             formats[name] = OutputFormat(name, known[suffix], (suffix,), _registry_writer(suffix))
@@ -537,7 +571,7 @@ def _parse_tree_formats(text: str | None) -> list[str]:
     """``--formats`` of a tree: the names of kinegami.export.tree_build.TREE_FORMATS and png."""
     from kinegami.export.tree_build import DEFAULT_TREE_FORMATS, TREE_FORMATS
 
-    known = [*TREE_FORMATS, "png"]
+    known = [*TREE_FORMATS, "png", "guide"]
     if text is None:
         return [*DEFAULT_TREE_FORMATS, "png"]
     names = [item.strip().lower().lstrip(".") for item in text.split(",") if item.strip()]
@@ -550,6 +584,21 @@ def _parse_tree_formats(text: str | None) -> list[str]:
             f"{', '.join(known)}, all"
         )
     return known if "all" in names else list(dict.fromkeys(names))
+
+
+def _write_tree_guide(fabrication, path: Path, info, stem: str, bom, layouts, names) -> None:
+    """The folding guide of a tree (kinegami.viz.guide), every sheet's steps then its
+    junctions."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    from kinegami.export.tree_build import sheet_labels
+    from kinegami.viz.guide import tree_guide_data
+
+    labels = sheet_labels(fabrication, names, info.units)
+    path.write_bytes(tree_guide_data(
+        fabrication, bom=bom, layouts=layouts, title=info.name or stem, units=info.units,
+        names=names, labels=labels, twistPortion=info.twistPortion))  # fmt: skip
 
 
 def _write_tree_pictures(fabrication, folder: Path, stem: str, units: str | None = None
@@ -762,13 +811,19 @@ def _write_tree_build(command: str, label: str, tree, info, stem: str, out: Path
         except BedTooSmallError as error:
             raise _bed_failure(label, error) from None
         lines += _bed_summary(layouts, info, [sheet.index for sheet in fabrication.sheets])
+    from kinegami.fabrication.bom import bill_of_materials
+
+    bom = bill_of_materials([sheet.pattern for sheet in fabrication.sheets],
+                            UNITS_IN_MM[info.units], material=info.material, layouts=layouts,
+                            fabrication=fabrication)  # fmt: skip
+    lines += _bom_lines(bom)
     report = _clearance(fitted)
     if not report.ok:
         _warn(command, _overlap_warning(report, info, label))
     staging = _open_staging(command, out)
     try:
         try:
-            data = [f for f in formats if f != "png"]
+            data = [f for f in formats if f not in ("png", "guide")]
             write_tree_files(
                 fabrication,
                 staging.new,
@@ -781,6 +836,9 @@ def _write_tree_build(command: str, label: str, tree, info, stem: str, out: Path
             )
             if "png" in formats:
                 _write_tree_pictures(fabrication, staging.new, stem, info.units)
+            if "guide" in formats:
+                _write_tree_guide(fabrication, staging.new / f"{stem}_guide.pdf", info, stem,
+                                  bom, layouts, _joint_names(fitted))  # fmt: skip
             for name, write in extra:
                 write(staging.new / name)
         except KinegamiError as error:
@@ -838,6 +896,8 @@ def _write_chain_build(command: str, label: str, job: BuildJob, stem: str, out: 
             except BedTooSmallError as error:
                 raise _bed_failure(label, error) from None
             lines += _bed_summary([layout], job.info)
+        bom = _chain_bom(job, layout)
+        lines += _bom_lines(bom)
         if not job.clearance.ok:
             _warn(command, _overlap_warning(job.clearance, job.info, label))
         # write everything into a hidden staging folder in the target, then publish it as one
@@ -856,6 +916,8 @@ def _write_chain_build(command: str, label: str, job: BuildJob, stem: str, out: 
 
                         for name, text in bed_files(layout, stem, f".{fmt.name}").items():
                             (staging.new / name).write_text(text, encoding="utf-8")
+                    elif fmt.name == "guide":
+                        _write_guide(job, paths, layout, bom)
                     else:
                         fmt.write(job, paths)
                 except KinegamiError as error:

@@ -491,9 +491,10 @@ def test_formats_all(design, tmp_path):
     names = sorted(p.name for p in (tmp_path / "o").iterdir())
     assert names == sorted(
         ["arm.dxf", "arm.svg", "arm_3d.png", "arm_pattern.png", "arm.fold", "arm.pdf",
-         "arm.stl", "arm.obj", "arm.urdf", "arm_meshes"]
+         "arm.stl", "arm.obj", "arm.urdf", "arm_meshes", "arm_guide.pdf"]
     )  # fmt: skip
-    assert set(output_formats()) == {"dxf", "svg", "png", "fold", "pdf", "stl", "obj", "urdf"}
+    assert set(output_formats()) == {"dxf", "svg", "png", "fold", "pdf", "stl", "obj", "urdf",
+                                     "guide"}  # fmt: skip
 
 
 def test_every_registered_suffix_is_a_build_format(design, tmp_path):
