@@ -159,7 +159,7 @@ def _raster(fig, dpi: float) -> np.ndarray:
     try:
         fig.set_dpi(dpi)
         fig.canvas.draw()
-        return np.asarray(fig.canvas.buffer_rgba()).copy()
+        return np.asarray(fig.canvas.buffer_rgba())[:, :, :3].copy()
     finally:
         plt.close(fig)
 
@@ -177,7 +177,8 @@ def _thumbnail(pattern) -> tuple[np.ndarray, tuple[float, float, float, float]]:
     for kind, color, width in (("C", "black", 0.6), ("M", _MOUNTAIN, 0.3),
                                ("V", _VALLEY, 0.3)):  # fmt: skip
         segments = sheet.select(kind)[:, :, ::-1]  # (y, x): the strip lies down
-        ax.add_collection(LineCollection(segments, colors=color, linewidths=width))
+        ax.add_collection(LineCollection(segments, colors=color, linewidths=width,
+                                         antialiaseds=False))  # compresses well
     ax.set_xlim(ymin, ymax)
     ax.set_ylim(xmin, xmax)
     ax.set_axis_off()
@@ -186,7 +187,7 @@ def _thumbnail(pattern) -> tuple[np.ndarray, tuple[float, float, float, float]]:
     FigureCanvasAgg(fig)
     fig.set_dpi(80)  # 800 x 80 pixels: every step's page embeds it
     fig.canvas.draw()
-    image = np.asarray(fig.canvas.buffer_rgba()).copy()
+    image = np.asarray(fig.canvas.buffer_rgba())[:, :, :3].copy()  # RGB: smaller pages
     return image, (ymin, ymax, xmin, xmax)
 
 
@@ -212,7 +213,7 @@ def _text_page(pdf, title: str, paragraphs: Sequence[str], image=None) -> None:
     if image is not None:
         data, extent, spans = image
         ax = fig.add_axes((0.05, 0.05, 0.9, 0.18))
-        ax.imshow(data, extent=extent, aspect="auto", interpolation="bilinear")
+        ax.imshow(data, extent=extent, aspect="auto", interpolation="none")
         for y0, y1, label in spans:
             ax.axvspan(y0, y1, color="orange", alpha=0.35)
             ax.text(0.5 * (y0 + y1), extent[3], label, ha="center", va="bottom", fontsize=8)
@@ -248,8 +249,8 @@ def _draw_step(pdf, step: GuideStep, number: int, total: int, sheet: GuideSheet,
     fig.text(0.04, 0.875, hint, fontsize=10, va="top", style="italic")
     # where it is on the sheet
     image, extent = thumb
-    ax = fig.add_axes((0.04, 0.70, 0.92, 0.13))
-    ax.imshow(image, extent=extent, aspect="auto", interpolation="bilinear")
+    ax = fig.add_axes((0.04, 0.68, 0.92, 0.13))
+    ax.imshow(image, extent=extent, aspect="auto", interpolation="none")
     ax.axvspan(y0, max(y1, y0 + 1e-3 * (extent[1] - extent[0])), color="orange", alpha=0.45)
     if sheet.layout is not None:
         for piece in sheet.layout.pieces[1:]:
@@ -309,7 +310,7 @@ def _cover(pdf, title: str, picture: np.ndarray | None, bom: BillOfMaterials, st
              family="monospace")  # fmt: skip
     if picture is not None:
         ax = fig.add_axes((0.52, 0.06, 0.45, 0.78))
-        ax.imshow(picture, interpolation="bilinear")
+        ax.imshow(picture, interpolation="none")
         ax.set_axis_off()
     pdf.savefig(fig)
 
@@ -374,7 +375,7 @@ def _pieces_page(sheets: Sequence[GuideSheet], unit: float) -> list[tuple[str, l
         if layout is None or len(layout.pieces) < 2:
             continue
         start = layout.pieces[0].start
-        name = sheet.name or "the sheet"
+        name = sheet.name.capitalize() or "The sheet"
         for piece in layout.pieces[:-1]:
             paragraphs.append(
                 f"{name}: glue the {piece.tab * unit:g} mm tab of piece {piece.index} of "
