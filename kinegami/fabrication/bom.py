@@ -74,7 +74,7 @@ class BillOfMaterials:
                      f" ({self.bed_area / 1e6:.3f} m²)")  # fmt: skip
         joins = self.joins + self.sockets
         tape = (f"tape: about {self.tape:,.0f} mm (one turn of the {self.tube_perimeter:.0f} mm "
-                f"tube at each of {_counted(joins, 'join or socket', 'joins and sockets')})"
+                f"tube at each of {_counted(joins, *_JOINS[self.sockets > 0])})"
                 if joins else "tape: none needed (no joins of pieces, no sockets)")  # fmt: skip
         lines = [
             f"material: {area}",
@@ -87,6 +87,9 @@ class BillOfMaterials:
             lines.append(f"printed connectors: {self.connectors} "
                          f"({_counted(self.sockets, 'socket', 'sockets')})")  # fmt: skip
         return lines
+
+
+_JOINS = (("join", "joins"), ("join or socket", "joins and sockets"))
 
 
 def _counted(count: int, one: str, many: str) -> str:

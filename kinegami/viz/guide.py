@@ -443,20 +443,21 @@ def tree_guide_data(fabrication, *, bom: BillOfMaterials, layouts=None,
     picture = _picture(lambda: show_fabrication(fabrication, units=units))
     joins = []
     for sheet in fabrication.sheets:
+        name = sheet.name.capitalize()
         if sheet.junction is not None:
             junction = next(j for j in fabrication.junctions if j.index == sheet.junction)
-            joins.append(f"{sheet.name} (joints {sheet.joints[0]} to {sheet.leaf}) goes into "
+            joins.append(f"{name} (joints {sheet.joints[0]} to {sheet.leaf}) goes into "
                          f"junction {junction.index} at joint {junction.joint}: push its start "
                          f"into the socket of joint {sheet.joints[0]} and tape it.")  # fmt: skip
         elif sheet.takeoff is not None:
-            joins.append(f"{sheet.name} starts at take-off {sheet.takeoff}: glue its skirt "
+            joins.append(f"{name} starts at take-off {sheet.takeoff}: glue its skirt "
                          f"inside hole {sheet.takeoff} of sheet {sheet.takeoff_sheet}.")
         else:
-            joins.append(f"{sheet.name} (joints {sheet.joints[0]} to {sheet.leaf}) starts at "
+            joins.append(f"{name} (joints {sheet.joints[0]} to {sheet.leaf}) starts at "
                          "the root.")  # fmt: skip
     for junction in fabrication.junctions:
         trunk = next(s.name for s in fabrication.sheets if junction.trunk in s.joints)
-        joins.append(f"junction {junction.index} (printed connector) at joint {junction.joint}: "
+        joins.append(f"Junction {junction.index} (printed connector) at joint {junction.joint}: "
                      f"{trunk} runs through it (child {junction.trunk}); children "
                      f"{', '.join(str(c) for c in junction.children)}.")  # fmt: skip
     closing = _pieces_page(sheets, unit) + [("Sheets and junctions", [

@@ -130,9 +130,9 @@ def test_tree_guide_names_each_sheets_junction(tmp_path, capsys, reference):
     assert "    printed connectors: 1 (1 socket)" in out
     text = _check(tmp_path / "gripper_guide.pdf", tmp_path, reference["gripper"])
     flat = " ".join(text.split())
-    assert "sheet 1 (joints 7 to 9) goes into junction 0 at joint 3" in flat
-    assert "sheet 0 (joints 0 to 6) starts at the root" in flat
-    assert "junction 0 (printed connector) at joint 3: sheet 0 runs through it" in flat
+    assert "Sheet 1 (joints 7 to 9) goes into junction 0 at joint 3" in flat
+    assert "Sheet 0 (joints 0 to 6) starts at the root" in flat
+    assert "Junction 0 (printed connector) at joint 3: sheet 0 runs through it" in flat
 
 
 def test_all_includes_the_guide():
