@@ -42,11 +42,12 @@ def reference() -> dict:
                     "glue tab: 2,435 mm", "tape: about 600 mm"],
         },
         "gripper": {
-            "steps": 25, "closing": 1,
+            "steps": 25, "closing": 2,
             "joints": ["sheet 0, joint 0 (StartTip 'mount')", "sheet 0, joint 6 (EndTip",
                        "sheet 1, joint 7 (RevoluteJoint 'rightBase')", "sheet 1, joint 9 (EndTip"],
             "links": [1, 2, 3, 4, 5, 6, 7, 8, 9],
-            "bom": ["pieces: 2 (2 sheets, 0 joins)", "printed connectors: 1 (1 socket)"],
+            "bom": ["pieces: 3 (2 sheets, 1 join)", "cut from 2 bed sheets",
+                    "printed connectors: 1 (1 socket)"],
         },
     }  # fmt: skip
 
@@ -125,7 +126,9 @@ def test_puma_guide_on_a_600_by_400_laser(tmp_path, capsys, reference):
 
 
 def test_tree_guide_names_each_sheets_junction(tmp_path, capsys, reference):
-    assert main_in_process("build", GRIPPER, "-o", tmp_path, "--formats", "guide") == 0
+    """The gripper on a 300 x 200 mm bed: sheet 0 in two pieces, sheet 1 whole."""
+    assert main_in_process("build", GRIPPER, "-o", tmp_path, "--bed", "300x200", "--formats",
+                           "guide") == 0  # fmt: skip
     out = capsys.readouterr().out
     assert "    printed connectors: 1 (1 socket)" in out
     text = _check(tmp_path / "gripper_guide.pdf", tmp_path, reference["gripper"])
@@ -133,6 +136,8 @@ def test_tree_guide_names_each_sheets_junction(tmp_path, capsys, reference):
     assert "Sheet 1 (joints 7 to 9) goes into junction 0 at joint 3" in flat
     assert "Sheet 0 (joints 0 to 6) starts at the root" in flat
     assert "Junction 0 (printed connector) at joint 3: sheet 0 runs through it" in flat
+    assert "Sheet 0: glue the 10 mm tab of piece 1 of 2 (bed sheet 1) inside piece 2" in flat
+    assert re.search(r"sheet 0, joint 6 \(EndTip 'leftTip'\)\s+\S.* on piece 2 of 2", text)
 
 
 def test_all_includes_the_guide():
