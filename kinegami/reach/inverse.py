@@ -687,15 +687,24 @@ def _escape(design, compiled: Kinematics, q: np.ndarray, columns: np.ndarray, de
     # pair closer than the margin (and a hundredth of r more: the configurations are a
     # nudge from one that is not clear) is measured; a report's words are not needed here
     reach = (float(getattr(design, "margin", 0.0)) if margin is None else margin) + 0.01 * r
+    judged = True  # whether ``verdict`` is q's (the worded report is made only when needed)
     for _ in range(ESCAPE_STEPS):
-        base = float(verdict[0])  # _judge's clearance of this q (measured once)
-        nudged = np.repeat(q[None, :], columns.size, axis=0)
+        # q itself, then q nudged along each joint: one batch of the engine
+        nudged = np.repeat(q[None, :], columns.size + 1, axis=0)
         for m, c in enumerate(columns.tolist()):
-            nudged[m, c] = min(q[c] + h * (1.0 if revolute[m] else r), high_p[m])
-            if nudged[m, c] == q[c]:
-                nudged[m, c] = q[c] - h * (1.0 if revolute[m] else r)
+            nudged[m + 1, c] = min(q[c] + h * (1.0 if revolute[m] else r), high_p[m])
+            if nudged[m + 1, c] == q[c]:
+                nudged[m + 1, c] = q[c] - h * (1.0 if revolute[m] else r)
         closest = engine.worst_arrays(nudged, reach)[0]
-        steps_taken = nudged[np.arange(columns.size), columns] - q[columns]
+        base = float(closest[0])
+        if not judged and base > reach - 0.015 * r:  # maybe clear: the report says
+            verdict, judged = _judge(design, q, clear, margin), True
+            if verdict[2]:
+                break
+        if not np.isfinite(base):
+            base = float(verdict[0])
+        closest = closest[1:]
+        steps_taken = nudged[1 + np.arange(columns.size), columns] - q[columns]
         gradient = np.where(np.isfinite(closest), (closest - base) / steps_taken, 0.0)
         J = compiled.jacob0(q)[:, columns]
         J = np.vstack([J[:3] / r, J[3:]])[: rows if kind != 1 else 6]
@@ -713,10 +722,9 @@ def _escape(design, compiled: Kinematics, q: np.ndarray, columns: np.ndarray, de
         if not exact:
             break
         trial[columns] = near
-        q = trial
+        q, judged = trial, False
+    if not judged:
         verdict = _judge(design, q, clear, margin)
-        if verdict[2]:
-            break
     return q, verdict, iterations
 
 
