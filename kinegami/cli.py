@@ -222,8 +222,8 @@ def output_formats() -> dict[str, OutputFormat]:
     known = known_formats()
     png = OutputFormat("png", "pictures of the 3D chain and of the pattern",
                        ("_3d.png", "_pattern.png"), _write_pngs)  # fmt: skip
-    guide = OutputFormat("guide", "folding guide PDF: a cover with the robot and the bill of "
-                         "materials, one step per module in folding order",
+    guide = OutputFormat("guide", "folding guide PDF (<stem>_guide.pdf): a cover with the robot "
+                         "and the bill of materials, one step per module in folding order",
                          ("_guide.pdf",), _write_guide)  # fmt: skip
     order = [".dxf", ".svg", "png"] + [s for s in known if s not in (".dxf", ".svg")] + ["guide"]
     formats = {}

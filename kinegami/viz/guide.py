@@ -412,6 +412,16 @@ def chain_guide_data(chain, *, bom: BillOfMaterials, pattern=None, layout=None,
         The design's length unit (``'mm'``, ``'cm'``, ...); None: units of r (and 1 mm each).
     names : sequence of str or None, optional
         The joints' names (the design file's).
+
+    Examples
+    --------
+    >>> from kinegami.design import load_design_with_info
+    >>> from kinegami.fabrication.bom import bill_of_materials
+    >>> chain, info = load_design_with_info("examples/designs/example1.json")  # doctest: +SKIP
+    >>> pattern = chain.creasePattern()  # doctest: +SKIP
+    >>> bom = bill_of_materials([pattern], 10.0)  # cm: 10 mm per unit  # doctest: +SKIP
+    >>> data = chain_guide_data(chain, bom=bom, pattern=pattern, title=info.name,
+    ...                         units=info.units)  # doctest: +SKIP
     """
     from kinegami.validation import UNITS_IN_MM
 
