@@ -200,26 +200,24 @@ def _module_extents(pattern) -> list[tuple[float, float]]:
     return [(float(ys[v].min()), float(ys[v].max())) if len(v) else (0.0, 0.0) for v in placed]
 
 
-def _text_page(pdf, title: str, paragraphs: Sequence[str], image=None) -> None:
-    """A page of text (wrapped), with an optional image (array, extent) under it."""
+#: Lines of text on a text page (10 pt, 1.5 spacing, under the title).
+_TEXT_LINES = 32
+
+
+def _text_page(pdf, title: str, paragraphs: Sequence[str]) -> None:
+    """Pages of text (wrapped), as many as it needs: the title, then "(continued)"."""
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=_PAGE)
-    fig.text(0.05, 0.94, title, fontsize=18, weight="bold", va="top")
     lines: list[str] = []
     for paragraph in paragraphs:
         lines += textwrap.wrap(paragraph, 120, subsequent_indent="    ") or [""]
-    fig.text(0.05, 0.87, "\n".join(lines[:40]), fontsize=10, va="top", linespacing=1.5)
-    if image is not None:
-        data, extent, spans = image
-        ax = fig.add_axes((0.05, 0.05, 0.9, 0.18))
-        ax.imshow(data, extent=extent, aspect="auto", interpolation="none")
-        for y0, y1, label in spans:
-            ax.axvspan(y0, y1, color="orange", alpha=0.35)
-            ax.text(0.5 * (y0 + y1), extent[3], label, ha="center", va="bottom", fontsize=8)
-        ax.set_yticks([])
-        ax.set_xlabel("along the sheet")
-    pdf.savefig(fig)
+    for first in range(0, max(len(lines), 1), _TEXT_LINES):
+        fig = Figure(figsize=_PAGE)
+        heading = title if first == 0 else f"{title} (continued)"
+        fig.text(0.05, 0.94, heading, fontsize=18, weight="bold", va="top")
+        fig.text(0.05, 0.87, "\n".join(lines[first:first + _TEXT_LINES]), fontsize=10,
+                 va="top", linespacing=1.5)  # fmt: skip
+        pdf.savefig(fig)
 
 
 def _draw_step(pdf, step: GuideStep, number: int, total: int, sheet: GuideSheet, thumb,
