@@ -60,6 +60,7 @@ FOLDING_HINTS = {
     "mountains and valleys alternating; it slides along the tube.",
     "rebo": "REBO bellows: collapse the layers one by one like an accordion, mountains and "
     "valleys alternating.",
+    "waypoint": "Waypoint: nothing to fold; the tube starts here.",
     "takeoff_skirt": "Take-off skirt: fold the glue tabs inward and glue them inside the hole "
     "of the trunk's sheet.",
 }
