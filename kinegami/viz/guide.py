@@ -320,7 +320,11 @@ def _picture(draw) -> np.ndarray | None:
         fig, _ = draw()
     except KinegamiError:
         return None
-    return _raster(fig, 100)
+    image = _raster(fig, 100)
+    rows, cols = np.nonzero((image < 245).any(axis=2))  # crop the white around the drawing
+    if rows.size:
+        image = image[max(rows.min() - 5, 0):rows.max() + 6, max(cols.min() - 5, 0):cols.max() + 6]
+    return image
 
 
 def _folded(pattern):
