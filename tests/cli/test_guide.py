@@ -122,7 +122,9 @@ def test_puma_guide_on_a_600_by_400_laser(tmp_path, capsys, reference):
     assert "Join the pieces" in text
     for k in range(1, 5):
         assert f"tab of piece {k} of 5" in text
-    assert re.search(r"on piece 5 of 5 \(bed sheet \d\)", text)
+    pieces = [int(k) for k in re.findall(r"on piece (\d) of 5 \(bed sheet \d\)", text)]
+    assert len(pieces) == 37 and pieces == sorted(pieces)  # every step on its piece, in order
+    assert set(pieces) == {1, 2, 3, 4, 5}
 
 
 def test_tree_guide_names_each_sheets_junction(tmp_path, capsys, reference):
