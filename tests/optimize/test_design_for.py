@@ -315,7 +315,8 @@ def test_a_base_region_lets_the_search_place_the_base():
     box = {"min": [60.0, -5.0, 0.0], "max": [80.0, 5.0, 1.0]}
     with pytest.raises(InfeasibleTaskError, match="from the base at"):
         design_for(points, "RRR", r=1, numSides=4, max_tube_length=60)
-    arm = design_for(points, "RRR", r=1, numSides=4, max_tube_length=60, base_region=box)
+    arm = design_for(points, "RRR", r=1, numSides=4, max_tube_length=60, base_region=box,
+                     seed=2, starts=16)  # (seed 0 needs more starts: ~3x the time)
     check_reaches(arm, points)
     P = arm.Joints[0].pose_matrix  # the axis (z) meets the region's box
     assert abs(P[2, 2]) > 0.5
