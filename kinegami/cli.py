@@ -1028,11 +1028,10 @@ INFEASIBLE = 3
 
 
 def cmd_design(args: argparse.Namespace) -> int:
-    import json
 
     from kinegami.design.reader import DesignInfo
     from kinegami.design.task import read_task
-    from kinegami.design.writer import design_to_dict, dumps_design
+    from kinegami.design.writer import design_to_dict
     from kinegami.errors import InfeasibleTaskError
     from kinegami.optimize import design_for
 
@@ -1063,27 +1062,38 @@ def cmd_design(args: argparse.Namespace) -> int:
     report = _task_report(chain, task, answers, paths)
     document = design_to_dict(chain, name=task.name, description=task.description,
                               units=task.units, task=task.document)  # fmt: skip
-    extra = [
-        (f"{stem}.json", lambda path: path.write_text(dumps_design(document), "utf-8")),
-        (f"{stem}_task.txt", lambda path: path.write_text("\n".join(report[0]) + "\n", "utf-8")),
-        (f"{stem}_task.json", lambda path: path.write_text(json.dumps(report[1], indent=2) + "\n",
-                                                            "utf-8")),
-        (f"{stem}_task.png", lambda path: _task_picture(chain, answers, task, path)),
-    ]  # fmt: skip
+    extra = _task_files(stem, document, report,
+                        lambda path: _task_picture(chain, answers, task, path))  # fmt: skip
     formats = _parse_formats(",".join(DEFAULT_FORMATS) if args.formats is None else args.formats)
     lines = _write_chain_build(args.command, args.task, job, stem, out, formats, extra)
     print("\n".join([*report[0], *lines]))
     return 0
 
 
+def _task_files(stem: str, document: dict, report: tuple, picture) -> list:
+    """What ``kinegami design`` writes beside a build: ``(name, write(path))`` for the design
+    file (with its task), the report as text and JSON, and the picture (``picture(path)``)."""
+    import json
+
+    from kinegami.design.writer import dumps_design
+
+    text = "\n".join(report[0]) + "\n"
+    data = json.dumps(report[1], indent=2) + "\n"
+    return [
+        (f"{stem}.json", lambda path: path.write_text(dumps_design(document), "utf-8")),
+        (f"{stem}_task.txt", lambda path: path.write_text(text, "utf-8")),
+        (f"{stem}_task.json", lambda path: path.write_text(data, "utf-8")),
+        (f"{stem}_task.png", picture),
+    ]
+
+
 def _write_tree_design(args: argparse.Namespace, task, tree, answers, stem: str, out: Path
                        ) -> int:  # fmt: skip
     """``kinegami design`` of a tree task: the tree's design file (with its task), its build
     (as ``kinegami build`` writes a tree) and the report, published as one transaction."""
-    import json
 
     from kinegami.design.reader import DesignInfo
-    from kinegami.design.writer import design_to_dict, dumps_design
+    from kinegami.design.writer import design_to_dict
 
     info = DesignInfo(name=task.name, description=task.description, units=task.units,
                       twistPortion=0.2, file=None, structure="tree",
@@ -1092,13 +1102,8 @@ def _write_tree_design(args: argparse.Namespace, task, tree, answers, stem: str,
     report = _tree_task_report(tree, task, answers, tips)
     document = design_to_dict(tree, name=task.name, description=task.description,
                               units=task.units, task=task.document)  # fmt: skip
-    extra = [
-        (f"{stem}.json", lambda path: path.write_text(dumps_design(document), "utf-8")),
-        (f"{stem}_task.txt", lambda path: path.write_text("\n".join(report[0]) + "\n", "utf-8")),
-        (f"{stem}_task.json", lambda path: path.write_text(json.dumps(report[1], indent=2) + "\n",
-                                                            "utf-8")),
-        (f"{stem}_task.png", lambda path: _task_picture(tree, answers, task, path)),
-    ]  # fmt: skip
+    extra = _task_files(stem, document, report,
+                        lambda path: _task_picture(tree, answers, task, path))  # fmt: skip
     lines = _write_tree_build(args.command, args.task, tree, info, stem, out, args.formats,
                               None, extra)  # fmt: skip
     print("\n".join([*report[0], *lines]))

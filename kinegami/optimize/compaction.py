@@ -816,6 +816,26 @@ def end_tips_at(frame: np.ndarray, numSides: int, r: float, length: float,
     return out
 
 
+def reach_clear(design, target, q0, seeds: int, margin: float, boxes=()) -> tuple:
+    """``(answer, "")``: the first :func:`kinegami.reach.solve` answer of seeds 0 to
+    ``seeds - 1`` (from ``q0``) that is exact, in range, clear with ``margin`` and outside the
+    keep-out ``boxes``; or ``(None, why)`` with the last reason."""
+    from kinegami.clearance.keep_out import keep_out_violation
+    from kinegami.reach import solve
+
+    why = ""
+    for seed in range(seeds):
+        answer = solve(design, target, q0=q0, seed=seed, margin=margin)
+        if not answer.ok:
+            why = answer.reason
+            continue
+        hit = keep_out_violation(design, answer.states, boxes, margin)
+        if hit is None:
+            return answer, ""
+        why = f"it enters keep-out box {hit[0]}"
+    return None, why
+
+
 def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(),
                      margin: float | None = None, seed: int = 0, executor=None, starts: int = 4,
                      time_limit: float | None = None, progress=None) -> tuple:  # fmt: skip
@@ -838,8 +858,8 @@ def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(
     CompactionError
         When the input itself does not reach a target so.
     """
-    from kinegami.clearance.keep_out import Box, keep_out_violation
-    from kinegami.reach import Target, solve
+    from kinegami.clearance.keep_out import Box
+    from kinegami.reach import Target
 
     if not isinstance(chain, KinematicChain):
         raise InvalidParameterError(
@@ -855,17 +875,11 @@ def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(
     def reached(design, start) -> tuple[list | None, str]:
         found = []
         for k, goal in enumerate(goals):
-            for attempt in range(4):
-                answer = solve(design, goal, q0=None if start is None else start[k],
-                               seed=attempt, margin=margin)  # fmt: skip
-                hit = None if not answer.ok else keep_out_violation(design, answer.states,
-                                                                     boxes, margin)  # fmt: skip
-                if answer.ok and hit is None:
-                    found.append(answer)
-                    break
-            else:
-                why = answer.reason if not answer.ok else f"it enters keep-out box {hit[0]}"
+            answer, why = reach_clear(design, goal, None if start is None else start[k], 4,
+                                      margin, boxes)  # fmt: skip
+            if answer is None:
                 return None, f"target {k}: {why}"
+            found.append(answer)
         return found, ""
 
     if answers is None:

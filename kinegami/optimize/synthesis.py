@@ -598,24 +598,14 @@ def _answers(chain, states: np.ndarray, task: _Task) -> tuple[list | None, str]:
     """One reach answer per target on the built chain, each exact, in range, clear with the
     margin and outside every box (solved again from the fit's states, then from other seeds),
     or (None, why)."""
-    from kinegami.reach import solve
+    from kinegami.optimize.compaction import reach_clear
 
     answers = []
     for k, target in enumerate(task.targets):
-        why = ""
-        for seed in range(4):
-            answer = solve(chain, target, q0=states[k], seed=seed, margin=task.margin)
-            if not answer.ok:
-                why = f"target {k}: {answer.reason}"
-                continue
-            hit = keep_out_violation(chain, answer.states, task.boxes, task.margin)
-            if hit is not None:
-                why = f"target {k}: the robot enters keep-out box {hit[0]}"
-                continue
-            answers.append(answer)
-            break
-        else:
-            return None, why
+        answer, why = reach_clear(chain, target, states[k], 4, task.margin, task.boxes)
+        if answer is None:
+            return None, f"target {k}: {why}"
+        answers.append(answer)
     return answers, ""
 
 
@@ -1081,8 +1071,7 @@ def _check_tree(models: list, xs: list, root: np.ndarray) -> tuple:
     from kinegami.chain.joints import StartTip
     from kinegami.errors import ClearanceWarning, NoPathError, PlacementWarning
     from kinegami.fabrication.sheets import fit_junctions
-    from kinegami.optimize.compaction import tube_length
-    from kinegami.reach import solve
+    from kinegami.optimize.compaction import reach_clear, tube_length
     from kinegami.tree.model import KinematicTree
 
     task = models[0].task
@@ -1141,20 +1130,10 @@ def _check_tree(models: list, xs: list, root: np.ndarray) -> tuple:
     answers = []
     for k in range(models[0].T):
         mapping = {tip: model.task.targets[k] for model, tip in zip(models, tips, strict=True)}
-        why = ""
-        for seed in range(2):
-            answer = solve(tree, mapping, q0=Q[k], seed=seed, margin=margin)
-            if not answer.ok:
-                why = f"target {k}: {answer.reason}"
-                continue
-            hit = keep_out_violation(tree, answer.states, task.boxes, margin)
-            if hit is not None:
-                why = f"target {k}: the robot enters keep-out box {hit[0]}"
-                continue
-            answers.append(answer)
-            break
-        else:
-            return None, why
+        answer, why = reach_clear(tree, mapping, Q[k], 2, margin, task.boxes)
+        if answer is None:
+            return None, f"target {k}: {why}"
+        answers.append(answer)
     return (tree, answers, Q), ""
 
 
