@@ -95,7 +95,7 @@ class Kinematics:
         """The tip's pose at ``q``: (4, 4) for one configuration (n,), (m, 4, 4) for a batch
         (m, n); with several tips, (..., L, 4, 4), the tips in joint-index order."""
         Q, single = self.configurations(q)
-        T = self.tip_poses(Q)
+        T = self.tip_poses(Q) if Q.shape[0] < COMPILED_BATCH else self._tip_poses_compiled(Q)
         if T.shape[1] == 1:
             T = T[:, 0]
         return T[0] if single else T
@@ -103,6 +103,24 @@ class Kinematics:
     def tip_poses(self, Q: np.ndarray) -> np.ndarray:
         """(m, L, 4, 4): every tip's pose at the configurations ``Q`` (m, n), unchecked."""
         return self.screws.frame_poses(Q, self.screws.body_of[list(self.tips)], self.tip_frames)
+
+    def _tip_poses_compiled(self, Q: np.ndarray) -> np.ndarray:
+        """:meth:`tip_poses` by the compiled, threaded kernel
+        (:func:`kinegami.reach.kernels.frame_poses`; equal to rounding), or by numpy where
+        numba cannot run."""
+        kernel = _frame_kernel()
+        if kernel is None:
+            return self.tip_poses(Q)
+        screws = self.screws
+        steps, inverse = screws.elementary()
+        bodies = screws.body_of[list(self.tips)]
+        E = np.array([inverse[b] @ frame for b, frame in zip(bodies.tolist(), self.tip_frames,
+                                                             strict=True)])  # fmt: skip
+        delta = np.ascontiguousarray(Q[:, screws.moving] - screws.q_ref[screws.moving])
+        out = np.empty((Q.shape[0], bodies.size, 4, 4))
+        kernel(np.array(steps, dtype=float).reshape(-1, 4, 4), screws.body_parent,
+               np.asarray(screws.revolute, dtype=np.bool_), delta, E, bodies, out)  # fmt: skip
+        return out
 
     def jacob0(self, q) -> np.ndarray:
         """The geometric Jacobian of the tip at ``q`` in the world frame, rows (v, ω), one
@@ -166,6 +184,25 @@ class Kinematics:
                 b = parent[b]
             masks.append(mask)
         return masks
+
+
+#: Configurations from which :meth:`Kinematics.fkine` runs the compiled, threaded kernel (a
+#: smaller batch stays on numpy: loading numba costs about 0.4 s once).
+COMPILED_BATCH = 2048
+
+_FRAME_KERNEL: list = []
+
+
+def _frame_kernel():
+    """:func:`kinegami.reach.kernels.frame_poses`, loaded on first use; None where numba
+    cannot be imported or cannot keep its machine code."""
+    if not _FRAME_KERNEL:
+        try:
+            from kinegami.reach.kernels import frame_poses
+        except (ImportError, OSError, RuntimeError):
+            frame_poses = None
+        _FRAME_KERNEL.append(frame_poses)
+    return _FRAME_KERNEL[0]
 
 
 #: Compiled designs, until their joint list changes (a state change replaces joints).

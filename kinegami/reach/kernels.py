@@ -17,9 +17,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
-__all__ = ["descend"]
+__all__ = ["descend", "frame_poses"]
 
 #: Target kinds.
 POSITION, AXIS, POSE = 0, 1, 2
@@ -213,3 +213,47 @@ def descend(steps, path, revolute, reference, E, low, high, kind, target_p, targ
     if pos <= tol_p * r and ang <= tol_a:
         return True, patience, pos, ang, q.copy(), pos, ang
     return False, patience, pos, ang, best, best_pos, best_ang
+
+
+@njit(cache=True, parallel=True)
+def frame_poses(steps, parent, revolute, delta, E, bodies, out):
+    """Batched :meth:`kinegami.geometry.screws.JointScrews.frame_poses` (without axes): for
+    each configuration k (rows of ``delta`` (K, M), the moving joints' states minus the
+    reference ones) and frame l, ``out[k, l]`` (4, 4) = S_bodies[l] E[l], with S_b = S_parent(b)
+    steps[b - 1] then body b's turn about (or slide along) its z. The same products as the
+    numpy path, in plain loops over configurations split across threads (equal to rounding,
+    1e-15 relative)."""
+    K, M = delta.shape
+    L = bodies.size
+    for k in prange(K):
+        S = np.empty((M + 1, 3, 4))
+        for i in range(3):
+            for j in range(4):
+                S[0, i, j] = 1.0 if i == j else 0.0
+        for b in range(1, M + 1):
+            step = steps[b - 1]
+            P = S[parent[b]]
+            A = S[b]
+            for i in range(3):
+                for j in range(4):
+                    A[i, j] = P[i, 0] * step[0, j] + P[i, 1] * step[1, j] \
+                        + P[i, 2] * step[2, j] + P[i, 3] * step[3, j]
+            d = delta[k, b - 1]
+            if revolute[b - 1]:
+                c, s = math.cos(d), math.sin(d)
+                for i in range(3):
+                    x, y = A[i, 0], A[i, 1]
+                    A[i, 0] = c * x + s * y
+                    A[i, 1] = c * y - s * x
+            else:
+                for i in range(3):
+                    A[i, 3] += d * A[i, 2]
+        for l in range(L):  # noqa: E741 - frame l
+            B = S[bodies[l]]
+            F = E[l]
+            T = out[k, l]
+            for i in range(3):
+                for j in range(4):
+                    T[i, j] = B[i, 0] * F[0, j] + B[i, 1] * F[1, j] + B[i, 2] * F[2, j] \
+                        + B[i, 3] * F[3, j]
+            T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0

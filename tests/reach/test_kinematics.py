@@ -185,3 +185,34 @@ def test_frame_poses_are_the_body_motions_to_rounding(path, seed, m):
     found = screws.frame_poses(Q, bodies, compiled.tip_frames)
     scale = max(1.0, float(np.abs(expected[..., :3, 3]).max()))
     assert np.abs(found - expected).max() <= 1e-13 * scale
+
+
+@pytest.mark.parametrize("path", GALLERY, ids=lambda p: p.stem)
+def test_large_batches_run_compiled_and_agree_with_numpy(path, monkeypatch):
+    """fkine of a batch of COMPILED_BATCH or more configurations runs the threaded kernel
+    (kinegami.reach.kernels.frame_poses): the same poses as the numpy path to rounding, every
+    tip of a tree included; and where numba cannot run, numpy answers the same call."""
+    from kinegami.reach import forward
+
+    compiled = kinematics(design(path))
+    Q = random_states(compiled, np.random.default_rng(7), forward.COMPILED_BATCH)
+    expected = compiled.tip_poses(Q)
+    expected = expected[:, 0] if expected.shape[1] == 1 else expected
+    calls = []
+    kernel = forward._frame_kernel()
+    assert kernel is not None  # numba is a core dependency
+
+    def counted(*args):
+        calls.append(1)
+        return kernel(*args)
+
+    monkeypatch.setattr(forward, "_FRAME_KERNEL", [counted])
+    found = compiled.fkine(Q)
+    assert calls == [1]
+    scale = max(1.0, float(np.abs(expected[..., :3, 3]).max()))
+    assert found.shape == expected.shape
+    assert np.abs(found - expected).max() <= 1e-13 * scale
+    assert np.all(found[..., 3, :] == [0.0, 0.0, 0.0, 1.0])
+    monkeypatch.setattr(forward, "_FRAME_KERNEL", [None])
+    assert np.array_equal(compiled.fkine(Q), expected)
+    assert np.array_equal(compiled.fkine(Q[:5]), expected[:5])  # small batches: numpy
