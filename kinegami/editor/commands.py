@@ -1038,9 +1038,12 @@ class DesignForTask(LongCommand):
     """Replace the chain by one designed for the document's task
     (:func:`kinegami.optimize.design_for`, docs/design-for-a-task.md): its tip reaches every
     target exactly, in range, clear of itself and outside the keep-out boxes, as
-    ``kinegami design`` makes it. The task stays in the document; the design's length units
-    become the task's (the designed chain is in them), its name and description stay (a
-    design without a name takes the task's). ``seed`` and ``starts`` default to the task's.
+    ``kinegami design`` makes it. A tree task (joints given per leaf) designs a
+    :class:`~kinegami.tree.KinematicTree` whose leaves reach their k-th targets at once; the
+    task decides the kind, whatever the design was. The task stays in the document; the
+    design's length units become the task's (the designed chain is in them), its name and
+    description stay (a design without a name takes the task's). ``seed`` and ``starts``
+    default to the task's.
     Refused (the design unchanged) when the search finds no design, with its reason
     (:class:`~kinegami.errors.InfeasibleTaskError`). ``task`` is filled in by
     :meth:`prepared` from the document.
@@ -1059,9 +1062,6 @@ class DesignForTask(LongCommand):
         return replace(self, task=document.task)
 
     def check(self, document: Document) -> None:
-        if document.is_tree or _is_tree_task(self.task):
-            _fail("design for task: tasks are for chains for now, and this design or its task "
-                  "is a tree's")
         if self.task is None:
             _fail("design for task: this design has no task (a design file made by kinegami "
                   "design carries one in its \"task\" block; docs/design-for-a-task.md)")
@@ -1076,10 +1076,13 @@ class DesignForTask(LongCommand):
             options["seed"] = self.seed
         if self.starts is not None:
             options["starts"] = self.starts
+        targets, joints = list(task.targets), task.joints
+        if task.is_tree:  # one list of targets and one joint string per leaf
+            targets, joints = [list(leaf) for leaf in task.targets], list(task.joints)
         # a search, run as kinegami design runs it (numpy's default floating-point handling)
         with np.errstate(over="warn", invalid="warn", divide="warn", under="ignore"):
-            return design_for(list(task.targets), task.joints, executor=self.executor,
-                              progress=progress, **options)  # fmt: skip
+            return design_for(targets, joints, executor=self.executor, progress=progress,
+                              **options)  # fmt: skip
 
     def finish(self, document: Document, computed) -> Outcome:
         new, warned = computed

@@ -678,8 +678,9 @@ class EditorModel:
         return self.apply(command)
 
     def design_for_task(self, **options) -> CommandResult:
-        """Replace the chain by one designed for the document's task (options of
-        :class:`~kinegami.editor.commands.DesignForTask`); one undoable step, the task kept."""
+        """Replace the chain (or tree) by one designed for the document's task (a tree for a
+        tree task; options of :class:`~kinegami.editor.commands.DesignForTask`); one undoable
+        step, the task kept."""
         try:
             command = cmd.DesignForTask(**options)
         except TypeError as error:

@@ -892,9 +892,9 @@ class EditorView:
         with self._task_folder:
             self._task_html = gui.add_html("")
             self._design_button = gui.add_button(
-                "Design for task", hint="search a design whose tip reaches every target "
-                "exactly, clear of itself, as kinegami design does (runs in the background: "
-                "Cancel stops it, Undo takes it back)",
+                "Design for task", hint="search a design whose tip (a tree: every leaf's tip, "
+                "grasp by grasp) reaches every target exactly, clear of itself, as kinegami "
+                "design does (runs in the background: Cancel stops it, Undo takes it back)",
             )  # fmt: skip
             self._design_button.on_click(lambda _: self.design_for_task())
         with gui.add_folder("View"):
@@ -1086,14 +1086,15 @@ class EditorView:
     def check_task(self) -> bool:
         """Check every target of the shown design's task (the view calls it after a pause;
         see :meth:`flush`): reached exactly, in range, clear and outside the keep-out boxes,
-        or why not (:func:`~kinegami.editor.tasks.check_targets`), drawn green or red in the
-        scene and listed in the Task panel. Returns whether a new result was shown (nothing
-        is shown when another document has replaced the one checked meanwhile)."""
+        or why not (:func:`~kinegami.editor.tasks.check_targets`; a tree task grasp by grasp,
+        every leaf at once), drawn green or red in the scene and listed in the Task panel.
+        Returns whether a new result was shown (nothing is shown when another document has
+        replaced the one checked meanwhile)."""
         with self.lock:
             if self._closed:
                 return False
             model, document = self.model, self.model.document
-            if document.task is None or document.is_tree:
+            if document.task is None:
                 return False
         checks = self._checks_of(document)
         with self.lock:
@@ -1108,12 +1109,12 @@ class EditorView:
         """The Task panel and the targets in the scene, for the shown design and the latest
         checks (of it, or of the design before it until the new ones come)."""
         document = self.model.document
-        if self._task_folder.visible != (document.task is not None):
-            self._task_folder.visible = document.task is not None
-        chain_task = document.task is not None and not document.is_tree
-        if self._design_button.visible != chain_task:
-            self._design_button.visible = chain_task
-        checks = self.task_checks if chain_task else None
+        has_task = document.task is not None
+        if self._task_folder.visible != has_task:
+            self._task_folder.visible = has_task
+        if self._design_button.visible != has_task:
+            self._design_button.visible = has_task
+        checks = self.task_checks if has_task else None
         if checks is not None and self.task_checked is not None and \
                 self.task_checked.task is not document.task:  # fmt: skip
             checks = None  # of another task
@@ -1170,8 +1171,9 @@ class EditorView:
                 f"{name}_label", label, position=position))  # fmt: skip
 
     def task_html(self, document: Document, checks) -> str:
-        """The Task panel: the task's name and joints, then one line per target, its colour
-        and whether the design reaches it (or why not)."""
+        """The Task panel: the task's name and joints, then one line per target (a tree
+        task's leaf by leaf, each leaf's tip joint named), its colour and whether the design
+        reaches it (or why not)."""
         from html import escape
 
         task = document.task
@@ -1180,7 +1182,8 @@ class EditorView:
         title = escape(str(task.get("name") or "task"))
         count = len(task.get("targets", ()))
         joints = task.get("joints")
-        if isinstance(joints, list):  # a tree task: one joint string and target list per leaf
+        tree_task = isinstance(joints, list)  # one joint string and target list per leaf
+        if tree_task:
             grasps = len(task["targets"][0]) if task.get("targets") else 0
             head = (f"<b>{title}</b>: {len(joints)} leaves, {grasps} "
                     f"grasp{'s' if grasps != 1 else ''}, joints "
@@ -1188,29 +1191,29 @@ class EditorView:
         else:
             head = (f"<b>{title}</b>: {count} target{'s' if count != 1 else ''}, joints "
                     f"{escape(str(joints))}")  # fmt: skip
-        if document.is_tree:
-            return _task_box(f"{head}.<br><b>Tasks are for chains for now</b>: this design is a "
-                             "tree, so its targets are not checked and it cannot be designed "
-                             "for its task here (the task is kept when the design is "
-                             "saved).")  # fmt: skip
         goals = self._goals(document)
         if isinstance(goals, Exception):
             return _task_box(f"{head}.<br><b>The task cannot be read:</b> {escape(str(goals))}")
         if isinstance(checks, Exception):
             return _task_box(f"{head}.<br><b>The targets could not be checked:</b> "
                              f"{escape(str(checks))}")  # fmt: skip
+        targets = labelled_targets(goals)
         units = document.units
         if checks is None:
             summary = "checking the targets..."
         else:
             reached = sum(1 for c in checks if c.reached)
             summary = f"{reached} of {len(checks)} reached"
+            if tree_task:
+                whole = sum(1 for k in range(grasps)
+                            if all(c.reached for c in checks if c.index == k))  # fmt: skip
+                summary += f" ({whole} of {grasps} grasp{'s' if grasps != 1 else ''})"
+                tips = sorted({(c.leaf, c.tip) for c in checks})
+                head += "; leaf tips: joints " + ", ".join(str(tip) for _, tip in tips)
             if self.task_checked is not document:
                 summary += " (checking the design as changed...)"
         rows = []
-        for k in range(count):
-            spec = task["targets"][k]
-            label = escape(f"target {k}" + (f" '{spec['name']}'" if spec.get("name") else ""))
+        for k, (label, _) in enumerate(targets):
             if checks is None:
                 state, text, colour = "unchecked", "not checked yet", UNCHECKED_COLOR
             elif checks[k].reached:
@@ -1221,10 +1224,13 @@ class EditorView:
                 state, colour = "missed", MISSED_COLOR
                 reason = checks[k].reason.removeprefix("not reached").removeprefix(": ")
                 text = f"<b>not reached</b>: {escape(reason)}"
+            where = ""
+            if tree_task and checks is not None:
+                where = f' data-leaf="{checks[k].leaf}" data-grasp="{checks[k].index}"'
             dot = "#{:02x}{:02x}{:02x}".format(*colour)
-            rows.append(f'<li data-target="{k}" data-state="{state}" style="margin:0.2em 0">'
-                        f'<span style="color:{dot}">&#9679;</span> {label}: {text}'
-                        '</li>')  # fmt: skip
+            rows.append(f'<li data-target="{k}"{where} data-state="{state}" '
+                        f'style="margin:0.2em 0"><span style="color:{dot}">&#9679;</span> '
+                        f"{escape(label)}: {text}</li>")  # fmt: skip
         return _task_box(f"{head}; {summary}.<ul style=\"list-style:none;padding-left:0;"
                          f"margin:0.3em 0\">{''.join(rows)}</ul>")  # fmt: skip
 
@@ -1757,8 +1763,8 @@ class EditorView:
     def design_for_task(self, **options) -> Job | None:
         """Design for the document's task in the background (the Design for task button;
         ``options`` of :class:`~kinegami.editor.commands.DesignForTask`): the designed chain
-        replaces the design as one command, the task kept; a search that finds none shows its
-        reason and changes nothing."""
+        (a tree for a tree task) replaces the design as one command, the task kept; a search
+        that finds none shows its reason and changes nothing."""
         try:
             command = DesignForTask(**options)
         except TypeError as error:

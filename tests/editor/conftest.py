@@ -1,6 +1,7 @@
 """Every editor test gets its own data folder (``XDG_DATA_HOME``), so that autosaves never go
 to the real one of the user running the tests; ``view`` is the editor view of the module's own
-``server`` fixture (each module serves its design)."""
+``server`` fixture (each module serves its design); ``browser`` is headless Chromium for the
+browser tests (a module that needs another one defines its own)."""
 
 from __future__ import annotations
 
@@ -21,3 +22,14 @@ def view(server):
     view = server.new_view(server.server)
     yield view
     view.close()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    """Headless Chromium (Playwright; tests/headless_chromium.py), one per module; skips when
+    playwright, viser or chromium is missing."""
+    import headless_chromium
+
+    headless_chromium.require(headless_chromium.missing("viser"))
+    with headless_chromium.browser() as chromium:
+        yield chromium

@@ -30,7 +30,7 @@ from kinegami.errors import InvalidTypeError  # noqa: E402
 from kinegami.optimize import tube_length  # noqa: E402
 from kinegami.reach import solve  # noqa: E402
 
-from .helpers import GRIPPER, ROOT, snapshot  # noqa: E402
+from .helpers import ROOT, snapshot  # noqa: E402
 
 TASK_ARM = ROOT / "tests" / "data" / "task_arm.json"
 #: Where target C was when the arm was designed (it reaches it there).
@@ -101,13 +101,10 @@ def test_a_task_in_other_units_is_converted_to_the_designs():
     assert cm.scale == 0.1 and cm.keep_out[0].max[2] == pytest.approx(mm.keep_out[0].max[2] / 10)
 
 
-def test_design_for_task_without_a_task_or_on_a_tree_is_refused():
+def test_design_for_task_without_a_task_is_refused():
     plain = EditorModel(Document.load(TASK_ARM).replaced(task=None))
     result = plain.design_for_task()
     assert not result.ok and "this design has no task" in result.reason
-    tree = EditorModel(Document.load(GRIPPER).replaced(task=Document.load(TASK_ARM).task))
-    result = tree.design_for_task()
-    assert not result.ok and "tasks are for chains for now" in result.reason
 
 
 def test_a_task_no_design_can_reach_is_refused_with_its_reason():
@@ -188,34 +185,10 @@ def test_axis_and_pose_targets_are_drawn_with_their_direction(view):
     assert len(view.target_colours()) == 3
 
 
-def test_a_tree_with_a_task_says_tasks_are_for_chains(view):
-    tree = Document.load(GRIPPER).replaced(task=view.model.document.task)
-    view.set_model(EditorModel(tree))
-    view.flush()
-    assert view._task_folder.visible and not view._design_button.visible
-    assert "Tasks are for chains for now" in view._task_html.content
-    assert view.design_for_task() is None and "tasks are for chains for now" in view.message
-
-
-def test_a_tree_with_a_tree_task_draws_every_leaf_target_and_says_tasks_are_for_chains(view):
-    tree = Document.load(GRIPPER).replaced(task=starter_task(tree=True))
-    view.set_model(EditorModel(tree))
-    view.flush()
-    assert "2 leaves, 2 grasps, joints RRR, RRR" in view._task_html.content
-    assert "Tasks are for chains for now" in view._task_html.content
-    np.testing.assert_allclose(view.task_positions(), [[-60, 20, 120], [-40, 30, 130],
-                                                       [60, -20, 120], [40, -30, 130]])
-    labels = sorted(h.name for h in view._task_handles if h.name.endswith("_label"))
-    assert len(labels) == 4 and len(view.target_colours()) == 4
-    assert view.design_for_task() is None and "tasks are for chains for now" in view.message
-
-
 def test_a_tree_task_is_not_checked_on_a_chain():
     document = Document.load(TASK_ARM)
     with pytest.raises(InvalidTypeError, match="a tree task"):
         check_targets(document.chain, starter_task(tree=True), document.units)
-    result = EditorModel(document.replaced(task=starter_task(tree=True))).design_for_task()
-    assert not result.ok and "tasks are for chains for now" in result.reason
 
 
 def test_design_for_task_is_one_undo_step_that_keeps_the_task(view):
