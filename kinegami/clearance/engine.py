@@ -1503,7 +1503,9 @@ _ENGINES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def engine_for(chain, names=None) -> ClearanceEngine:
-    """The chain's :class:`ClearanceEngine`, cached until the chain's joints or links change."""
+    """The chain's :class:`ClearanceEngine` for ``names``, cached until the chain's joints or
+    links change (a few per chain: the editor asks with its joint names, inverse kinematics
+    without, in turn)."""
     from kinegami.chain.model import KinematicChain
 
     if not isinstance(chain, KinematicChain):
@@ -1511,11 +1513,17 @@ def engine_for(chain, names=None) -> ClearanceEngine:
     joints, links = chain.Joints, chain.Links
     names = None if names is None else tuple(names)
     cached = _ENGINES.get(chain)
-    if (cached is not None and cached[2] == names and _same_objects(cached[0], joints)
-            and _same_objects(cached[1], links)):  # fmt: skip
-        return cached[3]
-    engine = ClearanceEngine(chain, names)
-    _ENGINES[chain] = (tuple(joints), tuple(links), names, engine)
+    if cached is None or not (_same_objects(cached[0], joints)
+                              and _same_objects(cached[1], links)):  # fmt: skip
+        cached = (tuple(joints), tuple(links), {})
+        _ENGINES[chain] = cached
+    engines = cached[2]
+    engine = engines.get(names)
+    if engine is None:
+        engine = ClearanceEngine(chain, names)
+        if len(engines) >= 4:
+            engines.pop(next(iter(engines)))
+        engines[names] = engine
     return engine
 
 

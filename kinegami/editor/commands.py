@@ -850,7 +850,7 @@ class SetJointState(Command):
         run = _Run()
         new = fork_chain(document.chain)
         run(f"set state of {_label(document, j)}", lambda: new.setJointState(j, s))
-        return Outcome(document.replaced(chain=new), j, run.clear_warning(new),
+        return Outcome(document.at_other_states(new), j, run.clear_warning(new),
                        tuple(range(len(new.Joints))))  # fmt: skip
 
 
@@ -874,7 +874,7 @@ class SetJointStates(Command):
         run = _Run()
         new = fork_chain(document.chain)
         run("set states", lambda: new.setJointStates(values))
-        return Outcome(document.replaced(chain=new), None, run.clear_warning(new),
+        return Outcome(document.at_other_states(new), None, run.clear_warning(new),
                        tuple(range(n)))  # fmt: skip
 
 

@@ -129,6 +129,9 @@ class Document:
         commands keep it, :meth:`save` writes it back.
     material, bed : the design's sheet material and laser bed (version 4,
         kinegami.fabrication.beds.Material and Bed; None: none), kept and written back.
+    shape_of : a document whose chain is this one's at other states (set by the commands
+        that only change states; None otherwise): the clearance is measured with its chain's
+        engine, built once for a whole drag or animation instead of once per step.
 
     ``chain.requireClearance`` and ``chain.maxAnglePerElbow`` are the design's chain options;
     the joints' states are the chain's.
@@ -143,6 +146,7 @@ class Document:
     task: dict | None = None
     material: Material | None = None
     bed: Bed | None = None
+    shape_of: Document | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.chain, KinematicChain | KinematicTree):
@@ -257,7 +261,15 @@ class Document:
         named (kinegami.clearance.clearance_report: the verdict build and check give)."""
         from kinegami.clearance import clearance_report
 
+        if self.shape_of is not None:  # the same chain at other states: its engine, cached
+            states = [float(joint.state) for joint in self.chain.Joints]
+            return clearance_report(self.shape_of.chain, names=self.names, states=states)
         return clearance_report(self.chain, names=self.names)
+
+    def at_other_states(self, chain) -> Document:
+        """This document with ``chain``, which is its chain at other states (what a command
+        that only changes states makes; :attr:`shape_of` remembers the chain they share)."""
+        return self.replaced(chain=chain, shape_of=self.shape_of or self)
 
     @cached_property
     def verdict(self) -> str:

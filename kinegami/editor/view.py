@@ -68,7 +68,7 @@ from kinegami.editor.units import (
     state_unit,
 )
 from kinegami.errors import Cancelled, InvalidParameterError, InvalidTypeError, KinegamiError
-from kinegami.geometry.screws import FIXED
+from kinegami.geometry.screws import FIXED, REVOLUTE
 from kinegami.limits import MAX_FILE_BYTES
 
 __all__ = ["EditorView", "DOWNLOADS", "SHEET_FORMATS", "MAX_UPLOAD_BYTES", "gallery",
@@ -221,6 +221,13 @@ def _locked(method):
     return wrapper
 
 
+def _local_pieces(joint) -> list[np.ndarray]:
+    """A joint's convex pieces' points in its own frame (its pose's)."""
+    P = np.asarray(joint.pose_matrix, dtype=float)
+    return [(np.asarray(piece.points, dtype=float) - P[:3, 3]) @ P[:3, :3]
+            for piece in joint.body_pieces()]  # fmt: skip
+
+
 def _wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
     """Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method; called for every
     moved part of a drag step, so plain floats rather than scipy)."""
@@ -290,6 +297,8 @@ class _Node:
     lo: Any = None  # its meshes' box in its own frame (3-vectors; None before any mesh)
     hi: Any = None
     matrix: Any = None  # its frame now (4x4, world)
+    turn: Any = None  # a revolute joint's: the frame its distal half hangs from (see _joint_node)
+    shape: Any = None  # with ``turn``: the joint's pieces at state 0 in its own frame
 
 
 class EditorView:
@@ -605,6 +614,9 @@ class EditorView:
     def _remove(self, node: _Node) -> None:
         for handle in node.handles:
             handle.remove()
+        if node.turn is not None:
+            node.turn.remove()
+            node.turn = None
         if node.frame is not None:
             node.frame.remove()
         node.handles = []
@@ -621,17 +633,52 @@ class EditorView:
         self._update_task()
 
     def _joint_node(self, joint, i: int) -> _Node:
+        """A joint's meshes under a frame at its pose. A revolute joint's are made at state 0,
+        its distal half under a frame of its own turned by the state (the half turns rigidly
+        about the axis): a change of state, as in a drag, then turns that frame
+        (:meth:`_turn`) instead of making and sending new meshes."""
         from kinegami.clearance.solids import joint_parts
 
         node = _Node(self._new_uid(), joint)
         pose = np.asarray(joint.pose_matrix, dtype=float)
         node.frame = self._add_frame(f"/chain/joint{node.uid}", pose, axes=joint.r)
-        for part in joint_parts(joint, i):
+        turns = joint.motion == REVOLUTE
+        shape = joint.with_state(0.0) if turns else joint
+        for part in joint_parts(shape, i):
             name = f"/chain/joint{node.uid}/{part.side or 'body'}"
+            vertices = part.vertices
+            if turns and part.side == "distal":
+                node.turn = self.scene.add_frame(f"/chain/joint{node.uid}/turn", show_axes=False)
+                name = f"/chain/joint{node.uid}/turn/distal"
+                G = joint.state_transform(float(joint.state))
+                vertices = vertices @ G[:3, :3].T + G[:3, 3]  # where it is drawn
             node.handles.append(self._add_mesh(name, part, pose, JOINT_COLOR, node))
-            self._grow(node, part.vertices, pose)
+            self._grow(node, vertices, pose)
+        if turns:
+            node.shape = _local_pieces(shape)
+            self._turn(node, joint)
         node.sent += 1
         return node
+
+    def _turn(self, node: _Node, joint) -> None:
+        """Turn a revolute joint's distal half to the joint's state (its frame, in the joint's
+        frame: P^-1 G(state) P, G the joint's world motion and P its pose)."""
+        if node.turn is None:
+            return
+        P = np.asarray(joint.pose_matrix, dtype=float)
+        local = np.linalg.inv(P) @ joint.state_transform(float(joint.state)) @ P
+        node.turn.wxyz, node.turn.position = _wxyz(local[:3, :3]), local[:3, 3]
+
+    @staticmethod
+    def _same_shape(node: _Node, joint) -> bool:
+        """Whether ``joint`` is the node's revolute joint but for its state and a rigid move:
+        its pieces at state 0, in its own frame, are the node's (1e-9 r)."""
+        if node.turn is None or joint.motion != REVOLUTE or type(joint) is not type(node.obj):
+            return False
+        pieces = _local_pieces(joint.with_state(0.0))
+        return len(pieces) == len(node.shape) and all(
+            a.shape == b.shape and np.abs(a - b).max() <= 1e-9 * joint.r
+            for a, b in zip(pieces, node.shape, strict=True))  # fmt: skip
 
     def _link_node(self, link, i: int) -> _Node:
         from kinegami.clearance.solids import link_parts
@@ -726,7 +773,11 @@ class EditorView:
         else:
             reshaped = set(change.reshaped_joints)
             for i in change.joints:
-                if i in reshaped:
+                if i in reshaped and self._same_shape(old_joints[i], joints[i]):
+                    self._joints[i].obj = joints[i]  # turned: its distal half's frame only
+                    self._move(self._joints[i], np.asarray(joints[i].pose_matrix, dtype=float))
+                    self._turn(self._joints[i], joints[i])
+                elif i in reshaped:
                     self._remove(old_joints[i])
                     self._joints[i] = self._joint_node(joints[i], i)
                 else:
@@ -1268,9 +1319,12 @@ class EditorView:
             self._say(f"**Refused:** reach: the target must be three finite numbers, got "
                       f"{position!r}")  # fmt: skip
             return None
-        chain = self.model.chain
-        q0 = [float(joint.state) for joint in chain.Joints]
-        answer = solve(chain, point, tip=self.reach_tip(), q0=q0)
+        document = self.model.document
+        q0 = [float(joint.state) for joint in document.chain.Joints]
+        # a drag's previews are the same chain at other states: solve on the chain they share,
+        # whose kinematics and clearance engine are then built once for the whole drag
+        shared = (document.shape_of or document).chain
+        answer = solve(shared, point, tip=self.reach_tip(), q0=q0)
         self.reach_answer = answer
         self._draw_target(point, answer.ok)
         units = self.model.document.units

@@ -74,3 +74,18 @@ def test_a_path_through_a_collision_names_where():
     k = int(np.flatnonzero(crossing.reshape(len(A), -1).any(axis=1))[0])
     found = check_path(chain, A[k], B[k])
     assert not found.ok and "of the way" in found.reason
+
+
+def test_engines_are_kept_per_names_until_the_chain_changes():
+    """engine_for keeps one engine per names asked for (the editor asks with joint names,
+    inverse kinematics without, in turn: neither evicts the other) until the joints change."""
+    chain = arm()
+    plain = engine_for(chain)
+    named = engine_for(chain, ["a"] * len(chain.Joints))
+    assert named is not plain
+    assert engine_for(chain) is plain
+    assert engine_for(chain, ["a"] * len(chain.Joints)) is named
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClearanceWarning)
+        chain.setJointState(0, 0.3)  # new joints: new engines
+    assert engine_for(chain) is not plain

@@ -135,3 +135,31 @@ def test_replace_document_is_one_undoable_step(model, tmp_path):
 def test_replace_document_refuses_what_is_not_a_document(model):
     result = model.apply(ReplaceDocument("not a document"))
     assert not result.ok and "document must be an editor Document" in result.reason
+
+
+def test_a_state_preview_measures_its_clearance_with_the_shared_engine(model):
+    """A document that is its base at other states (set states, a drag's or an animation's
+    previews) remembers the base (``shape_of``) and measures its clearance with the base's
+    engine: the same report as the chain's own, at every step; an edit forgets the base."""
+    import numpy as np
+
+    from kinegami.clearance import clearance_report
+
+    base = model.document
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        states = [lo + (hi - lo) * rng.random() for lo, hi in
+                  (j.stateRange() for j in base.chain.Joints)]  # fmt: skip
+        assert model.preview(SetJointStates(states)).ok
+        shown = model.document
+        assert shown.shape_of is base
+        own = clearance_report(shown.chain, names=shown.names)
+        shared = shown.clearance
+        assert shared.ok == own.ok
+        assert abs(shared.min_clearance - own.min_clearance) <= 1e-9 * base.chain.r
+        assert [p.elements for p in shared.pairs] == [p.elements for p in own.pairs]
+    model.end_preview()
+    assert model.set_states(states).ok
+    assert model.document.shape_of is base
+    assert model.slide(4, 0.5).ok
+    assert model.document.shape_of is None

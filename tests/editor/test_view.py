@@ -53,10 +53,57 @@ def test_slide_without_propagation_resends_only_its_links(view):
     assert view.meshes_sent - before == expected
 
 
-def test_state_change_resends_only_the_joint(view):
+def _world(handle, *frames) -> np.ndarray:
+    """A mesh's vertices in the world: its own, moved by the frames it hangs from (outermost
+    first), each a viser (wxyz, position)."""
+    from scipy.spatial.transform import Rotation
+
+    points = np.asarray(handle.vertices, dtype=float)
+    for frame in reversed(frames):
+        w, x, y, z = frame.wxyz
+        points = points @ Rotation.from_quat([x, y, z, w]).as_matrix().T + np.asarray(
+            frame.position)
+    return points
+
+
+def test_a_prismatic_state_change_resends_only_the_joint(view):
     before = view.meshes_sent
-    assert view.set_state(4, 0.3).ok
-    assert view.meshes_sent - before == len(joint_parts(view.model.chain.Joints[4], 4))
+    assert view.set_state(2, 0.3).ok
+    assert view.meshes_sent - before == len(joint_parts(view.model.chain.Joints[2], 2))
+
+
+def test_a_revolute_state_change_turns_its_distal_half_and_sends_no_mesh(view):
+    """A revolute joint's halves are drawn at state 0, the distal one under a frame turned by
+    the state: a state change (a drag, an animation) sends no mesh, and every vertex is where
+    the joint's own parts at the new state put it (1e-6: viser sends single precision)."""
+    from scipy.spatial import ConvexHull
+
+    node = view._joints[4]
+    before = view.meshes_sent
+    for state in (0.3, -1.2, 0.7):
+        assert view.set_state(4, state).ok
+        assert view._joints[4] is node
+        joint = view.model.chain.Joints[4]
+        for part, handle in zip(joint_parts(joint, 4), node.handles, strict=True):
+            frames = (node.frame, node.turn) if part.side == "distal" else (node.frame,)
+            drawn = _world(handle, *frames)
+            expected = np.asarray(part.vertices, dtype=float)
+            # the same hull: every drawn vertex is a vertex of the part's, and the other way
+            # (to viser's single precision)
+            gap = np.linalg.norm(drawn[:, None] - expected[None], axis=2)
+            assert gap.min(axis=1).max() <= 1e-6 and gap.min(axis=0).max() <= 1e-6
+            assert ConvexHull(drawn).volume == pytest.approx(ConvexHull(expected).volume,
+                                                             rel=1e-6)  # fmt: skip
+    assert view.meshes_sent == before
+    # an edit that reshapes the joint (its bending angle) draws it again, at its new shape
+    assert view.act(lambda: view.model.set_parameters(4, totalBendingAngle=2.0)).ok
+    assert view.meshes_sent > before and view._joints[4] is not node
+    node, joint = view._joints[4], view.model.chain.Joints[4]
+    for part, handle in zip(joint_parts(joint, 4), node.handles, strict=True):
+        frames = (node.frame, node.turn) if part.side == "distal" else (node.frame,)
+        drawn = _world(handle, *frames)
+        gap = np.linalg.norm(drawn[:, None] - np.asarray(part.vertices)[None], axis=2)
+        assert gap.min(axis=1).max() <= 1e-6 and gap.min(axis=0).max() <= 1e-6
 
 
 def test_moved_meshes_get_the_new_pose(view):
