@@ -372,6 +372,7 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
     tol_p, tol_a, seed, clear, margin = options
     r = float(design.r)
     problem = _Problem(compiled, goals, r)
+    tips = tuple(problem.keys)
     G = len(goals)
     low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
     mov = compiled.movable
@@ -428,7 +429,7 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
             _keep(best, g, Q[row], pos[i], ang[i], verdict)
             if verdict[2]:
                 done[g] = True
-                answers[g] = _answer(best[g], iterations[g], started[g] - 1, "", problem)
+                answers[g] = _answer(best[g], iterations[g], started[g] - 1, "", tips)
             else:
                 collided[g] = verdict[1]
             active[row] = False
@@ -474,7 +475,7 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
     for g in range(G):
         if answers[g] is None:
             answers[g] = _failure(design, best[g], iterations[g], started[g] - 1, collided[g],
-                                  options, compiled, goals[g], problem)  # fmt: skip
+                                  options, compiled, goals[g], tips)  # fmt: skip
     return answers  # type: ignore[return-value]
 
 
@@ -610,15 +611,22 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
     (tip, target), = goal.items()
     steps, path, revolute, reference, E, columns, low_p, high_p = _tip_path(compiled, tip)
     low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
-    problem = _Problem(compiled, [goal], r)
     rng = None  # the target's own random stream, made at the first restart (it costs ~70 us)
     hopeless = bool(_beyond_reach(compiled, goal))
     budget, patience = (1, 12) if hopeless else (MAX_STARTS, ITERATIONS)
     kind = _KINDS[target.kind]
     axis = target.axis if target.axis is not None else np.zeros(3)
     rotation = target.rotation if target.rotation is not None else np.eye(3)
+    arguments = (steps, path, revolute, reference, E, low_p, high_p, kind, target.position,
+                 rotation, axis, r, tol_p, tol_a)  # fmt: skip
+    redundant = path.size > (3 if kind == 0 else 6)
+    if clear and redundant:
+        engine = _engine_of(design, margin)
+        required = _margin_value(design, margin)
+        limit = _limit(design, required)
+        apart = required + ESCAPE_BUFFER * r  # an escape pushes pairs apart up to it
     best: list = [None]
-    collided = ""
+    collided = None  # (q, verdict or None): the last exact solution that passes through itself
     iterations = escapes = 0
     q = np.clip(start, low, high)
     seeds = None
@@ -634,108 +642,142 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
                     rng = np.random.default_rng([seed, *_words(goal)])
                 q = low + (high - low) * rng.random(low.size)
         if path.size == 0:  # nothing moves the tip: one evaluation
-            exact, count, pos, ang = _still(problem, q, tol_p, tol_a, r)
+            exact, count, pos, ang = _still(_Problem(compiled, [goal], r), q, tol_p, tol_a, r)
             near, near_pos, near_ang = q[columns], pos, ang
         else:
             exact, count, pos, ang, near, near_pos, near_ang = descend(
-                steps, path, revolute, reference, E, low_p, high_p, kind, target.position,
-                rotation, axis, r, tol_p, tol_a, q[columns].copy(), patience, DAMPING,
-                DAMPING_MIN, DAMPING_MAX)  # fmt: skip
+                *arguments, q[columns].copy(), patience, DAMPING, DAMPING_MIN,
+                DAMPING_MAX)  # fmt: skip
         iterations += count
         found = q.copy()
         found[columns] = near
-        if exact:
-            verdict = _judge(design, found, clear, margin)
-            if not verdict[2] and path.size > (3 if kind == 0 else 6) and escapes < ESCAPES:
-                # a redundant arm: move along the solutions, away from the binding pair
-                escapes += 1
-                arguments = (steps, path, revolute, reference, E, low_p, high_p, kind,
-                             target.position, rotation, axis, r, tol_p, tol_a)  # fmt: skip
-                found, verdict, count = _escape(design, compiled, found, columns, descend,
-                                                arguments, verdict, clear, margin)  # fmt: skip
-                iterations += count
-            _keep(best, 0, found, near_pos, near_ang, verdict)
-            if verdict[2]:
-                return _answer(best[0], iterations, started, "", problem)
-            collided = verdict[1]
-        else:
+        if not exact:
             _keep(best, 0, found, near_pos, near_ang, None)
-    return _failure(design, best[0], iterations, budget - 1, collided, options, compiled, goal,
-                    problem)  # fmt: skip
+            continue
+        if clear and redundant and escapes < ESCAPES:
+            # the clearance first without words (the engine's closest pairs: the report's
+            # verdict); moved along the solutions, away from the binding pairs, if not clear
+            pairs = engine.closest_pairs(found, apart)
+            if not _is_clear(pairs, limit):
+                escapes += 1
+                found, pairs, count = _escape(engine, compiled, tip, found, columns,
+                                              arguments, pairs, limit, apart)  # fmt: skip
+                iterations += count
+            verdict = _judge(design, found, clear, margin) if _is_clear(pairs, limit) \
+                else None  # fmt: skip
+        else:  # the report says (and words the clearance)
+            verdict = _judge(design, found, clear, margin)
+        _keep(best, 0, found, near_pos, near_ang, verdict)
+        if verdict is not None and verdict[2]:
+            return _answer(best[0], iterations, started, "", (tip,))
+        collided = (found, verdict)
+    words = "" if collided is None else (collided[1] or _judge(design, collided[0], clear,
+                                                                margin))[1]  # fmt: skip
+    return _failure(design, best[0], iterations, budget - 1, words, options, compiled, goal,
+                    (tip,))  # fmt: skip
 
 
 #: Exact solutions that pass through themselves that one target moves away from (redundant
-#: arms), and the steps of each move.
-ESCAPES, ESCAPE_STEPS = 16, 24
+#: arms), and the most steps of each move.
+ESCAPES, ESCAPE_STEPS = 16, 16
+#: A move's pairs: those closer than the margin plus this (units of r) are pushed apart, up
+#: to it; the longest step (rad, a slide in units of r), the shortest tried before giving up,
+#: and the descent's iterations back onto the target after each step.
+ESCAPE_BUFFER, ESCAPE_RADIUS, ESCAPE_SHORTEST, ESCAPE_PATIENCE = 0.2, 0.3, 1e-3, 12
 
 
-def _escape(design, compiled: Kinematics, q: np.ndarray, columns: np.ndarray, descend,
-            arguments: tuple, verdict: tuple, clear: bool, margin) -> tuple:  # fmt: skip
+def _escape(engine, compiled: Kinematics, tip: int, q: np.ndarray, columns: np.ndarray,
+            arguments: tuple, pairs: tuple, limit: float, apart: float) -> tuple:  # fmt: skip
     """For an arm with more joints on the tip's path than the target fixes: from the exact
-    solution ``q`` that passes through itself, steps that raise the smallest clearance (its
-    gradient by finite differences, projected onto the Jacobian's null space so that the tip
-    stays put to first order), each followed by the compiled descent back onto the target.
-    Returns (q, verdict, iterations): the first exact, clear solution met, or the last exact
-    one."""
-    (steps, path, revolute, reference, E, low_p, high_p, kind, position, rotation, axis, r,
-     tol_p, tol_a) = arguments
-    rows = 3 if kind == 0 else 6
+    solution ``q`` that passes through itself (``pairs``: the engine's pairs closer than the
+    margin ``apart`` there), steps along the solutions that push those pairs apart up to
+    ``apart`` (:func:`kinegami.reach.kernels.escape_step`: their clearances' analytic
+    gradients projected onto the Jacobian's null space, then the descent back onto the
+    target). A step is kept when it lessens the overlap (the sum of the clearances'
+    shortfalls below ``limit``), and the next may be twice as long; otherwise it is tried
+    half as long. Returns (q, pairs, iterations): the first clear solution met, or the exact
+    one that overlaps least."""
+    from kinegami.reach.kernels import descend, escape_step
+
+    path = arguments[1]
+    moves = _per_tip(compiled, "moves", tip, lambda c, _: _moves(engine, c, path))
+    shortfall = _shortfall(pairs[0], limit)
+    radius = ESCAPE_RADIUS
     iterations = 0
-    h = 1e-6
-    engine = _engine_of(design)
-    # the smallest clearance at the nudged configurations, one batch of the engine: every
-    # pair closer than the margin (and a hundredth of r more: the configurations are a
-    # nudge from one that is not clear) is measured; a report's words are not needed here
-    reach = (float(getattr(design, "margin", 0.0)) if margin is None else margin) + 0.01 * r
-    judged = True  # whether ``verdict`` is q's (the worded report is made only when needed)
     for _ in range(ESCAPE_STEPS):
-        # q itself, then q nudged along each joint: one batch of the engine
-        nudged = np.repeat(q[None, :], columns.size + 1, axis=0)
-        for m, c in enumerate(columns.tolist()):
-            nudged[m + 1, c] = min(q[c] + h * (1.0 if revolute[m] else r), high_p[m])
-            if nudged[m + 1, c] == q[c]:
-                nudged[m + 1, c] = q[c] - h * (1.0 if revolute[m] else r)
-        closest = engine.worst_arrays(nudged, reach)[0]
-        base = float(closest[0])
-        if not judged and base > reach - 0.015 * r:  # maybe clear: the report says
-            verdict, judged = _judge(design, q, clear, margin), True
-            if verdict[2]:
-                break
-        if not np.isfinite(base):
-            base = float(verdict[0])
-        closest = closest[1:]
-        steps_taken = nudged[1 + np.arange(columns.size), columns] - q[columns]
-        gradient = np.where(np.isfinite(closest), (closest - base) / steps_taken, 0.0)
-        J = compiled.jacob0(q)[:, columns]
-        J = np.vstack([J[:3] / r, J[3:]])[: rows if kind != 1 else 6]
-        null = np.eye(columns.size) - np.linalg.pinv(J) @ J
-        direction = null @ gradient
-        size = float(np.linalg.norm(direction))
-        if size < 1e-12:
+        clearance, ends, bodies, s, t = pairs
+        step = escape_step(*arguments[:8], arguments[11], q[columns], clearance, ends, bodies,
+                           s, t, moves, apart, radius)  # fmt: skip
+        if np.array_equal(step, q[columns]):  # no step raises a pair
             break
-        trial = q.copy()
-        trial[columns] = np.clip(q[columns] + 0.05 * direction / size, low_p, high_p)
-        exact, count, _, _, near, _, _ = descend(
-            steps, path, revolute, reference, E, low_p, high_p, kind, position, rotation, axis,
-            r, tol_p, tol_a, trial[columns].copy(), 12, DAMPING, DAMPING_MIN, DAMPING_MAX)
+        exact, count, _, _, near, _, _ = descend(*arguments, step, ESCAPE_PATIENCE, DAMPING,
+                                                 DAMPING_MIN, DAMPING_MAX)  # fmt: skip
         iterations += count
-        if not exact:
+        if exact:
+            trial = q.copy()
+            trial[columns] = near
+            moved = engine.closest_pairs(trial, apart)
+            lack = _shortfall(moved[0], limit)
+            if lack < shortfall:
+                q, pairs, shortfall = trial, moved, lack
+                if lack == 0.0:
+                    break
+                radius = min(ESCAPE_RADIUS, 2.0 * radius)
+                continue
+        radius *= 0.5
+        if radius < ESCAPE_SHORTEST:
             break
-        trial[columns] = near
-        q, judged = trial, False
-    if not judged:
-        verdict = _judge(design, q, clear, margin)
-    return q, verdict, iterations
+    return q, pairs, iterations
 
 
-def _engine_of(design):
+def _shortfall(clearance: np.ndarray, limit: float) -> float:
+    """How far the pairs are from clear: the sum of their clearances' shortfalls below the
+    limit (0 when clear)."""
+    return float(np.maximum(limit - clearance, 0.0).sum())
+
+
+def _moves(engine, compiled: Kinematics, path: np.ndarray) -> np.ndarray:
+    """(P, bodies) bool: whether the tip path's joint m turns or slides the engine's body b
+    (b is that joint's body or hangs from it)."""
+    screws = engine.screws
+    parent = screws.body_parent.tolist()
+    own = screws.body_of[compiled.screws.moving[path - 1]].tolist()
+    moves = np.zeros((len(own), screws.bodies), dtype=bool)
+    for b in range(screws.bodies):
+        above, x = set(), b
+        while x > 0:
+            above.add(x)
+            x = parent[x]
+        moves[:, b] = [o in above for o in own]
+    return moves
+
+
+def _margin_value(design, margin) -> float:
+    """The clearance required: ``margin``, or the design's own."""
+    return float(getattr(design, "margin", 0.0)) if margin is None else float(margin)
+
+
+def _limit(design, margin: float) -> float:
+    """The smallest clearance that is clear with ``margin`` (every verdict's limit)."""
+    from kinegami.chain.bodies import clear_limit
+
+    return clear_limit(float(design.r), margin)
+
+
+def _is_clear(pairs: tuple, limit: float) -> bool:
+    """Whether the closest pairs ``pairs`` (:meth:`ClearanceEngine.closest_pairs`) are clear:
+    the smallest clearance at least ``limit`` (the report's verdict)."""
+    return pairs[0].size == 0 or float(pairs[0][0]) >= limit
+
+
+def _engine_of(design, margin=None):
     """The clearance engine of a chain or a tree (what ``design.clearance`` measures with)."""
     from kinegami.chain.model import KinematicChain
-    from kinegami.clearance.engine import TreeMotion, engine_for
+    from kinegami.clearance.engine import engine_for, tree_engine
 
     if isinstance(design, KinematicChain):
         return engine_for(design)
-    return TreeMotion(design).engine
+    return tree_engine(design, None, _margin_value(design, margin))
 
 
 def _still(problem: _Problem, q: np.ndarray, tol_p: float, tol_a: float, r: float) -> tuple:
@@ -756,8 +798,9 @@ def _words(goal: dict) -> list[int]:
 
 
 def _judge(design, q: np.ndarray, clear: bool, margin) -> tuple[float, str, bool]:
-    """(clearance, binding pair in words, acceptable) of the design at ``q``."""
-    report = design.clearance(q.tolist(), margin)
+    """(clearance, binding pair in words, acceptable) of the design at ``q``: its clearance
+    report (``design.clearance``'s, from the same engine)."""
+    report = _engine_of(design, margin).report(q.tolist(), _margin_value(design, margin))
     pair = "" if report.closest is None else f"{report.closest.first} and {report.closest.second}"
     return report.min_clearance, pair, (report.ok or not clear)
 
@@ -769,15 +812,15 @@ def _keep(best: list, g: int, q, pos: float, ang: float, verdict) -> None:
         best[g] = (score, np.array(q, dtype=float), float(pos), float(ang), verdict)
 
 
-def _answer(kept, iterations, restarts, reason, problem) -> Answer:
+def _answer(kept, iterations, restarts, reason, tips: tuple) -> Answer:
     _, q, pos, ang, verdict = kept
     clearance, pair, ok = verdict if verdict is not None else (math.nan, "", False)
     return Answer(ok and not reason, tuple(float(x) for x in q), pos, ang, float(clearance),
-                  pair, int(iterations), int(restarts), reason, tuple(problem.keys))  # fmt: skip
+                  pair, int(iterations), int(restarts), reason, tips)  # fmt: skip
 
 
 def _failure(design, kept, iterations, restarts, collided, options, compiled, goal,
-             problem) -> Answer:  # fmt: skip
+             tips: tuple) -> Answer:  # fmt: skip
     """The answer when no start gave an exact, clear configuration: the nearest one, and
     why in one sentence."""
     tol_p, tol_a, _, clear, margin = options
@@ -799,7 +842,7 @@ def _failure(design, kept, iterations, restarts, collided, options, compiled, go
         reason = f"not reached: the nearest tip position is {pos:.4g} away" + \
             (f"; {at}" if at else "")  # fmt: skip
     kept = (kept[0], q, pos, ang, verdict)
-    return _answer(kept, iterations, restarts, reason, problem)
+    return _answer(kept, iterations, restarts, reason, tips)
 
 
 def _at_limit(compiled: Kinematics, q: np.ndarray) -> str:

@@ -1,4 +1,5 @@
-"""Compiled damped least squares for one tip (numba; docs/reach.md, "Speed").
+"""Compiled damped least squares for one tip, and a redundant arm's moves along its solutions
+(numba; docs/reach.md, "Inverse kinematics").
 
 :func:`kinegami.reach.inverse.solve` on a target of one tip spends its time in the fixed cost
 of some hundred small numpy calls per iteration, not in arithmetic: a 6-joint arm's forward
@@ -7,6 +8,9 @@ runs one start's whole iteration compiled: the tip's pose by the product of elem
 transforms of :meth:`kinegami.geometry.screws.JointScrews.frame_poses` (the constant step to
 each joint's axis frame, then its turn or slide), the geometric Jacobian from the axes, the
 damped step with the same damping rule as the numpy path, and the projection onto the ranges.
+:func:`escape_step` moves an exact solution of a redundant arm along its solutions, away
+from itself: the clearance's analytic gradient (:func:`clearance_gradients`) projected onto
+the Jacobian's null space, then :func:`descend` back onto the target.
 
 Compiled once per machine (``cache=True``); :func:`kinegami.reach.inverse.solve` loads this
 module on first use and keeps the numpy path where numba cannot run.
@@ -23,6 +27,13 @@ __all__ = ["descend", "frame_poses"]
 
 #: Target kinds.
 POSITION, AXIS, POSE = 0, 1, 2
+#: A start has stalled when its error (position in r plus angle in rad, above the floor) has
+#: fallen by less than a tenth over the last window of iterations (looked at every few, from
+#: the window and a look on): measured on the 9-joint spherical series, the PUMA and the
+#: 7-joint spiral, this stops about half of the iterations of stalled starts and almost never
+#: a start that would have converged (1 in about 350).
+STALL_EVERY, STALL_WINDOW, STALL_FACTOR, STALL_FLOOR = 10, 20, 0.9, 1e-6
+STALL_LOOK = (STALL_WINDOW + STALL_EVERY) // STALL_EVERY  # the first look (in marks)
 
 
 @njit(cache=True)
@@ -153,8 +164,9 @@ def descend(steps, path, revolute, reference, E, low, high, kind, target_p, targ
     """Iterate one start: ``q`` (P,) the path joints' states, changed in place to the last
     iterate. Returns (exact, iterations, position error, angle error, best q, its position and
     angle errors): exact when the tip is within ``tol_p`` r and ``tol_a`` rad; otherwise the
-    start stalled (``patience`` iterations, or damped to ``damping_max``) and best is its
-    nearest iterate (position error, then angle error)."""
+    start stalled (``patience`` iterations, damped to ``damping_max``, or too little progress:
+    :data:`STALL_FACTOR`) and best is its nearest iterate (position error, then angle
+    error)."""
     P = path.size
     size = 3 if kind == POSITION else 6
     axes = np.empty((P, 3, 4))
@@ -169,9 +181,16 @@ def descend(steps, path, revolute, reference, E, low, high, kind, target_p, targ
     pos, ang = _residual(T, kind, target_p, target_R, target_a, r, e, w)
     best_pos, best_ang = pos, ang
     lam = damping
+    marks = np.empty(patience // STALL_EVERY + 1)  # the error every STALL_EVERY iterations
     for iteration in range(patience):
         if pos <= tol_p * r and ang <= tol_a:
             return True, iteration + 1, pos, ang, q.copy(), pos, ang
+        if iteration % STALL_EVERY == 0:  # stalled: too little progress over the window
+            n = iteration // STALL_EVERY
+            marks[n] = error = pos / r + ang
+            before = marks[n - STALL_WINDOW // STALL_EVERY] if n >= STALL_LOOK else math.inf
+            if error > STALL_FLOOR and error > STALL_FACTOR * before:
+                return False, iteration, pos, ang, best, best_pos, best_ang
         # the geometric Jacobian of the residual
         for m in range(P):
             dx, dy, dz = axes[m, 0, 2], axes[m, 1, 2], axes[m, 2, 2]
@@ -257,3 +276,175 @@ def frame_poses(steps, parent, revolute, delta, E, bodies, out):
                     T[i, j] = B[i, 0] * F[0, j] + B[i, 1] * F[1, j] + B[i, 2] * F[2, j] \
                         + B[i, 3] * F[3, j]
             T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0
+
+
+@njit(cache=True)
+def clearance_gradients(steps, path, revolute, reference, E, q, ends, bodies, s, t, moves):
+    """(k, P): the gradient of each pair's clearance with respect to the path joints' states
+    ``q`` (P,) (per radian, or per length unit of a slide). The pairs are
+    :meth:`kinegami.clearance.engine.ClearanceEngine.closest_pairs`' at ``q``: ``ends`` (k,
+    4, 3) world end points, ``bodies`` (k, 4) their bodies, ``s``, ``t`` the closest points'
+    parameters; ``moves`` (P, bodies): whether path joint m moves body b.
+
+    The closest points p1 (first capsule) and p2 move with their segments' ends (the
+    parameters held: the distance is smallest there, so their change adds nothing to first
+    order); joint m moves an end x riding on a body it moves at a_m x (x - o_m) (revolute,
+    axis a_m through o_m at ``q``) or a_m (prismatic). The clearance |p1 - p2| - 2r changes
+    at n . (dp1 - dp2), n the unit vector from p2 to p1; a pair whose points coincide gets
+    a zero row (no direction)."""
+    P = path.size
+    K = ends.shape[0]
+    axes = np.empty((P, 3, 4))
+    T = np.empty((4, 4))
+    _frames(steps, path, revolute, q - reference, E, axes, T)
+    G = np.zeros((K, P))
+    weight = np.empty(4)
+    for k in range(K):
+        dx, dy, dz = 0.0, 0.0, 0.0
+        for c in range(3):
+            p1 = ends[k, 0, c] + s[k] * (ends[k, 1, c] - ends[k, 0, c])
+            p2 = ends[k, 2, c] + t[k] * (ends[k, 3, c] - ends[k, 2, c])
+            if c == 0:
+                dx = p1 - p2
+            elif c == 1:
+                dy = p1 - p2
+            else:
+                dz = p1 - p2
+        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if not dist > 0.0:
+            continue
+        nx, ny, nz = dx / dist, dy / dist, dz / dist
+        weight[0], weight[1] = 1.0 - s[k], s[k]
+        weight[2], weight[3] = t[k] - 1.0, -t[k]
+        for e in range(4):
+            w = weight[e]
+            if w == 0.0:
+                continue
+            b = bodies[k, e]
+            x, y, z = ends[k, e, 0], ends[k, e, 1], ends[k, e, 2]
+            for m in range(P):
+                if not moves[m, b]:
+                    continue
+                ax, ay, az = axes[m, 0, 2], axes[m, 1, 2], axes[m, 2, 2]
+                if revolute[m]:
+                    px, py, pz = x - axes[m, 0, 3], y - axes[m, 1, 3], z - axes[m, 2, 3]
+                    vx, vy, vz = ay * pz - az * py, az * px - ax * pz, ax * py - ay * px
+                else:
+                    vx, vy, vz = ax, ay, az
+                G[k, m] += w * (nx * vx + ny * vy + nz * vz)
+    return G
+
+
+@njit(cache=True)
+def _residual_jacobian(axes, T, revolute, kind, r, J):
+    """The residual's Jacobian J (3 or 6, P) at the tip pose T and axis frames ``axes``, as
+    :func:`descend` makes it."""
+    for m in range(J.shape[1]):
+        dx, dy, dz = axes[m, 0, 2], axes[m, 1, 2], axes[m, 2, 2]
+        if revolute[m]:
+            px, py, pz = T[0, 3] - axes[m, 0, 3], T[1, 3] - axes[m, 1, 3], T[2, 3] - axes[m, 2, 3]
+            vx, vy, vz = dy * pz - dz * py, dz * px - dx * pz, dx * py - dy * px
+            wx, wy, wz = dx, dy, dz
+        else:
+            vx, vy, vz = dx, dy, dz
+            wx, wy, wz = 0.0, 0.0, 0.0
+        J[0, m], J[1, m], J[2, m] = vx / r, vy / r, vz / r
+        if kind == POSE:
+            J[3, m], J[4, m], J[5, m] = wx, wy, wz
+        elif kind == AXIS:
+            zx, zy, zz = T[0, 2], T[1, 2], T[2, 2]
+            J[3, m], J[4, m], J[5, m] = wy * zz - wz * zy, wz * zx - wx * zz, wx * zy - wy * zx
+
+
+@njit(cache=True)
+def _null_step(J, G, rise, held, scale):
+    """x (P,): the damped least-squares step (in units of ``scale``: rad, or r for a slide)
+    that raises each pair's clearance by ``rise`` (K,) to first order (gradients G (K, P))
+    while the residual does not change (J x = 0: the step lies in J's null space), the
+    ``held`` joints not moving."""
+    size, P = J.shape
+    K = G.shape[0]
+    Js = np.empty((size, P))
+    Gs = np.empty((K, P))
+    for m in range(P):
+        f = 0.0 if held[m] else scale[m]
+        for i in range(size):
+            Js[i, m] = J[i, m] * f
+        for k in range(K):
+            Gs[k, m] = G[k, m] * f
+    # the null space's projector N = I - Js^T (Js Js^T + eps I)^-1 Js
+    A = Js @ Js.T
+    eps = 1e-12 * (np.trace(A) + 1.0)
+    for i in range(size):
+        A[i, i] += eps
+    M = np.empty((size, P))
+    for m in range(P):
+        M[:, m] = _solve_spd(A, Js[:, m].copy())
+    N = -(Js.T @ M)
+    for m in range(P):
+        N[m, m] += 1.0
+    GN = Gs @ N
+    H = GN.T @ GN
+    mu = 1e-6 * (np.trace(H) / P) + 1e-300
+    for m in range(P):
+        H[m, m] += mu
+    return _solve_spd(H, GN.T @ rise)
+
+
+@njit(cache=True)
+def escape_step(steps, path, revolute, reference, E, low, high, kind, r, q, clearance, ends,
+                bodies, s, t, moves, goal, radius):  # fmt: skip
+    """One move of a redundant arm along its exact solutions, away from itself, before the
+    descent back onto the target (:func:`descend`). ``q`` (P,): the path joints' states at an
+    exact solution; ``clearance``, ``ends``, ``bodies``, ``s``, ``t``: the engine's closest
+    pairs there, ``moves`` as :func:`clearance_gradients`.
+
+    Every pair closer than ``goal`` asks its clearance to rise to it; the step that does so
+    best to first order while the tip stays put (Gauss-Newton on the pairs' gradients,
+    projected onto the null space of the residual's Jacobian, damped), at most ``radius``
+    long (rad; a slide in units of r), a joint at a limit that it would push beyond held
+    there, the others projected onto their ranges. Returns the path joints' new states, or
+    ``q`` itself when no step raises a pair."""
+    P = path.size
+    size = 3 if kind == POSITION else 6
+    axes = np.empty((P, 3, 4))
+    T = np.empty((4, 4))
+    _frames(steps, path, revolute, q - reference, E, axes, T)
+    J = np.zeros((size, P))
+    _residual_jacobian(axes, T, revolute, kind, r, J)
+    G_all = clearance_gradients(steps, path, revolute, reference, E, q, ends, bodies, s, t,
+                                moves)  # fmt: skip
+    K = 0
+    for k in range(clearance.size):
+        if clearance[k] < goal:
+            K += 1
+    G = np.empty((K, P))
+    rise = np.empty(K)
+    n = 0
+    for k in range(clearance.size):
+        if clearance[k] < goal:
+            G[n] = G_all[k]
+            rise[n] = goal - clearance[k]
+            n += 1
+    scale = np.empty(P)
+    for m in range(P):
+        scale[m] = 1.0 if revolute[m] else r
+    held = np.zeros(P, dtype=np.bool_)
+    x = _null_step(J, G, rise, held, scale)
+    again = False
+    for m in range(P):
+        d = x[m] * scale[m]
+        if (q[m] + d > high[m] and q[m] >= high[m] - 1e-12) or \
+                (q[m] + d < low[m] and q[m] <= low[m] + 1e-12):  # fmt: skip
+            held[m] = True
+            again = True
+    if again:
+        x = _null_step(J, G, rise, held, scale)
+    length = math.sqrt(np.dot(x, x))
+    trial = q.copy()
+    if not length > 0.0:
+        return trial
+    f = min(1.0, radius / length)
+    for m in range(P):
+        trial[m] = min(max(q[m] + f * x[m] * scale[m], low[m]), high[m])
+    return trial
