@@ -1588,15 +1588,11 @@ def cmd_compact(args: argparse.Namespace) -> int:
     chain, info = _load(args.design)
     _margin(args, chain)
     info = _fabrication(args, chain, info)
-    if info.task is not None and _is_tree(chain):
-        _note(args.command, "the design's task is not checked: compaction keeps a task for "
-                            "chains only, so the compacted tree may no longer reach its "
-                            "targets (the task is written as it was)")  # fmt: skip
     before = BuildJob(chain, info)
     if not _is_tree(chain):  # a tree's sheets are checked by build
         _check_pattern(before)
     task = None
-    if info.task is not None and not _is_tree(chain):  # the task it was made for: kept
+    if info.task is not None:  # the task it was made for: kept
         from kinegami.design.task import task_from_dict
 
         task = task_from_dict(info.task, args.design, where=("task",))
@@ -1605,7 +1601,11 @@ def cmd_compact(args: argparse.Namespace) -> int:
                                 "target still reached, clear)")  # fmt: skip
     try:
         if task is not None:
-            compacted = compact(chain, seed=seed, time_limit=limit, targets=list(task.targets),
+            # a tree's task: one target list per leaf, the leaves in the order of their tip
+            # joints (as kinegami design writes the tree), every grasp kept
+            targets = [list(leaf) for leaf in task.targets] if task.is_tree \
+                else list(task.targets)  # fmt: skip
+            compacted = compact(chain, seed=seed, time_limit=limit, targets=targets,
                                 keep_out=task.keep_out)  # fmt: skip
         else:
             compacted = compact(chain, seed=seed, motion=args.motion, time_limit=limit)

@@ -50,6 +50,7 @@ __all__ = [
     "compact",
     "compact_for_task",
     "CompactionError",
+    "repaired_vertices",
     "shorten_by_axis_translations",
     "tube_length",
 ]
@@ -406,10 +407,10 @@ def _clear_choice(layers: _Layers, motion, require: bool, deadline: float | None
     return None
 
 
-def _motion_collision(chain: KinematicChain, motion) -> tuple[int, int] | None:
-    """The most frequent colliding pair of parts (elements) when the chain collides in more
-    sampled configurations than allowed, else None."""
-    from kinegami.clearance import engine_for
+def _motion_collision(chain: KinematicChain | KinematicTree, motion) -> tuple[int, int] | None:
+    """The most frequent colliding pair of parts (elements) when the chain (or tree) collides
+    in more of the configurations of ``motion`` than allowed, else None."""
+    from kinegami.clearance.engine import engine_for, tree_engine
 
     movable_states, limit = motion
     movable = [i for i, j in enumerate(chain.Joints) if j.stateRange() != (0.0, 0.0)]
@@ -417,7 +418,9 @@ def _motion_collision(chain: KinematicChain, motion) -> tuple[int, int] | None:
         return None
     Q = np.tile([j.state for j in chain.Joints], (movable_states.shape[0], 1))
     Q[:, movable] = movable_states
-    clearance, pairs = engine_for(chain).worst(Q, chain.margin)
+    engine = tree_engine(chain, margin=chain.margin) if isinstance(chain, KinematicTree) \
+        else engine_for(chain)  # fmt: skip
+    clearance, pairs = engine.worst(Q, chain.margin)
     if float(np.mean(np.isfinite(clearance))) <= limit + 1e-12:
         return None
     counts: dict = {}
@@ -428,15 +431,16 @@ def _motion_collision(chain: KinematicChain, motion) -> tuple[int, int] | None:
 
 
 def _coarse_options(
-    joints: list, r: float, rng: np.random.Generator | None, parents=None, keep_last=False
+    joints: list, r: float, rng: np.random.Generator | None, parents=None, fixed=frozenset()
 ) -> list:
     """Per joint, the first candidate set: slides around the feet of the common normals with
     its neighbours' axes (and the point itself), times four rolls when rolling matters. With
-    ``rng``, the offsets are scaled and the rolls turned at random. ``keep_last``: the last
-    joint stays where it is (a task's end tip)."""
+    ``rng``, the offsets are scaled and the rolls turned at random. ``fixed``: the indices (in
+    ``joints``) of the joints that stay where they are (a task's end tips, a tree task's
+    root)."""
     options = []
     for j in range(len(joints)):
-        if (not joints[j].has_body and j > 0) or (keep_last and j == len(joints) - 1):
+        if (not joints[j].has_body and j > 0) or j in fixed:
             options.append(np.zeros((1, 2)))
             continue
         T = joints[j].pose_matrix
@@ -466,14 +470,14 @@ def _coarse_options(
     return options
 
 
-def _fine_options(layers: _Layers, choice: list[int], level: int, keep_last=False) -> list:
+def _fine_options(layers: _Layers, choice: list[int], level: int, fixed=frozenset()) -> list:
     """Candidates around the chosen ones: slides of 0, +-h, +-2h and rolls of 0, +-delta."""
     h = _FINE_SLIDES[level] * layers.r
     delta = _FINE_ROLLS[level]
     options = []
     for j in range(len(choice)):
         t, th = layers.options[j][choice[j]]
-        if (not layers.base[j].has_body and j > 0) or (keep_last and j == len(choice) - 1):
+        if (not layers.base[j].has_body and j > 0) or j in fixed:
             options.append(np.array([(t, th)]))
             continue
         rolls = [th] if layers.base[j].pathIndex() == 2 else [th, th - delta, th + delta]
@@ -483,25 +487,25 @@ def _fine_options(layers: _Layers, choice: list[int], level: int, keep_last=Fals
 
 
 def _dp_search(chain, rng: np.random.Generator | None, motion, deadline, junctions=False,
-               keep_last=False):  # fmt: skip
+               fixed: tuple[int, ...] = ()):  # fmt: skip
     """The shortest clear chain the layered search finds from ``chain``'s joints, or None.
 
     The waypoints are dropped; when no clear chain is found without them, they are tried
-    where they are. ``keep_last`` (chains): the last joint stays where it is.
+    where they are. ``fixed``: the indices of the joints (of ``chain``, none a waypoint but the
+    root) that stay where they are.
     """
     if isinstance(chain, KinematicTree):
         kept, parents = _without_waypoints(chain)
-        joints = [chain.Joints[k] for k in kept]
-        found = _dp_search_joints(chain, joints, rng, motion, deadline, parents, junctions)
-        if found is None and len(joints) < len(chain.Joints):
-            found = _dp_search_joints(chain, list(chain.Joints), rng, motion, deadline,
-                                      list(chain.Parents), junctions)  # fmt: skip
-        return found
-    joints = [j for i, j in enumerate(chain.Joints) if i == 0 or j.has_body]
-    found = _dp_search_joints(chain, joints, rng, motion, deadline, keep_last=keep_last)
+    else:
+        kept = [i for i, j in enumerate(chain.Joints) if i == 0 or j.has_body]
+        parents = None
+    joints = [chain.Joints[k] for k in kept]
+    inside = frozenset(kept.index(k) for k in fixed if k in kept)
+    found = _dp_search_joints(chain, joints, rng, motion, deadline, parents, junctions, inside)
     if found is None and len(joints) < len(chain.Joints):
         found = _dp_search_joints(chain, list(chain.Joints), rng, motion, deadline,
-                                  keep_last=keep_last)  # fmt: skip
+                                  None if parents is None else list(chain.Parents), junctions,
+                                  frozenset(fixed))  # fmt: skip
     return found
 
 
@@ -522,21 +526,28 @@ def _without_waypoints(tree: KinematicTree) -> tuple[list[int], list[int]]:
 
 
 def _dp_search_joints(chain, joints: list, rng, motion, deadline, parents=None,
-                      junctions=False, keep_last=False):  # fmt: skip
+                      junctions=False, fixed=frozenset()):  # fmt: skip
     if len(joints) < 2:
         return None
     require = chain.requireClearance
-    layers = _Layers(chain, joints, _coarse_options(joints, chain.r, rng, parents, keep_last),
+    layers = _Layers(chain, joints, _coarse_options(joints, chain.r, rng, parents, fixed),
                      restarts=False, parents=parents)  # fmt: skip
     layers.junctions = junctions
     found = _clear_choice(layers, motion, require, deadline)
+    if found is None and fixed:
+        # a task's search: when no coarse choice is clear, the finer levels refine the joints
+        # as given (clear where the task needs them, when the task's design is)
+        layers = _Layers(chain, joints, [np.zeros((1, 2))] * len(joints), restarts=False,
+                         parents=parents)  # fmt: skip
+        layers.junctions = junctions
+        found = _clear_choice(layers, motion, require, deadline)
     if found is None:
         return None
     best, choice = found
     for level in range(len(_FINE_SLIDES)):
         if deadline is not None and time.monotonic() > deadline:
             break
-        fine = _Layers(chain, joints, _fine_options(layers, choice, level, keep_last),
+        fine = _Layers(chain, joints, _fine_options(layers, choice, level, fixed),
                        restarts=False, parents=parents)  # fmt: skip
         fine.junctions = junctions
         keep = [0] * len(choice)  # candidate 0 of every layer is the current one
@@ -571,7 +582,7 @@ def _colliding_fraction(chain: KinematicChain, movable_states: np.ndarray) -> fl
 def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
     """One start of :func:`compact` (a top-level function, so any executor can run it):
     (objective, overlap, start, chain), chain None when the start found no clear design."""
-    chain, k, seed, kind, deadline_seconds, motion, junctions, keep_last = task
+    chain, k, seed, kind, deadline_seconds, motion, junctions, fixed = task
     deadline = None if deadline_seconds is None else time.monotonic() + deadline_seconds
     rng = np.random.default_rng([seed, k])
     # trial builds and edits that fail or collide warn; nobody wants thousands of those. Not a
@@ -579,10 +590,10 @@ def _run_start(task: tuple) -> tuple[float, float, int, KinematicChain | None]:
     # restores the caller's filters around the whole search; worker processes keep these).
     warnings.filterwarnings("ignore", category=PlacementWarning)
     warnings.filterwarnings("ignore", category=ClearanceWarning)
-    found = _dp_search(chain, None if k == 0 else rng, motion, deadline, junctions, keep_last)
+    found = _dp_search(chain, None if k == 0 else rng, motion, deadline, junctions, fixed)
     if kind == "length" and found is not None:
         return tube_length(found), 0.0, k, found
-    if keep_last:  # the descent below may slide any joint
+    if fixed:  # the descent below may slide any joint
         return math.inf, math.inf, k, None
     # the ball (or no clear design found): greedy descent from the shortest design (or the
     # input)
@@ -701,10 +712,13 @@ def compact(
     margin : float, optional
         The clearance required between the parts (chain units, >= 0; folded sheets have a
         thickness); default: ``chain.margin``. The result's ``margin`` is this value.
-    targets : sequence of targets, optional (chains only)
+    targets : sequence of targets, optional
         A task to keep (:func:`compact_for_task`): the end tip keeps its place on the last
         movable joint's body, and a shorter design is accepted only when every target is still
-        reached exactly, in range, clear with the margin and outside ``keep_out``.
+        reached exactly, in range, clear with the margin and outside ``keep_out``; otherwise
+        the input itself is returned. A tree's task: one list of targets per leaf (the leaves
+        in the order of their tip joints), grasp k every leaf's k-th target at once; every
+        leaf tip and the root stay where they are.
     keep_out : boxes no part may come near at the targets' configurations (with ``targets``).
 
     Raises
@@ -761,11 +775,13 @@ def compact(
 
 
 def _search(chain, seed: int, executor, time_limit, progress, objective: str, starts: int,
-            motion_task, junctions: bool, keep_last: bool = False):  # fmt: skip
+            motion_task, junctions: bool, fixed: tuple[int, ...] = (),
+            every: bool = False):  # fmt: skip
     """:func:`compact`'s search of checked arguments; ``motion_task``: (movable joints' states
-    (S, m), the largest colliding fraction allowed) or None; ``keep_last``: the chain's last
-    joint stays where it is."""
-    tasks = [(chain, k, seed, objective, time_limit, motion_task, junctions, keep_last)
+    (S, m), the largest colliding fraction allowed) or None; ``fixed``: the indices of the
+    joints that stay where they are (none a waypoint but the root). The best design, or with
+    ``every`` every design found (the starts' and the input's when it is valid), best first."""
+    tasks = [(chain, k, seed, objective, time_limit, motion_task, junctions, fixed)
              for k in range(starts)]  # fmt: skip
     own = executor is None
     if own:
@@ -786,8 +802,8 @@ def _search(chain, seed: int, executor, time_limit, progress, objective: str, st
             f"{problem[1]} and {starts} start(s) could not fix it); try more starts or another "
             "seed"
         )
-    value, _, _, best = min(found, key=lambda res: (res[0], res[2]))
-    return best
+    found.sort(key=lambda res: (res[0], res[2]))
+    return [res[3] for res in found] if every else found[0][3]
 
 
 #: Rotations of a position target's tip frame about its point (the end tip's tube leaves
@@ -836,9 +852,32 @@ def reach_clear(design, target, q0, seeds: int, margin: float, boxes=()) -> tupl
     return None, why
 
 
-def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(),
-                     margin: float | None = None, seed: int = 0, executor=None, starts: int = 4,
-                     time_limit: float | None = None, progress=None) -> tuple:  # fmt: skip
+def repaired_vertices(design, twistPortion: float = 0.2) -> int:
+    """How many vertices of ``design``'s folded form the isometry repair moves
+    (:attr:`kinegami.pattern.folded.FoldedForm.repairedVertices`; a tree: summed over its
+    sheets): 0 when every module folds exactly as its crease pattern says, more near a nearly
+    degenerate module (an elbow that barely turns its plane, say). ``twistPortion`` as for the
+    crease pattern (design files' default 0.2)."""
+    from kinegami.pattern.folded import folded_form
+
+    if isinstance(design, KinematicTree):
+        from kinegami.fabrication.sheets import fabricate
+
+        sheets = fabricate(design, twistPortion=twistPortion).sheets
+        patterns = [getattr(sheet.pattern, "pattern", sheet.pattern) for sheet in sheets]
+        return sum(folded_form(pattern).repairedVertices for pattern in patterns)
+    return folded_form(design, twistPortion=twistPortion).repairedVertices
+
+
+def _last_body(chain: KinematicChain) -> int:
+    """The index of the chain's last joint that is not a waypoint (the root when none is)."""
+    return max(k for k, joint in enumerate(chain.Joints) if k == 0 or joint.has_body)
+
+
+def compact_for_task(chain: KinematicChain | KinematicTree, targets, answers=None, *,
+                     keep_out=(), margin: float | None = None, seed: int = 0, executor=None,
+                     starts: int = 4, time_limit: float | None = None, progress=None,
+                     exact_fold: bool = False) -> tuple:  # fmt: skip
     """``(design, answers)``: :func:`compact` that keeps a task (docs/design-for-a-task.md).
 
     Compaction slides and rolls joints along their axes, which keeps each joint's motion but
@@ -853,24 +892,54 @@ def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(
     ``keep_out`` boxes, with a tube no longer than the input's; otherwise the input itself is
     returned.
 
+    A :class:`~kinegami.KinematicTree` keeps a tree task: ``targets`` is one list of targets per
+    leaf (the leaves in the order of their tip joints' indices; or a mapping {tip joint index:
+    list}), all of the same length, and grasp k puts every leaf's tip on its k-th target at
+    once, in one configuration of the whole tree (``answers``: one reach answer per grasp).
+    Every leaf tip stays where it is in the world at the tree's home states, so its frame on
+    its leaf's last movable joint, and the tree's kinematics, do not change; the root stays at
+    its pose (the task's base); every junction's sockets must fit. The search bans choices that
+    collide at a grasp, and a shorter tree is accepted only when every grasp is still reached
+    so; otherwise the input itself is returned.
+
+    ``exact_fold``: accept only a design whose folded form needs no isometry repair
+    (:func:`repaired_vertices` 0), as design for a task requires.
+
     Raises
     ------
     CompactionError
-        When the input itself does not reach a target so.
+        When the input itself does not reach a target (a tree: a grasp) so.
     """
     from kinegami.clearance.keep_out import Box
-    from kinegami.reach import Target
 
-    if not isinstance(chain, KinematicChain):
-        raise InvalidParameterError(
-            "compaction with targets is available for chains only (got a "
-            f"{type(chain).__name__})"
+    if not isinstance(chain, KinematicChain | KinematicTree):
+        raise InvalidTypeError(
+            "compaction with targets takes a KinematicChain or a KinematicTree, got a "
+            f"{type(chain).__name__}"
         )
     margin = float(chain.margin) if margin is None else check_margin(margin)
-    if isinstance(targets, (str, bytes)) or not isinstance(targets, (list, tuple)):
+    if isinstance(targets, (str, bytes)) or not isinstance(targets, (list, tuple, dict)) or \
+            (isinstance(targets, dict) and isinstance(chain, KinematicChain)):  # fmt: skip
         raise InvalidTypeError(f"targets must be a list of targets, got {targets!r}")
-    goals = [Target.of(t) for t in targets]
     boxes = tuple(Box.of(b, f"keep_out box {k}") for k, b in enumerate(keep_out or ()))
+    exact_fold = check_bool("exact_fold", exact_fold)
+    _check_executor(executor)
+    search = (check_int("seed", seed, minimum=0, floats=False), executor,
+              None if time_limit is None else check_positive("time_limit", time_limit),
+              check_progress(progress), "length", check_starts(starts))  # fmt: skip
+    if isinstance(chain, KinematicTree):
+        return _compact_tree_for_task(chain, targets, answers, boxes, margin, search,
+                                      exact_fold)  # fmt: skip
+    return _compact_chain_for_task(chain, targets, answers, boxes, margin, search, exact_fold)
+
+
+def _compact_chain_for_task(chain: KinematicChain, targets, answers, boxes: tuple,
+                            margin: float, search: tuple, exact_fold: bool) -> tuple:  # fmt: skip
+    """:func:`compact_for_task` of a chain (checked arguments; ``search``: the first six
+    arguments of :func:`_search` after the design)."""
+    from kinegami.reach import Target
+
+    goals = [Target.of(t) for t in targets]
 
     def reached(design, start) -> tuple[list | None, str]:
         found = []
@@ -902,40 +971,41 @@ def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(
         # the search bans the choices whose head collides at a target's configuration (as
         # compact(motion=True) does with sampled ones), so the task's configurations stay clear
         at_targets = np.array([np.asarray(answer.states)[movable] for answer in answers])
-        _check_executor(executor)
-        search = (check_int("seed", seed, minimum=0, floats=False), executor,
-                  None if time_limit is None else check_positive("time_limit", time_limit),
-                  check_progress(progress), "length", check_starts(starts), (at_targets, 0.0),
-                  False)  # fmt: skip
+        search = (*search, (at_targets, 0.0), False)
+        # every start's design competes (best first), not only the best: a shorter one may
+        # not keep the task, or (exact_fold) fold only after the repair
         candidates = []
         if len(tail) == 1:  # the whole chain, its end tip kept: the last link counts too
             whole = copy.copy(chain)
             whole.margin = margin
             try:
-                candidates.append(_search(whole, *search, keep_last=True))
+                candidates += _search(whole, *search, fixed=(_last_body(whole),), every=True)
             except CompactionError:
                 pass
         try:
-            shorter = _search(head, *search)
+            heads = _search(head, *search, every=True)
         except CompactionError:
-            shorter = None
-        tails = [tail] if shorter is not None else []
+            heads = []
+        tails = [tail]
         if len(tail) == 1 and isinstance(tail[0], EndTip) and \
                 all(goal.kind == "position" for goal in goals):  # fmt: skip
             # a point's tip frame may turn about it: the end tip may leave in any direction
             frame = np.asarray(getattr(tail[0].DistalDubinsFrame(), "A",
                                        tail[0].DistalDubinsFrame()))  # fmt: skip
             tails = [[end] for end in end_tips_at(frame, chain.numSides, chain.r,
-                                                  tail[0].neutralLength)] if tails else []
-        for joints in tails:
-            trial = copy.copy(shorter)
-            placed = (trial.append(joint, relative=False, safe=False, fixedPosition=True,
-                                   fixedOrientation=True) for joint in joints)  # fmt: skip
-            if all(index is not None for index in placed):
-                candidates.append(trial)
+                                                  tail[0].neutralLength)]  # fmt: skip
+        for shorter in heads:
+            for joints in tails:
+                trial = copy.copy(shorter)
+                placed = (trial.append(joint, relative=False, safe=False, fixedPosition=True,
+                                       fixedOrientation=True) for joint in joints)  # fmt: skip
+                if all(index is not None for index in placed):
+                    candidates.append(trial)
     for trial in sorted(candidates, key=tube_length):  # the shortest that keeps the task
         if tube_length(trial) > tube_length(chain):
             break
+        if exact_fold and repaired_vertices(trial) != 0:
+            continue
         new_movable = [k for k, j in enumerate(trial.Joints) if j.stateRange() != (0.0, 0.0)]
         starts_q = []
         for answer in answers:
@@ -946,6 +1016,105 @@ def compact_for_task(chain: KinematicChain, targets, answers=None, *, keep_out=(
         if found is not None:
             return trial, found
     return chain, answers
+
+
+def _leaves(tree: KinematicTree) -> list[int]:
+    """The tree's leaf tips (joints without children), in index order."""
+    return [k for k, children in enumerate(tree.Children) if not children]
+
+
+def _tree_goals(tree: KinematicTree, targets) -> list[tuple]:
+    """A tree task's targets as one tuple of reach Targets per leaf of ``tree`` (the leaves in
+    index order), checked: one list per leaf (or a mapping {leaf tip: list}), all as long."""
+    from kinegami.reach import Target
+
+    leaves = _leaves(tree)
+    if isinstance(targets, dict):
+        if sorted(targets) != leaves:
+            raise InvalidParameterError(
+                f"a tree task's targets map every leaf tip {leaves} to its targets, got the "
+                f"keys {sorted(targets, key=str)}"
+            )
+        targets = [targets[k] for k in leaves]
+    if len(targets) != len(leaves):
+        raise InvalidParameterError(
+            f"a tree task gives one list of targets per leaf: the tree has {len(leaves)} leaves "
+            f"(tips {leaves}), got {len(targets)} list(s)"
+        )
+    goals = []
+    for i, leaf in enumerate(targets):
+        if isinstance(leaf, (str, bytes)) or not isinstance(leaf, (list, tuple)):
+            raise InvalidTypeError(
+                f"targets[{i}] must be the list of leaf {i}'s targets (tip {leaves[i]}), got "
+                f"{leaf!r}"
+            )
+        goals.append(tuple(Target.of(t) for t in leaf))
+    counts = [len(leaf) for leaf in goals]
+    if len(set(counts)) != 1 or counts[0] == 0:
+        raise InvalidParameterError(
+            "every leaf of a tree task needs the same number (>= 1) of targets (grasp k puts "
+            f"every leaf on its k-th target at once), got {counts}"
+        )
+    return goals
+
+
+def _compact_tree_for_task(tree: KinematicTree, targets, answers, boxes: tuple, margin: float,
+                           search: tuple, exact_fold: bool) -> tuple:  # fmt: skip
+    """:func:`compact_for_task` of a tree (checked arguments; ``search``: the first six
+    arguments of :func:`_search` after the design)."""
+    goals = _tree_goals(tree, targets)
+    grasps = len(goals[0])
+    if answers is not None and len(answers) != grasps:
+        raise InvalidParameterError(
+            f"answers must be one reach answer per grasp ({grasps}), got {len(answers)}"
+        )
+
+    def reached(design, start) -> tuple[list | None, str]:
+        tips = _leaves(design)
+        found = []
+        for k in range(grasps):
+            mapping = {tip: leaf[k] for tip, leaf in zip(tips, goals, strict=True)}
+            answer, why = reach_clear(design, mapping, None if start is None else start[k], 4,
+                                      margin, boxes)  # fmt: skip
+            if answer is None:
+                return None, f"grasp {k}: {why}"
+            found.append(answer)
+        return found, ""
+
+    if answers is None:
+        answers, why = reached(tree, None)
+        if answers is None:
+            raise CompactionError(f"the design does not reach its task before compaction: {why}")
+    movable = [k for k, joint in enumerate(tree.Joints) if joint.stateRange() != (0.0, 0.0)]
+    if not movable:
+        return tree, answers
+    whole = copy.copy(tree)
+    whole.margin = margin
+    # the leaf tips stay where they are (their frames on their leaves' last movable joints do
+    # not change) and so does the root; the search bans the choices that collide at a grasp
+    at_grasps = np.array([np.asarray(answer.states)[movable] for answer in answers])
+    try:
+        trials = _search(whole, *search, (at_grasps, 0.0), True, fixed=(0, *_leaves(tree)),
+                         every=True)  # fmt: skip
+    except CompactionError:
+        return tree, answers
+    for trial in trials:  # the shortest that keeps the task
+        # not shorter (the input itself may win the search): the input, unchanged
+        if tube_length(trial) >= tube_length(tree):
+            break
+        new_movable = [k for k, j in enumerate(trial.Joints) if j.stateRange() != (0.0, 0.0)]
+        if len(_leaves(trial)) != len(goals) or len(new_movable) != len(movable) or \
+                (exact_fold and repaired_vertices(trial) != 0):  # fmt: skip
+            continue
+        starts_q = []
+        for answer in answers:
+            q = np.zeros(len(trial.Joints))
+            q[new_movable] = np.asarray(answer.states)[movable]
+            starts_q.append(q)
+        found, _ = reached(trial, starts_q)
+        if found is not None:
+            return trial, found
+    return tree, answers
 
 
 def _run_all(executor, own: bool, tasks: list, bar: Progress) -> list:

@@ -8,8 +8,9 @@ starts, until every target's residual is below 1e-11 r. Such a table is then bui
 kinegami's own placement (the joints slide along their axes, which keeps the kinematics; the end
 tip is placed exactly where the table puts the tip), and every target is solved again on the
 built chain by :func:`kinegami.reach.solve` with clearance, the margin and the keep-out boxes:
-only a chain that passes those checks is an answer. Compaction with the targets
-(:func:`kinegami.optimize.compact`) then shortens its tube.
+only a chain that passes those checks is an answer, and only one whose folded form needs no
+isometry repair is returned. Compaction with the targets (:func:`kinegami.optimize.compact`)
+then shortens its tube.
 
 Before any search, bounds that prove a task impossible raise :class:`InfeasibleTaskError` (the
 certificate): a target farther from the base than the longest tube allowed; orientations that
@@ -667,6 +668,20 @@ def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = Tr
     return (x, length, min(a.clearance for a in answers)), "", fitted
 
 
+def _fold_refusal(chain) -> str:
+    """Why a designed chain is refused for its folded form: its crease pattern folds only
+    after the isometry repair moves vertices (a nearly degenerate module, whose folded form is
+    not the one its creases give exactly; gallery designs may not need it); "" when it folds
+    exactly."""
+    from kinegami.optimize.compaction import repaired_vertices
+
+    count = repaired_vertices(chain)
+    if not count:
+        return ""
+    return (f"the design's folded form needs the isometry repair for {count} vertices (a "
+            "nearly degenerate module)")  # fmt: skip
+
+
 def _paths(chain, answers, task: _Task) -> tuple[list | None, str]:
     """The certified straight joint-space moves from each target's answer to the next
     (:func:`kinegami.clearance.paths.check_path`), as their measured configurations, or
@@ -805,7 +820,8 @@ def design_for(
     margin : the clearance required between parts and from the boxes (>= 0).
     starts : the fit's starts per joint-type string (>= 1).
     compact : shorten the found design by compaction that keeps the task (chains; a tree is
-        the shortest of the leaves' designs tried, its junctions fitted).
+        the shortest of the leaves' designs tried, its junctions fitted: compact it with
+        ``compact(tree, targets=...)``, which keeps a tree task).
     path : (chains) also require that the robot moves from each target's configuration to the
         next along the straight line in joint space without passing through itself (certified
         by :func:`kinegami.clearance.paths.check_path`).
@@ -816,7 +832,10 @@ def design_for(
     progress : ``progress(done, total)`` per start (False from it cancels), True for a bar.
 
     Among designs that reach every target: fewer joints first, then a shorter tube, then a
-    larger smallest clearance over the targets' configurations.
+    larger smallest clearance over the targets' configurations. A chain whose folded form needs
+    the isometry repair (:func:`kinegami.optimize.compaction.repaired_vertices` above 0: a
+    nearly degenerate module) is skipped for the next best one, and compaction passes over such
+    designs too (``exact_fold``); a tree's sheets are not checked.
 
     Raises
     ------
@@ -879,18 +898,26 @@ def design_for(
                     results += _run(executor, task, types, seed, [k for k, _ in again], True,
                                     [x for _, x in again])  # fmt: skip
                 bar.update(len(batch))
+                passed = []
                 for result, why, _ in results:
                     if result is None:
                         last = why
                         continue
-                    key = (result[1], -result[2])
-                    if best is None or key < best[0]:
-                        best = (key, result[0])
+                    passed.append(result)
+                # the best first (a shorter tube, then a larger clearance); one whose folded
+                # form needs the isometry repair is refused and the next one tried
+                for result in sorted(passed, key=lambda res: (res[1], -res[2])):
+                    why = _fold_refusal(_build(_Model(task, types), result[0])[0][0])
+                    if why:
+                        last = why
+                        continue
+                    best = result[0]
+                    break
                 if best is not None:
                     bar.update(starts - batch.stop)
                     break
             if best is not None:
-                found = (types, best[1])
+                found = (types, best)
                 break
     if found is None:
         raise InfeasibleTaskError(
@@ -911,7 +938,7 @@ def design_for(
         with concurrent.futures.ThreadPoolExecutor(1) as own:
             shorter, shorter_answers = compact_for_task(
                 chain, list(task.targets), answers, keep_out=task.boxes, margin=task.margin,
-                seed=seed, executor=executor or own)  # fmt: skip
+                seed=seed, executor=executor or own, exact_fold=True)  # fmt: skip
         if tube_length(shorter) <= tube_length(chain) and \
                 (not path or _paths(shorter, shorter_answers, task)[0] is not None):  # fmt: skip
             chain, answers = shorter, shorter_answers
