@@ -957,11 +957,13 @@ class Compact(LongCommand):
     (:func:`kinegami.optimize.compact`, docs/clearance.md; a tree's sockets fit afterwards);
     names follow their joints. ``motion`` is for chains only.
 
-    A chain with a task keeps it (``keep_task``, as ``kinegami compact`` does): a shorter design
-    is accepted only when every target is still reached exactly, in range, clear with the
-    larger of the chain's and the task's margins and outside the keep-out boxes
+    A design with a task keeps it (``keep_task``, as ``kinegami compact`` does): a shorter
+    design is accepted only when every target (a tree's: every grasp, the k-th target of every
+    leaf at once) is still reached exactly, in range, clear with the larger of the design's and
+    the task's margins and outside the keep-out boxes
     (:func:`kinegami.optimize.compact_for_task`; ``motion`` and ``objective`` are then not
-    used), else the command is refused. ``task`` is the task document to keep (default: the
+    used), else the command is refused. A tree task on a chain, or a chain's on a tree, is not
+    kept (the design cannot reach it as it is). ``task`` is the task document to keep (default: the
     document's) and ``units`` the design's length units; :meth:`prepared` fills both in.
     """
 
@@ -979,9 +981,9 @@ class Compact(LongCommand):
 
     def prepared(self, document: Document) -> Compact:
         task = self.task
-        if task is None and self.keep_task and not document.is_tree and \
-                not _is_tree_task(document.task):  # fmt: skip
-            task = document.task
+        if task is None and self.keep_task and document.task is not None and \
+                document.is_tree == _is_tree_task(document.task):  # fmt: skip
+            task = document.task  # (a chain's task for a chain, a tree's for a tree)
         if task is None:
             return self
         return replace(self, task=task, units=document.units)

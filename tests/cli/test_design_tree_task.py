@@ -117,16 +117,17 @@ def test_compact_and_the_editor_read_a_tree_with_its_tree_task(designed):
     result = run("compact", folder / "out" / "hand.json", "-o", folder / "compact.json",
                  "--time-limit", "1")  # fmt: skip
     assert result.returncode == 0, result.stderr
-    assert "task is not checked" in result.stderr and "Traceback" not in result.stderr
+    assert "task kept" in result.stdout and "Traceback" not in result.stderr
     _, info = load_design_with_info(folder / "compact.json")
     assert info.task == starter_task(tree=True)  # written as it was
     pytest.importorskip("viser")
     from kinegami.editor import EditorModel
 
+    from kinegami.editor.commands import Compact
+
     model = EditorModel.open(folder / "out" / "hand.json")
     assert model.is_tree and model.document.task == starter_task(tree=True)
-    refused = model.design_for_task()
-    assert not refused.ok and "tasks are for chains for now" in refused.reason
+    assert Compact().prepared(model.document).task == starter_task(tree=True)  # kept
 
 
 def test_an_infeasible_tree_task_exits_3_at_once_writing_nothing(tmp_path):

@@ -79,6 +79,7 @@ def test_the_task_panel_lists_a_tree_tasks_targets_per_leaf(served, tmp_path):
     assert partner.endswith("leaf 0, target 1 'left 1': not reached: its tip reaches it, but "
                             "not at once with leaf 1, target 1 'right 1', which is not reached")  # fmt: skip
     assert "reached, exactly and clear" in page.locator('li[data-target="0"]').inner_text()
-    assert view.target_colours() == (REACHED_COLOR, MISSED_COLOR, REACHED_COLOR, MISSED_COLOR)
+    assert view.target_colours() == (REACHED_COLOR, MISSED_COLOR, REACHED_COLOR,
+                                     MISSED_COLOR)  # fmt: skip
     page.get_by_role("button", name="Design for task", exact=True).wait_for()
     page.screenshot(path=tmp_path / "tree_task.png")

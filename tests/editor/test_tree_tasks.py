@@ -265,10 +265,36 @@ def test_cancel_of_design_for_a_tree_task_leaves_the_design_bit_for_bit(view):
     assert "design for task cancelled: the design is unchanged" in view.message
 
 
-def test_compact_of_a_tree_does_not_take_its_task():
-    """Compact keeps a task for chains only (docs/editor.md, Tasks): a tree's is not given to
-    compaction, and stays in the document."""
+def test_compact_of_a_tree_keeps_its_tree_task():
+    """Compact of a tree with a tree task (docs/editor.md, Tasks) keeps the task: the shorter
+    tree reaches every grasp exactly and clear (checked by the editor's own check, then each
+    grasp's states set on a copy and the tips put on their targets to 1e-9 r), as one command
+    that keeps the task; a chain's task on a tree is not given to compaction."""
     from kinegami.editor.commands import Compact
+    from kinegami.optimize import tube_length
 
     document = Document.load(FINGERS)
-    assert Compact().prepared(document).task is None
+    command = Compact(starts=2).prepared(document)
+    assert command.task is document.task
+    model = EditorModel(document)
+    result = model.apply(command)
+    assert result.ok, result.reason
+    shorter = model.document
+    assert shorter.task is document.task and model.can_undo
+    assert tube_length(shorter.chain) < tube_length(document.chain)
+    checks = check_targets(shorter.chain, shorter.task, shorter.units)
+    assert all(check.reached for check in checks), [c.reason for c in checks]
+    goals = task_goals(shorter.task, shorter.units)
+    tips = leaf_tips(shorter.chain)
+    for check in checks:
+        moved = copy.deepcopy(shorter.chain)
+        moved.requireClearance = True
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            assert moved.setJointStates(list(check.states))
+        tip = moved.Joints[tips[check.leaf]].distal_dubins_frame()[:3, 3]
+        target = goals.targets[check.leaf][check.index].position
+        assert np.abs(tip - target).max() <= 1e-9 * shorter.chain.r
+    chain_task = {**document.task, "joints": "RRR",
+                  "targets": document.task["targets"][0]}  # fmt: skip
+    assert Compact().prepared(document.replaced(task=chain_task)).task is None

@@ -1,11 +1,12 @@
 """Compaction of a tree keeps its tree task (issue 32): ``compact(tree, targets=...)`` with one
 target list per leaf, grasp k every leaf's k-th target at once.
 
-The tree is the starter tree task's design (two three-joint fingers, r = 10 mm), cached in
-tests/data/two_finger_tree.json with its task (``python tests/optimize/test_compact_tree_task.py``
-writes it again; the design takes about 16 s). Every grasp of a compacted tree is checked as a
-user would: a fresh kinegami.reach.solve of the grasp, its states set on a fresh copy (no
-warning), every leaf's tip on its target to 1e-9 r, and the tree's own clearance report."""
+The tree is the starter tree task's design (two three-joint fingers, r = 10 mm):
+tests/data/task_fingers.json, what ``kinegami design`` wrote for the task of ``kinegami new
+--task --tree`` (the editor's tree-task tests use it too). Every grasp of a compacted tree
+is checked as a user would: a fresh kinegami.reach.solve of the grasp, its states set on a
+fresh copy (no warning), every leaf's tip on its target to 1e-9 r, and the tree's own
+clearance report."""
 
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ from kinegami.optimize import compact, compact_for_task, tube_length
 from kinegami.reach import solve
 
 DATA = Path(__file__).resolve().parents[1] / "data"
-TREE_FILE = DATA / "two_finger_tree.json"
+TREE_FILE = DATA / "task_fingers.json"
 
 
 def leaf_tips(tree: KinematicTree) -> list[int]:
@@ -204,22 +205,3 @@ def test_kinegami_compact_of_a_tree_that_misses_its_task_exits_3(tmp_path, capsy
     assert code == 3
     assert "does not reach its task before compaction: grasp 0" in captured.err
     assert not (tmp_path / "out.json").exists()
-
-
-def write_fixture() -> None:
-    """Design the starter tree task and write it with its task to :data:`TREE_FILE`."""
-    from kinegami.design import save_design
-    from kinegami.design.task import starter_task
-    from kinegami.optimize import design_for
-
-    document = starter_task(tree=True)
-    task = task_from_dict(document)
-    tree = design_for([list(leaf) for leaf in task.targets], list(task.joints),
-                      **task.options())  # fmt: skip
-    save_design(tree, TREE_FILE, name=task.name, description="The starter tree task's design "
-                "(tests/optimize/test_compact_tree_task.py)", units=task.units,
-                task=document)  # fmt: skip
-
-
-if __name__ == "__main__":
-    write_fixture()
