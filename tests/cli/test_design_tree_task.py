@@ -122,7 +122,6 @@ def test_compact_and_the_editor_read_a_tree_with_its_tree_task(designed):
     assert info.task == starter_task(tree=True)  # written as it was
     pytest.importorskip("viser")
     from kinegami.editor import EditorModel
-
     from kinegami.editor.commands import Compact
 
     model = EditorModel.open(folder / "out" / "hand.json")
