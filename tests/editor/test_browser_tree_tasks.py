@@ -76,8 +76,9 @@ def test_the_task_panel_lists_a_tree_tasks_targets_per_leaf(served, tmp_path):
     assert far.startswith("● leaf 1, target 1 'right 1': not reached: beyond reach: the target")
     assert view.task_checks[3].reason in far  # the solver's reason, whole
     partner = page.locator('li[data-target="1"]').inner_text()
-    assert partner.endswith("leaf 0, target 1 'left 1': not reached: its tip reaches it, but "
-                            "not at once with leaf 1, target 1 'right 1', which is not reached")  # fmt: skip
+    assert partner.endswith(
+        "leaf 0, target 1 'left 1': not reached: its tip reaches it, but not at once with "
+        "leaf 1, target 1 'right 1', which is not reached")  # fmt: skip
     assert "reached, exactly and clear" in page.locator('li[data-target="0"]').inner_text()
     assert view.target_colours() == (REACHED_COLOR, MISSED_COLOR, REACHED_COLOR,
                                      MISSED_COLOR)  # fmt: skip
