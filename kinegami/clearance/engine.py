@@ -1128,34 +1128,38 @@ class ClearanceEngine:
         """Where the parts bind at one configuration (absolute states, checked): the tested
         pairs of capsules closer than ``margin`` (chain units, >= 0, to within
         ``CONTACT_TOLERANCE`` r as every verdict) and the closest pair (all of them on a
-        tie), closest first, without words: what a solver needs for the clearance's gradient
-        (docs/reach.md, "Inverse kinematics").
+        tie), in the order of :meth:`report` (closest first), without words: what a solver
+        needs for the clearance's gradient (docs/reach.md, "Inverse kinematics").
 
-        Returns ``(clearance, ends, bodies, s, t)``: ``clearance`` (k,) chain units (negative:
-        overlap depth); ``ends`` (k, 4, 3) the world end points of the two capsules'
-        segments (first start, first end, second start, second end); ``bodies`` (k, 4) the
-        rigid body each end point rides on (0 the base, b the body that moving joint
-        ``screws.moving[b - 1]`` turns or slides; a sliding capsule's ends ride on two);
-        ``s``, ``t`` (k,) the closest points' parameters: the first at ``ends[:, 0] + s
+        Returns ``(clearance, ends, bodies, s, t, capsules)``: ``clearance`` (k,) chain units
+        (negative: overlap depth); ``ends`` (k, 4, 3) the world end points of the two
+        capsules' segments (first start, first end, second start, second end); ``bodies``
+        (k, 4) the rigid body each end point rides on (0 the base, b the body that moving
+        joint ``screws.moving[b - 1]`` turns or slides; a sliding capsule's ends ride on
+        two); ``s``, ``t`` (k,) the closest points' parameters: the first at ``ends[:, 0] + s
         (ends[:, 1] - ends[:, 0])``, the second at ``ends[:, 2] + t (ends[:, 3] - ends[:,
-        2])``. Pairs inside one rigid body are listed too (they never move apart). The
-        smallest clearance is :meth:`report`'s ``min_clearance`` at these states with this
-        margin, the same arithmetic; none at all (k = 0) when nothing is tested.
+        2])``; ``capsules`` (k, 2) the two capsules (``label(capsules[n, 0], s[n])`` words the
+        first part). Pairs inside one rigid body are listed too (they never move apart). The
+        first pair is the report's ``closest`` at these states and its clearance the
+        report's ``min_clearance``, the same arithmetic (k = 0 when nothing is tested).
         """
         margin = check_margin(margin)
         limit = clear_limit(self.r, margin)
         Q = self._configurations(self.check_states(states)[None, :])
         S = self._S
         one = self._one_arrays() if self._listed else None
-        if one is not None and one.pairs and _kernel() is not None:
+        compiled = one is not None and one.pairs and _kernel() is not None
+        if compiled:  # the kernel keeps the pairs closer than the limit and the closest
             B = self.screws.body_motions_one(Q[0])
             c, n, s, t, W = _kernel()(B, *one.kernel_arrays(self), Q[0],
                                       math.pi - TURN_TOLERANCE, limit, one.static_first[0],
                                       one.slack, 2.0 * self.r)  # fmt: skip
-            if c.size > 1:  # closest first
-                order = c.argsort(kind="stable")
-                c, n, s, t = c[order], n[order], s[order], t[order]
-            rows = self._closest_rows(one)[n]
+            listed = getattr(self, "_closest_listed", None)
+            if listed is None:  # every listed pair's end point rows and tie rank, made once
+                i, j = one.pair_ij
+                listed = self._closest_listed = (np.stack([i, S + i, j, S + j], axis=1),
+                                                 np.asarray(one.rank, dtype=np.int64))  # fmt: skip
+            rows, rank = listed[0][n], listed[1][n]
         else:  # the batched candidates, the search widened until the closest is among them
             threshold = (4.0 if self._listed else 0.5) * self.r + margin
             static_min = float(self._static_clearance.min()) if self._static_clearance.size \
@@ -1167,35 +1171,31 @@ class ClearanceEngine:
                     break
                 threshold = max(2.0 * threshold, best)
             W = np.concatenate(self._segments_at(B, 0))
-            keep = np.flatnonzero((c < limit) | (c == c.min())) if c.size else i
-            keep = keep[c[keep].argsort(kind="stable")]  # closest first
-            c, s, t = c[keep], s[keep], t[keep]
-            rows = np.stack([i[keep], S + i[keep], j[keep], S + j[keep]], axis=1)
+            rows, rank = np.stack([i, S + i, j, S + j], axis=1), self._rank(i, j)
         static = self._static_clearance
-        if static.size:  # the pairs inside one body closer than the limit, or the closest
-            low = float(static.min()) if one is None else one.static_first[0]
-            if low < limit or not c.size or low <= float(c[0]):
-                fixed = np.flatnonzero((static < limit) | (static == low))
-                si, sj = self._static_pairs[0][fixed], self._static_pairs[1][fixed]
-                c = np.concatenate([c, static[fixed]])
-                s = np.concatenate([s, self._static_st[0][fixed]])
-                t = np.concatenate([t, self._static_st[1][fixed]])
-                rows = np.concatenate([rows, np.stack([si, S + si, sj, S + sj], axis=1)])
-                keep = np.flatnonzero((c < limit) | (c == c.min()))
-                keep = keep[c[keep].argsort(kind="stable")]
-                c, s, t, rows = c[keep], s[keep], t[keep], rows[keep]
+        low = one.static_first[0] if one is not None else \
+            float(static.min()) if static.size else math.inf  # fmt: skip
+        if low < limit or (static.size and (not c.size or low <= float(c.min()))):
+            # the pairs inside one body closer than the limit, or the closest
+            fixed = np.flatnonzero((static < limit) | (static == low))
+            si, sj = self._static_pairs[0][fixed], self._static_pairs[1][fixed]
+            kind = np.r_[np.zeros(c.size, dtype=np.int64), np.ones(fixed.size, dtype=np.int64)]
+            c = np.concatenate([c, static[fixed]])
+            s = np.concatenate([s, self._static_st[0][fixed]])
+            t = np.concatenate([t, self._static_st[1][fixed]])
+            rows = np.concatenate([rows, np.stack([si, S + si, sj, S + sj], axis=1)])
+            rank = np.concatenate([rank, self._static_rank[fixed]])
+            keep = np.flatnonzero((c < limit) | (c == c.min()))
+            # the report's order: a chain's moving pairs before its static ones
+            keep = keep[np.lexsort((rank[keep], kind[keep], c[keep]) if self._caps is None
+                                   else (rank[keep], c[keep]))]  # fmt: skip
+            c, s, t, rows = c[keep], s[keep], t[keep], rows[keep]
+        elif c.size > 1:  # the moving pairs only, in the report's order
+            keep = np.arange(c.size) if compiled else np.flatnonzero((c < limit) | (c == c.min()))
+            keep = keep[np.lexsort((rank[keep], c[keep]))]
+            c, s, t, rows = c[keep], s[keep], t[keep], rows[keep]
         bodies = one.rows if one is not None else np.concatenate([self.body_a, self.body_b])
-        return c, W[rows], bodies[rows], s, t
-
-    def _closest_rows(self, one: _OneConfiguration) -> np.ndarray:
-        """(pairs, 4): the end points' rows (in the moved end points, starts then ends) of
-        every listed pair's two capsules, for :meth:`closest_pairs` (made once)."""
-        rows = getattr(self, "_listed_rows", None)
-        if rows is None:
-            i, j = one.pair_ij
-            S = self._S
-            rows = self._listed_rows = np.stack([i, S + i, j, S + j], axis=1)
-        return rows
+        return c, W[rows], bodies[rows], s, t, rows[:, ::2]
 
     def _distinct_pairs(self, i, j, s, t, clearance) -> tuple[np.ndarray, int, int]:
         """Of capsule pairs (rows i and j at parameters s and t), closest first: the index of

@@ -250,7 +250,8 @@ def _goals(design, target, tip) -> dict[int, Target]:
             raise InvalidParameterError("a mapping of tips to targets must not be empty")
         return out
     if tip is None:
-        leaves = [k for k in range(n) if k not in {p for p in design.Parents if p >= 0}]
+        parents = {p for p in design.Parents if p >= 0}
+        leaves = [k for k in range(n) if k not in parents]
         if len(leaves) != 1:
             raise InvalidParameterError(
                 f"the design has {len(leaves)} tips ({leaves}): give tip=J or a mapping "
@@ -620,13 +621,12 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
     arguments = (steps, path, revolute, reference, E, low_p, high_p, kind, target.position,
                  rotation, axis, r, tol_p, tol_a)  # fmt: skip
     redundant = path.size > (3 if kind == 0 else 6)
-    if clear and redundant:
-        engine = _engine_of(design, margin)
-        required = _margin_value(design, margin)
-        limit = _limit(design, required)
-        apart = required + ESCAPE_BUFFER * r  # an escape pushes pairs apart up to it
+    engine = _engine_of(design, margin)
+    required = _margin_value(design, margin)
+    limit = _limit(design, required)
+    apart = required + ESCAPE_BUFFER * r  # an escape pushes pairs apart up to it
     best: list = [None]
-    collided = None  # (q, verdict or None): the last exact solution that passes through itself
+    collided = ""  # the binding pair of the last exact solution that passes through itself
     iterations = escapes = 0
     q = np.clip(start, low, high)
     seeds = None
@@ -654,26 +654,21 @@ def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
         if not exact:
             _keep(best, 0, found, near_pos, near_ang, None)
             continue
-        if clear and redundant and escapes < ESCAPES:
-            # the clearance first without words (the engine's closest pairs: the report's
-            # verdict); moved along the solutions, away from the binding pairs, if not clear
-            pairs = engine.closest_pairs(found, apart)
-            if not _is_clear(pairs, limit):
-                escapes += 1
-                found, pairs, count = _escape(engine, compiled, tip, found, columns,
-                                              arguments, pairs, limit, apart)  # fmt: skip
-                iterations += count
-            verdict = _judge(design, found, clear, margin) if _is_clear(pairs, limit) \
-                else None  # fmt: skip
-        else:  # the report says (and words the clearance)
-            verdict = _judge(design, found, clear, margin)
+        # the engine's closest pairs (the report's verdict and words); a redundant arm that
+        # passes through itself moves along its solutions, away from the binding pairs
+        escape = clear and redundant and escapes < ESCAPES
+        pairs = engine.closest_pairs(found, apart if escape else required)
+        if escape and not _is_clear(pairs, limit):
+            escapes += 1
+            found, pairs, count = _escape(engine, compiled, tip, found, columns, arguments,
+                                          pairs, limit, apart)  # fmt: skip
+            iterations += count
+        verdict = _verdict(engine, pairs, limit, clear)
         _keep(best, 0, found, near_pos, near_ang, verdict)
-        if verdict is not None and verdict[2]:
+        if verdict[2]:
             return _answer(best[0], iterations, started, "", (tip,))
-        collided = (found, verdict)
-    words = "" if collided is None else (collided[1] or _judge(design, collided[0], clear,
-                                                                margin))[1]  # fmt: skip
-    return _failure(design, best[0], iterations, budget - 1, words, options, compiled, goal,
+        collided = verdict[1]
+    return _failure(design, best[0], iterations, budget - 1, collided, options, compiled, goal,
                     (tip,))  # fmt: skip
 
 
@@ -705,7 +700,7 @@ def _escape(engine, compiled: Kinematics, tip: int, q: np.ndarray, columns: np.n
     radius = ESCAPE_RADIUS
     iterations = 0
     for _ in range(ESCAPE_STEPS):
-        clearance, ends, bodies, s, t = pairs
+        clearance, ends, bodies, s, t, _ = pairs
         step = escape_step(*arguments[:8], arguments[11], q[columns], clearance, ends, bodies,
                            s, t, moves, apart, radius)  # fmt: skip
         if np.array_equal(step, q[columns]):  # no step raises a pair
@@ -798,11 +793,23 @@ def _words(goal: dict) -> list[int]:
 
 
 def _judge(design, q: np.ndarray, clear: bool, margin) -> tuple[float, str, bool]:
-    """(clearance, binding pair in words, acceptable) of the design at ``q``: its clearance
-    report (``design.clearance``'s, from the same engine)."""
-    report = _engine_of(design, margin).report(q.tolist(), _margin_value(design, margin))
-    pair = "" if report.closest is None else f"{report.closest.first} and {report.closest.second}"
-    return report.min_clearance, pair, (report.ok or not clear)
+    """(clearance, binding pair in words, acceptable) of the design at ``q``, as its
+    clearance report (``design.clearance``) gives them."""
+    engine = _engine_of(design, margin)
+    required = _margin_value(design, margin)
+    return _verdict(engine, engine.closest_pairs(q, required), _limit(design, required), clear)
+
+
+def _verdict(engine, pairs: tuple, limit: float, clear: bool) -> tuple[float, str, bool]:
+    """(clearance, binding pair in words, acceptable) from the engine's closest pairs
+    (:meth:`ClearanceEngine.closest_pairs`, whose first is the report's closest pair: the
+    report's smallest clearance, its closest pair's words and its verdict)."""
+    clearance, _, _, s, t, capsules = pairs
+    if clearance.size == 0:  # nothing is tested
+        return math.inf, "", True
+    first, second = capsules[0].tolist()
+    words = f"{engine.label(first, float(s[0]))} and {engine.label(second, float(t[0]))}"
+    return float(clearance[0]), words, float(clearance[0]) >= limit or not clear
 
 
 def _keep(best: list, g: int, q, pos: float, ang: float, verdict) -> None:

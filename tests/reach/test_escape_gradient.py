@@ -34,11 +34,12 @@ def engine_of(design):
 
 
 @pytest.mark.parametrize("compiled_kernel", [True, False], ids=["compiled", "numpy"])
-@pytest.mark.parametrize("name", ["spherical_series", "hand"])
+@pytest.mark.parametrize("name", ["spherical_series", "prismatic_spiral", "hand"])
 def test_closest_pairs_are_the_reports_and_where_they_are(name, compiled_kernel, monkeypatch):
-    """The smallest clearance is the report's to the bit (with the compiled kernel and
-    without), every pair's clearance is the distance of its points less 2r, the pairs are
-    those closer than the margin (and the closest), closest first."""
+    """The first pair is the report's closest (the same words) and its clearance the report's
+    smallest to the bit (with the compiled kernel and without), every pair's clearance is
+    the distance of its points less 2r, the pairs are those closer than the margin (and the
+    closest), closest first."""
     import kinegami.clearance.engine as engine_module
 
     if not compiled_kernel:
@@ -47,10 +48,13 @@ def test_closest_pairs_are_the_reports_and_where_they_are(name, compiled_kernel,
     engine = engine_of(design)
     r = float(design.r)
     for margin in (0.0, 0.5 * r):
-        for q in random_configurations(kinematics(design), 12, seed=2):
+        states = np.array([joint.state for joint in design.Joints])  # ties, often
+        for q in [states] + random_configurations(kinematics(design), 12, seed=2):
             report = engine.report(q.tolist(), margin)
-            clearance, ends, bodies, s, t = engine.closest_pairs(q, margin)
+            clearance, ends, bodies, s, t, capsules = engine.closest_pairs(q, margin)
             assert clearance[0] == report.min_clearance
+            assert engine.label(capsules[0, 0], s[0]) == report.closest.first
+            assert engine.label(capsules[0, 1], t[0]) == report.closest.second
             assert np.all(np.diff(clearance) >= 0.0)
             limit = margin - 1e-9 * r
             assert np.all((clearance < limit) | (clearance == clearance[0]))
@@ -81,7 +85,8 @@ def _capsule_rows(engine, q, ends) -> tuple[int, int]:
     return i, j
 
 
-@pytest.mark.parametrize("name, tip", [("spherical_series", None), ("hand", 4)])
+@pytest.mark.parametrize("name, tip", [("spherical_series", None), ("prismatic_spiral", None),
+                                       ("hand", 4)])  # fmt: skip
 def test_the_analytic_gradient_is_the_finite_differences_one(name, tip):
     """Each listed pair's clearance gradient with respect to the tip path's joints (the
     closest points moved by the joints' screws, kinegami.reach.kernels.clearance_gradients)
@@ -99,7 +104,7 @@ def test_the_analytic_gradient_is_the_finite_differences_one(name, tip):
     r, h = float(design.r), 1e-6
     checked = 0
     for q in random_configurations(compiled, 6, seed=11):
-        clearance, ends, bodies, s, t = engine.closest_pairs(q, 2.0 * r)
+        clearance, ends, bodies, s, t, _ = engine.closest_pairs(q, 2.0 * r)
         G = clearance_gradients(steps, path, revolute, reference, E, q[columns], ends, bodies,
                                 s, t, moves)  # fmt: skip
         for k in range(min(clearance.size, 8)):
