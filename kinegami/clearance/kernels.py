@@ -88,6 +88,24 @@ def segment_distance_compiled(ax, ay, az, bx, by, bz, cx, cy, cz, ex, ey, ez):
 
 
 @njit(cache=True)
+def _sift_down(heap, key, root, size):
+    """Restore the min-heap order of ``heap[:size]`` (indices into ``key``) below ``root``."""
+    item = heap[root]
+    while True:
+        child = 2 * root + 1
+        if child >= size:
+            break
+        if child + 1 < size and key[heap[child + 1]] < key[heap[child]]:
+            child += 1
+        if key[heap[child]] < key[item]:
+            heap[root] = heap[child]
+            root = child
+        else:
+            break
+    heap[root] = item
+
+
+@njit(cache=True)
 def one_configuration(B, rows, points, pair_i, pair_j, twice_half, sure, maybe_turn, maybe_bi,
                       maybe_bj, kink_joints, kink_parents, values, turn_max, limit, static_min,
                       slack, r2):  # fmt: skip
@@ -153,16 +171,23 @@ def one_configuration(B, rows, points, pair_i, pair_j, twice_half, sure, maybe_t
                     continue  # the turning rule does not test it here
             chosen[count] = n
             count += 1
-    chosen = chosen[:count]
-    order = np.argsort(low[chosen])
+    # the chosen pairs in the order of their bounds, taken from a binary heap one at a time
+    # (numba's argsort costs seconds of compilation; the loop usually stops after a few)
+    heap = chosen[:count].copy()
+    for root in range(count // 2 - 1, -1, -1):
+        _sift_down(heap, low, root, count)
     clearance = np.empty(count)
     pair = np.empty(count, dtype=np.int64)
     s_out = np.empty(count)
     t_out = np.empty(count)
     best = math.inf
     measured = 0
-    for k in range(count):
-        n = chosen[order[k]]
+    size = count
+    while size > 0:
+        n = heap[0]
+        size -= 1
+        heap[0] = heap[size]
+        _sift_down(heap, low, 0, size)
         if low[n] > 2.0 * (max(limit, min(best, static_min)) + slack + r2):
             break
         i, j = pair_i[n], pair_j[n]
