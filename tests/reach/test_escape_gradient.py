@@ -203,6 +203,7 @@ def test_a_stalled_start_is_cut_short():
     r = float(design.r)
     q0 = np.array([joint.state for joint in design.Joints])
     target = centre + np.array([0.0, 0.0, -0.99 * radius])  # below the base: out of reach
+    # (arguments of the solver's own types, contiguous: no second compilation of descend)
     exact, count, pos, ang, best, best_pos, _ = descend(
         steps, path, revolute, reference, E, low_p, high_p, 0, target, np.eye(3), np.zeros(3),
         r, 1e-9, 1e-9, q0[columns].copy(), inverse.ITERATIONS, inverse.DAMPING,
@@ -214,10 +215,10 @@ def test_a_stalled_start_is_cut_short():
     assert best_pos == pytest.approx(np.linalg.norm(compiled.fkine(nearest)[:3, 3] - target))
     # a reachable target from the same start converges
     (q,) = random_configurations(compiled, 1, seed=3)
-    T = compiled.fkine(q)
+    pose = Target.of(compiled.fkine(q))
     exact, count, *_ = descend(
-        steps, path, revolute, reference, E, low_p, high_p, 2, T[:3, 3], T[:3, :3], np.zeros(3),
-        r, 1e-9, 1e-9, q0[columns].copy(), inverse.ITERATIONS, inverse.DAMPING,
+        steps, path, revolute, reference, E, low_p, high_p, 2, pose.position, pose.rotation,
+        np.zeros(3), r, 1e-9, 1e-9, q0[columns].copy(), inverse.ITERATIONS, inverse.DAMPING,
         inverse.DAMPING_MIN, inverse.DAMPING_MAX)  # fmt: skip
     assert exact
 
