@@ -117,11 +117,22 @@ def _kernel():
     the same reports, slower)."""
     if not _KERNEL:
         try:
-            from kinegami.clearance.kernels import one_configuration
+            from kinegami.clearance.kernels import body_motions, one_configuration
         except (ImportError, OSError, RuntimeError):  # no numba, or no cache it can write
-            one_configuration = None
-        _KERNEL.append(one_configuration)
+            body_motions = one_configuration = None
+        _KERNEL.extend((one_configuration, body_motions))
     return _KERNEL[0]
+
+
+def _compiled_motions(screws, q: np.ndarray) -> np.ndarray:
+    """``screws.body_motions_one(q)`` by the compiled kernel
+    (:func:`kinegami.clearance.kernels.body_motions`: the same bits; sin and cos are numpy's,
+    as there); call only where :func:`_kernel` is not None."""
+    moving = screws.moving
+    delta = q.take(moving) - screws.q_ref.take(moving)
+    K1, K2 = screws.rotation_generators
+    return _KERNEL[1](delta, np.sin(delta), 1.0 - np.cos(delta), K1, K2, screws.points,
+                      screws.axes, screws.revolute, screws.body_parent)  # fmt: skip
 
 
 class _Layout:
@@ -1150,7 +1161,7 @@ class ClearanceEngine:
         one = self._one_arrays() if self._listed else None
         compiled = one is not None and one.pairs and _kernel() is not None
         if compiled:  # the kernel keeps the pairs closer than the limit and the closest
-            B = self.screws.body_motions_one(Q[0])
+            B = _compiled_motions(self.screws, Q[0])
             c, n, s, t, W = _kernel()(B, *one.kernel_arrays(self), Q[0],
                                       math.pi - TURN_TOLERANCE, limit, one.static_first[0],
                                       one.slack, 2.0 * self.r)  # fmt: skip
@@ -1361,22 +1372,22 @@ class ClearanceEngine:
         are closer than the limit. The turning rule is applied to the pairs measured only."""
         one = self._one_arrays()
         r2 = 2.0 * self.r
-        B = self.screws.body_motions_one(Q[0])
         S = self._S
         static_min = one.static_first[0]
         found: list[tuple] = []
         one.queries += 1
         if one.pairs and one.queries > COMPILED_AFTER and _kernel() is not None:
-            one_configuration = _kernel()  # many queries: the compiled kernel
+            one_configuration = _kernel()  # many queries: the compiled kernels
             clearance, n, s, t, moved = one_configuration(
-                B, *one.kernel_arrays(self), Q[0], math.pi - TURN_TOLERANCE, limit, static_min,
-                one.slack, r2)  # fmt: skip
+                _compiled_motions(self.screws, Q[0]), *one.kernel_arrays(self), Q[0],
+                math.pi - TURN_TOLERANCE, limit, static_min, one.slack, r2)  # fmt: skip
             if clearance.size > _FOUND_AS_ARRAYS:  # a design folded onto itself
                 found = (clearance, n.astype(np.int64), s, t)
             else:
                 found = list(zip(clearance.tolist(), n.tolist(), s.tolist(), t.tolist(),
                                  strict=True))  # fmt: skip
             return self._one_report(one, found, moved, values, limit, margin)
+        B = self.screws.body_motions_one(Q[0])
         # every end point moved (the arithmetic of _Layout.move), coordinate-major (3, 2S)
         NB = B.shape[0]
         M = B.reshape(NB, 16)[:, :12].T.take(one.rows, axis=1).reshape(3, 4, -1)

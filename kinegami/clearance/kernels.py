@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["one_configuration", "segment_distance_compiled"]
+__all__ = ["body_motions", "one_configuration", "segment_distance_compiled"]
 
 #: A squared segment length below which a segment is a point (geometry.segments' _DEGENERATE).
 DEGENERATE = 1e-30
@@ -85,6 +85,51 @@ def segment_distance_compiled(ax, ay, az, bx, by, bz, cx, cy, cz, ex, ey, ez):
         if d < best:
             best, bp, bq = d, p, q
     return best, bp, bq
+
+
+@njit(cache=True)
+def body_motions(delta, sine, versine, K1, K2, points, axes, revolute, parent):
+    """:meth:`kinegami.geometry.screws.JointScrews.body_motions_one` compiled: (NB, 4, 4)
+    every body's motion for the moving joints' state changes ``delta`` (M,), with ``sine`` and
+    ``versine`` (sin, 1 - cos: numpy's, passed in), each joint's cross-product matrix ``K1``
+    and its square ``K2`` (M, 3, 3), its axis's point and direction (M, 3), whether it turns,
+    and each body's parent (M + 1,). The same sums in the same order as the numpy path
+    (:meth:`~kinegami.geometry.screws.JointScrews.local_motions`,
+    :func:`~kinegami.geometry.screws.rigid_product`), so the same bits."""
+    M = delta.shape[0]
+    B = np.empty((M + 1, 4, 4))
+    for i in range(4):
+        for j in range(4):
+            B[0, i, j] = 1.0 if i == j else 0.0
+    R = np.empty((3, 3))
+    t = np.empty(3)
+    for b in range(1, M + 1):
+        m = b - 1
+        s = sine[m] if revolute[m] else 0.0
+        c = versine[m] if revolute[m] else 0.0
+        for i in range(3):
+            for j in range(3):
+                R[i, j] = ((1.0 if i == j else 0.0) + s * K1[m, i, j]) + c * K2[m, i, j]
+        px, py, pz = points[m, 0], points[m, 1], points[m, 2]
+        for i in range(3):
+            if revolute[m]:
+                t[i] = (points[m, i]) - ((R[i, 0] * px + R[i, 1] * py) + R[i, 2] * pz)
+            else:
+                t[i] = delta[m] * axes[m, i]
+        out = B[b]
+        out[3, 0], out[3, 1], out[3, 2], out[3, 3] = 0.0, 0.0, 0.0, 1.0
+        if parent[b] == 0:
+            for i in range(3):
+                for j in range(3):
+                    out[i, j] = R[i, j]
+                out[i, 3] = t[i]
+            continue
+        P = B[parent[b]]
+        for i in range(3):
+            for j in range(3):
+                out[i, j] = (P[i, 0] * R[0, j] + P[i, 1] * R[1, j]) + P[i, 2] * R[2, j]
+            out[i, 3] = ((P[i, 0] * t[0] + P[i, 1] * t[1]) + P[i, 2] * t[2]) + P[i, 3]
+    return B
 
 
 @njit(cache=True)

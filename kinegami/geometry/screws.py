@@ -26,6 +26,7 @@ import numpy as np
 
 __all__ = [
     "JointScrews",
+    "rigid_product",
     "FIXED",
     "REVOLUTE",
     "PRISMATIC",
@@ -107,41 +108,31 @@ class JointScrews:
 
     def body_motions(self, Q) -> np.ndarray:
         """(K, bodies, 4, 4): the world motion of every rigid body (0 = base) from ``q_ref``
-        to each configuration of ``Q`` (K, J)."""
+        to each configuration of ``Q`` (K, J).
+
+        The arithmetic is written out (:func:`rigid_product`, :meth:`local_motions`), not left
+        to BLAS, so that a compiled kernel can do the same sums in the same order and give the
+        same bits (the clearance engine's one-configuration query does)."""
         Q = np.asarray(Q, dtype=float)
         K, NB = Q.shape[0], self.bodies
         B = np.empty((K, NB, 4, 4))
         B[:, 0] = _EYE4
         if NB == 1:
             return B
-        delta = Q[:, self.moving] - self.q_ref[self.moving]
-        rev = self.revolute
-        # revolute: Rodrigues' rotation about the hinge line; prismatic: a slide along the axis
-        if self.all_revolute:
-            s = np.sin(delta)[..., None, None]
-            c = (1.0 - np.cos(delta))[..., None, None]
-        else:
-            s = np.where(rev, np.sin(delta), 0.0)[..., None, None]
-            c = np.where(rev, 1.0 - np.cos(delta), 0.0)[..., None, None]
-        R = _EYE3 + s * self._K1 + c * self._K2
-        p = self.points
-        M = np.empty((K, NB - 1, 4, 4))
-        M[..., 3, :] = _LAST_ROW
-        M[..., :3, :3] = R
-        if self.all_revolute:
-            M[..., :3, 3] = p - (R @ p[:, :, None])[..., 0]
-        else:
-            M[..., :3, 3] = np.where(rev[:, None], p - (R @ p[:, :, None])[..., 0],
-                                     delta[..., None] * self.axes)  # fmt: skip
-        parent = self.body_parent
+        delta = Q[:, self.moving] - self._ref_moving
+        R, t = self.local_motions(delta, np.sin(delta), 1.0 - np.cos(delta))
+        B[..., 3, :] = _LAST_ROW
+        parent = self._parent_list
         for b in range(1, NB):
-            np.matmul(B[:, parent[b]], M[:, b - 1], out=B[:, b])
+            if parent[b] == 0:
+                B[:, b, :3, :3], B[:, b, :3, 3] = R[:, b - 1], t[:, b - 1]
+            else:
+                rigid_product(B[:, parent[b]], R[:, b - 1], t[:, b - 1], B[:, b])
         return B
 
     def body_motions_one(self, q) -> np.ndarray:
         """(bodies, 4, 4): :meth:`body_motions` of one configuration ``q`` (J,), the same
-        arithmetic on the same shapes but one, so the same bits, in fewer numpy calls (what
-        a one-configuration clearance query asks)."""
+        arithmetic on the same shapes but one, so the same bits."""
         q = np.asarray(q, dtype=float)
         NB = self.bodies
         B = np.empty((NB, 4, 4))
@@ -149,28 +140,41 @@ class JointScrews:
         if NB == 1:
             return B
         delta = q.take(self.moving) - self._ref_moving
+        R, t = self.local_motions(delta, np.sin(delta), 1.0 - np.cos(delta))
+        B[:, 3, :] = _LAST_ROW
+        parent = self._parent_list
+        for b in range(1, NB):
+            if parent[b] == 0:
+                B[b, :3, :3], B[b, :3, 3] = R[b - 1], t[b - 1]
+            else:
+                rigid_product(B[parent[b]], R[b - 1], t[b - 1], B[b])
+        return B
+
+    def local_motions(self, delta, sine, versine) -> tuple[np.ndarray, np.ndarray]:
+        """Each moving joint's motion G (rotation (..., M, 3, 3), translation (..., M, 3)) for
+        its state change ``delta`` (..., M), with ``sine`` = sin(delta) and ``versine`` =
+        1 - cos(delta) given (numpy's, which a compiled kernel takes as they are): a revolute
+        joint's R = (I + sin K) + (1 - cos) K² about its axis (K its cross-product matrix) and
+        t = p - R p for the point p on it; a prismatic joint's R = I, t = delta axis."""
         rev = self.revolute
         if self.all_revolute:
-            s = np.sin(delta)[:, None, None]
-            c = (1.0 - np.cos(delta))[:, None, None]
+            s, c = sine[..., None, None], versine[..., None, None]
         else:
-            s = np.where(rev, np.sin(delta), 0.0)[:, None, None]
-            c = np.where(rev, 1.0 - np.cos(delta), 0.0)[:, None, None]
+            s = np.where(rev, sine, 0.0)[..., None, None]
+            c = np.where(rev, versine, 0.0)[..., None, None]
         R = _EYE3 + s * self._K1 + c * self._K2
         p = self.points
-        M = np.empty((NB - 1, 4, 4))
-        M[:, 3, :] = _LAST_ROW
-        M[:, :3, :3] = R
-        if self.all_revolute:
-            M[:, :3, 3] = p - (R @ p[:, :, None])[..., 0]
-        else:
-            M[:, :3, 3] = np.where(rev[:, None], p - (R @ p[:, :, None])[..., 0],
-                                   delta[:, None] * self.axes)  # fmt: skip
-        parent = self._parent_list
-        matmul = np.matmul
-        for b in range(1, NB):
-            matmul(B[parent[b]], M[b - 1], out=B[b])
-        return B
+        Rp = (R[..., 0] * p[:, None, 0] + R[..., 1] * p[:, None, 1]) + R[..., 2] * p[:, None, 2]
+        t = p - Rp
+        if not self.all_revolute:
+            t = np.where(rev[:, None], t, delta[..., None] * self.axes)
+        return R, t
+
+    @property
+    def rotation_generators(self) -> tuple[np.ndarray, np.ndarray]:
+        """(K, K²) per moving joint (M, 3, 3) each: the cross-product matrix of its axis and
+        its square, as :meth:`local_motions` uses them."""
+        return self._K1, self._K2
 
     def frame_poses(self, Q, bodies, frames, axes: bool = False):
         """Poses of frames fixed in rigid bodies, at many configurations: for frame l, fixed in
@@ -256,6 +260,19 @@ class JointScrews:
 _EYE3 = np.eye(3)
 _EYE4 = np.eye(4)
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
+
+
+def rigid_product(P: np.ndarray, R: np.ndarray, t: np.ndarray, out: np.ndarray) -> None:
+    """``out`` = P [R | t] for rigid motions (..., 4, 4) P and out (last rows 0 0 0 1) and a
+    rotation R (..., 3, 3) and translation t (..., 3), the sums in a fixed order
+    (((P_i0 x_0j + P_i1 x_1j) + P_i2 x_2j), plus P_i3 for the translation): what
+    :meth:`JointScrews.body_motions` and the compiled kernels compute, bit for bit."""
+    PR = P[..., :3, :3]
+    out[..., :3, :3] = (PR[..., :, 0, None] * R[..., None, 0, :]
+                        + PR[..., :, 1, None] * R[..., None, 1, :]) \
+        + PR[..., :, 2, None] * R[..., None, 2, :]  # fmt: skip
+    out[..., :3, 3] = ((PR[..., 0] * t[..., None, 0] + PR[..., 1] * t[..., None, 1])
+                       + PR[..., 2] * t[..., None, 2]) + P[..., :3, 3]  # fmt: skip
 
 
 def _configurations(q, joints: int) -> tuple[np.ndarray, bool]:

@@ -122,15 +122,21 @@ def test_many_pairs_kept_as_arrays_give_the_same_report(name, monkeypatch):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_body_motions_of_one_configuration_are_the_batch_bits(name):
-    """JointScrews.body_motions_one gives the bits of body_motions for that configuration
-    (revolute and prismatic joints, chains and trees)."""
+    """JointScrews.body_motions_one gives the bits of body_motions for that configuration, and
+    so does the compiled kernel of the one-configuration query (revolute and prismatic joints,
+    chains and trees)."""
     _, listed, _ = engines(name)
     screws = listed.screws
     rng = np.random.default_rng(5)
     lo, hi = listed.ranges[:, 0], listed.ranges[:, 1]
     Q = lo + (hi - lo) * rng.random((200, lo.size))
+    from kinegami.clearance.engine import _compiled_motions
+
+    clearance_module._kernel()
     for q in Q:
-        assert np.array_equal(screws.body_motions_one(q), screws.body_motions(q[None])[0])
+        one = screws.body_motions_one(q)
+        assert one.tobytes() == screws.body_motions(q[None])[0].tobytes()  # -0.0 too
+        assert _compiled_motions(screws, q).tobytes() == one.tobytes()  # the compiled kernel
 
 
 def test_states_are_checked_as_before():
@@ -205,7 +211,7 @@ def test_an_engine_runs_the_kernel_once_asked_many_times(monkeypatch):
         calls.append(1)
         return kernel(*args)
 
-    monkeypatch.setattr(clearance_module, "_KERNEL", [counted])
+    monkeypatch.setattr(clearance_module, "_KERNEL", [counted, kernels.body_motions])
     rng = np.random.default_rng(6)
     Q = [configuration(engine, f) for f in rng.random((40, 18))]
     reports = [engine.report(q) for q in Q]
@@ -237,7 +243,7 @@ def test_without_numba_the_numpy_path_answers(monkeypatch):
     """Where numba cannot run (no wheel, no cache it can write) the engine keeps to numpy."""
     design, compiled, numpy_path = _paths("puma")
     q = [joint.state for joint in design.Joints]
-    monkeypatch.setattr(clearance_module, "_KERNEL", [None])
+    monkeypatch.setattr(clearance_module, "_KERNEL", [None, None])
     engine = ClearanceEngine(design)
     engine._one_arrays().queries = 10**12
     assert repr(engine.report(q)) == repr(numpy_path.report(q)) == repr(compiled.report(q))

@@ -43,7 +43,7 @@ def test_closest_pairs_are_the_reports_and_where_they_are(name, compiled_kernel,
     import kinegami.clearance.engine as engine_module
 
     if not compiled_kernel:
-        monkeypatch.setattr(engine_module, "_KERNEL", [None])
+        monkeypatch.setattr(engine_module, "_KERNEL", [None, None])
     design = load_design(DESIGNS / f"{name}.json")
     engine = engine_of(design)
     r = float(design.r)
