@@ -13,7 +13,11 @@ from itself: the clearance's analytic gradient (:func:`clearance_gradients`) pro
 the Jacobian's null space, then :func:`descend` back onto the target.
 
 Compiled once per machine (``cache=True``); :func:`kinegami.reach.inverse.solve` loads this
-module on first use and keeps the numpy path where numba cannot run.
+module on first use and keeps the numpy path where numba cannot run. The first use compiles,
+so the kernels are written for a short compilation as well as a fast run: plain loops over
+scalars, no matrix products, ``np.linalg``, ``np.dot`` or sorting (numba compiles a BLAS or
+LAPACK wrapper for each: ``np.linalg.solve`` alone took about 5 s), no array expressions or
+slice assignments (their shape checks compile error messages), no ``min``/``max`` builtins.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["descend", "frame_poses"]
+__all__ = ["clearance_gradients", "descend", "escape_step", "frame_poses", "solve_spd"]
 
 #: Target kinds.
 POSITION, AXIS, POSE = 0, 1, 2
@@ -37,35 +41,49 @@ STALL_LOOK = (STALL_WINDOW + STALL_EVERY) // STALL_EVERY  # the first look (in m
 
 
 @njit(cache=True)
-def _frames(steps, path, revolute, delta, E, axes, T):
-    """The tip's pose T (4, 4) and every path joint's axis frame (P, 3, 4) at ``delta`` (the
-    path joints' states minus the reference ones)."""
-    S = np.eye(4)
-    A = np.empty((3, 4))
+def _frames(steps, path, revolute, q, reference, E, axes, T):
+    """The tip's pose T (4, 4) and every path joint's axis frame (P, 3, 4) at the path
+    joints' states ``q`` (P,) (their turns or slides: ``q - reference``). Plain loops, no
+    array expressions: an array expression's shape checks compile their error messages
+    (seconds on a fresh install)."""
+    S = np.empty((3, 4))  # the running product's top rows
+    for i in range(3):
+        for j in range(4):
+            S[i, j] = 1.0 if i == j else 0.0
     for m in range(path.size):
         step = steps[path[m] - 1]
         for i in range(3):
             for j in range(4):
-                A[i, j] = S[i, 0] * step[0, j] + S[i, 1] * step[1, j] + S[i, 2] * step[2, j] \
+                axes[m, i, j] = (
+                    S[i, 0] * step[0, j]
+                    + S[i, 1] * step[1, j]
+                    + S[i, 2] * step[2, j]
                     + S[i, 3] * step[3, j]
-        axes[m] = A
-        d = delta[m]
+                )
+        d = q[m] - reference[m]
         if revolute[m]:
             c, s = math.cos(d), math.sin(d)
             for i in range(3):
-                x, y = A[i, 0], A[i, 1]
+                x, y = axes[m, i, 0], axes[m, i, 1]
                 S[i, 0] = c * x + s * y
                 S[i, 1] = c * y - s * x
-                S[i, 2] = A[i, 2]
-                S[i, 3] = A[i, 3]
+                S[i, 2] = axes[m, i, 2]
+                S[i, 3] = axes[m, i, 3]
         else:
             for i in range(3):
-                S[i, 0], S[i, 1], S[i, 2] = A[i, 0], A[i, 1], A[i, 2]
-                S[i, 3] = A[i, 3] + d * A[i, 2]
+                S[i, 0], S[i, 1], S[i, 2] = axes[m, i, 0], axes[m, i, 1], axes[m, i, 2]
+                S[i, 3] = axes[m, i, 3] + d * axes[m, i, 2]
     for i in range(3):
         for j in range(4):
             T[i, j] = S[i, 0] * E[0, j] + S[i, 1] * E[1, j] + S[i, 2] * E[2, j] + S[i, 3] * E[3, j]
     T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0
+
+
+@njit(cache=True)
+def _copy(source, out):
+    """out[:] = source for vectors (n,), in a plain loop."""
+    for i in range(source.size):
+        out[i] = source[i]
 
 
 @njit(cache=True)
@@ -74,7 +92,7 @@ def _rotation_vector(R, out):
     wx, wy, wz = R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]
     s = 0.5 * math.sqrt(wx * wx + wy * wy + wz * wz)
     c = 0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1.0)
-    c = min(max(c, -1.0), 1.0)
+    c = -1.0 if -1.0 > c else 1.0 if 1.0 < c else c  # (no min and max: cheaper to compile)
     angle = math.atan2(s, c)
     if s >= 1e-12:
         scale = angle / (2.0 * s)
@@ -110,8 +128,9 @@ def _residual(T, kind, target_p, target_R, target_a, r, e, w):
         M = np.empty((3, 3))
         for i in range(3):
             for j in range(3):
-                M[i, j] = target_R[i, 0] * T[j, 0] + target_R[i, 1] * T[j, 1] \
-                    + target_R[i, 2] * T[j, 2]
+                M[i, j] = (
+                    target_R[i, 0] * T[j, 0] + target_R[i, 1] * T[j, 1] + target_R[i, 2] * T[j, 2]
+                )
         _rotation_vector(M, w)
         e[3], e[4], e[5] = w[0], w[1], w[2]
         return pos, math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
@@ -125,37 +144,97 @@ def _residual(T, kind, target_p, target_R, target_a, r, e, w):
 
 
 @njit(cache=True)
-def _solve_spd(A, b):
-    """x with A x = b for a small symmetric positive definite A (J J^T + lambda I, 3x3 or
-    6x6), by Cholesky in plain loops: no LAPACK call, so a threaded BLAS loaded by another
-    library (Robotics Toolbox's import made each solve 2x slower) costs nothing here. A
-    pivot that is not positive (A singular to rounding) falls back to LAPACK."""
+def solve_spd(A, b):
+    """x (n,) with A x = b for a small symmetric positive definite A (n, n): J J^T + lambda I
+    (3x3, 6x6) or a null-space step's normal matrix, by Cholesky in plain loops. Where a
+    pivot is not positive (A singular to rounding), A + delta I is solved instead, delta
+    from 1e-12 of A's largest diagonal entry up by tens until every pivot is positive: a
+    little more damping (x = 0 for a matrix that is not finite). No LAPACK or BLAS call: on a
+    fresh install those cost seconds of compilation, and a threaded BLAS loaded by another
+    library (Robotics Toolbox's import made each solve 2x slower) costs nothing here."""
     n = A.shape[0]
-    L = np.zeros((n, n))
+    x = np.empty(n)
+    _spd_solve_into(A, b, np.empty((n, n)), x)
+    return x
+
+
+@njit(cache=True)
+def _spd_solve_into(A, b, L, x):
+    """:func:`solve_spd` into ``x`` (n,), ``L`` (n, n) its work space."""
+    n = A.shape[0]
+    largest = 0.0
     for i in range(n):
-        for j in range(i + 1):
-            total = A[i, j]
-            for k in range(j):
-                total -= L[i, k] * L[j, k]
-            if i == j:
-                if not total > 0.0:
-                    return np.linalg.solve(A, b)
-                L[i, i] = math.sqrt(total)
-            else:
-                L[i, j] = total / L[j, j]
-    y = np.empty(n)
-    for i in range(n):
+        d = A[i, i] if A[i, i] >= 0.0 else -A[i, i]
+        if d > largest:
+            largest = d
+    shift = 0.0
+    for attempt in range(40):
+        if attempt:  # a pivot was not positive: a little more damping
+            shift = 1e-12 * largest + 1e-300 if attempt == 1 else 10.0 * shift
+        positive = True
+        for i in range(n):
+            for j in range(i + 1):
+                total = A[i, j] + shift if i == j else A[i, j]
+                for k in range(j):
+                    total -= L[i, k] * L[j, k]
+                if i == j:
+                    if not total > 0.0:
+                        positive = False
+                        break
+                    L[i, i] = math.sqrt(total)
+                else:
+                    L[i, j] = total / L[j, j]
+            if not positive:
+                break
+        if positive:
+            break
+    if not positive:  # not finite
+        for i in range(n):
+            x[i] = 0.0
+        return
+    for i in range(n):  # L y = b (y in x)
         total = b[i]
         for k in range(i):
-            total -= L[i, k] * y[k]
-        y[i] = total / L[i, i]
-    x = np.empty(n)
-    for i in range(n - 1, -1, -1):
-        total = y[i]
+            total -= L[i, k] * x[k]
+        x[i] = total / L[i, i]
+    for i in range(n - 1, -1, -1):  # L^T x = y
+        total = x[i]
         for k in range(i + 1, n):
             total -= L[k, i] * x[k]
         x[i] = total / L[i, i]
-    return x
+
+
+@njit(cache=True)
+def _gram(X, out):
+    """out (m, m) = X X^T for X (m, n), in plain loops."""
+    m, n = X.shape
+    for i in range(m):
+        for j in range(i + 1):
+            total = 0.0
+            for k in range(n):
+                total += X[i, k] * X[j, k]
+            out[i, j] = total
+            out[j, i] = total
+
+
+@njit(cache=True)
+def _transposed_times(X, v, out):
+    """out (n,) = X^T v for X (m, n), v (m,), in plain loops."""
+    m, n = X.shape
+    for j in range(n):
+        total = 0.0
+        for i in range(m):
+            total += X[i, j] * v[i]
+        out[j] = total
+
+
+@njit(cache=True)
+def _squared(v):
+    """v . v for v (n,)."""
+    total = 0.0
+    for i in range(v.size):
+        total += v[i] * v[i]
+    return total
 
 
 @njit(cache=True)
@@ -169,68 +248,72 @@ def descend(steps, path, revolute, reference, E, low, high, kind, target_p, targ
     error)."""
     P = path.size
     size = 3 if kind == POSITION else 6
-    axes = np.empty((P, 3, 4))
+    axes = np.empty((P, 3, 4))  # the axis frames and the tip's pose at q
     T = np.empty((4, 4))
+    trial_axes = np.empty((P, 3, 4))  # and at the trial step
+    trial_T = np.empty((4, 4))
     e = np.empty(size)
     e2 = np.empty(size)
     w = np.empty(3)
     J = np.zeros((size, P))
+    G = np.empty((size, size))  # J J^T at q
+    A = np.empty((size, size))
+    L = np.empty((size, size))
+    x = np.empty(size)
     trial = np.empty(P)
-    best = q.copy()
-    _frames(steps, path, revolute, q - reference, E, axes, T)
+    step = np.empty(P)
+    best = np.empty(P)
+    _copy(q, best)
+    _frames(steps, path, revolute, q, reference, E, axes, T)
     pos, ang = _residual(T, kind, target_p, target_R, target_a, r, e, w)
     best_pos, best_ang = pos, ang
     lam = damping
+    moved = True  # q changed: its Jacobian is to be made
     marks = np.empty(patience // STALL_EVERY + 1)  # the error every STALL_EVERY iterations
     for iteration in range(patience):
         if pos <= tol_p * r and ang <= tol_a:
-            return True, iteration + 1, pos, ang, q.copy(), pos, ang
+            return True, iteration + 1, pos, ang, q, pos, ang
         if iteration % STALL_EVERY == 0:  # stalled: too little progress over the window
             n = iteration // STALL_EVERY
             marks[n] = error = pos / r + ang
             before = marks[n - STALL_WINDOW // STALL_EVERY] if n >= STALL_LOOK else math.inf
             if error > STALL_FLOOR and error > STALL_FACTOR * before:
                 return False, iteration, pos, ang, best, best_pos, best_ang
-        # the geometric Jacobian of the residual
-        for m in range(P):
-            dx, dy, dz = axes[m, 0, 2], axes[m, 1, 2], axes[m, 2, 2]
-            if revolute[m]:
-                px, py, pz = T[0, 3] - axes[m, 0, 3], T[1, 3] - axes[m, 1, 3], \
-                    T[2, 3] - axes[m, 2, 3]
-                vx, vy, vz = dy * pz - dz * py, dz * px - dx * pz, dx * py - dy * px
-                wx, wy, wz = dx, dy, dz
-            else:
-                vx, vy, vz = dx, dy, dz
-                wx, wy, wz = 0.0, 0.0, 0.0
-            J[0, m], J[1, m], J[2, m] = vx / r, vy / r, vz / r
-            if kind == POSE:
-                J[3, m], J[4, m], J[5, m] = wx, wy, wz
-            elif kind == AXIS:  # dz/dt = w x z
-                zx, zy, zz = T[0, 2], T[1, 2], T[2, 2]
-                J[3, m], J[4, m], J[5, m] = wy * zz - wz * zy, wz * zx - wx * zz, wx * zy - wy * zx
-        A = J @ J.T
-        for i in range(size):
+        if moved:  # the residual's Jacobian at q (kept while steps are refused)
+            _residual_jacobian(axes, T, revolute, kind, r, J)
+            _gram(J, G)
+            moved = False
+        for i in range(size):  # (J J^T + lambda I) x = e, the step J^T x
+            for j in range(size):
+                A[i, j] = G[i, j]
             A[i, i] += lam
-        step = J.T @ _solve_spd(A, e)
+        _spd_solve_into(A, e, L, x)
+        _transposed_times(J, x, step)
         for m in range(P):
-            trial[m] = min(max(q[m] + step[m], low[m]), high[m])
-        _frames(steps, path, revolute, trial - reference, E, axes, T)
-        pos2, ang2 = _residual(T, kind, target_p, target_R, target_a, r, e2, w)
-        if np.dot(e2, e2) < np.dot(e, e):
-            q[:] = trial
-            e[:] = e2
+            v = q[m] + step[m]
+            v = low[m] if low[m] > v else v
+            trial[m] = high[m] if high[m] < v else v
+        _frames(steps, path, revolute, trial, reference, E, trial_axes, trial_T)
+        pos2, ang2 = _residual(trial_T, kind, target_p, target_R, target_a, r, e2, w)
+        if _squared(e2) < _squared(e):
+            _copy(trial, q)
+            _copy(e2, e)
+            axes, trial_axes = trial_axes, axes
+            T, trial_T = trial_T, T
+            moved = True
             pos, ang = pos2, ang2
-            lam = max(lam * 0.3, damping_min)
+            lam = lam * 0.3
+            lam = damping_min if damping_min > lam else lam
             if pos < best_pos or (pos == best_pos and ang < best_ang):
-                best[:] = q
+                _copy(q, best)
                 best_pos, best_ang = pos, ang
         else:
-            lam = min(lam * 8.0, damping_max)
-            _frames(steps, path, revolute, q - reference, E, axes, T)  # back to q
+            lam = lam * 8.0
+            lam = damping_max if damping_max < lam else lam
             if lam >= damping_max:
                 return False, iteration + 1, pos, ang, best, best_pos, best_ang
     if pos <= tol_p * r and ang <= tol_a:
-        return True, patience, pos, ang, q.copy(), pos, ang
+        return True, patience, pos, ang, q, pos, ang
     return False, patience, pos, ang, best, best_pos, best_ang
 
 
@@ -255,8 +338,12 @@ def frame_poses(steps, parent, revolute, delta, E, bodies, out):
             A = S[b]
             for i in range(3):
                 for j in range(4):
-                    A[i, j] = P[i, 0] * step[0, j] + P[i, 1] * step[1, j] \
-                        + P[i, 2] * step[2, j] + P[i, 3] * step[3, j]
+                    A[i, j] = (
+                        P[i, 0] * step[0, j]
+                        + P[i, 1] * step[1, j]
+                        + P[i, 2] * step[2, j]
+                        + P[i, 3] * step[3, j]
+                    )
             d = delta[k, b - 1]
             if revolute[b - 1]:
                 c, s = math.cos(d), math.sin(d)
@@ -273,8 +360,12 @@ def frame_poses(steps, parent, revolute, delta, E, bodies, out):
             T = out[k, l]
             for i in range(3):
                 for j in range(4):
-                    T[i, j] = B[i, 0] * F[0, j] + B[i, 1] * F[1, j] + B[i, 2] * F[2, j] \
+                    T[i, j] = (
+                        B[i, 0] * F[0, j]
+                        + B[i, 1] * F[1, j]
+                        + B[i, 2] * F[2, j]
                         + B[i, 3] * F[3, j]
+                    )
             T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0
 
 
@@ -296,7 +387,7 @@ def clearance_gradients(steps, path, revolute, reference, E, q, ends, bodies, s,
     K = ends.shape[0]
     axes = np.empty((P, 3, 4))
     T = np.empty((4, 4))
-    _frames(steps, path, revolute, q - reference, E, axes, T)
+    _frames(steps, path, revolute, q, reference, E, axes, T)
     G = np.zeros((K, P))
     weight = np.empty(4)
     for k in range(K):
@@ -372,23 +463,56 @@ def _null_step(J, G, rise, held, scale):
             Js[i, m] = J[i, m] * f
         for k in range(K):
             Gs[k, m] = G[k, m] * f
-    # the null space's projector N = I - Js^T (Js Js^T + eps I)^-1 Js
-    A = Js @ Js.T
-    eps = 1e-12 * (np.trace(A) + 1.0)
+    # the null space's projector N = I - Js^T (Js Js^T + eps I)^-1 Js (plain loops)
+    A = np.empty((size, size))
+    _gram(Js, A)
+    trace = 0.0
+    for i in range(size):
+        trace += A[i, i]
+    eps = 1e-12 * (trace + 1.0)
     for i in range(size):
         A[i, i] += eps
-    M = np.empty((size, P))
+    L = np.empty((size, size))
+    column = np.empty(size)
+    solved = np.empty(size)
+    M = np.empty((size, P))  # (Js Js^T + eps I)^-1 Js, a column at a time
     for m in range(P):
-        M[:, m] = _solve_spd(A, Js[:, m].copy())
-    N = -(Js.T @ M)
+        for i in range(size):
+            column[i] = Js[i, m]
+        _spd_solve_into(A, column, L, solved)
+        for i in range(size):
+            M[i, m] = solved[i]
+    N = np.empty((P, P))
+    for a in range(P):
+        for c in range(P):
+            total = 0.0
+            for i in range(size):
+                total += Js[i, a] * M[i, c]
+            N[a, c] = (1.0 if a == c else 0.0) - total
+    GN = np.empty((K, P))
+    for k in range(K):
+        for c in range(P):
+            total = 0.0
+            for a in range(P):
+                total += Gs[k, a] * N[a, c]
+            GN[k, c] = total
+    H = np.empty((P, P))  # GN^T GN + mu I
+    for a in range(P):
+        for c in range(a + 1):
+            total = 0.0
+            for k in range(K):
+                total += GN[k, a] * GN[k, c]
+            H[a, c] = total
+            H[c, a] = total
+    trace = 0.0
     for m in range(P):
-        N[m, m] += 1.0
-    GN = Gs @ N
-    H = GN.T @ GN
-    mu = 1e-6 * (np.trace(H) / P) + 1e-300
+        trace += H[m, m]
+    mu = 1e-6 * (trace / P) + 1e-300
     for m in range(P):
         H[m, m] += mu
-    return _solve_spd(H, GN.T @ rise)
+    right = np.empty(P)
+    _transposed_times(GN, rise, right)
+    return solve_spd(H, right)
 
 
 @njit(cache=True)
@@ -409,7 +533,7 @@ def escape_step(steps, path, revolute, reference, E, low, high, kind, r, q, clea
     size = 3 if kind == POSITION else 6
     axes = np.empty((P, 3, 4))
     T = np.empty((4, 4))
-    _frames(steps, path, revolute, q - reference, E, axes, T)
+    _frames(steps, path, revolute, q, reference, E, axes, T)
     J = np.zeros((size, P))
     _residual_jacobian(axes, T, revolute, kind, r, J)
     G_all = clearance_gradients(steps, path, revolute, reference, E, q, ends, bodies, s, t,
@@ -423,7 +547,8 @@ def escape_step(steps, path, revolute, reference, E, low, high, kind, r, q, clea
     n = 0
     for k in range(clearance.size):
         if clearance[k] < goal:
-            G[n] = G_all[k]
+            for m in range(P):
+                G[n, m] = G_all[k, m]
             rise[n] = goal - clearance[k]
             n += 1
     scale = np.empty(P)
@@ -440,11 +565,15 @@ def escape_step(steps, path, revolute, reference, E, low, high, kind, r, q, clea
             again = True
     if again:
         x = _null_step(J, G, rise, held, scale)
-    length = math.sqrt(np.dot(x, x))
-    trial = q.copy()
+    length = math.sqrt(_squared(x))
+    trial = np.empty(P)
+    _copy(q, trial)
     if not length > 0.0:
         return trial
-    f = min(1.0, radius / length)
+    f = radius / length
+    f = f if f < 1.0 else 1.0
     for m in range(P):
-        trial[m] = min(max(q[m] + f * x[m] * scale[m], low[m]), high[m])
+        v = q[m] + f * x[m] * scale[m]
+        v = low[m] if low[m] > v else v
+        trial[m] = high[m] if high[m] < v else v
     return trial
