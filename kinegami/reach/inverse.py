@@ -440,9 +440,7 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
             sr = rows[step_rows]
             Jr, er = J[step_rows], e[step_rows]
             lam = damping[sr]
-            A = Jr @ np.swapaxes(Jr, -1, -2)
-            A[:, np.arange(A.shape[1]), np.arange(A.shape[1])] += lam[:, None]
-            dq = np.einsum("kej,ke->kj", Jr, np.linalg.solve(A, er[..., None])[..., 0])
+            dq = _held_steps(Jr, er, lam, Q[sr][:, mov], low[mov], high[mov])
             trial = Q[sr].copy()
             trial[:, mov] = np.clip(trial[:, mov] + dq, low[mov], high[mov])
             e2, pos2, ang2 = problem.evaluate(trial, owner[sr], False)
@@ -478,6 +476,34 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
             answers[g] = _failure(design, best[g], iterations[g], started[g] - 1, collided[g],
                                   options, compiled, goals[g], tips)  # fmt: skip
     return answers  # type: ignore[return-value]
+
+
+def _damped_steps(J: np.ndarray, e: np.ndarray, lam: np.ndarray) -> np.ndarray:
+    """(k, P): the damped least-squares steps J^T (J J^T + lambda I)^-1 e of k rows."""
+    A = J @ np.swapaxes(J, -1, -2)
+    A[:, np.arange(A.shape[1]), np.arange(A.shape[1])] += lam[:, None]
+    return np.einsum("kej,ke->kj", J, np.linalg.solve(A, e[..., None])[..., 0])
+
+
+def _held_steps(J: np.ndarray, e: np.ndarray, lam: np.ndarray, q: np.ndarray, low: np.ndarray,
+                high: np.ndarray) -> np.ndarray:  # fmt: skip
+    """(k, P): the damped steps of k rows (Jacobians J (k, E, P), residuals e, damping lam)
+    from the states ``q`` (k, P) with ranges ``low``, ``high``, the joints at a limit that a
+    step pushes beyond held (their columns left out, the step solved again: the others make
+    up for them, as :func:`kinegami.reach.kernels.descend` does). Without it, a start whose
+    solution lies along a limit is clipped there to a standstill."""
+    dq = _damped_steps(J, e, lam)
+    held = np.zeros(dq.shape, dtype=bool)
+    at_high, at_low = q >= high, q <= low
+    for _ in range(dq.shape[1]):
+        new = ~held & (((dq > 0.0) & at_high) | ((dq < 0.0) & at_low))
+        rows = np.flatnonzero(new.any(axis=1))
+        if rows.size == 0:
+            break
+        held |= new
+        Jh = J[rows] * ~held[rows][:, None, :]
+        dq[rows] = _damped_steps(Jh, e[rows], lam[rows])
+    return dq
 
 
 _KERNEL: list = []  # [kinegami.reach.kernels.descend, or None where numba cannot run]

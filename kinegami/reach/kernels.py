@@ -238,6 +238,36 @@ def _squared(v):
 
 
 @njit(cache=True)
+def _hold(q, step, low, high, held):
+    """Mark in ``held`` the joints at a limit of their range that ``step`` pushes beyond it;
+    True when it marked one not marked before."""
+    more = False
+    for m in range(q.size):
+        if not held[m] and (
+            (step[m] > 0.0 and q[m] >= high[m]) or (step[m] < 0.0 and q[m] <= low[m])
+        ):
+            held[m] = True
+            more = True
+    return more
+
+
+@njit(cache=True)
+def _held_step(J, held, lam, e, Jh, A, L, x, step):
+    """The damped least-squares step ``step`` (P,) with the ``held`` joints' columns of J
+    left out (their entries 0): the joints at their limits stay, and the others make up for
+    them. ``Jh``, ``A``, ``L``, ``x`` are work space."""
+    size, P = J.shape
+    for i in range(size):
+        for m in range(P):
+            Jh[i, m] = 0.0 if held[m] else J[i, m]
+    _gram(Jh, A)
+    for i in range(size):
+        A[i, i] += lam
+    _spd_solve_into(A, e, L, x)
+    _transposed_times(Jh, x, step)
+
+
+@njit(cache=True)
 def descend(steps, path, revolute, reference, E, low, high, kind, target_p, target_R, target_a,
             r, tol_p, tol_a, q, patience, damping, damping_min, damping_max):  # fmt: skip
     """Iterate one start: ``q`` (P,) the path joints' states, changed in place to the last
@@ -263,6 +293,8 @@ def descend(steps, path, revolute, reference, E, low, high, kind, target_p, targ
     trial = np.empty(P)
     step = np.empty(P)
     best = np.empty(P)
+    held = np.zeros(P, dtype=np.bool_)  # joints at a limit that the step pushes beyond
+    Jh = np.empty((size, P))  # J without their columns
     _copy(q, best)
     _frames(steps, path, revolute, q, reference, E, axes, T)
     pos, ang = _residual(T, kind, target_p, target_R, target_a, r, e, w)
@@ -289,6 +321,12 @@ def descend(steps, path, revolute, reference, E, low, high, kind, target_p, targ
             A[i, i] += lam
         _spd_solve_into(A, e, L, x)
         _transposed_times(J, x, step)
+        if _hold(q, step, low, high, held):  # the step again without the joints held
+            _held_step(J, held, lam, e, Jh, A, L, x, step)
+            while _hold(q, step, low, high, held):
+                _held_step(J, held, lam, e, Jh, A, L, x, step)
+            for m in range(P):
+                held[m] = False
         for m in range(P):
             v = q[m] + step[m]
             v = low[m] if low[m] > v else v
