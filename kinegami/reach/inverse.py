@@ -207,7 +207,7 @@ def solve_many(design, targets, *, tip=None, tool=None, q0=None, seed: int = 0,
         from kinegami.chain.bodies import check_margin
 
         margin = check_margin(margin)
-    goals = [_goals(design, t, tip) for t in targets]
+    goals = _all_goals(design, targets, tip)
     tips = sorted({k for goal in goals for k in goal})
     compiled = kinematics(design, tips if tips else None, tool)
     start = compiled.configurations(
@@ -249,6 +249,12 @@ def _goals(design, target, tip) -> dict[int, Target]:
         if not out:
             raise InvalidParameterError("a mapping of tips to targets must not be empty")
         return out
+    return {_tip_of(design, tip): Target.of(target)}
+
+
+def _tip_of(design, tip) -> int:
+    """The tip joint of a target that is not a mapping: ``tip``, or a chain's only leaf."""
+    n = len(design.Joints)
     if tip is None:
         parents = {p for p in design.Parents if p >= 0}
         leaves = [k for k in range(n) if k not in parents]
@@ -260,7 +266,43 @@ def _goals(design, target, tip) -> dict[int, Target]:
         tip = leaves[0]
     if isinstance(tip, bool) or not isinstance(tip, (int, np.integer)) or not 0 <= tip < n:
         raise InvalidParameterError(f"tip {tip!r} is not a joint index: 0 to {n - 1}")
-    return {int(tip): Target.of(target)}
+    return int(tip)
+
+
+def _all_goals(design, targets: Sequence, tip) -> list[dict[int, Target]]:
+    """:func:`_goals` of every target; a list of 4x4 float arrays (poses, the common batch)
+    is checked at once, and any that the batch's check does not pass with room to spare
+    goes through :func:`_goals` (which words the error)."""
+    poses = _poses_at_once(targets)
+    if poses is None:
+        return [_goals(design, t, tip) for t in targets]
+    k = _tip_of(design, tip)
+    return [{k: target} for target in poses]
+
+
+def _poses_at_once(targets: Sequence) -> list[Target] | None:
+    """Pose targets of ``targets`` when every one is a (4, 4) float array that is finite and
+    rigid well within :func:`kinegami.chain.joints.pose_array`'s tolerance (1e-8; here half
+    of it, so that rounding cannot tell them apart), else None."""
+    if not targets or not all(type(t) is np.ndarray and t.shape == (4, 4)
+                              and t.dtype == np.float64 for t in targets):  # fmt: skip
+        return None
+    A = np.stack(targets)
+    R = A[:, :3, :3]
+    tol = 0.5e-8
+    if not (np.isfinite(A).all()
+            and np.abs(np.einsum("kji,kjl->kil", R, R) - np.eye(3)).max() <= tol
+            and np.abs(np.linalg.det(R) - 1.0).max() <= tol
+            and np.abs(A[:, 3] - [0.0, 0.0, 0.0, 1.0]).max() <= tol):  # fmt: skip
+        return None
+    out = []
+    for T in A:
+        target = object.__new__(Target)
+        object.__setattr__(target, "position", T[:3, 3].copy())
+        object.__setattr__(target, "axis", None)
+        object.__setattr__(target, "rotation", T[:3, :3].copy())
+        out.append(target)
+    return out
 
 
 def _rotation_vector(R: np.ndarray) -> np.ndarray:
@@ -359,8 +401,9 @@ def _solve_chunk(design, compiled: Kinematics, goals: list, indices: list, start
     answers: list[Answer | None] = [None] * len(goals)
     for key, members in groups.items():
         if len(key) == 1 and _kernel() is not None:  # one tip: each target compiled
+            solver = _TipSolver(design, compiled, key[0][0], options)
             for k in members:
-                answers[k] = _solve_compiled(design, compiled, goals[k], start, options)
+                answers[k] = solver.answer(goals[k], start)
             continue
         found = _solve_group(design, compiled, [goals[k] for k in members],
                              [indices[k] for k in members], start, options)  # fmt: skip
@@ -381,17 +424,16 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
     table = _seed_table(design, compiled, tuple(problem.keys), seed)
     kinds = tuple(problem.kinds)
     seeds: list = [None] * G
-    used = [0] * G
 
     def fresh(g: int, first: bool) -> np.ndarray:
         """The first start (q0), then the table's nearest configurations, then random."""
         if first:
             return np.clip(start, low, high)
         if seeds[g] is None:
-            seeds[g] = table.nearest(goals[g], kinds, SEEDED_STARTS)
-        if used[g] < seeds[g].shape[0]:
-            used[g] += 1
-            return seeds[g][used[g] - 1].copy()
+            seeds[g] = table.starts(goals[g], kinds, SEEDED_STARTS)
+        q = next(seeds[g], None)
+        if q is not None:
+            return q.copy()
         return low + (high - low) * rngs[g].random(low.size)
 
     # rows of the batch: (goal, start); STARTS rows per goal at first
@@ -541,24 +583,29 @@ def _per_tip(compiled: Kinematics, what: str, tip: int, make):
 
 
 class _SeedTable:
-    """Seeded random configurations of a design and its tips' poses there (clear ones only,
-    for a chain): the nearest to a target, by tip positions in units of the reach and
-    rotations or axes, are good starts (a KD-tree each, per target kind)."""
+    """Seeded random configurations of a design and its tips' poses there: those nearest to
+    a target (by tip positions in units of the reach, and rotations or axes; a KD-tree per
+    target kind) that are clear (a chain's; a tree's all count) are good starts.
+
+    Whether a configuration is clear is asked of the design's clearance engine (its closest
+    pairs, with the design's margin) the first time a target's starts reach it, and kept: a
+    target checks only the few nearest it uses (the PUMA's 663 restarts over 1,000 targets
+    about 1,300 configurations), not the whole table (8,192 checks, 0.25-0.6 s)."""
 
     def __init__(self, design, compiled: Kinematics, tips: tuple, seed: int):
         from kinegami.chain.model import KinematicChain
 
         low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
         rng = np.random.default_rng([seed, 0x5EED])
-        Q = low + (high - low) * rng.random((SEED_TABLE, low.size))
-        if isinstance(design, KinematicChain):  # clear ones (a chain's batch: ~0.1 s)
-            from kinegami.clearance.engine import engine_for
-
-            Q = Q[~engine_for(design).colliding(Q, float(design.margin))]
-        T = compiled.tip_poses(Q)  # (m, L, 4, 4), the compiled tips
-        order = [compiled.tips.index(t) for t in tips]
-        self.Q = Q
-        self.T = T[:, order]
+        self.Q = low + (high - low) * rng.random((SEED_TABLE, low.size))
+        T = compiled.tip_poses(self.Q)  # (m, L, 4, 4), the compiled tips
+        self.T = T[:, [compiled.tips.index(t) for t in tips]]
+        # per configuration: 1 clear, 0 not, -1 not asked yet
+        chain = isinstance(design, KinematicChain)
+        self.clear = np.full(SEED_TABLE, -1 if chain else 1, dtype=np.int8)
+        self.engine = _engine_of(design) if chain else None
+        self.margin = float(getattr(design, "margin", 0.0))
+        self.limit = _limit(design, self.margin)
         scale = max((_per_tip(compiled, "bound", t, reach_bound)[0] for t in tips),
                     default=1.0)
         self.scale = scale if scale > 0 else 1.0
@@ -575,10 +622,32 @@ class _SeedTable:
                 parts.append(T[:, n, :3, 2] / 2.0)
         return np.concatenate(parts, axis=1)
 
+    def is_clear(self, row: int) -> bool:
+        """Whether configuration ``row`` is clear (asked of the engine once)."""
+        verdict = self.clear[row]
+        if verdict < 0:
+            pairs = self.engine.closest_pairs(self.Q[row], self.margin)
+            verdict = self.clear[row] = _is_clear(pairs, self.limit)
+        return bool(verdict)
+
+    def starts(self, goal: dict, kinds: tuple, count: int):
+        """The clear configurations nearest to ``goal`` (tip -> Target), nearest first, at
+        most ``count`` (a generator: each is checked when it is asked for)."""
+        given = 0
+        for row in self._rows(goal, kinds):
+            if given >= count:
+                return
+            if self.is_clear(row):
+                given += 1
+                yield self.Q[row]
+
     def nearest(self, goal: dict, kinds: tuple, count: int) -> np.ndarray:
-        """The table's configurations nearest to ``goal`` (tip -> Target), nearest first."""
-        if self.Q.shape[0] == 0 or count <= 0:
-            return self.Q[:0]
+        """(k, n): :meth:`starts` at once, k <= ``count``."""
+        return np.array(list(self.starts(goal, kinds, count))).reshape(-1, self.Q.shape[1])
+
+    def _rows(self, goal: dict, kinds: tuple):
+        """Every configuration's index, nearest to ``goal`` first (asked of the KD-tree 64,
+        then four times as many at a time)."""
         tree = self.trees.get(kinds)
         if tree is None:
             from scipy.spatial import cKDTree
@@ -592,9 +661,13 @@ class _SeedTable:
                 parts.append(target.rotation.reshape(9) / 3.0)
             elif kind == "axis":
                 parts.append(target.axis / 2.0)
-        k = min(count, self.Q.shape[0])
-        _, index = tree.query(np.concatenate(parts), k=k)
-        return self.Q[np.atleast_1d(index)]
+        x = np.concatenate(parts)
+        size = self.Q.shape[0]
+        done, k = 0, min(size, 64)
+        while done < size:
+            _, index = tree.query(x, k=k)
+            yield from np.atleast_1d(index)[done:k].tolist()
+            done, k = k, min(size, 4 * k)
 
 
 def _seed_table(design, compiled: Kinematics, tips: tuple, seed: int) -> _SeedTable:
@@ -626,76 +699,97 @@ def _make_tip_path(compiled: Kinematics, tip: int) -> tuple:
             np.ascontiguousarray(compiled.ranges[columns, 1]))  # fmt: skip
 
 
-def _solve_compiled(design, compiled: Kinematics, goal: dict, start: np.ndarray,
-                    options: tuple) -> Answer:  # fmt: skip
-    """:func:`_solve_group`'s answer for a target of one tip, each start iterated by the
-    compiled descent (:func:`kinegami.reach.kernels.descend`) in turn: the first from
-    ``start``, the others drawn from the target's own random stream, until one is exact and
-    clear or the budget is spent."""
-    tol_p, tol_a, seed, clear, margin = options
-    descend = _kernel()
-    r = float(design.r)
-    (tip, target), = goal.items()
-    steps, path, revolute, reference, E, columns, low_p, high_p = _tip_path(compiled, tip)
-    low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
-    rng = None  # the target's own random stream, made at the first restart (it costs ~70 us)
-    hopeless = bool(_beyond_reach(compiled, goal))
-    budget, patience = (1, 12) if hopeless else (MAX_STARTS, ITERATIONS)
-    kind = _KINDS[target.kind]
-    axis = target.axis if target.axis is not None else np.zeros(3)
-    rotation = target.rotation if target.rotation is not None else np.eye(3)
-    arguments = (steps, path, revolute, reference, E, low_p, high_p, kind, target.position,
-                 rotation, axis, r, tol_p, tol_a)  # fmt: skip
-    redundant = path.size > (3 if kind == 0 else 6)
-    engine = _engine_of(design, margin)
-    required = _margin_value(design, margin)
-    limit = _limit(design, required)
-    apart = required + ESCAPE_BUFFER * r  # an escape pushes pairs apart up to it
-    best: list = [None]
-    collided = ""  # the binding pair of the last exact solution that passes through itself
-    iterations = escapes = 0
-    q = np.clip(start, low, high)
-    seeds = None
-    for started in range(budget):
-        if started:
-            if seeds is None:  # the table's configurations nearest the target, then random
-                seeds = _seed_table(design, compiled, (tip,), seed).nearest(
-                    goal, (target.kind,), SEEDED_STARTS)  # fmt: skip
-            if started <= seeds.shape[0]:
-                q = seeds[started - 1].copy()
+class _TipSolver:
+    """:func:`_solve_group`'s answers for targets of one tip, each start iterated by the
+    compiled descent (:func:`kinegami.reach.kernels.descend`) in turn: the first from the
+    start given, then the seed table's clear configurations nearest the target, then random
+    ones from the target's own stream, until one is exact and clear or the budget is spent.
+    What the targets share (the tip's path, the engine, the margins, the reach bound) is
+    made once."""
+
+    def __init__(self, design, compiled: Kinematics, tip: int, options: tuple):
+        tol_p, tol_a, seed, clear, margin = options
+        self.design, self.compiled, self.tip, self.options = design, compiled, tip, options
+        self.tol_p, self.tol_a, self.seed, self.clear = tol_p, tol_a, seed, clear
+        self.r = r = float(design.r)
+        steps, path, revolute, reference, E, columns, low_p, high_p = _tip_path(compiled, tip)
+        self.path, self.columns = path, columns
+        self.head = (steps, path, revolute, reference, E, low_p, high_p)
+        self.low, self.high = compiled.ranges[:, 0], compiled.ranges[:, 1]
+        self.engine = _engine_of(design, margin)
+        self.required = _margin_value(design, margin)
+        self.limit = _limit(design, self.required)
+        self.apart = self.required + ESCAPE_BUFFER * r  # an escape pushes pairs apart up to it
+        self.bound = _per_tip(compiled, "bound", tip, reach_bound)
+        self.descend = _kernel()
+        self.table = None
+
+    def answer(self, goal: dict, start: np.ndarray) -> Answer:
+        """The answer to ``goal`` ({tip: Target}) from ``start`` (a full configuration)."""
+        (tip, target), = goal.items()
+        r, tol_p, tol_a, columns, engine = self.r, self.tol_p, self.tol_a, self.columns, \
+            self.engine  # fmt: skip
+        low, high = self.low, self.high
+        rng = None  # the target's own random stream, made at the first restart (~70 us)
+        hopeless = _outside(target.position, *self.bound)
+        budget, patience = (1, 12) if hopeless else (MAX_STARTS, ITERATIONS)
+        kind = _KINDS[target.kind]
+        axis = target.axis if target.axis is not None else _NO_AXIS
+        rotation = target.rotation if target.rotation is not None else _NO_ROTATION
+        arguments = self.head + (kind, target.position, rotation, axis, r, tol_p, tol_a)
+        redundant = self.path.size > (3 if kind == 0 else 6)
+        best: list = [None]
+        collided = ""  # the binding pair of the last exact solution that passes through itself
+        iterations = escapes = 0
+        q = np.clip(start, low, high)
+        seeds = None
+        for started in range(budget):
+            if started:
+                if seeds is None:  # the table's clear configurations nearest the target
+                    if self.table is None:
+                        self.table = _seed_table(self.design, self.compiled, (tip,), self.seed)
+                    seeds = self.table.starts(goal, (target.kind,), SEEDED_STARTS)
+                q = next(seeds, None)
+                if q is not None:
+                    q = q.copy()
+                else:  # then random ones
+                    if rng is None:
+                        rng = np.random.default_rng([self.seed, *_words(goal)])
+                    q = low + (high - low) * rng.random(low.size)
+            if self.path.size == 0:  # nothing moves the tip: one evaluation
+                exact, count, pos, ang = _still(_Problem(self.compiled, [goal], r), q, tol_p,
+                                                tol_a, r)  # fmt: skip
+                near, near_pos, near_ang = q[columns], pos, ang
             else:
-                if rng is None:
-                    rng = np.random.default_rng([seed, *_words(goal)])
-                q = low + (high - low) * rng.random(low.size)
-        if path.size == 0:  # nothing moves the tip: one evaluation
-            exact, count, pos, ang = _still(_Problem(compiled, [goal], r), q, tol_p, tol_a, r)
-            near, near_pos, near_ang = q[columns], pos, ang
-        else:
-            exact, count, pos, ang, near, near_pos, near_ang = descend(
-                *arguments, q[columns].copy(), patience, DAMPING, DAMPING_MIN,
-                DAMPING_MAX)  # fmt: skip
-        iterations += count
-        found = q.copy()
-        found[columns] = near
-        if not exact:
-            _keep(best, 0, found, near_pos, near_ang, None)
-            continue
-        # the engine's closest pairs (the report's verdict and words); a redundant arm that
-        # passes through itself moves along its solutions, away from the binding pairs
-        escape = clear and redundant and escapes < ESCAPES
-        pairs = engine.closest_pairs(found, apart if escape else required)
-        if escape and not _is_clear(pairs, limit):
-            escapes += 1
-            found, pairs, count = _escape(engine, compiled, tip, found, columns, arguments,
-                                          pairs, limit, apart)  # fmt: skip
+                exact, count, pos, ang, near, near_pos, near_ang = self.descend(
+                    *arguments, q[columns], patience, DAMPING, DAMPING_MIN,
+                    DAMPING_MAX)  # fmt: skip
             iterations += count
-        verdict = _verdict(engine, pairs, limit, clear)
-        _keep(best, 0, found, near_pos, near_ang, verdict)
-        if verdict[2]:
-            return _answer(best[0], iterations, started, "", (tip,))
-        collided = verdict[1]
-    return _failure(design, best[0], iterations, budget - 1, collided, options, compiled, goal,
-                    (tip,))  # fmt: skip
+            found = q.copy()
+            found[columns] = near
+            if not exact:
+                _keep(best, 0, found, near_pos, near_ang, None)
+                continue
+            # the engine's closest pairs (the report's verdict and words); a redundant arm
+            # that passes through itself moves along its solutions, away from the binding pairs
+            escape = self.clear and redundant and escapes < ESCAPES
+            pairs = engine.closest_pairs(found, self.apart if escape else self.required)
+            if escape and not _is_clear(pairs, self.limit):
+                escapes += 1
+                found, pairs, count = _escape(engine, self.compiled, tip, found, columns,
+                                              arguments, pairs, self.limit,
+                                              self.apart)  # fmt: skip
+                iterations += count
+            verdict = _verdict(engine, pairs, self.limit, self.clear)
+            _keep(best, 0, found, near_pos, near_ang, verdict)
+            if verdict[2]:
+                return _answer(best[0], iterations, started, "", (tip,))
+            collided = verdict[1]
+        return _failure(self.design, best[0], iterations, budget - 1, collided, self.options,
+                        self.compiled, goal, (tip,))  # fmt: skip
+
+
+_NO_AXIS, _NO_ROTATION = np.zeros(3), np.eye(3)
 
 
 #: Exact solutions that pass through themselves that one target moves away from (redundant
@@ -895,11 +989,16 @@ def _beyond_reach(compiled: Kinematics, goal: dict) -> str:
         return ""
     for tip, target in goal.items():
         radius, centre = _per_tip(compiled, "bound", tip, reach_bound)
-        distance = float(np.linalg.norm(target.position - centre))
-        if distance > radius * (1.0 + 1e-9) + 1e-9:
+        if _outside(target.position, radius, centre):
+            distance = float(np.linalg.norm(target.position - centre))
             return (f"beyond reach: the target is {distance:.6g} from the first moving joint's "
                     f"axis point, and the tip reaches at most {radius:.6g} from it")
     return ""
+
+
+def _outside(position: np.ndarray, radius: float, centre: np.ndarray) -> bool:
+    """Whether ``position`` is beyond the reach bound (R, c) of :func:`reach_bound`."""
+    return float(np.linalg.norm(position - centre)) > radius * (1.0 + 1e-9) + 1e-9
 
 
 def reach_bound(compiled: Kinematics, tip: int) -> tuple[float, np.ndarray]:

@@ -316,28 +316,38 @@ def test_a_margin_is_kept_or_refused():
         solve(design, compiled.fkine(q), margin=-1.0)
 
 
-def test_the_seed_table_holds_clear_configurations_nearest_first():
+def test_the_seed_table_gives_clear_configurations_nearest_first():
     """Restarts begin with the seed table's configurations whose tip poses are nearest the
-    target's: each is in range and clear (a chain), they come nearest first by the table's
-    features, and the same seed gives the same table."""
+    target's: each is in range and clear (a chain; asked of the engine when first used, and
+    the same verdict as the design's), they come nearest first by the table's features and
+    are the nearest of the table's clear configurations, and the same seed gives the same
+    table."""
     import kinegami.reach.inverse as inverse
+    from kinegami.clearance.engine import engine_for
 
     design = load_design(DESIGNS / "puma.json")
     compiled = kinematics(design)
     tip = compiled.tips[0]
     table = inverse._seed_table(design, compiled, (tip,), 0)
-    assert 0 < table.Q.shape[0] <= inverse.SEED_TABLE
+    assert table.Q.shape[0] == inverse.SEED_TABLE and np.all(table.clear == -1)
     low, high = compiled.ranges[:, 0], compiled.ranges[:, 1]
     assert np.all(table.Q >= low) and np.all(table.Q <= high)
-    for q in table.Q[:20]:
-        assert design.clearance(q.tolist()).ok
     T = compiled.fkine(clear_configurations(design, 1, seed=9)[0])
     goal = {tip: Target.of(T)}
     near = table.nearest(goal, ("pose",), 5)
+    assert near.shape == (5, compiled.n)
+    for q in near:
+        assert design.clearance(q.tolist()).ok
+    asked = np.flatnonzero(table.clear >= 0)  # only the nearest were asked, and rightly
+    assert 5 <= asked.size < 100
+    for row in asked:
+        assert bool(table.clear[row]) == design.clearance(table.Q[row].tolist()).ok
     wanted = table.features(T[None, None], ("pose",))[0]
+    clear = ~engine_for(design).colliding(table.Q, 0.0)
+    every = np.linalg.norm(table.features(table.T[clear], ("pose",)) - wanted, axis=1)
     gaps = np.linalg.norm(table.features(compiled.tip_poses(near), ("pose",)) - wanted, axis=1)
-    every = np.linalg.norm(table.features(table.T, ("pose",)) - wanted, axis=1)
-    assert np.all(np.diff(gaps) >= 0) and gaps[0] == pytest.approx(every.min())
+    np.testing.assert_array_equal(gaps, np.sort(every)[:5])
+    assert [q.tolist() for q in table.starts(goal, ("pose",), 3)] == near[:3].tolist()
     assert inverse._seed_table(design, compiled, (tip,), 0) is table  # made once
     again = inverse._SeedTable(design, compiled, (tip,), 0)
     assert np.array_equal(again.Q, table.Q)
