@@ -1155,8 +1155,30 @@ class ClearanceEngine:
         report's ``min_clearance``, the same arithmetic (k = 0 when nothing is tested).
         """
         margin = check_margin(margin)
+        return self._closest_at(self._configurations(self.check_states(states)[None, :]),
+                                margin)  # fmt: skip
+
+    def closest_pairs_many(self, Q, margin: float = 0.0) -> list[tuple]:
+        """:meth:`closest_pairs` at each configuration of ``Q`` (K, J) (absolute states,
+        checked at once): the same arrays to the bit, a tuple per configuration, without
+        checking the states and the margin once per configuration (a solver's batch of
+        targets asks them together)."""
+        margin = check_margin(margin)
+        Q = np.asarray(Q, dtype=float)
+        J = self.ranges.shape[0]
+        plain = Q.ndim == 2 and Q.shape[1] == J and bool(np.all(
+            (self.ranges[:, 0] - 1e-12 <= Q) & (Q <= self.ranges[:, 1] + 1e-12)
+            & np.isfinite(Q)))  # fmt: skip
+        if not plain:  # the first configuration that is not states says why
+            if Q.ndim != 2:
+                raise InvalidParameterError(f"Q must be (K, {J}) states, got shape {Q.shape}")
+            Q = np.array([self.check_states(q, f"Q[{k}]") for k, q in enumerate(Q)])
+        Q = self._configurations(Q.copy())
+        return [self._closest_at(Q[k : k + 1], margin) for k in range(Q.shape[0])]
+
+    def _closest_at(self, Q: np.ndarray, margin: float) -> tuple:
+        """:meth:`closest_pairs` at the one checked configuration ``Q`` (1, J)."""
         limit = clear_limit(self.r, margin)
-        Q = self._configurations(self.check_states(states)[None, :])
         S = self._S
         one = self._one_arrays() if self._listed else None
         compiled = one is not None and one.pairs and _kernel() is not None

@@ -75,6 +75,32 @@ def test_closest_pairs_refuse_states_out_of_range():
         engine_for(design).closest_pairs(q)
 
 
+@pytest.mark.parametrize("compiled_kernel", [True, False], ids=["compiled", "numpy"])
+@pytest.mark.parametrize("name", ["spherical_series", "puma", "hand"])
+def test_closest_pairs_of_many_configurations_are_each_ones(name, compiled_kernel, monkeypatch):
+    """ClearanceEngine.closest_pairs_many (a solver's batch of targets asks together) gives
+    closest_pairs' arrays at each configuration, to the bit, and checks the states."""
+    import kinegami.clearance.engine as engine_module
+
+    if not compiled_kernel:
+        monkeypatch.setattr(engine_module, "_KERNEL", [None, None])
+    design = load_design(DESIGNS / f"{name}.json")
+    engine = engine_of(design)
+    states = np.array([joint.state for joint in design.Joints])
+    Q = np.array([states] + random_configurations(kinematics(design), 12, seed=4))
+    for margin in (0.0, 0.5 * float(design.r)):
+        many = engine.closest_pairs_many(Q, margin)
+        assert len(many) == Q.shape[0]
+        for q, got in zip(Q, many, strict=True):
+            for mine, theirs in zip(got, engine.closest_pairs(q, margin), strict=True):
+                assert mine.dtype == theirs.dtype and np.array_equal(mine, theirs)
+    assert engine.closest_pairs_many(Q[:0]) == []
+    bad = Q[:3].copy()
+    bad[2, 1] = 1e3
+    with pytest.raises(ValueError, match=r"Q\[2\].*range"):
+        engine.closest_pairs_many(bad)
+
+
 def _capsule_rows(engine, q, ends) -> tuple[int, int]:
     """The capsules (rows of engine.segments) whose segments are a pair's ``ends`` at q."""
     a, b = engine.segments(q[None, :])
