@@ -402,8 +402,9 @@ def _solve_chunk(design, compiled: Kinematics, goals: list, indices: list, start
     for key, members in groups.items():
         if len(key) == 1 and _kernel() is not None:  # one tip: each target compiled
             solver = _TipSolver(design, compiled, key[0][0], options)
-            for k in members:
-                answers[k] = solver.answer(goals[k], start)
+            for k, answer in zip(members, solver.answers([goals[k] for k in members], start),
+                                 strict=True):  # fmt: skip
+                answers[k] = answer
             continue
         found = _solve_group(design, compiled, [goals[k] for k in members],
                              [indices[k] for k in members], start, options)  # fmt: skip
@@ -624,17 +625,35 @@ class _SeedTable:
 
     def is_clear(self, row: int) -> bool:
         """Whether configuration ``row`` is clear (asked of the engine once)."""
-        verdict = self.clear[row]
-        if verdict < 0:
-            pairs = self.engine.closest_pairs(self.Q[row], self.margin)
-            verdict = self.clear[row] = _is_clear(pairs, self.limit)
-        return bool(verdict)
+        if self.clear[row] < 0:
+            self.record(row, self.engine.closest_pairs(self.Q[row], self.margin))
+        return bool(self.clear[row])
+
+    def record(self, row: int, pairs: tuple) -> bool:
+        """Keep whether configuration ``row`` is clear from the engine's closest pairs there
+        (with :attr:`margin`), and return it."""
+        verdict = _is_clear(pairs, self.limit)
+        self.clear[row] = verdict
+        return verdict
+
+    def next_clear(self, rows):
+        """The next clear configuration of ``rows`` (an iterator of :meth:`rows`), or None
+        when there is none: a generator that yields (configuration, :attr:`margin`) for a
+        configuration not asked yet and is sent the engine's closest pairs there (see
+        :meth:`_TipSolver.search`)."""
+        for row in rows:
+            verdict = self.clear[row]
+            if verdict < 0:
+                verdict = self.record(row, (yield self.Q[row], self.margin))
+            if verdict:
+                return self.Q[row]
+        return None
 
     def starts(self, goal: dict, kinds: tuple, count: int):
         """The clear configurations nearest to ``goal`` (tip -> Target), nearest first, at
         most ``count`` (a generator: each is checked when it is asked for)."""
         given = 0
-        for row in self._rows(goal, kinds):
+        for row in self.rows(goal, kinds):
             if given >= count:
                 return
             if self.is_clear(row):
@@ -645,7 +664,7 @@ class _SeedTable:
         """(k, n): :meth:`starts` at once, k <= ``count``."""
         return np.array(list(self.starts(goal, kinds, count))).reshape(-1, self.Q.shape[1])
 
-    def _rows(self, goal: dict, kinds: tuple):
+    def rows(self, goal: dict, kinds: tuple):
         """Every configuration's index, nearest to ``goal`` first (asked of the KD-tree 64,
         then four times as many at a time)."""
         tree = self.trees.get(kinds)
@@ -724,11 +743,19 @@ class _TipSolver:
         self.descend = _kernel()
         self.table = None
 
-    def answer(self, goal: dict, start: np.ndarray) -> Answer:
-        """The answer to ``goal`` ({tip: Target}) from ``start`` (a full configuration)."""
+    def answers(self, goals: list, start: np.ndarray) -> list[Answer]:
+        """The answers to ``goals`` ({tip: Target} each) from ``start``: every target's
+        search (:meth:`search`) runs in step with the others, and what they ask of the
+        clearance engine at a step is asked in one call per margin
+        (:meth:`kinegami.clearance.engine.ClearanceEngine.closest_pairs_many`: the same
+        arrays as one by one, so a target's answer does not depend on the others)."""
+        return _in_step([self.search(goal, start) for goal in goals], self.engine)
+
+    def search(self, goal: dict, start: np.ndarray):
+        """The answer to ``goal`` from ``start``, as a generator that yields (configuration,
+        margin) whenever it needs the engine's closest pairs there, and is sent them."""
         (tip, target), = goal.items()
-        r, tol_p, tol_a, columns, engine = self.r, self.tol_p, self.tol_a, self.columns, \
-            self.engine  # fmt: skip
+        r, tol_p, tol_a, columns = self.r, self.tol_p, self.tol_a, self.columns
         low, high = self.low, self.high
         rng = None  # the target's own random stream, made at the first restart (~70 us)
         hopeless = _outside(target.position, *self.bound)
@@ -742,17 +769,23 @@ class _TipSolver:
         collided = ""  # the binding pair of the last exact solution that passes through itself
         iterations = escapes = 0
         q = np.clip(start, low, high)
-        seeds = None
+        rows = None  # the seed table's configurations, nearest the target first
+        seeded = 0
         for started in range(budget):
             if started:
-                if seeds is None:  # the table's clear configurations nearest the target
-                    if self.table is None:
-                        self.table = _seed_table(self.design, self.compiled, (tip,), self.seed)
-                    seeds = self.table.starts(goal, (target.kind,), SEEDED_STARTS)
-                q = next(seeds, None)
+                q = None
+                if seeded < SEEDED_STARTS:  # the table's clear configurations nearest it
+                    if rows is None:
+                        if self.table is None:
+                            self.table = _seed_table(self.design, self.compiled, (tip,),
+                                                     self.seed)  # fmt: skip
+                        rows = self.table.rows(goal, (target.kind,))
+                    q = yield from self.table.next_clear(rows)
                 if q is not None:
+                    seeded += 1
                     q = q.copy()
                 else:  # then random ones
+                    seeded = SEEDED_STARTS
                     if rng is None:
                         rng = np.random.default_rng([self.seed, *_words(goal)])
                     q = low + (high - low) * rng.random(low.size)
@@ -773,20 +806,49 @@ class _TipSolver:
             # the engine's closest pairs (the report's verdict and words); a redundant arm
             # that passes through itself moves along its solutions, away from the binding pairs
             escape = self.clear and redundant and escapes < ESCAPES
-            pairs = engine.closest_pairs(found, self.apart if escape else self.required)
+            pairs = yield found, (self.apart if escape else self.required)
             if escape and not _is_clear(pairs, self.limit):
                 escapes += 1
-                found, pairs, count = _escape(engine, self.compiled, tip, found, columns,
-                                              arguments, pairs, self.limit,
-                                              self.apart)  # fmt: skip
+                found, pairs, count = yield from _escape_steps(
+                    self.engine, self.compiled, tip, found, columns, arguments, pairs,
+                    self.limit, self.apart)  # fmt: skip
                 iterations += count
-            verdict = _verdict(engine, pairs, self.limit, self.clear)
+            verdict = _verdict(self.engine, pairs, self.limit, self.clear)
             _keep(best, 0, found, near_pos, near_ang, verdict)
             if verdict[2]:
                 return _answer(best[0], iterations, started, "", (tip,))
             collided = verdict[1]
         return _failure(self.design, best[0], iterations, budget - 1, collided, self.options,
                         self.compiled, goal, (tip,))  # fmt: skip
+
+
+def _in_step(searches: list, engine) -> list:
+    """Run generators that yield (configuration, margin) for the engine's closest pairs
+    there (and are sent them) until each returns: at every step, the configurations asked
+    for with one margin are measured in one call
+    (:meth:`kinegami.clearance.engine.ClearanceEngine.closest_pairs_many`). Returns their
+    values, in order."""
+    results: list = [None] * len(searches)
+    waiting: dict[int, tuple] = {}
+
+    def advance(k: int, value) -> None:
+        try:
+            waiting[k] = searches[k].send(value)
+        except StopIteration as stop:
+            waiting.pop(k, None)
+            results[k] = stop.value
+
+    for k in range(len(searches)):
+        advance(k, None)
+    while waiting:
+        by_margin: dict[float, list[int]] = {}
+        for k, (_, margin) in waiting.items():
+            by_margin.setdefault(margin, []).append(k)
+        for margin, asking in by_margin.items():
+            Q = np.array([waiting[k][0] for k in asking])
+            for k, pairs in zip(asking, engine.closest_pairs_many(Q, margin), strict=True):
+                advance(k, pairs)
+    return results
 
 
 _NO_AXIS, _NO_ROTATION = np.zeros(3), np.eye(3)
@@ -801,7 +863,7 @@ ESCAPES, ESCAPE_STEPS = 16, 16
 ESCAPE_BUFFER, ESCAPE_RADIUS, ESCAPE_SHORTEST, ESCAPE_PATIENCE = 0.2, 0.3, 1e-3, 12
 
 
-def _escape(engine, compiled: Kinematics, tip: int, q: np.ndarray, columns: np.ndarray,
+def _escape_steps(engine, compiled: Kinematics, tip: int, q: np.ndarray, columns: np.ndarray,
             arguments: tuple, pairs: tuple, limit: float, apart: float) -> tuple:  # fmt: skip
     """For an arm with more joints on the tip's path than the target fixes: from the exact
     solution ``q`` that passes through itself (``pairs``: the engine's pairs closer than the
@@ -811,7 +873,9 @@ def _escape(engine, compiled: Kinematics, tip: int, q: np.ndarray, columns: np.n
     target). A step is kept when it lessens the overlap (the sum of the clearances'
     shortfalls below ``limit``), and the next may be twice as long; otherwise it is tried
     half as long. Returns (q, pairs, iterations): the first clear solution met, or the exact
-    one that overlaps least."""
+    one that overlaps least. A generator: it yields (configuration, margin) for the engine's
+    closest pairs there and is sent them (:func:`_in_step`); :func:`_escape` runs it
+    alone."""
     from kinegami.reach.kernels import descend, escape_step
 
     path = arguments[1]
@@ -831,7 +895,7 @@ def _escape(engine, compiled: Kinematics, tip: int, q: np.ndarray, columns: np.n
         if exact:
             trial = q.copy()
             trial[columns] = near
-            moved = engine.closest_pairs(trial, apart)
+            moved = yield trial, apart
             lack = _shortfall(moved[0], limit)
             if lack < shortfall:
                 q, pairs, shortfall = trial, moved, lack
@@ -843,6 +907,13 @@ def _escape(engine, compiled: Kinematics, tip: int, q: np.ndarray, columns: np.n
         if radius < ESCAPE_SHORTEST:
             break
     return q, pairs, iterations
+
+
+def _escape(engine, compiled: Kinematics, tip: int, q: np.ndarray, columns: np.ndarray,
+            arguments: tuple, pairs: tuple, limit: float, apart: float) -> tuple:  # fmt: skip
+    """:func:`_escape_steps` run alone, asking ``engine`` for the closest pairs."""
+    return _in_step([_escape_steps(engine, compiled, tip, q, columns, arguments, pairs, limit,
+                                   apart)], engine)[0]  # fmt: skip
 
 
 def _shortfall(clearance: np.ndarray, limit: float) -> float:
