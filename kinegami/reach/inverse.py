@@ -37,6 +37,11 @@ DAMPING, DAMPING_MIN, DAMPING_MAX = 1e-3, 1e-12, 1e8
 #: Configurations of the seed table (per design, tips and seed), and how many of the nearest
 #: to a target are tried after its first start, before random ones.
 SEED_TABLE, SEEDED_STARTS = 8192, 63
+#: Restarts taken from the seed table before random starts take every other turn: the
+#: table's nearest configurations can all lie in one basin that a joint limit closes (the
+#: PUMA's target 1137 of benchmarks/reach_success.py: its 63 nearest all stop at limits, 15%
+#: of random starts reach it).
+TABLE_FIRST = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -426,20 +431,22 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
     kinds = tuple(problem.kinds)
     seeds: list = [None] * G
 
-    def fresh(g: int, first: bool) -> np.ndarray:
-        """The first start (q0), then the table's nearest configurations, then random."""
-        if first:
+    def fresh(g: int, number: int) -> np.ndarray:
+        """Start ``number`` of goal g: q0, then the table's nearest configurations (random
+        ones taking every other turn after :data:`TABLE_FIRST`), then random ones."""
+        if number == 0:
             return np.clip(start, low, high)
-        if seeds[g] is None:
-            seeds[g] = table.starts(goals[g], kinds, SEEDED_STARTS)
-        q = next(seeds[g], None)
-        if q is not None:
-            return q.copy()
+        if _table_turn(number):
+            if seeds[g] is None:
+                seeds[g] = table.starts(goals[g], kinds, SEEDED_STARTS)
+            q = next(seeds[g], None)
+            if q is not None:
+                return q.copy()
         return low + (high - low) * rngs[g].random(low.size)
 
     # rows of the batch: (goal, start); STARTS rows per goal at first
     owner = np.repeat(np.arange(G), STARTS)
-    Q = np.array([fresh(g, s == 0) for g in range(G) for s in range(STARTS)])
+    Q = np.array([fresh(g, s) for g in range(G) for s in range(STARTS)])
     # a target a bound puts out of reach: one start, a few iterations for the nearest
     # configuration, no restarts (the verdict is known)
     hopeless = np.array([bool(_beyond_reach(compiled, goal)) for goal in goals])
@@ -508,7 +515,7 @@ def _solve_group(design, compiled, goals, indices, start, options) -> list[Answe
                 if done[g] or started[g] >= budget[g]:
                     active[row] = False
                     continue
-                Q[row] = fresh(g, False)
+                Q[row] = fresh(g, int(started[g]))
                 started[g] += 1
                 damping[row], age[row] = DAMPING, 0
         for row in np.flatnonzero(active).tolist():
@@ -718,6 +725,12 @@ def _make_tip_path(compiled: Kinematics, tip: int) -> tuple:
             np.ascontiguousarray(compiled.ranges[columns, 1]))  # fmt: skip
 
 
+def _table_turn(number: int) -> bool:
+    """Whether restart ``number`` (1, 2, ...) is the seed table's turn (while it has
+    configurations left): the first :data:`TABLE_FIRST`, then every other one."""
+    return number <= TABLE_FIRST or (number - TABLE_FIRST) % 2 == 0
+
+
 class _TipSolver:
     """:func:`_solve_group`'s answers for targets of one tip, each start iterated by the
     compiled descent (:func:`kinegami.reach.kernels.descend`) in turn: the first from the
@@ -774,21 +787,20 @@ class _TipSolver:
         for started in range(budget):
             if started:
                 q = None
-                if seeded < SEEDED_STARTS:  # the table's clear configurations nearest it
-                    if rows is None:
+                if seeded < SEEDED_STARTS and _table_turn(started):  # the table's clear
+                    if rows is None:  # configurations nearest the target
                         if self.table is None:
                             self.table = _seed_table(self.design, self.compiled, (tip,),
                                                      self.seed)  # fmt: skip
                         rows = self.table.rows(goal, (target.kind,))
                     q = yield from self.table.next_clear(rows)
-                if q is not None:
-                    seeded += 1
-                    q = q.copy()
-                else:  # then random ones
-                    seeded = SEEDED_STARTS
+                    seeded = SEEDED_STARTS if q is None else seeded + 1
+                if q is None:  # a random one
                     if rng is None:
                         rng = np.random.default_rng([self.seed, *_words(goal)])
                     q = low + (high - low) * rng.random(low.size)
+                else:
+                    q = q.copy()
             if self.path.size == 0:  # nothing moves the tip: one evaluation
                 exact, count, pos, ang = _still(_Problem(self.compiled, [goal], r), q, tol_p,
                                                 tol_a, r)  # fmt: skip

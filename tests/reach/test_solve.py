@@ -159,6 +159,26 @@ def test_targets_whose_starts_stopped_at_joint_limits_are_reached(name, k):
     check(path, answer, {compiled.tips[0]: Target.of(T)})
 
 
+def test_random_starts_take_turns_with_the_seed_table(monkeypatch):
+    """After the seed table's first TABLE_FIRST configurations, random starts take every
+    other turn: the PUMA's target 1137 of benchmarks/reach_success.py (seed 0), whose 63
+    nearest table configurations all stop at joint limits, is reached; with the table's
+    turns only, it is not."""
+    import kinegami.reach.inverse as inverse
+
+    path = DESIGNS / "puma.json"
+    design = load_design(path)
+    compiled = kinematics(design)
+    T = compiled.fkine(np.array([-1.3917002833779568, -1.5557739445204641, 0.04949994135196811,
+                                 -1.2593825661356983, -0.3879779214323096, -1.3495348459861591,
+                                 0.0]))  # fmt: skip
+    answer = solve(design, T)
+    check(path, answer, {compiled.tips[0]: Target.of(T)})
+    assert answer.restarts > inverse.TABLE_FIRST
+    monkeypatch.setattr(inverse, "TABLE_FIRST", inverse.MAX_STARTS)
+    assert not solve(design, T).ok
+
+
 def test_a_step_holds_the_joints_at_limits_that_it_pushes_beyond():
     """The numpy path's steps (several tips, or no numba): a joint at a limit is never pushed
     beyond it; the step is the damped step of the Jacobian without the held joints, which
