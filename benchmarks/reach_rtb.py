@@ -188,6 +188,83 @@ def _checked(path: Path, states, T, tolerance: float) -> bool:
     return float(np.abs(check.Joints[-1].distal_dubins_frame() - T).max()) <= tolerance
 
 
+#: One fresh process: the CPU time of the first use of the compiled kernels (numba compiles
+#: them unless its cache has them), printed as JSON. The clearance engine's own kernel is
+#: warmed first unless "all" is given, so that the reach kernels are measured alone.
+_FIRST_USE = """
+import json, sys, time
+import numpy as np
+start = time.process_time()
+from kinegami.clearance.engine import engine_for
+from kinegami.design import load_design
+from kinegami.reach import kinematics, solve
+from kinegami.reach import inverse
+designs = {designs!r}
+puma = load_design(designs + "/puma.json")
+series = load_design(designs + "/spherical_series.json")
+arm, nine = kinematics(puma), kinematics(series)
+q = np.array([joint.state for joint in puma.Joints])
+if sys.argv[1] != "all":
+    engine_for(puma).closest_pairs(q, 0.0)
+    engine_for(series).closest_pairs(np.array([joint.state for joint in series.Joints]), 0.0)
+out = {{}}
+T = arm.fkine(q + 0.05 * (np.arange(q.size) % 3 - 1) * (arm.kinds != 0))  # near q0
+t0 = time.process_time()
+assert solve(puma, T).ok
+out["first solve"] = time.process_time() - t0
+# the escape's kernels, on an exact 9R solution and its closest pairs
+steps, path, revolute, reference, E, columns, low, high = inverse._tip_path(nine, nine.tips[0])
+engine = engine_for(series)
+q9 = np.array([joint.state for joint in series.Joints])
+clearance, ends, bodies, s, t, _ = engine.closest_pairs(q9, 10.0 * float(series.r))
+moves = inverse._moves(engine, nine, path)
+from kinegami.reach.kernels import escape_step
+t0 = time.process_time()
+escape_step(steps, path, revolute, reference, E, low, high, 2, float(series.r), q9[columns],
+            clearance, ends, bodies, s, t, moves, 10.0 * float(series.r), 0.3)
+out["first escape"] = time.process_time() - t0
+out["process"] = time.process_time() - start
+print(json.dumps(out))
+"""
+
+
+def first_use_rows(repeat: int = 2) -> list[tuple[str, str, str]]:
+    """What a fresh install pays once: the CPU time (process_time) of the first ``solve``
+    (the compiled descent) and of the first escape of a redundant arm (its kernels), each in
+    a fresh process whose numba cache is an empty folder (``NUMBA_CACHE_DIR``), so numba
+    compiles them; the reach kernels alone (the clearance kernel compiled beforehand), then
+    with the clearance kernel. Kinegami's side only: RTB is not needed."""
+    import json
+    import os
+    import subprocess
+    import sys
+    import tempfile
+
+    script = _FIRST_USE.format(designs=str(DESIGNS))
+    found: dict[str, list[float]] = {}
+    for which in ("reach", "all"):
+        for _ in range(repeat):
+            with tempfile.TemporaryDirectory() as cache:
+                env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+                run = subprocess.run([sys.executable, "-c", script, which], env=env,
+                                     capture_output=True, text=True, check=True)  # fmt: skip
+            for key, value in json.loads(run.stdout.strip().splitlines()[-1]).items():
+                found.setdefault(f"{which}: {key}", []).append(value)
+    words = {"reach: first solve": "first solve, reach kernels (the descent) compiled, CPU",
+             "reach: first escape": "first escape of a redundant arm, its kernels compiled, "
+                                    "CPU",
+             "all: first solve": "first solve on an empty numba cache, clearance kernel too, "
+                                 "CPU"}  # fmt: skip
+    return [(text, " / ".join(f"{v:.1f} s" for v in found[key]), "-")
+            for key, text in words.items()]  # fmt: skip
+
+
 if __name__ == "__main__":
-    for row in rows() + batch_rows():
-        print(" | ".join(row))
+    import sys
+
+    if "--first-use" in sys.argv:
+        for row in first_use_rows():
+            print(" | ".join(row))
+    else:
+        for row in rows() + batch_rows():
+            print(" | ".join(row))

@@ -252,22 +252,6 @@ def _hold(q, step, low, high, held):
 
 
 @njit(cache=True)
-def _held_step(J, held, lam, e, Jh, A, L, x, step):
-    """The damped least-squares step ``step`` (P,) with the ``held`` joints' columns of J
-    left out (their entries 0): the joints at their limits stay, and the others make up for
-    them. ``Jh``, ``A``, ``L``, ``x`` are work space."""
-    size, P = J.shape
-    for i in range(size):
-        for m in range(P):
-            Jh[i, m] = 0.0 if held[m] else J[i, m]
-    _gram(Jh, A)
-    for i in range(size):
-        A[i, i] += lam
-    _spd_solve_into(A, e, L, x)
-    _transposed_times(Jh, x, step)
-
-
-@njit(cache=True)
 def descend(steps, path, revolute, reference, E, low, high, kind, target_p, target_R, target_a,
             r, tol_p, tol_a, q, patience, damping, damping_min, damping_max):  # fmt: skip
     """Iterate one start: ``q`` (P,) the path joints' states, changed in place to the last
@@ -286,7 +270,6 @@ def descend(steps, path, revolute, reference, E, low, high, kind, target_p, targ
     e2 = np.empty(size)
     w = np.empty(3)
     J = np.zeros((size, P))
-    G = np.empty((size, size))  # J J^T at q
     A = np.empty((size, size))
     L = np.empty((size, size))
     x = np.empty(size)
@@ -313,20 +296,22 @@ def descend(steps, path, revolute, reference, E, low, high, kind, target_p, targ
                 return False, iteration, pos, ang, best, best_pos, best_ang
         if moved:  # the residual's Jacobian at q (kept while steps are refused)
             _residual_jacobian(axes, T, revolute, kind, r, J)
-            _gram(J, G)
             moved = False
-        for i in range(size):  # (J J^T + lambda I) x = e, the step J^T x
-            for j in range(size):
-                A[i, j] = G[i, j]
-            A[i, i] += lam
-        _spd_solve_into(A, e, L, x)
-        _transposed_times(J, x, step)
-        if _hold(q, step, low, high, held):  # the step again without the joints held
-            _held_step(J, held, lam, e, Jh, A, L, x, step)
-            while _hold(q, step, low, high, held):
-                _held_step(J, held, lam, e, Jh, A, L, x, step)
-            for m in range(P):
-                held[m] = False
+        # the step J^T (J J^T + lambda I)^-1 e, the joints at a limit that it pushes beyond
+        # held (their columns left out, the step solved again: the others make up for them)
+        for m in range(P):
+            held[m] = False
+        while True:
+            for i in range(size):
+                for m in range(P):
+                    Jh[i, m] = 0.0 if held[m] else J[i, m]
+            _gram(Jh, A)
+            for i in range(size):
+                A[i, i] += lam
+            _spd_solve_into(A, e, L, x)
+            _transposed_times(Jh, x, step)
+            if not _hold(q, step, low, high, held):
+                break
         for m in range(P):
             v = q[m] + step[m]
             v = low[m] if low[m] > v else v
