@@ -89,8 +89,11 @@ def measure(name: str, count: int, executor, seed: int = 0) -> dict:
     answers = solve_many(design, targets, seed=seed, executor=executor, chunk=64)
     took = time.perf_counter() - t0
     ok = checked(path, answers, goals, float(design.r))
-    reasons = collections.Counter(a.reason.split(":")[0].split("(")[0].strip()
-                                  for a, good in zip(answers, ok, strict=True) if not good)
+    reasons = collections.Counter(
+        a.reason.split(":")[0].split("(")[0].strip()
+        for a, good in zip(answers, ok, strict=True)
+        if not good
+    )
     return {"name": name, "targets": count, "reached": sum(ok), "reasons": reasons,
             "seconds": took, "tips": len(compiled.tips)}  # fmt: skip
 

@@ -8,8 +8,16 @@ the others.
 
 from kinegami._lazy import lazy_names
 
-__all__ = ["Answer", "Kinematics", "Target", "Workspace", "kinematics", "solve", "solve_many",
-           "workspace"]
+__all__ = [
+    "Answer",
+    "Kinematics",
+    "Target",
+    "Workspace",
+    "kinematics",
+    "solve",
+    "solve_many",
+    "workspace",
+]
 
 #: Names imported on first use: name -> module.
 _LAZY = {

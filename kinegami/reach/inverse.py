@@ -85,7 +85,7 @@ class Target:
 
     @property
     def kind(self) -> str:
-        """"pose", "axis" or "position"."""
+        """ "pose", "axis" or "position"."""
         return "pose" if self.rotation is not None else "axis" if self.axis is not None \
             else "position"  # fmt: skip
 
@@ -218,8 +218,8 @@ def solve_many(design, targets, *, tip=None, tool=None, q0=None, seed: int = 0,
     goals = _all_goals(design, targets, tip)
     tips = sorted({k for goal in goals for k in goal})
     compiled = kinematics(design, tips if tips else None, tool)
-    start = compiled.configurations(
-        [joint.state for joint in design.Joints] if q0 is None else q0)[0][0]
+    states = [joint.state for joint in design.Joints] if q0 is None else q0
+    start = compiled.configurations(states)[0][0]
     options = (tol_p, tol_a, int(seed), clear, margin)
     chunk = max(1, int(chunk))
     pieces = [list(range(a, min(a + chunk, len(goals)))) for a in range(0, len(goals), chunk)]
@@ -617,8 +617,7 @@ class _SeedTable:
         self.engine = _engine_of(design) if chain else None
         self.margin = float(getattr(design, "margin", 0.0))
         self.limit = _limit(design, self.margin)
-        scale = max((_per_tip(compiled, "bound", t, reach_bound)[0] for t in tips),
-                    default=1.0)
+        scale = max((_per_tip(compiled, "bound", t, reach_bound)[0] for t in tips), default=1.0)
         self.scale = scale if scale > 0 else 1.0
         self.trees: dict = {}
 
@@ -792,7 +791,7 @@ class _TipSolver:
         """The answer to ``goal`` from ``start``, as a generator that yields what it needs
         of the engine (closest pairs) and of the seed table (the nearest configurations) and
         is sent them (:func:`_in_step`)."""
-        (tip, target), = goal.items()
+        ((tip, target),) = goal.items()
         r, tol_p, tol_a, columns = self.r, self.tol_p, self.tol_a, self.columns
         low, high = self.low, self.high
         rng = None  # the target's own random stream, made at the first restart (~70 us)
@@ -1115,8 +1114,10 @@ def _beyond_reach(compiled: Kinematics, goal: dict) -> str:
         radius, centre = _per_tip(compiled, "bound", tip, reach_bound)
         if _outside(target.position, radius, centre):
             distance = float(np.linalg.norm(target.position - centre))
-            return (f"beyond reach: the target is {distance:.6g} from the first moving joint's "
-                    f"axis point, and the tip reaches at most {radius:.6g} from it")
+            return (
+                f"beyond reach: the target is {distance:.6g} from the first moving joint's "
+                f"axis point, and the tip reaches at most {radius:.6g} from it"
+            )
     return ""
 
 

@@ -254,8 +254,19 @@ def workspace(design, samples: int = 20_000, *, seed: int = 0, voxel: float | No
     if reachability:
         directions = approach_directions(reachability)
         maps["directions"] = directions
-        maps["reachability"] = _reachability(design, compiled.tips[0], points, which, keys, h,
-                                             directions, margin, seed, executor, progress)
+        maps["reachability"] = _reachability(
+            design,
+            compiled.tips[0],
+            points,
+            which,
+            keys,
+            h,
+            directions,
+            margin,
+            seed,
+            executor,
+            progress,
+        )
     return Workspace(
         points=points, configurations=configurations, lost=tips[~clear], samples=int(samples),
         voxel=h, voxels=keys, volume=volume, half_volume=half.shape[0] * h**3,
