@@ -137,21 +137,31 @@ def puma_compaction() -> tuple[str, str, str]:
 
 
 def rows(count: int = 20, workers: int = 1, pose_count: int | None = None,
-         print_rows: bool = False) -> list[tuple[str, str, str]]:  # fmt: skip
+         print_rows: bool = False, first_seed: int = 0) -> list[tuple[str, str, str]]:  # fmt: skip
     """The benchmark's rows (what, result, goal); ``pose_count`` pose tasks (default
-    ``count``: each may take minutes); ``print_rows``: each row printed as it is measured."""
+    ``count``: each may take minutes); ``print_rows``: each row printed as it is measured,
+    and one line per task; ``first_seed``: the tasks' seeds start there (default 0)."""
     out = _Rows(print_rows)
     goals = {"position": ("95%", 60.0), "pose": ("90%", 300.0), "infeasible": ("-", 1.0)}
     for kind in ("position", "pose", "infeasible"):
         number = pose_count if kind == "pose" and pose_count is not None else count
         if number <= 0:
             continue
-        jobs = [(kind, seed) for seed in range(number)]
+        jobs = [(kind, seed) for seed in range(first_seed, first_seed + number)]
         if workers > 1:
             with concurrent.futures.ProcessPoolExecutor(workers) as pool:
                 results = list(pool.map(one_task, *zip(*jobs, strict=True)))
         else:
             results = [one_task(*job) for job in jobs]
+        if print_rows and kind != "infeasible":
+            for (_, seed), r in zip(jobs, results, strict=True):
+                ratio = ""
+                if r["ok"] and r["plain"] > 0:
+                    ratio = f", tube {r['tube']:.2f} r / {r['plain']:.2f} r = " \
+                        f"{r['tube'] / r['plain']:.3f}"  # fmt: skip
+                why = "" if r["ok"] else f": {r['why']}"
+                print(f"  {kind} task {seed}: {'designed' if r['ok'] else 'not designed'}, "
+                      f"{r['seconds']:.1f} s{ratio}{why}", flush=True)  # fmt: skip
         seconds = [r["seconds"] for r in results]
         if kind == "infeasible":
             proven = sum(r["proven"] for r in results)
@@ -202,12 +212,22 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--full", action="store_true", help="100 tasks of each kind (not 20)")
     parser.add_argument("--tasks", type=int, default=None, help="tasks of each kind")
-    parser.add_argument("--pose-tasks", type=int, default=None,
-                        help="pose tasks (default: as many as --tasks; each may take minutes)")
+    parser.add_argument(
+        "--pose-tasks",
+        type=int,
+        default=None,
+        help="pose tasks (default: as many as --tasks; each may take minutes)",
+    )
     parser.add_argument("--workers", type=int, default=1, help="tasks run in parallel")
+    parser.add_argument(
+        "--first-seed",
+        type=int,
+        default=0,
+        help="the tasks' seeds start here (other tasks than the default ones)",
+    )
     args = parser.parse_args()
     count = args.tasks if args.tasks is not None else 100 if args.full else 20
-    rows(count, args.workers, args.pose_tasks, print_rows=True)
+    rows(count, args.workers, args.pose_tasks, print_rows=True, first_seed=args.first_seed)
 
 
 if __name__ == "__main__":

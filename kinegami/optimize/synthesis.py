@@ -52,6 +52,13 @@ FIT_TOLERANCE = 1e-11
 ROUND = 8
 #: Default number of starts per joint-type string.
 STARTS = 64
+#: The fit's bounds, tried in order until one gives an exact fit: (share of each revolute
+#: joint's range kept free at either end, largest distance of the tip from the last joint's
+#: axis in r (position targets; None: no bound)). A joint near its limit folds the elbows beside
+#: it into each other: with 0.2 of the range kept (within 54 deg of the middle of a revolute
+#: joint's), 5 of 8 starts of a benchmark pose task gave a design, against 1 of 23 without.
+#: The last link spans the tip's distance from the last axis, which no placement shortens.
+FIT_STAGES = ((0.2, 5.0), (0.2, None), (0.0, None))
 #: The default longest tube, in units of r.
 MAX_TUBE_LENGTH_R = 100.0
 
@@ -128,8 +135,11 @@ def _task(targets, r, numSides, base, keep_out, max_tube_length, margin,
     n = check_num_sides(numSides)
     if isinstance(targets, np.ndarray) and targets.ndim >= 2:
         targets = list(targets)
-    if isinstance(targets, (str, bytes)) or not isinstance(targets, Sequence) \
-            or (len(targets) and all(isinstance(v, (int, float, np.number)) for v in targets)):
+    if (
+        isinstance(targets, (str, bytes))
+        or not isinstance(targets, Sequence)
+        or (len(targets) and all(isinstance(v, (int, float, np.number)) for v in targets))
+    ):
         # one position given alone is not a list of targets
         raise InvalidTypeError(
             "targets must be a list of targets (3-vectors, 4x4 poses or reach Targets), got "
@@ -305,15 +315,11 @@ class _Model:
     Jacobian is exact: a step's unit twist, moved to the world by the product before it."""
 
     def __init__(self, task: _Task, types: str):
-        from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
-
         self.task, self.types = task, types
         self.n, self.T = len(types), len(task.targets)
         self.revolute = np.array([c == "R" for c in types])
         r = task.r
-        ranges = {"R": RevoluteJoint(task.numSides, r, math.pi, np.eye(4)).stateRange(),
-                  "P": PrismaticJoint(task.numSides, r, 3.0 * r, 3, math.pi / 4,
-                                      np.eye(4)).stateRange()}  # fmt: skip
+        ranges = {kind: _joint(task, kind).stateRange() for kind in "RP"}
         self.low = np.array([ranges[c][0] for c in types])
         self.high = np.array([ranges[c][1] for c in types])
         self.tool_size = 6 if task.oriented else 0
@@ -351,6 +357,9 @@ class _Model:
         self.row_start = np.r_[0, np.cumsum(rows)[:-1]].astype(int)
         self.rows = int(sum(rows))
         self.penalty = 0.0  # weight of the lengths' rows (a first, short-tube stage)
+        self.reserve = 0.0  # share of a revolute joint's range kept free at each end
+        self.tip_reach = None  # the largest |a| of the last row (the tip from the last axis)
+        self.reserve = 0.0  # share of a revolute joint's range kept free at each end
 
     def split(self, x: np.ndarray):
         n, T = self.n, self.T
@@ -464,10 +473,13 @@ class _Model:
         if self.tool_size:
             lo = np.r_[lo, [-s] * 3, [-2 * math.pi] * 3]
             hi = np.r_[hi, [s] * 3, [2 * math.pi] * 3]
+        if self.tip_reach is not None:
+            reach = min(s, self.tip_reach)
+            lo[4 * n - 2], hi[4 * n - 2] = -reach, reach
         if self.base_size:
             region = self.task.region
             lo, hi = np.r_[lo, region.min], np.r_[hi, region.max]
-        inset = 1e-6 * (self.high - self.low)
+        inset = np.where(self.revolute, max(1e-6, self.reserve), 1e-6) * (self.high - self.low)
         lo = np.r_[lo, np.tile(self.low + inset, self.T)]
         hi = np.r_[hi, np.tile(self.high - inset, self.T)]
         return lo, hi
@@ -489,71 +501,132 @@ class _Model:
 
 #: Weight of the table's lengths (over r) in the fit's first stage: it keeps the tube short; the
 #: second stage, without it, makes the residual exact.
-LENGTH_PENALTY = 1e-2
+LENGTH_PENALTY = 1e-1
+#: Iterations of the fit's first stage (lengths kept short) and of its exact stage.
+SHORT_ITERATIONS, EXACT_ITERATIONS = 200, 300
 
 
 def _fit(model: _Model, seed: int, start: int) -> np.ndarray | None:
-    """The fitted unknowns of start ``start`` (every residual <= FIT_TOLERANCE), or None: a
-    first stage that also keeps the table's lengths small, then the exact fit from there."""
-    from scipy.optimize import least_squares
+    """The fitted unknowns of start ``start`` (every residual <= FIT_TOLERANCE), or None.
 
+    Tried under bounds that give a better robot first (:data:`FIT_STAGES`), then wider ones
+    when no exact fit is found so. Each time a first stage that also keeps the table's lengths
+    small, then the exact fit from there; when that stage led where no exact fit is near (a task
+    of many poses, whose joints' ranges leave a short table no room), the exact fit from the
+    start itself."""
     rng = np.random.default_rng([seed, start, len(model.types), *map(ord, model.types)])
-    x = model.start(rng)
-    lo, hi = model.bounds()
-    x = np.clip(x, lo, hi)
-    scale = np.ones(model.size)
-    lengths = np.r_[np.tile([False, False, True, True], model.n),
-                    [True] * 3 + [False] * 3 if model.tool_size else [],
-                    [True] * model.base_size,
-                    np.tile(~model.revolute, model.T)].astype(bool)  # fmt: skip
-    scale[lengths] = model.task.r
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        # the exact stage by dogbox: on these small bounded problems it converges in a third
-        # of trf's time, as often (16 of 16 fits of two benchmark tasks)
-        for penalty, tol, budget, method in ((LENGTH_PENALTY, 1e-8, 200, "trf"),
-                                             (0.0, 1e-15, 50 * model.size, "dogbox")):
-            model.penalty = penalty
-            fit = least_squares(model.residual, x, jac=model.jacobian, bounds=(lo, hi),
-                                x_scale=scale, ftol=tol, xtol=tol, gtol=tol, max_nfev=budget,
-                                method=method)  # fmt: skip
-            x = np.clip(fit.x, lo, hi)
-    model.penalty = 0.0
-    if not np.all(np.isfinite(x)) or np.abs(model.residual(x)).max() > FIT_TOLERANCE:
-        return None
+    x0 = model.start(rng)
+    stages = [(reserve, None if reach is None or model.tool_size else reach * model.task.r)
+              for reserve, reach in FIT_STAGES]  # fmt: skip
+    with np.errstate(all="ignore"):
+        for model.reserve, model.tip_reach in dict.fromkeys(stages):
+            lo, hi = model.bounds()
+            start_x = np.clip(x0, lo, hi)
+            model.penalty = LENGTH_PENALTY
+            x = _descend(model, start_x, lo, hi, SHORT_ITERATIONS, exact=False)
+            model.penalty = 0.0
+            x = _descend(model, x, lo, hi, EXACT_ITERATIONS, exact=True)
+            if not _exact(model, x):
+                x = _descend(model, start_x, lo, hi, EXACT_ITERATIONS, exact=True)
+            if _exact(model, x):
+                break
+        else:
+            x = None
+    model.reserve, model.tip_reach = 0.0, None
+    return x
+
+
+def _exact(model: _Model, x: np.ndarray) -> bool:
+    """Whether every residual of ``x`` (without the lengths' rows) is below FIT_TOLERANCE."""
+    return bool(np.all(np.isfinite(x)) and np.abs(model.residual(x)).max() <= FIT_TOLERANCE)
+
+
+def _descend(model: _Model, x: np.ndarray, lo: np.ndarray, hi: np.ndarray, iterations: int,
+             exact: bool) -> np.ndarray:  # fmt: skip
+    """Bounded Levenberg-Marquardt on ``model``'s residual from ``x``: the damped normal
+    equations with Marquardt's scaling (the diagonal of J^T J, so lengths and angles need no
+    units), a variable at a bound that the gradient pushes beyond held there, the step projected
+    into the bounds. ``exact``: until every residual is a tenth of FIT_TOLERANCE; otherwise
+    until a step lowers the cost by less than 1e-8 of it. Returns the best unknowns met.
+
+    Written out rather than :func:`scipy.optimize.least_squares`: its trust region reflective
+    method takes a singular value decomposition per iteration, which a threaded BLAS on a
+    loaded two-core machine made 10 to 30 times slower (3 to 22 s a fit, 0.6 s on one thread);
+    a 66-unknown normal equation is solved in a fifth of a millisecond either way."""
+    e = model.residual(x)
+    cost = float(e @ e)
+    damping = 1e-3
+    span = hi - lo
+    for _ in range(iterations):
+        if not np.isfinite(cost) or (exact and np.abs(e).max() <= 0.1 * FIT_TOLERANCE):
+            break
+        J = model.jacobian(x)
+        g = J.T @ e
+        free = ~(((x <= lo + 1e-12 * span) & (g > 0)) | ((x >= hi - 1e-12 * span) & (g < 0)))
+        Jf = J[:, free]
+        H = Jf.T @ Jf
+        scale = np.diagonal(H).copy()
+        scale = np.maximum(scale, 1e-12 * max(float(scale.max(initial=0.0)), 1.0))
+        moved = False
+        while damping < 1e12:
+            try:
+                step = np.linalg.solve(H + damping * np.diag(scale), -g[free])
+            except np.linalg.LinAlgError:
+                damping *= 4.0
+                continue
+            trial = x.copy()
+            trial[free] += step
+            trial = np.clip(trial, lo, hi)
+            trial_e = model.residual(trial)
+            trial_cost = float(trial_e @ trial_e)
+            if np.isfinite(trial_cost) and trial_cost < cost:
+                drop = (cost - trial_cost) / cost
+                x, e, cost = trial, trial_e, trial_cost
+                damping = max(damping / 3.0, 1e-12)
+                moved = True
+                break
+            damping *= 4.0
+        if not moved or (not exact and drop < 1e-8):
+            break
     return x
 
 
 # --- building and checking a fitted table ---------------------------------------------------------
+#: The length of a designed chain's end tip, in units of r.
+END_TIP_LENGTH_R = 1.5
+
+
 def _end_tips(model: _Model, tip: np.ndarray) -> list:
-    """End tips (length 1.5 r) whose distal frame is ``tip`` (4x4), to try in turn: a position
-    task's tip frame may also turn about its point (:data:`TIP_TURNS`)."""
+    """End tips (END_TIP_LENGTH_R r long) whose distal frame is ``tip`` (4x4), to try in turn:
+    a position task's tip frame may also turn about its point (:data:`TIP_TURNS`)."""
     from kinegami.optimize.compaction import TIP_TURNS, end_tips_at
 
     turns = (np.eye(3),) if model.tool_size else TIP_TURNS
-    return end_tips_at(tip, model.task.numSides, model.task.r, 1.5 * model.task.r, turns)
+    return end_tips_at(tip, model.task.numSides, model.task.r, END_TIP_LENGTH_R * model.task.r,
+                       turns)  # fmt: skip
 
 
 def _model_joints(model: _Model, x: np.ndarray) -> tuple[list, np.ndarray]:
     """The joints of the fitted unknowns ``x`` on their DH axes (world frame), and the tip frame
     (4x4) the table and the tool put the tip on."""
-    from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
-
-    task, r = model.task, model.task.r
+    task = model.task
     table, tool, _ = model.split(x)
     frames = [model.base_pose(x)]
     for i in range(model.n):
         th, al, a, d = table[i]
         frames.append(frames[-1] @ _dh(th, al, a, d))
     tip = frames[-1] @ (_tool(tool) if model.tool_size else np.eye(4))
-    joints = []
-    for i, kind in enumerate(model.types):
-        if kind == "R":
-            joint = RevoluteJoint(task.numSides, r, math.pi, np.eye(4))
-        else:
-            joint = PrismaticJoint(task.numSides, r, 3.0 * r, 3, math.pi / 4, np.eye(4))
-        joints.append(joint.with_pose(frames[i]))
+    joints = [_joint(task, kind).with_pose(frames[i]) for i, kind in enumerate(model.types)]
     return joints, tip
+
+
+def _joint(task: _Task, kind: str):
+    """A joint of the task's tube at the identity: "R" revolute (turning pi), "P" prismatic."""
+    from kinegami.chain.joints import PrismaticJoint, RevoluteJoint
+
+    if kind == "R":
+        return RevoluteJoint(task.numSides, task.r, math.pi, np.eye(4))
+    return PrismaticJoint(task.numSides, task.r, 3.0 * task.r, 3, math.pi / 4, np.eye(4))
 
 
 def _build(model: _Model, x: np.ndarray):
@@ -611,13 +684,17 @@ def _answers(chain, states: np.ndarray, task: _Task) -> tuple[list | None, str]:
 
 
 def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = True,
-             fitted: np.ndarray | None = None) -> tuple:  # fmt: skip
-    """One start: ((table unknowns, tube length, smallest clearance), "", x) of a design that
-    reaches every target, or (None, why, x): x the fitted unknowns (None when the fit failed),
-    which a thorough attempt of the same start takes as ``fitted``. Not ``thorough``: only
-    when the fit's own configurations are clear and outside the boxes (one batch of the
-    clearance engine, about a millisecond); ``thorough``: other configurations of the same
-    table are searched for the targets whose fitted one is not (about a second)."""
+             fitted: np.ndarray | None = None, repair: bool = True) -> tuple:  # fmt: skip
+    """One start: ((table unknowns, tube length, smallest clearance, chain, states), "", x) of a
+    design that reaches every target (states: one full configuration per target), or (None,
+    why, x): x the fitted unknowns (None when the fit failed), which a thorough attempt of the
+    same start takes as ``fitted``. Not ``thorough``: only when the fit's own configurations
+    are clear and outside the boxes (one batch of the clearance engine, about a millisecond);
+    ``thorough``: the placement is searched again so that the fitted configurations are clear
+    (``repair``: :func:`_repaired`, a few seconds), then other configurations of the same table
+    for the targets whose fitted one is not (about a second), and the placement again for
+    those. Without ``repair`` (a tree's leaves, which the tree builds again from x) the chain is
+    the one :func:`_build` makes of x."""
     from kinegami.clearance.engine import engine_for
     from kinegami.optimize.compaction import tube_length
 
@@ -638,26 +715,47 @@ def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = Tr
     if bad and not thorough:
         k, why = bad[0]
         return None, f"target {k}: the fitted configuration {why}", fitted
+    if bad and repair:
+        found = _repaired(chain, states, task, seed + start)
+        if found is not None:
+            return (x, *found), "", fitted
     if bad:  # other configurations of the same table for those targets, a batch at a time
         movable = [m for m, joint in enumerate(chain.Joints) if joint.stateRange() != (0.0, 0.0)]
         rng = np.random.default_rng([seed, start, 0x0C0F])
         first_q = model.first_q
+        blocked = []  # the targets with no clear configuration on this placement
         for k, _ in bad:
+            nearest = None  # (clearance, configuration) of the least overlapping one found
             for count in OTHER_CONFIGURATIONS:  # more starts only when none is clear
                 found = _other_configurations(model, x, k, count, rng)
                 trial = np.zeros((len(found), states.shape[1]))
                 trial[:, movable] = np.reshape(found, (len(found), model.n))
-                clear = [m for m in np.flatnonzero(~engine.colliding(trial, task.margin))
-                         if keep_out_violation(chain, trial[m], task.boxes, task.margin) is None]
+                worst = engine.worst_arrays(trial, task.margin)[0]
+                clear = [
+                    m
+                    for m in np.flatnonzero(~np.isfinite(worst))
+                    if keep_out_violation(chain, trial[m], task.boxes, task.margin) is None
+                ]
                 if clear:
                     states[k] = trial[clear[0]]
                     x = x.copy()
                     x[first_q + k * model.n : first_q + (k + 1) * model.n] = found[clear[0]]
                     break
+                if len(found) and (nearest is None or worst.max() > nearest[0]):
+                    nearest = (float(worst.max()), trial[int(np.argmax(worst))])
             else:
-                # the solver's escapes along a redundant arm's solutions rarely find what these
-                # starts did not (1 of 14 thorough attempts of a benchmark task, at 1-12 s each)
-                return None, f"target {k}: every configuration found {dict(bad)[k]}", fitted
+                blocked.append(k)
+                if nearest is not None:
+                    states[k] = nearest[1]
+        if blocked and repair:  # the placement again, for the least overlapping ones
+            found = _repaired(chain, states, task, seed + start)
+            if found is not None:
+                return (x, *found), "", fitted
+        if blocked:
+            # the solver's escapes along a redundant arm's solutions rarely find what these
+            # starts did not (1 of 14 thorough attempts of a benchmark task, at 1-12 s each)
+            k = blocked[0]
+            return None, f"target {k}: every configuration found {dict(bad)[k]}", fitted
     answers, why = _answers(chain, states, task)
     if answers is None:
         return None, why, fitted
@@ -665,7 +763,43 @@ def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = Tr
         paths, why = _paths(chain, answers, task)
         if paths is None:
             return None, why, fitted
-    return (x, length, min(a.clearance for a in answers)), "", fitted
+    return (x, length, min(a.clearance for a in answers), chain, states), "", fitted
+
+
+#: Starts of the compaction search that places a fitted table again so that its
+#: configurations at the targets are clear (:func:`_repaired`).
+REPAIR_STARTS = 2
+
+
+def _repaired(chain, states: np.ndarray, task: _Task, seed: int) -> tuple | None:
+    """(tube length, smallest clearance, chain, states) of the same kinematics placed again so
+    that every target's configuration in ``states`` (full configurations, one per target) is
+    clear with the margin and outside the boxes, or None.
+
+    A 6R arm at an exact pose has no freedom left to move away from itself, and placing each
+    joint compactly puts elbows beside the joints, which a large turn folds into each other:
+    compaction that keeps the task (:func:`kinegami.optimize.compact_for_task`, its search
+    banning the placements that collide at these configurations; the tip's frame stays on the
+    last movable joint's body) slides and rolls the joints along their axes until none does,
+    and solves every target again from these states on the result (exact, in range, clear,
+    outside the boxes; a design whose folded form needs the isometry repair passed over)."""
+    from kinegami.optimize.compaction import compact_for_task, tube_length
+    from kinegami.reach import Answer
+
+    # the states to start from, in the form compaction takes a task's answers in: they pass
+    # through the chain itself (or enter a box), which the search is to undo
+    starts = [Answer(False, tuple(q), 0.0, 0.0, -math.inf, "", 0, 0,
+                     "the fitted configuration passes through itself") for q in states]  # fmt: skip
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        shorter, answers = compact_for_task(
+            chain, list(task.targets), starts, keep_out=task.boxes, margin=task.margin,
+            seed=seed, executor=pool, starts=REPAIR_STARTS, exact_fold=True)  # fmt: skip
+    if shorter is chain:
+        return None
+    if task.path and _paths(shorter, answers, task)[0] is None:
+        return None
+    states = np.array([answer.states for answer in answers])
+    return tube_length(shorter), min(a.clearance for a in answers), shorter, states
 
 
 def _fold_refusal(chain) -> str:
@@ -889,30 +1023,31 @@ def design_for(
             best = None
             for first in range(0, starts, ROUND):
                 batch = range(first, min(starts, first + ROUND))
-                # first the fits whose own configurations are clear; when none is, the solver
-                # looks for other configurations of the same fits
+                # first the fits whose own configurations are clear: the best of them (a
+                # shorter tube, then a larger clearance); one whose folded form needs the
+                # isometry repair is refused and the next one tried
                 results = _run(executor, task, types, seed, batch, False)
-                if all(result is None for result, _, _ in results):
-                    again = [(k, x) for k, (_, why, x) in zip(batch, results, strict=True)
-                             if "fitted configuration" in why]  # fmt: skip
-                    results += _run(executor, task, types, seed, [k for k, _ in again], True,
-                                    [x for _, x in again])  # fmt: skip
-                bar.update(len(batch))
                 passed = []
                 for result, why, _ in results:
                     if result is None:
                         last = why
                         continue
                     passed.append(result)
-                # the best first (a shorter tube, then a larger clearance); one whose folded
-                # form needs the isometry repair is refused and the next one tried
                 for result in sorted(passed, key=lambda res: (res[1], -res[2])):
-                    why = _fold_refusal(_build(_Model(task, types), result[0])[0][0])
+                    why = _fold_refusal(result[3])
                     if why:
                         last = why
                         continue
-                    best = result[0]
+                    best = result
                     break
+                if best is None:
+                    # when none is, the same fits placed again and their other
+                    # configurations: the first start in order that gives a design
+                    again = [(k, x) for k, (_, why, x) in zip(batch, results, strict=True)
+                             if "fitted configuration" in why]  # fmt: skip
+                    best, why = _first_design(executor, task, types, seed, again)
+                    last = why or last
+                bar.update(len(batch))
                 if best is not None:
                     bar.update(starts - batch.stop)
                     break
@@ -926,9 +1061,7 @@ def design_for(
             "another seed, more joints or a longer max_tube_length", target=_named(last),
             proven=False,
         )  # fmt: skip
-    types, x = found
-    model = _Model(task, types)
-    (chain, states), _ = _build(model, x)
+    _, (_, _, _, chain, states) = found
     answers, why = _answers(chain, states, task)
     if answers is None:  # pragma: no cover - the attempt checked the same chain
         raise InfeasibleTaskError(f"the design found no longer reaches: {why}", proven=False)
@@ -950,16 +1083,45 @@ def design_for(
 
 
 def _run(executor, task: _Task, types: str, seed: int, starts, thorough: bool,
-         fitted=None) -> list:  # fmt: skip
+         fitted=None, repair: bool = True) -> list:  # fmt: skip
     """The attempts of ``starts``, in order (on ``executor`` when given); ``fitted``: each
-    start's fitted unknowns from a first attempt."""
+    start's fitted unknowns from a first attempt; ``repair`` as :func:`_attempt`'s."""
     fitted = [None] * len(starts) if fitted is None else fitted
     if executor is None:
-        return [_attempt(task, types, seed, k, thorough, x)
+        return [_attempt(task, types, seed, k, thorough, x, repair)
                 for k, x in zip(starts, fitted, strict=True)]  # fmt: skip
-    futures = [executor.submit(_attempt, task, types, seed, k, thorough, x)
+    futures = [executor.submit(_attempt, task, types, seed, k, thorough, x, repair)
                for k, x in zip(starts, fitted, strict=True)]  # fmt: skip
     return [future.result() for future in futures]
+
+
+def _first_design(executor, task: _Task, types: str, seed: int, fitted: list) -> tuple:
+    """(result, "") of the first of the thorough attempts of ``fitted`` ((start, fitted
+    unknowns) in order) that gives a design whose folded form needs no isometry repair, or
+    (None, the last reason). With an executor every attempt is submitted at once and the ones
+    after the first design are cancelled (those not yet running); the design is the same as
+    without one."""
+    last = ""
+    if executor is None:
+        attempts = (_attempt(task, types, seed, k, True, x) for k, x in fitted)
+    else:
+        futures = [executor.submit(_attempt, task, types, seed, k, True, x) for k, x in fitted]
+        attempts = (future.result() for future in futures)
+    try:
+        for result, why, _ in attempts:
+            if result is None:
+                last = why
+                continue
+            why = _fold_refusal(result[3])
+            if why:
+                last = why
+                continue
+            return result, ""
+    finally:
+        if executor is not None:
+            for future in futures:
+                future.cancel()
+    return None, last
 
 
 def _budget(joints) -> str:
@@ -1055,12 +1217,12 @@ def _tree_search(leaves: list, strings: list[str], root: np.ndarray, seed: int, 
         for i, (task, types) in enumerate(zip(leaves, strings, strict=True)):
             # each leaf alone, as a chain from its ring frame: first the fits whose own
             # configurations are clear, then other configurations of the same fits
-            results = _run(executor, task, types, seed + 7919 * i, batch, False)
+            results = _run(executor, task, types, seed + 7919 * i, batch, False, repair=False)
             if all(result is None for result, _, _ in results):
                 again = [(k, x) for k, (_, why, x) in zip(batch, results, strict=True)
                          if "fitted configuration" in why]  # fmt: skip
                 results += _run(executor, task, types, seed + 7919 * i, [k for k, _ in again],
-                                True, [x for _, x in again])  # fmt: skip
+                                True, [x for _, x in again], repair=False)  # fmt: skip
             for result, why, _ in results:
                 if result is None:
                     last = f"leaf {i}: {why}"
@@ -1087,6 +1249,7 @@ def _tree_search(leaves: list, strings: list[str], root: np.ndarray, seed: int, 
             if best is None or key < best[0]:
                 best = (key, result)
         if best is not None:
+            bar.update(starts - batch.stop)  # the progress is complete
             return best[1], ""
     return None, last
 

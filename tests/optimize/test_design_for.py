@@ -72,8 +72,12 @@ def check_reaches(design, targets, boxes=(), margin: float = 0.0) -> None:
         if goal.rotation is not None:
             assert np.abs(T[:3, :3] - goal.rotation).max() <= 1e-8
         assert design.clearance(list(answer.states), margin).ok
-        assert all(lo - 1e-12 <= s <= hi + 1e-12 for s, (lo, hi) in
-                   zip(answer.states, (j.stateRange() for j in design.Joints), strict=True))
+        assert all(
+            lo - 1e-12 <= s <= hi + 1e-12
+            for s, (lo, hi) in zip(
+                answer.states, (j.stateRange() for j in design.Joints), strict=True
+            )
+        )
         assert keep_out_violation(design, answer.states, boxes, margin) is None
 
 
@@ -208,7 +212,8 @@ def test_bad_input_is_one_clear_error():
 def test_compaction_with_targets_keeps_every_target_and_never_lengthens():
     """An uncompacted design for a task: compact(design, targets=...) returns a design no longer
     than it whose tip still reaches every target (the end tip is not slid, so the kinematics
-    of the tip are the same: equal fkine at the mapped configurations)."""
+    of the tip's point are the same: equal fkine positions at the mapped configurations; for
+    point targets the tip's frame may turn about its point)."""
     targets = hidden_targets(4)
     design, answers = design_for(targets, "RRRR", r=1.0, numSides=4, compact=False,
                                  return_answers=True)  # fmt: skip
@@ -226,7 +231,7 @@ def test_compaction_with_targets_keeps_every_target_and_never_lengthens():
         q = rng.uniform(-1.2, 1.2, len(m0))
         q0, q1 = np.zeros(len(design.Joints)), np.zeros(len(shorter.Joints))
         q0[m0], q1[m1] = q, q
-        assert np.abs(K0.fkine(q0) - K1.fkine(q1)).max() <= 1e-9
+        assert np.abs(K0.fkine(q0)[:3, 3] - K1.fkine(q1)[:3, 3]).max() <= 1e-9
 
 
 def test_compaction_with_targets_refuses_a_design_that_misses_its_task():
@@ -315,8 +320,9 @@ def test_a_base_region_lets_the_search_place_the_base():
     box = {"min": [60.0, -5.0, 0.0], "max": [80.0, 5.0, 1.0]}
     with pytest.raises(InfeasibleTaskError, match="from the base at"):
         design_for(points, "RRR", r=1, numSides=4, max_tube_length=60)
-    arm = design_for(points, "RRR", r=1, numSides=4, max_tube_length=60, base_region=box,
-                     seed=2, starts=16)  # (seed 0 needs more starts: ~3x the time)
+    arm = design_for(
+        points, "RRR", r=1, numSides=4, max_tube_length=60, base_region=box, seed=2, starts=16
+    )  # (seed 0 needs more starts: ~3x the time)
     check_reaches(arm, points)
     P = arm.Joints[0].pose_matrix  # the axis (z) meets the region's box
     assert abs(P[2, 2]) > 0.5

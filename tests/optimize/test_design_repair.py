@@ -80,10 +80,10 @@ def test_pick_and_place_with_seed_0_folds_exactly_and_reaches_every_target():
 
 
 def test_a_fitted_candidate_that_needs_the_repair_is_skipped_for_the_next():
-    """Hidden task 7 (4R, square tube, one round of 8 starts, no compaction): the best fitted
+    """Hidden task 4 (4R, square tube, one round of 8 starts, no compaction): the best fitted
     design of the round folds only after the repair moves 10 vertices; the next one is
     returned, and it folds exactly."""
-    targets = hidden_targets(7)
+    targets = hidden_targets(4)
     chain = design_for(targets, "RRRR", r=1.0, numSides=4, compact=False, starts=8)
     assert repaired_vertices(chain) == 0
     for target in targets:
@@ -108,8 +108,8 @@ def test_compaction_for_design_skips_a_candidate_that_needs_the_repair():
 
 
 def test_when_every_design_found_needs_the_repair_the_error_says_so():
-    """Hidden task 1 in one round of 8 starts: each design that reaches every target folds only
-    after the repair (4 vertices); none is returned, and the reason is the last one refused."""
+    """Hidden task 0 with one start: the design that reaches every target folds only after the
+    repair (4 vertices); none is returned, and the reason is the one refused."""
     with pytest.raises(InfeasibleTaskError, match="isometry repair for 4 vertices") as caught:
-        design_for(hidden_targets(1), "RRRR", r=1.0, numSides=4, compact=False, starts=8)
+        design_for(hidden_targets(0), "RRRR", r=1.0, numSides=4, compact=False, starts=1)
     assert not caught.value.proven
