@@ -140,7 +140,7 @@ GALLERY_TABLE = {
     "spherical_limb": (5, 3, 276.01, 70, 438),
     "doubling_back": (8, 6, 304.45, 70, 823),
     "spherical_series": (11, 9, 475.52, 70, 985),
-    "pick_and_place": (5, 4, 137.77, 70, 297),
+    "pick_and_place": (5, 4, 91.89, 70, 228),
 }
 
 
