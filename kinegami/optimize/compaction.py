@@ -890,7 +890,9 @@ def compact_for_task(chain: KinematicChain | KinematicTree, targets, answers=Non
     ``answers``, one reach answer per target, or of a first solve) and accepted only when each
     is reached exactly, in range, clear with ``margin`` (default the chain's) and outside the
     ``keep_out`` boxes, with a tube no longer than the input's; otherwise the input itself is
-    returned.
+    returned. With no targets (``[]``) this compacts the chain's kinematics as they are, its
+    tip's frame kept on the last joint's body (:func:`compact` may slide the end tip, which
+    moves that frame).
 
     A :class:`~kinegami.KinematicTree` keeps a tree task: ``targets`` is one list of targets per
     leaf (the leaves in the order of their tip joints' indices; or a mapping {tip joint index:
@@ -970,8 +972,9 @@ def _compact_chain_for_task(chain: KinematicChain, targets, answers, boxes: tupl
         head.margin = margin
         # the search bans the choices whose head collides at a target's configuration (as
         # compact(motion=True) does with sampled ones), so the task's configurations stay clear
+        # (no targets: the tip's frame is kept on the last body, and nothing is banned)
         at_targets = np.array([np.asarray(answer.states)[movable] for answer in answers])
-        search = (*search, (at_targets, 0.0), False)
+        search = (*search, (at_targets, 0.0) if len(answers) else None, False)
         # every start's design competes (best first), not only the best: a shorter one may
         # not keep the task, or (exact_fold) fold only after the repair
         candidates = []

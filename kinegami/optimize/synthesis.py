@@ -359,7 +359,6 @@ class _Model:
         self.penalty = 0.0  # weight of the lengths' rows (a first, short-tube stage)
         self.reserve = 0.0  # share of a revolute joint's range kept free at each end
         self.tip_reach = None  # the largest |a| of the last row (the tip from the last axis)
-        self.reserve = 0.0  # share of a revolute joint's range kept free at each end
 
     def split(self, x: np.ndarray):
         n, T = self.n, self.T
@@ -431,8 +430,15 @@ class _Model:
             e = np.r_[e, self.penalty * self._lengths(x)]
         return e
 
+    def _length_columns(self) -> np.ndarray:
+        """The columns of x that the first stage keeps short: every row's a and d, and the
+        tool's translation (which the last link has to span) when there is a tool."""
+        rows = 4 * np.arange(self.n)
+        tool = 4 * self.n + np.arange(3 if self.tool_size else 0)
+        return np.r_[rows + 2, rows + 3, tool]
+
     def _lengths(self, x: np.ndarray) -> np.ndarray:
-        return np.r_[x[2 : 4 * self.n : 4], x[3 : 4 * self.n : 4]] / self.task.r
+        return x[self._length_columns()] / self.task.r
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
         before, tips = self._products(x)
@@ -460,9 +466,9 @@ class _Model:
             J[a : a + block.shape[0], first_q + t * self.n + self.joint_of[moving]] = \
                 block[:, moving]  # the configuration moves this target's tip only  # fmt: skip
         if self.penalty:
-            L = np.zeros((2 * self.n, self.size))
-            L[np.arange(self.n), 4 * np.arange(self.n) + 2] = self.penalty / self.task.r
-            L[self.n + np.arange(self.n), 4 * np.arange(self.n) + 3] = self.penalty / self.task.r
+            columns = self._length_columns()
+            L = np.zeros((columns.size, self.size))
+            L[np.arange(columns.size), columns] = self.penalty / self.task.r
             J = np.vstack([J, L])
         return J
 

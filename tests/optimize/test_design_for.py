@@ -234,6 +234,37 @@ def test_compaction_with_targets_keeps_every_target_and_never_lengthens():
         assert np.abs(K0.fkine(q0)[:3, 3] - K1.fkine(q1)[:3, 3]).max() <= 1e-9
 
 
+def test_compaction_with_no_targets_keeps_the_tip_frame_on_the_last_body():
+    """compact_for_task(design, []): the joints compacted, the end tip placed again where it
+    was on the last joint's body, nothing else to keep: the same kinematics, tip frame and all
+    (equal fkine 4x4 at random configurations, to 1e-9), a tube no longer than before; the
+    benchmark's yardstick for a designed tube. Plain compact, whose end tip slides along its
+    axis, moves the tip's frame on that body."""
+    rng = np.random.default_rng(11)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlacementWarning)
+        robot = KinematicChain.from_dh([(0.0, rng.uniform(-3, 3), rng.uniform(0, 4),
+                                         rng.uniform(0, 4)) for _ in range(3)], 4, 1.0,
+                                       placement="safe")  # fmt: skip
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        kept, answers = compact_for_task(robot, [], executor=pool)
+        plain = compact(robot, executor=pool)
+    assert answers == [] and kept is not robot
+    assert tube_length(kept) < tube_length(robot)
+    K0, K1, K2 = kinematics(robot), kinematics(kept), kinematics(plain)
+    m0 = [k for k, j in enumerate(robot.Joints) if j.stateRange() != (0.0, 0.0)]
+    m1 = [k for k, j in enumerate(kept.Joints) if j.stateRange() != (0.0, 0.0)]
+    m2 = [k for k, j in enumerate(plain.Joints) if j.stateRange() != (0.0, 0.0)]
+    moved = 0.0
+    for _ in range(5):
+        q = rng.uniform(-1.2, 1.2, len(m0))
+        q0, q1, q2 = (np.zeros(len(c.Joints)) for c in (robot, kept, plain))
+        q0[m0], q1[m1], q2[m2] = q, q, q
+        assert np.abs(K0.fkine(q0) - K1.fkine(q1)).max() <= 1e-9
+        moved = max(moved, np.abs(K0.fkine(q0) - K2.fkine(q2)).max())
+    assert moved > 1e-3
+
+
 def test_compaction_with_targets_refuses_a_design_that_misses_its_task():
     design = design_for([(3.0, 2.0, 4.0)], "R", r=1.0, numSides=4)
     from kinegami.optimize import CompactionError
