@@ -959,9 +959,9 @@ def design_for(
     max_tube_length : the longest tube allowed (default 100 r).
     margin : the clearance required between parts and from the boxes (>= 0).
     starts : the fit's starts per joint-type string (>= 1).
-    compact : shorten the found design by compaction that keeps the task (chains; a tree is
-        the shortest of the leaves' designs tried, its junctions fitted: compact it with
-        ``compact(tree, targets=...)``, which keeps a tree task).
+    compact : shorten the found design by compaction that keeps the task
+        (:func:`kinegami.optimize.compact_for_task`; a tree keeps every grasp, its root and
+        leaf tips where they are and its junction sockets fitted).
     path : (chains) also require that the robot moves from each target's configuration to the
         next along the straight line in joint space without passing through itself (certified
         by :func:`kinegami.clearance.paths.check_path`).
@@ -1012,7 +1012,7 @@ def design_for(
         leaves, rooted, strings = _tree_tasks(targets, joints, r, numSides, base, keep_out,
                                               max_tube_length, margin)  # fmt: skip
         return _design_tree(leaves, rooted, strings, seed, starts, executor, progress,
-                            return_answers)  # fmt: skip
+                            return_answers, compact)  # fmt: skip
     task = _task(targets, r, numSides, base, keep_out, max_tube_length, margin, base_region)
     task = replace(task, path=path)
     strings = _joint_strings(joints)
@@ -1334,8 +1334,9 @@ def _check_tree(models: list, xs: list, root: np.ndarray) -> tuple:
 
 
 def _design_tree(leaves: list, rooted: list, strings: list[str], seed: int, starts: int,
-                 executor, progress, return_answers: bool):  # fmt: skip
-    """:func:`design_for` of a tree task (checked leaf tasks)."""
+                 executor, progress, return_answers: bool, compact: bool):  # fmt: skip
+    """:func:`design_for` of a tree task (checked leaf tasks); ``compact``: the tree found
+    compacted with its task kept (:func:`kinegami.optimize.compact_for_task`)."""
     for i, (task, types) in enumerate(zip(rooted, strings, strict=True)):
         certificate = task_certificate(task, types)
         if certificate is not None:
@@ -1353,4 +1354,14 @@ def _design_tree(leaves: list, rooted: list, strings: list[str], seed: int, star
             "seed, more joints or a longer max_tube_length", target=_named(last), proven=False,
         )  # fmt: skip
     tree, answers, _ = found
+    if compact:
+        from kinegami.optimize.compaction import compact_for_task, tube_length
+
+        task = leaves[0]
+        with concurrent.futures.ThreadPoolExecutor(1) as own:
+            shorter, shorter_answers = compact_for_task(
+                tree, [list(leaf.targets) for leaf in leaves], answers, keep_out=task.boxes,
+                margin=task.margin, seed=seed, executor=executor or own)  # fmt: skip
+        if tube_length(shorter) <= tube_length(tree):
+            tree, answers = shorter, shorter_answers
     return (tree, answers) if return_answers else tree

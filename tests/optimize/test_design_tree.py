@@ -103,3 +103,20 @@ def test_a_leaf_target_beyond_the_longest_tube_is_proven_infeasible_fast():
         design_for([LEFT, [(0, 0, 200), (0, 0, 12)]], ["RRR", "RRR"], r=1, numSides=4)
     assert time.perf_counter() - start < 1.0
     assert caught.value.proven and caught.value.target == 0
+
+
+def test_the_tree_found_is_compacted_keeping_its_task(fingers):
+    """design_for compacts the tree it finds with the task kept (compact=True, the default):
+    the same search without compaction gives a longer tree, and the compacted one is what
+    compact(tree, targets=...) of that tree gives (every grasp checked above)."""
+    import concurrent.futures
+
+    from kinegami.optimize import compact_for_task, tube_length
+
+    tree, _ = fingers
+    plain, answers = design_for([LEFT, RIGHT], ["RRR", "RRR"], r=1, numSides=4, starts=16,
+                                compact=False, return_answers=True)  # fmt: skip
+    assert tube_length(tree) < tube_length(plain)
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        again, _ = compact_for_task(plain, [LEFT, RIGHT], answers, executor=pool)
+    assert tube_length(again) == pytest.approx(tube_length(tree), abs=1e-9)
