@@ -11,7 +11,6 @@ import math
 import time
 from pathlib import Path
 
-import headless_chromium
 import pytest
 
 from tests.editor.helpers import wait_for as helpers_wait_for
@@ -21,13 +20,6 @@ from .helpers import EXAMPLE1, HAND
 pytestmark = pytest.mark.browser
 
 TIMEOUT = 60.0  # seconds for the page or the server to react (software rendering is slow)
-
-
-@pytest.fixture(scope="module")
-def browser():
-    headless_chromium.require(headless_chromium.missing("viser"))
-    with headless_chromium.browser() as chromium:
-        yield chromium
 
 
 @pytest.fixture(scope="module")

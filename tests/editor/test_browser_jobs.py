@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import shutil
 
-import headless_chromium
 import pytest
 
 from tests.editor.helpers import choose
@@ -22,13 +21,6 @@ pytestmark = pytest.mark.browser
 
 TIMEOUT = 90.0  # seconds for the page or the server to react (software rendering, busy cores)
 PUMA = ROOT / "examples" / "designs" / "puma.json"
-
-
-@pytest.fixture(scope="module")
-def browser():
-    headless_chromium.require(headless_chromium.missing("viser"))
-    with headless_chromium.browser() as chromium:
-        yield chromium
 
 
 def wait_for(condition, what: str, timeout: float = TIMEOUT):

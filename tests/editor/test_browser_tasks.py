@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import shutil
 
-import headless_chromium
 import pytest
 
 from tests.editor.helpers import wait_for as helpers_wait_for
@@ -22,13 +21,6 @@ TIMEOUT = 90.0  # seconds for the page or the server to react (software renderin
 TASK_ARM = ROOT / "tests" / "data" / "task_arm.json"
 #: The dot colours of the Task panel's rows, as the page computes them.
 GREEN, RED = "rgb(40, 160, 80)", "rgb(220, 40, 40)"
-
-
-@pytest.fixture(scope="module")
-def browser():
-    headless_chromium.require(headless_chromium.missing("viser"))
-    with headless_chromium.browser() as chromium:
-        yield chromium
 
 
 def wait_for(condition, what: str, timeout: float = TIMEOUT):

@@ -10,7 +10,6 @@ import math
 import shutil
 import time
 
-import headless_chromium
 import numpy as np
 import pytest
 
@@ -24,13 +23,6 @@ PUMA = ROOT / "examples" / "designs" / "puma.json"
 #: The least share of the canvas the design covers on first paint, and the most it may
 #: cover (all of it in view, with a margin).
 MIN_COVER, MAX_COVER = 0.01, 0.6
-
-
-@pytest.fixture(scope="module")
-def browser():
-    headless_chromium.require(headless_chromium.missing("viser"))
-    with headless_chromium.browser() as chromium:
-        yield chromium
 
 
 def _server(path):
