@@ -143,3 +143,42 @@ def test_task_forms_read_as_the_reach_targets():
                                atol=1e-15)  # fmt: skip
     assert read.base[2, 3] == 5
     assert read.options()["keep_out"][0].max == (1000.0, 1000.0, -20.0)
+
+
+def test_design_of_a_pose_task_reaches_every_pose(tmp_path):
+    """A task of three full poses (4x4 matrices in the task file; a hidden 3R arm's tip at
+    clear configurations, in mm with r = 10 mm) designed by ``kinegami design``: the design
+    file it writes reaches every pose afresh (position to 1e-9 r, orientation to 1e-9), and its
+    report says so."""
+    import warnings
+
+    from kinegami import KinematicChain
+    from kinegami.clearance.engine import engine_for
+    from kinegami.errors import PlacementWarning
+    from kinegami.reach import kinematics
+
+    rng = np.random.default_rng(11)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlacementWarning)
+        robot = KinematicChain.from_dh([(0.0, rng.uniform(-3, 3), rng.uniform(0, 40),
+                                         rng.uniform(0, 40)) for _ in range(3)], 4, 10.0,
+                                       placement="safe")  # fmt: skip
+    K = kinematics(robot)
+    low, high = K.ranges[:, 0], K.ranges[:, 1]
+    Q = low + (high - low) * rng.random((100, low.size))
+    poses = [K.fkine(q) for q in Q[~engine_for(robot).colliding(Q, 0.0)][:3]]
+    task = starter_task()
+    task.update(joints="RRR", keepOut=[], name="three poses")
+    task["targets"] = [{"name": f"P{k}", "pose": T.tolist()} for k, T in enumerate(poses)]
+    write(tmp_path / "poses.json", task)
+    result = run("design", tmp_path / "poses.json", "-o", tmp_path / "out")
+    assert result.returncode == 0, result.stderr
+    chain, _ = load_design_with_info(tmp_path / "out" / "poses.json")
+    for T in poses:
+        answer = solve(chain, T)
+        assert answer.ok, answer.reason
+        tip = kinematics(chain).fkine(np.asarray(answer.states))
+        assert np.abs(tip[:3, 3] - T[:3, 3]).max() <= 1e-9 * 10
+        assert np.abs(tip[:3, :3] - T[:3, :3]).max() <= 1e-9
+    report = json.loads((tmp_path / "out" / "poses_task.json").read_text())
+    assert [t["ok"] for t in report["targets"]] == [True, True, True]
