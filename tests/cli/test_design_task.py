@@ -15,7 +15,7 @@ from kinegami.design import load_design_with_info
 from kinegami.design.task import read_task, starter_task, task_from_dict
 from kinegami.errors import DesignError
 from kinegami.optimize import tube_length
-from kinegami.reach import solve
+from kinegami.reach import kinematics, solve
 
 from .helpers import assert_clean_failure, run, write
 
@@ -150,23 +150,9 @@ def test_design_of_a_pose_task_reaches_every_pose(tmp_path):
     clear configurations, in mm with r = 10 mm) designed by ``kinegami design``: the design
     file it writes reaches every pose afresh (position to 1e-9 r, orientation to 1e-9), and its
     report says so."""
-    import warnings
+    from optimize.test_design_for import hidden_3r_arm
 
-    from kinegami import KinematicChain
-    from kinegami.clearance.engine import engine_for
-    from kinegami.errors import PlacementWarning
-    from kinegami.reach import kinematics
-
-    rng = np.random.default_rng(11)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PlacementWarning)
-        robot = KinematicChain.from_dh([(0.0, rng.uniform(-3, 3), rng.uniform(0, 40),
-                                         rng.uniform(0, 40)) for _ in range(3)], 4, 10.0,
-                                       placement="safe")  # fmt: skip
-    K = kinematics(robot)
-    low, high = K.ranges[:, 0], K.ranges[:, 1]
-    Q = low + (high - low) * rng.random((100, low.size))
-    poses = [K.fkine(q) for q in Q[~engine_for(robot).colliding(Q, 0.0)][:3]]
+    _, poses = hidden_3r_arm(r=10.0)
     task = starter_task()
     task.update(joints="RRR", keepOut=[], name="three poses")
     task["targets"] = [{"name": f"P{k}", "pose": T.tolist()} for k, T in enumerate(poses)]

@@ -33,10 +33,11 @@ from kinegami.optimize import compact, compact_for_task, design_for, tube_length
 from kinegami.reach import Target, kinematics, solve
 
 
-def hidden_targets(seed: int, n: int = 4, count: int = 4, r: float = 1.0) -> list:
-    """Tip positions of a hidden random robot at clear configurations (the benchmark's tasks:
-    n revolute joints from a DH table with theta 0, alpha in (-pi, pi], a, d in [0, 4r])."""
-    rng = np.random.default_rng(seed)
+def hidden_tips(rng: np.random.Generator, n: int, count: int, samples: int,
+                r: float = 1.0) -> list:  # fmt: skip
+    """Tip poses (4x4) of a hidden random robot at ``count`` clear configurations (the
+    benchmark's tasks: n revolute joints from a DH table with theta 0, alpha in (-pi, pi],
+    a, d in [0, 4r], placed safely; ``samples`` random configurations per table tried)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PlacementWarning)
         warnings.simplefilter("ignore", ClearanceWarning)
@@ -46,10 +47,30 @@ def hidden_targets(seed: int, n: int = 4, count: int = 4, r: float = 1.0) -> lis
             robot = KinematicChain.from_dh(table, 4, r, placement="safe")
             K = kinematics(robot)
             low, high = K.ranges[:, 0], K.ranges[:, 1]
-            Q = low + (high - low) * rng.random((200, low.size))
+            Q = low + (high - low) * rng.random((samples, low.size))
             Q = Q[~engine_for(robot).colliding(Q, 0.0)]
             if len(Q) >= count:
-                return [K.fkine(q)[:3, 3] for q in Q[:count]]
+                return [K.fkine(q) for q in Q[:count]]
+
+
+def hidden_targets(seed: int, n: int = 4, count: int = 4, r: float = 1.0) -> list:
+    """Tip positions of a hidden random robot at clear configurations (:func:`hidden_tips`)."""
+    return [T[:3, 3] for T in hidden_tips(np.random.default_rng(seed), n, count, 200, r)]
+
+
+def hidden_3r_arm(r: float = 1.0) -> tuple:
+    """(robot, three tip poses (4x4) at clear configurations) of a fixed hidden 3R arm (seed
+    11: alpha in (-3, 3), a and d in [0, 4r], placed safely)."""
+    rng = np.random.default_rng(11)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlacementWarning)
+        robot = KinematicChain.from_dh([(0.0, rng.uniform(-3, 3), rng.uniform(0, 4 * r),
+                                         rng.uniform(0, 4 * r)) for _ in range(3)], 4, r,
+                                       placement="safe")  # fmt: skip
+    K = kinematics(robot)
+    low, high = K.ranges[:, 0], K.ranges[:, 1]
+    Q = low + (high - low) * rng.random((100, low.size))
+    return robot, [K.fkine(q) for q in Q[~engine_for(robot).colliding(Q, 0.0)][:3]]
 
 
 def check_reaches(design, targets, boxes=(), margin: float = 0.0) -> None:
@@ -116,17 +137,7 @@ def test_a_budget_uses_the_fewest_joints_that_reach():
 def test_pose_targets():
     """Full poses: three tip poses of a hidden 3R arm, reached in position and orientation by
     a designed RRR chain (a fitted tool frame on its last frame)."""
-    rng = np.random.default_rng(11)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PlacementWarning)
-        robot = KinematicChain.from_dh([(0.0, rng.uniform(-3, 3), rng.uniform(0, 4),
-                                         rng.uniform(0, 4)) for _ in range(3)], 4, 1.0,
-                                       placement="safe")  # fmt: skip
-    K = kinematics(robot)
-    low, high = K.ranges[:, 0], K.ranges[:, 1]
-    Q = low + (high - low) * rng.random((100, low.size))
-    Q = Q[~engine_for(robot).colliding(Q, 0.0)][:3]
-    targets = [K.fkine(q) for q in Q]
+    _, targets = hidden_3r_arm()
     design = design_for(targets, "RRR", r=1.0, numSides=4)
     check_reaches(design, targets)
 
@@ -240,12 +251,8 @@ def test_compaction_with_no_targets_keeps_the_tip_frame_on_the_last_body():
     (equal fkine 4x4 at random configurations, to 1e-9), a tube no longer than before; the
     benchmark's yardstick for a designed tube. Plain compact, whose end tip slides along its
     axis, moves the tip's frame on that body."""
-    rng = np.random.default_rng(11)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PlacementWarning)
-        robot = KinematicChain.from_dh([(0.0, rng.uniform(-3, 3), rng.uniform(0, 4),
-                                         rng.uniform(0, 4)) for _ in range(3)], 4, 1.0,
-                                       placement="safe")  # fmt: skip
+    robot, _ = hidden_3r_arm()
+    rng = np.random.default_rng(2)
     with concurrent.futures.ThreadPoolExecutor(1) as pool:
         kept, answers = compact_for_task(robot, [], executor=pool)
         plain = compact(robot, executor=pool)

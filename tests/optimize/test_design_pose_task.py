@@ -19,34 +19,17 @@ import warnings
 
 import numpy as np
 
-from kinegami import KinematicChain
-from kinegami.clearance.engine import engine_for
-from kinegami.errors import ClearanceWarning, PlacementWarning
 from kinegami.optimize import compact, design_for, tube_length
 from kinegami.optimize.compaction import repaired_vertices
-from kinegami.reach import Target, kinematics, solve
+from kinegami.reach import Target, solve
 
-from .test_design_for import hidden_targets
+from .test_design_for import hidden_targets, hidden_tips
 
 
 def hidden_poses(seed: int, count: int = 2, r: float = 1.0) -> list:
     """Tip poses (4x4) of a hidden random 6R robot at ``count`` clear configurations (the
-    benchmark's pose tasks, benchmarks/design_task.py: a DH table with theta 0, alpha in
-    (-pi, pi], a and d in [0, 4r], placed safely)."""
-    rng = np.random.default_rng([seed, 6, count])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", PlacementWarning)
-        warnings.simplefilter("ignore", ClearanceWarning)
-        while True:
-            table = [(0.0, rng.uniform(-math.pi, math.pi), rng.uniform(0, 4 * r),
-                      rng.uniform(0, 4 * r)) for _ in range(6)]  # fmt: skip
-            robot = KinematicChain.from_dh(table, 4, r, placement="safe")
-            K = kinematics(robot)
-            low, high = K.ranges[:, 0], K.ranges[:, 1]
-            Q = low + (high - low) * rng.random((50 * count, low.size))
-            Q = Q[~engine_for(robot).colliding(Q, 0.0)]
-            if len(Q) >= count:
-                return [K.fkine(q) for q in Q[:count]]
+    benchmark's pose tasks, benchmarks/design_task.py: :func:`hidden_tips` of 6 joints)."""
+    return hidden_tips(np.random.default_rng([seed, 6, count]), 6, count, 50 * count, r)
 
 
 def check_poses(design, targets, answers) -> None:
