@@ -691,8 +691,8 @@ def _answers(chain, states: np.ndarray, task: _Task) -> tuple[list | None, str]:
 
 def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = True,
              fitted: np.ndarray | None = None, repair: bool = True) -> tuple:  # fmt: skip
-    """One start: ((table unknowns, tube length, smallest clearance, chain, states), "", x) of a
-    design that reaches every target (states: one full configuration per target), or (None,
+    """One start: ((table unknowns, tube length, smallest clearance, chain, answers), "", x) of
+    a design that reaches every target (answers: one reach answer per target), or (None,
     why, x): x the fitted unknowns (None when the fit failed), which a thorough attempt of the
     same start takes as ``fitted``. Not ``thorough``: only when the fit's own configurations
     are clear and outside the boxes (one batch of the clearance engine, about a millisecond);
@@ -769,7 +769,7 @@ def _attempt(task: _Task, types: str, seed: int, start: int, thorough: bool = Tr
         paths, why = _paths(chain, answers, task)
         if paths is None:
             return None, why, fitted
-    return (x, length, min(a.clearance for a in answers), chain, states), "", fitted
+    return (x, length, min(a.clearance for a in answers), chain, answers), "", fitted
 
 
 #: Starts of the compaction search that places a fitted table again so that its
@@ -778,7 +778,7 @@ REPAIR_STARTS = 2
 
 
 def _repaired(chain, states: np.ndarray, task: _Task, seed: int) -> tuple | None:
-    """(tube length, smallest clearance, chain, states) of the same kinematics placed again so
+    """(tube length, smallest clearance, chain, answers) of the same kinematics placed again so
     that every target's configuration in ``states`` (full configurations, one per target) is
     clear with the margin and outside the boxes, or None.
 
@@ -804,8 +804,7 @@ def _repaired(chain, states: np.ndarray, task: _Task, seed: int) -> tuple | None
         return None
     if task.path and _paths(shorter, answers, task)[0] is None:
         return None
-    states = np.array([answer.states for answer in answers])
-    return tube_length(shorter), min(a.clearance for a in answers), shorter, states
+    return tube_length(shorter), min(a.clearance for a in answers), shorter, answers
 
 
 def _fold_refusal(chain) -> str:
@@ -1067,10 +1066,7 @@ def design_for(
             "another seed, more joints or a longer max_tube_length", target=_named(last),
             proven=False,
         )  # fmt: skip
-    _, (_, _, _, chain, states) = found
-    answers, why = _answers(chain, states, task)
-    if answers is None:  # pragma: no cover - the attempt checked the same chain
-        raise InfeasibleTaskError(f"the design found no longer reaches: {why}", proven=False)
+    _, (_, _, _, chain, answers) = found
     if compact:
         from kinegami.optimize.compaction import compact_for_task
 
